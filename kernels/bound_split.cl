@@ -1,0 +1,134 @@
+/* Bound & split, in two strategies that make the same decisions (mp_bound.h)
+ * and therefore reach the same set of diceable sub-patches:
+ *
+ *  - breadth-first (Patney & Owens 2008): every iteration classifies the whole
+ *    queue, then prefix sums compact the diceable sub-patches and the split
+ *    children into new arrays. Memory grows with the widest level.
+ *  - bounded (Weber, Wimmer & Owens 2015): a fixed pool of workers, each
+ *    processing sub-patches depth-first from a stack of its own; split
+ *    children are handed to idle workers through a small ring buffer. Memory
+ *    is fixed by the number of workers and the stack depth. */
+#include "mp_compat.h"
+#include "mp_patch.h"
+#include "mp_types.h"
+#include "mp_bound.h"
+
+/* ---- breadth-first ------------------------------------------------------ */
+
+/* Initial queue: one whole-domain sub-patch per patch. */
+__kernel void bs_init_queue(__global SubPatch* queue, uint n) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  SubPatch sp;
+  sp.u0 = 0.0f; sp.v0 = 0.0f; sp.u1 = 1.0f; sp.v1 = 1.0f;
+  sp.patch = i;
+  sp.info = 0u;
+  queue[i] = sp;
+}
+
+__kernel void bs_breadth_classify(__global const SubPatch* queue, uint n,
+                                  __global const float4* points, __global const uint* patch_info,
+                                  FrameParams f, __global uint* decision,
+                                  __global uint* dice_flag, __global uint* split_flag) {
+  uint i = get_global_id(0);
+  if (i > n) return;
+  if (i == n) { /* a zero past the end, so the exclusive scans end in the totals */
+    dice_flag[n] = 0u;
+    split_flag[n] = 0u;
+    return;
+  }
+  uint d = mp_classify(points, patch_info, queue[i], f);
+  uint action = MP_DECISION_ACTION(d);
+  decision[i] = d;
+  dice_flag[i] = action == MP_DICE ? 1u : 0u;
+  split_flag[i] = action >= MP_SPLIT_U ? 1u : 0u;
+}
+
+/* After the exclusive scans: dice_flag holds dice offsets, split_flag split offsets. */
+__kernel void bs_breadth_scatter(__global const SubPatch* queue, uint n, __global const uint* decision,
+                                 __global const uint* dice_offset, __global const uint* split_offset,
+                                 __global SubPatch* next_queue, __global SubPatch* diceable) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  uint d = decision[i];
+  uint action = MP_DECISION_ACTION(d);
+  SubPatch sp = queue[i];
+  if (action == MP_DICE) {
+    sp.info = (sp.info & 0xffu) | (d & 0xffff00u);
+    diceable[dice_offset[i]] = sp;
+  } else if (action >= MP_SPLIT_U) {
+    SubPatch a, b;
+    mp_split(sp, action, &a, &b);
+    next_queue[2 * split_offset[i]] = a;
+    next_queue[2 * split_offset[i] + 1] = b;
+  }
+}
+
+/* ---- bounded memory -------------------------------------------------------- */
+
+/* Counters shared by all workers (one small buffer). */
+#define BS_POOL_HEAD 0   /* next ring index to take */
+#define BS_POOL_TAIL 1   /* next ring index to write */
+#define BS_NEXT_PATCH 2  /* next input patch to take */
+#define BS_DICE_COUNT 3  /* diceable sub-patches written */
+#define BS_BUSY 4        /* workers left with work after this launch */
+#define BS_IDLE 5        /* workers that ran out of work in this launch */
+#define BS_COUNTERS 8
+
+__kernel void bs_bounded_step(__global const float4* points, __global const uint* patch_info,
+                              uint patch_count, FrameParams f,
+                              __global SubPatch* stacks, __global uint* stack_sizes, uint stack_depth,
+                              __global SubPatch* ring, uint ring_capacity,
+                              uint ring_head0, uint ring_tail0, uint donate_limit,
+                              __global SubPatch* diceable, uint dice_capacity,
+                              volatile __global uint* counters, uint steps) {
+  uint w = get_global_id(0);
+  __global SubPatch* stack = stacks + (ulong)w * stack_depth;
+  uint size = stack_sizes[w];
+  for (uint step = 0; step < steps; ++step) {
+    if (size == 0u) {
+      /* Refill: first from work that others handed out, then from the input. */
+      uint r = atomic_inc(&counters[BS_POOL_HEAD]);
+      if (r < ring_tail0) {
+        stack[size++] = ring[r % ring_capacity];
+      } else {
+        uint p = atomic_inc(&counters[BS_NEXT_PATCH]);
+        if (p >= patch_count) break;
+        SubPatch sp;
+        sp.u0 = 0.0f; sp.v0 = 0.0f; sp.u1 = 1.0f; sp.v1 = 1.0f;
+        sp.patch = p;
+        sp.info = 0u;
+        stack[size++] = sp;
+      }
+    }
+    SubPatch sp = stack[--size];
+    uint d = mp_classify(points, patch_info, sp, f);
+    uint action = MP_DECISION_ACTION(d);
+    if (action == MP_DICE) {
+      uint slot = atomic_inc(&counters[BS_DICE_COUNT]);
+      if (slot >= dice_capacity) {
+        stack[size++] = sp; /* batch full: keep it for after the flush */
+        break;
+      }
+      sp.info = (sp.info & 0xffu) | (d & 0xffff00u);
+      diceable[slot] = sp;
+    } else if (action >= MP_SPLIT_U) {
+      SubPatch a, b;
+      mp_split(sp, action, &a, &b);
+      int donated = 0;
+      if (donate_limit > 0u) {
+        /* Ring entries written now become visible to takers in the next launch
+         * only, so takers never read a slot that is still being written. */
+        uint t = atomic_inc(&counters[BS_POOL_TAIL]);
+        if (t - ring_tail0 < donate_limit && t - ring_head0 < ring_capacity) {
+          ring[t % ring_capacity] = b;
+          donated = 1;
+        }
+      }
+      if (!donated) stack[size++] = b;
+      stack[size++] = a;
+    }
+  }
+  stack_sizes[w] = size;
+  atomic_inc(&counters[size > 0u ? BS_BUSY : BS_IDLE]);
+}

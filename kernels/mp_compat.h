@@ -1,0 +1,55 @@
+/* Lets the device math headers compile both as OpenCL C 1.2 and as C++17.
+ * The kernels and the host tests include the same headers (patch evaluation,
+ * bounds, raster math), so the CPU reference and the device agree by
+ * construction. Only the vocabulary below differs between the two languages. */
+#ifndef MP_COMPAT_H
+#define MP_COMPAT_H
+
+#ifdef __OPENCL_VERSION__
+#define MP_INLINE inline
+#define MP_GLOBAL __global
+#define MP_CONSTANT __constant
+#define MP_F3(x, y, z) ((float3)((x), (y), (z)))
+#define MP_F4(x, y, z, w) ((float4)((x), (y), (z), (w)))
+#define MP_XYZ(v) ((v).xyz)
+#else
+#include <cmath>
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <algorithm>
+#include <cstring>
+typedef glm::vec3 float3;
+typedef glm::vec4 float4;
+typedef glm::vec2 float2;
+typedef std::uint32_t uint;
+typedef std::uint64_t ulong;
+#define MP_INLINE inline
+#define MP_GLOBAL
+#define MP_CONSTANT
+#define MP_F3(x, y, z) (glm::vec3((x), (y), (z)))
+#define MP_F4(x, y, z, w) (glm::vec4((x), (y), (z), (w)))
+#define MP_XYZ(v) (glm::vec3(v))
+namespace mp_compat {
+inline float dot(glm::vec3 a, glm::vec3 b) { return glm::dot(a, b); }
+inline glm::vec3 cross(glm::vec3 a, glm::vec3 b) { return glm::cross(a, b); }
+inline float length(glm::vec3 a) { return glm::length(a); }
+inline glm::vec3 normalize(glm::vec3 a) { return glm::normalize(a); }
+inline glm::vec3 fmin(glm::vec3 a, glm::vec3 b) { return glm::min(a, b); }
+inline glm::vec3 fmax(glm::vec3 a, glm::vec3 b) { return glm::max(a, b); }
+inline float fmin(float a, float b) { return std::fmin(a, b); }
+inline float fmax(float a, float b) { return std::fmax(a, b); }
+inline float clamp(float x, float a, float b) { return std::min(std::max(x, a), b); }
+inline int clamp(int x, int a, int b) { return std::min(std::max(x, a), b); }
+inline float mix(float a, float b, float t) { return a + (b - a) * t; }
+inline glm::vec3 mix(glm::vec3 a, glm::vec3 b, float t) { return a + (b - a) * t; }
+inline uint as_uint(float f) { uint u; std::memcpy(&u, &f, 4); return u; }
+}  // namespace mp_compat
+#include <cstring>
+using namespace mp_compat;
+using std::ceil;
+using std::floor;
+using std::sqrt;
+using std::fabs;
+#endif
+
+#endif

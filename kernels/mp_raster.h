@@ -1,0 +1,100 @@
+/* Micropolygon rasterisation math shared by the sampler, the resolve pass and
+ * host tests: fixed-point sub-pixel positions, jittered stratified samples and
+ * edge functions with a consistent tie rule (Fatahalian et al. 2009; Pineda
+ * 1988). Raster space: x right, y down, pixel (px, py) covers
+ * [px, px+1) x [py, py+1). */
+#ifndef MP_RASTER_H
+#define MP_RASTER_H
+
+#include "mp_compat.h"
+#include "mp_hash.h"
+#include "mp_types.h"
+
+#define MP_SUBPIXEL_BITS 8
+#define MP_SUBPIXEL_ONE 256
+/* Vertices further than this many pixels outside the frame are not rasterised
+ * (they belong to micropolygons the frustum test let through only partly). */
+#define MP_RASTER_GUARD 1.0e6f
+
+typedef struct {
+  long x, y;
+} MpFixed2;
+
+MP_INLINE long mp_to_fixed(float r) { return (long)floor(r * (float)MP_SUBPIXEL_ONE + 0.5f); }
+
+/* Position of sample s of pixel (px, py), in fixed point: one jittered sample
+ * per stratum of a spp_x x spp_y grid. */
+MP_INLINE MpFixed2 mp_sample_position(int px, int py, int s, FrameParams f) {
+  int sx = s % f.spp_x, sy = s / f.spp_x;
+  uint h = mp_hash_combine(mp_hash_combine(mp_hash32((uint)px ^ f.seed), (uint)py), (uint)s);
+  float jx = mp_hash_unit(h), jy = mp_hash_unit(mp_hash32(h));
+  MpFixed2 p;
+  p.x = (long)px * MP_SUBPIXEL_ONE + (long)(((float)sx + jx) / (float)f.spp_x * (float)MP_SUBPIXEL_ONE);
+  p.y = (long)py * MP_SUBPIXEL_ONE + (long)(((float)sy + jy) / (float)f.spp_y * (float)MP_SUBPIXEL_ONE);
+  return p;
+}
+
+/* Twice the signed area of (a, b, p); in raster space (y down) a triangle whose
+ * vertices run counter-clockwise on screen has a negative area. */
+MP_INLINE long mp_edge(MpFixed2 a, MpFixed2 b, MpFixed2 p) {
+  return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
+}
+
+/* Tie rule for samples exactly on an edge: of the two directions an edge can
+ * be walked in, exactly one owns it, so triangles sharing an edge never both
+ * (or neither) cover a sample on it. */
+MP_INLINE int mp_edge_owns(MpFixed2 a, MpFixed2 b) {
+  long dx = b.x - a.x, dy = b.y - a.y;
+  return dy > 0 || (dy == 0 && dx < 0);
+}
+
+MP_INLINE int mp_edge_inside(long e, int owns) { return e > 0 || (e == 0 && owns); }
+
+/* Octahedral encoding of a unit vector into 2 x 16 bits (Cigolle et al. 2014). */
+MP_INLINE uint mp_encode_normal(float3 n) {
+  float s = fabs(n.x) + fabs(n.y) + fabs(n.z);
+  if (!(s > 0.0f)) return 0x7fff7fffu;
+  float x = n.x / s, y = n.y / s;
+  if (n.z < 0.0f) {
+    float ox = (1.0f - fabs(y)) * (x >= 0.0f ? 1.0f : -1.0f);
+    float oy = (1.0f - fabs(x)) * (y >= 0.0f ? 1.0f : -1.0f);
+    x = ox;
+    y = oy;
+  }
+  uint qx = (uint)clamp((int)floor((x * 0.5f + 0.5f) * 65535.0f + 0.5f), 0, 65535);
+  uint qy = (uint)clamp((int)floor((y * 0.5f + 0.5f) * 65535.0f + 0.5f), 0, 65535);
+  return qx | (qy << 16);
+}
+
+MP_INLINE float3 mp_decode_normal(uint e) {
+  float x = (float)(e & 0xffffu) / 65535.0f * 2.0f - 1.0f;
+  float y = (float)(e >> 16) / 65535.0f * 2.0f - 1.0f;
+  float z = 1.0f - fabs(x) - fabs(y);
+  if (z < 0.0f) {
+    float ox = (1.0f - fabs(y)) * (x >= 0.0f ? 1.0f : -1.0f);
+    float oy = (1.0f - fabs(x)) * (y >= 0.0f ? 1.0f : -1.0f);
+    x = ox;
+    y = oy;
+  }
+  float3 n = MP_F3(x, y, z);
+  return n / length(n);
+}
+
+/* Pixel filters with RenderMan's conventions (RiBoxFilter, RiTriangleFilter,
+ * RiGaussianFilter); width is the full support in pixels. */
+#define MP_FILTER_BOX 0
+#define MP_FILTER_GAUSSIAN 1
+#define MP_FILTER_TRIANGLE 2
+
+MP_INLINE float mp_filter_weight(int type, float x, float y, float width) {
+  float h = 0.5f * width;
+  if (fabs(x) > h || fabs(y) > h) return 0.0f;
+  if (type == MP_FILTER_GAUSSIAN) {
+    float sx = x / h, sy = y / h;
+    return exp(-2.0f * (sx * sx + sy * sy));
+  }
+  if (type == MP_FILTER_TRIANGLE) return (1.0f - fabs(x) / h) * (1.0f - fabs(y) / h);
+  return 1.0f;
+}
+
+#endif

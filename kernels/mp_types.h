@@ -1,0 +1,66 @@
+/* Records that cross the host/device boundary. Plain 4-byte scalars only, so
+ * the C++ host and OpenCL C agree on the layout without padding rules. */
+#ifndef MP_TYPES_H
+#define MP_TYPES_H
+
+#include "mp_compat.h"
+
+/* A piece of a patch: the parametric rectangle [u0,u1] x [v0,v1] of patch
+ * `patch`. `info` packs the split depth (bits 0-7) and, once the sub-patch is
+ * diceable, its grid size in micropolygons (nu: bits 8-15, nv: bits 16-23). */
+typedef struct {
+  float u0, v0, u1, v1;
+  uint patch;
+  uint info;
+} SubPatch;
+
+#define MP_INFO_DEPTH(info) ((info) & 0xffu)
+#define MP_INFO_NU(info) (((info) >> 8) & 0xffu)
+#define MP_INFO_NV(info) (((info) >> 16) & 0xffu)
+#define MP_MAKE_INFO(depth, nu, nv) ((uint)(depth) | ((uint)(nu) << 8) | ((uint)(nv) << 16))
+
+/* Largest grid the dicer accepts (micropolygons per side). */
+#define MP_MAX_GRID 32
+
+/* Per-frame constants, passed by value to every kernel. Camera space is
+ * right-handed looking down -Z; d = -z is the depth in front of the eye.
+ * Raster position: rx = ax * x / d + bx, ry = ay * y / d + by (perspective),
+ * with d replaced by 1 for orthographic cameras. Raster y points down. */
+typedef struct {
+  float ax, bx, ay, by;
+  int ortho;
+  int width, height;        /* pixels of the sample buffer (crop region) */
+  int spp_x, spp_y;         /* stratified samples per pixel */
+  float clip_near, clip_far;
+  float micropoly_edge;     /* sqrt(shading rate): target edge length, pixels */
+  int max_grid;             /* grid side limit (<= MP_MAX_GRID) */
+  int max_depth;            /* split depth limit (eye-split and runaway guard) */
+  float ribbon;             /* frustum guard band, pixels */
+  float eye_epsilon;        /* bounds nearer than this straddle the eye plane */
+  int backface_culling;
+  uint seed;
+} FrameParams;
+
+/* Materials (see scene.h): color.w = model (0 constant, 1 matte, 2 plastic). */
+typedef struct {
+  float color[4];
+  float opacity[4];         /* rgb, w = average used for stochastic coverage */
+  float coeffs[4];          /* ka, kd, ks, roughness */
+  float specular[4];
+  float emission[4];
+} DeviceMaterial;
+
+#define MP_LIGHT_AMBIENT 0
+#define MP_LIGHT_DISTANT 1
+#define MP_LIGHT_POINT 2
+#define MP_LIGHT_SPOT 3
+
+/* Lights in camera space. */
+typedef struct {
+  float color[4];           /* rgb * intensity, w = type */
+  float position[4];
+  float direction[4];       /* unit direction the light travels */
+  float cone[4];            /* cos(outer), cos(inner), beam distribution, 0 */
+} DeviceLight;
+
+#endif

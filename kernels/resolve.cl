@@ -1,0 +1,54 @@
+/* Resolve: reconstruct pixels from samples with a pixel filter. Color is
+ * premultiplied by coverage and alpha is the filtered coverage, as Blender's
+ * render result expects. Depth is the nearest covered sample's camera-space
+ * depth (1e10 where nothing is covered, as Blender's Z pass); Normal is the
+ * mean world-space normal of the pixel's covered samples. */
+#include "mp_compat.h"
+#include "mp_types.h"
+#include "mp_hash.h"
+#include "mp_raster.h"
+
+#define MP_NO_DEPTH 1.0e10f
+
+__kernel void clear_samples(__global ulong* keys, ulong n) {
+  ulong i = get_global_id(0);
+  if (i < n) keys[i] = (ulong)0xffffffffffffffffUL;
+}
+
+__kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width, __global const ulong* keys,
+                             __global const float* colors, __global const uint* normals,
+                             float4 cam_to_world_x, float4 cam_to_world_y, float4 cam_to_world_z,
+                             __global float4* rgba, __global float* depth, __global float4* normal_out) {
+  int px = get_global_id(0), py = get_global_id(1);
+  if (px >= f.width || py >= f.height) return;
+  int spp = f.spp_x * f.spp_y;
+  int reach = (int)ceil(0.5f * filter_width - 0.5f);
+  float4 sum = (float4)(0.0f);
+  float wsum = 0.0f;
+  float cx = (float)px + 0.5f, cy = (float)py + 0.5f;
+  for (int qy = max(py - reach, 0); qy <= min(py + reach, f.height - 1); ++qy)
+    for (int qx = max(px - reach, 0); qx <= min(px + reach, f.width - 1); ++qx)
+      for (int s = 0; s < spp; ++s) {
+        MpFixed2 q = mp_sample_position(qx, qy, s, f);
+        float dx = (float)q.x / (float)MP_SUBPIXEL_ONE - cx, dy = (float)q.y / (float)MP_SUBPIXEL_ONE - cy;
+        float w = mp_filter_weight(filter_type, dx, dy, filter_width);
+        if (w <= 0.0f) continue;
+        ulong index = ((ulong)qy * (ulong)f.width + (ulong)qx) * (ulong)spp + (ulong)s;
+        wsum += w;
+        if (keys[index] != (ulong)0xffffffffffffffffUL) sum += w * (float4)(vload3(index, colors), 1.0f);
+      }
+  ulong pixel = (ulong)py * (ulong)f.width + (ulong)px;
+  rgba[pixel] = wsum > 0.0f ? sum / wsum : (float4)(0.0f);
+
+  float zmin = MP_NO_DEPTH;
+  float3 nsum = (float3)(0.0f);
+  for (int s = 0; s < spp; ++s) {
+    ulong key = keys[pixel * (ulong)spp + (ulong)s];
+    if (key == (ulong)0xffffffffffffffffUL) continue;
+    zmin = fmin(zmin, as_float((uint)(key >> 32)));
+    float3 n = mp_decode_normal(normals[pixel * (ulong)spp + (ulong)s]);
+    nsum += (float3)(dot(cam_to_world_x.xyz, n), dot(cam_to_world_y.xyz, n), dot(cam_to_world_z.xyz, n));
+  }
+  depth[pixel] = zmin;
+  normal_out[pixel] = (float4)(nsum / (float)spp, 0.0f);
+}

@@ -1,0 +1,119 @@
+/* Sample: a software rasteriser for micropolygons. Each work-item takes one
+ * micropolygon (two triangles of a grid quad), finds the jittered samples it
+ * covers with fixed-point edge functions, and resolves visibility per sample
+ * with a 64-bit atomic minimum of (depth, micropolygon id) (the visibility
+ * buffer trick of Karis et al. 2021, Nanite). A second pass, run after the
+ * first has finished, lets the one micropolygon whose key won each sample write
+ * its color and normal, so the result never depends on execution order. */
+#pragma OPENCL EXTENSION cl_khr_int64_base_atomics : enable
+#pragma OPENCL EXTENSION cl_khr_int64_extended_atomics : enable
+#include "mp_compat.h"
+#include "mp_patch.h"
+#include "mp_types.h"
+#include "mp_hash.h"
+#include "mp_raster.h"
+
+#define MP_PASS_DEPTH 0u
+#define MP_PASS_ATTRIBUTES 1u
+
+typedef struct {
+  MpFixed2 p;
+  float inv_d;    /* 1/depth (perspective) or depth (orthographic) */
+  float3 c_over_d;
+  float3 n_over_d;
+} MpRasterVertex;
+
+inline MpRasterVertex mp_raster_vertex(float4 p, float4 c, float4 n, FrameParams f, int* ok) {
+  MpRasterVertex v;
+  float d = -p.z;
+  float inv = f.ortho ? 1.0f : 1.0f / d;
+  float rx = f.ax * p.x * inv + f.bx, ry = f.ay * p.y * inv + f.by;
+  if (!(fabs(rx) < MP_RASTER_GUARD && fabs(ry) < MP_RASTER_GUARD) || (!f.ortho && !(d > 0.0f))) *ok = 0;
+  v.p.x = mp_to_fixed(rx);
+  v.p.y = mp_to_fixed(ry);
+  /* Perspective-correct interpolation: attributes / d and 1/d are affine in screen space. */
+  float w = f.ortho ? 1.0f : inv;
+  v.inv_d = f.ortho ? d : inv;
+  v.c_over_d = c.xyz * w;
+  v.n_over_d = n.xyz * w;
+  return v;
+}
+
+inline void mp_raster_triangle(MpRasterVertex a, MpRasterVertex b, MpRasterVertex c, uint mp_id, float opacity,
+                               FrameParams f, uint pass, volatile __global ulong* keys,
+                               __global float* colors, __global uint* normals) {
+  long area = mp_edge(a.p, b.p, c.p);
+  if (area == 0) return;
+  if (area > 0) { /* make the orientation uniform; culling happened before */
+    MpRasterVertex t = b; b = c; c = t;
+    area = -area;
+  }
+  int own0 = mp_edge_owns(b.p, c.p), own1 = mp_edge_owns(c.p, a.p), own2 = mp_edge_owns(a.p, b.p);
+  long xmin = min(a.p.x, min(b.p.x, c.p.x)), xmax = max(a.p.x, max(b.p.x, c.p.x));
+  long ymin = min(a.p.y, min(b.p.y, c.p.y)), ymax = max(a.p.y, max(b.p.y, c.p.y));
+  int px0 = (int)max(xmin >> MP_SUBPIXEL_BITS, (long)0), px1 = (int)min(xmax >> MP_SUBPIXEL_BITS, (long)f.width - 1);
+  int py0 = (int)max(ymin >> MP_SUBPIXEL_BITS, (long)0), py1 = (int)min(ymax >> MP_SUBPIXEL_BITS, (long)f.height - 1);
+  int spp = f.spp_x * f.spp_y;
+  float inv_area = 1.0f / (float)(-area);
+  for (int py = py0; py <= py1; ++py)
+    for (int px = px0; px <= px1; ++px)
+      for (int s = 0; s < spp; ++s) {
+        MpFixed2 q = mp_sample_position(px, py, s, f);
+        if (q.x < xmin || q.x > xmax || q.y < ymin || q.y > ymax) continue;
+        /* With the negative orientation, inside means all edges <= 0. */
+        long e0 = -mp_edge(b.p, c.p, q), e1 = -mp_edge(c.p, a.p, q), e2 = -mp_edge(a.p, b.p, q);
+        if (!(mp_edge_inside(e0, own0) && mp_edge_inside(e1, own1) && mp_edge_inside(e2, own2))) continue;
+        float la = (float)e0 * inv_area, lb = (float)e1 * inv_area, lc = (float)e2 * inv_area;
+        float inv_d = la * a.inv_d + lb * b.inv_d + lc * c.inv_d;
+        float d = f.ortho ? inv_d : 1.0f / inv_d;
+        if (!(d >= f.clip_near && d <= f.clip_far)) continue;
+        ulong index = ((ulong)py * (ulong)f.width + (ulong)px) * (ulong)spp + (ulong)s;
+        if (opacity < 1.0f && mp_hash_unit(mp_hash_combine(mp_id, (uint)index)) >= opacity) continue;
+        ulong key = ((ulong)as_uint(d) << 32) | (ulong)mp_id;
+        if (pass == MP_PASS_DEPTH) {
+          atom_min(&keys[index], key);
+        } else if (keys[index] == key) {
+          float w = f.ortho ? 1.0f : d;
+          float3 col = (la * a.c_over_d + lb * b.c_over_d + lc * c.c_over_d) * w;
+          float3 nrm = (la * a.n_over_d + lb * b.n_over_d + lc * c.n_over_d) * w;
+          vstore3(col, index, colors);
+          normals[index] = mp_encode_normal(normalize(nrm));
+        }
+      }
+}
+
+__kernel void sample_micropolygons(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
+                                   FrameParams f, __global const float4* grid_p, __global const float4* grid_c,
+                                   __global const float4* grid_n, uint pass, volatile __global ulong* keys,
+                                   __global float* colors, __global uint* normals) {
+  uint mg = (uint)f.max_grid;
+  uint gid = get_global_id(0);
+  uint slot = gid / (mg * mg);
+  if (slot >= count) return;
+  uint local_index = gid - slot * mg * mg;
+  uint i = local_index % mg, j = local_index / mg;
+  SubPatch sp = diceable[slot];
+  if (i >= MP_INFO_NU(sp.info) || j >= MP_INFO_NV(sp.info)) return;
+  uint stride = mg + 1u;
+  ulong base = (ulong)slot * stride * stride;
+  ulong i00 = base + j * stride + i, i10 = i00 + 1, i01 = i00 + stride, i11 = i01 + 1;
+  int ok = 1;
+  MpRasterVertex v00 = mp_raster_vertex(grid_p[i00], grid_c[i00], grid_n[i00], f, &ok);
+  MpRasterVertex v10 = mp_raster_vertex(grid_p[i10], grid_c[i10], grid_n[i10], f, &ok);
+  MpRasterVertex v01 = mp_raster_vertex(grid_p[i01], grid_c[i01], grid_n[i01], f, &ok);
+  MpRasterVertex v11 = mp_raster_vertex(grid_p[i11], grid_c[i11], grid_n[i11], f, &ok);
+  if (!ok) return;
+  uint flags = patch_info[4 * (ulong)sp.patch + 2];
+  if (f.backface_culling && !(flags & MP_PATCH_DOUBLE_SIDED)) {
+    /* Front faces run counter-clockwise on screen, i.e. negative raster area. */
+    long area = mp_edge(v00.p, v10.p, v11.p) + mp_edge(v00.p, v11.p, v01.p);
+    int front = (flags & MP_PATCH_FLIP_ORIENTATION) ? area > 0 : area < 0;
+    if (!front) return;
+  }
+  uint grid_id = mp_hash_combine(mp_hash_combine(mp_hash32(sp.patch), as_uint(sp.u0)), as_uint(sp.v0));
+  grid_id = mp_hash_combine(mp_hash_combine(grid_id, as_uint(sp.u1)), as_uint(sp.v1));
+  uint mp_id = mp_hash_combine(grid_id, local_index);
+  float opacity = grid_c[i00].w;
+  mp_raster_triangle(v00, v10, v11, mp_id, opacity, f, pass, keys, colors, normals);
+  mp_raster_triangle(v00, v11, v01, mp_id, opacity, f, pass, keys, colors, normals);
+}

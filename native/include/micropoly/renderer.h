@@ -1,0 +1,76 @@
+// The renderer: owns one OpenCL device session (context, queue, built
+// program) and renders Scenes into float images. Keep one Renderer alive to
+// render many frames without rebuilding kernels.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "micropoly/scene.h"
+
+namespace mp {
+
+struct DeviceInfo {
+  int index = 0;             // position in list_devices(), usable as a selector
+  std::string name;
+  std::string platform;
+  std::string type;          // "gpu", "cpu" or "other"
+  std::string version;
+};
+
+// All OpenCL devices on all platforms, in a stable order.
+std::vector<DeviceInfo> list_devices();
+
+struct StageTimings {
+  double upload = 0, bound_split = 0, dice = 0, shade = 0, sample = 0, resolve = 0, total = 0;
+};
+
+struct RenderStats {
+  std::string device;
+  int width = 0, height = 0, spp = 0;
+  size_t patches = 0;
+  size_t subpatches_diced = 0;
+  size_t micropolygons = 0;
+  size_t bound_split_peak_bytes = 0;
+  size_t batches = 0;
+  size_t bound_split_launches = 0;
+  double program_build_ms = 0;       // 0 when the binary cache was used... see program_cache_hit
+  bool program_cache_hit = false;
+  bool cancelled = false;
+  StageTimings timings_ms;
+  std::string to_json() const;
+};
+
+// Pixels are stored top row first. rgba: 4 floats per pixel, premultiplied,
+// scene-linear; depth: camera-space depth (1e10 where empty); normal: 3 floats
+// per pixel, world space.
+struct RenderResult {
+  int width = 0, height = 0;
+  std::vector<float> rgba, depth, normal;
+  RenderStats stats;
+};
+
+// Called between batches with progress in [0, 1]; return false to cancel.
+using ProgressCallback = std::function<bool(float progress)>;
+
+class Renderer {
+ public:
+  // selector: "" (MICROPOLY_DEVICE, else the first GPU, else the first CPU),
+  // "cpu", "gpu" or a device index. Throws mp::Error when no device fits or
+  // the kernels fail to build.
+  explicit Renderer(const std::string& selector = "");
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  const DeviceInfo& device() const;
+  RenderResult render(const Scene& scene, const ProgressCallback& progress = {});
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace mp

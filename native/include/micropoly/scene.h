@@ -1,0 +1,122 @@
+// The Scene: the only thing the front ends (Blender addon, RIB reader) produce
+// and the only thing the pipeline consumes. It is validated once, by
+// validate_scene(), so the pipeline never sees NaNs or bad indices.
+#pragma once
+
+#include <glm/glm.hpp>
+#include <string>
+#include <vector>
+
+namespace mp {
+
+enum class SubdivScheme { None, CatmullClark };  // None: flat polygons
+enum class BoundaryInterpolation { None, EdgeOnly, EdgeAndCorner };
+
+// A polygon or Catmull-Clark mesh. Faces may have any number (>= 3) of vertices.
+struct Mesh {
+  std::string name;
+  SubdivScheme scheme = SubdivScheme::None;
+  std::vector<glm::vec3> points;             // object space
+  std::vector<int> face_vertex_counts;       // one entry per face
+  std::vector<int> face_vertex_indices;      // concatenated, counter-clockwise = front
+  // Catmull-Clark tags (ignored for polygon meshes).
+  std::vector<int> crease_vertices;          // pairs of vertex indices, one pair per creased edge
+  std::vector<float> crease_sharpness;       // one per creased edge; >= 10 is infinitely sharp
+  std::vector<int> corner_vertices;
+  std::vector<float> corner_sharpness;       // one per corner vertex
+  std::vector<int> hole_faces;               // faces that are not rendered
+  BoundaryInterpolation boundary = BoundaryInterpolation::EdgeAndCorner;
+  // Materials: face_materials (one per face) if not empty, else `material`.
+  int material = 0;
+  std::vector<int> face_materials;
+  glm::mat4 object_to_world{1.0f};
+  bool double_sided = true;
+};
+
+// Bicubic patches already converted to Bezier form: 16 control points per
+// patch, row-major with u varying fastest (cp[4*j + i]).
+struct BezierPatches {
+  std::string name;
+  std::vector<glm::vec3> control_points;
+  int material = 0;
+  glm::mat4 object_to_world{1.0f};
+  bool double_sided = true;
+};
+
+// Shading follows RenderMan's shaders: constant (Cs), matte (Ka, Kd) and
+// plastic (Ka, Kd, Ks, roughness, specularcolor); emission is added as is.
+struct Material {
+  enum class Model { Constant, Matte, Plastic };
+  std::string name;
+  Model model = Model::Plastic;
+  glm::vec3 color{1.0f};
+  glm::vec3 opacity{1.0f};
+  float ka = 1.0f, kd = 0.5f, ks = 0.5f, roughness = 0.1f;
+  glm::vec3 specular_color{1.0f};
+  glm::vec3 emission{0.0f};
+};
+
+// Light sources in world space, with RenderMan's light shader semantics:
+// point and spot fall off with 1/d^2; the spot cone blends from cone_angle -
+// cone_delta_angle to cone_angle (half-angles, radians) and is raised to
+// beam_distribution.
+struct Light {
+  enum class Type { Ambient, Distant, Point, Spot };
+  Type type = Type::Point;
+  glm::vec3 color{1.0f};
+  float intensity = 1.0f;
+  glm::vec3 position{0.0f};
+  glm::vec3 direction{0.0f, 0.0f, -1.0f};  // direction the light travels
+  float cone_angle = 0.5235988f;           // 30 degrees
+  float cone_delta_angle = 0.0872665f;     // 5 degrees
+  float beam_distribution = 2.0f;
+};
+
+// Camera: right-handed camera space, looking down -Z with +Y up (Blender's
+// convention; the RIB reader converts from RenderMan's left-handed space).
+// Perspective screen coordinates are (x, y) / (-z * tan(fov/2)); orthographic
+// ones are (x, y). The screen window maps onto the image; left == right means
+// "derive it from the aspect ratio" (RenderMan's default: the shorter image
+// side spans [-1, 1]).
+struct Camera {
+  enum class Projection { Perspective, Orthographic };
+  Projection projection = Projection::Perspective;
+  glm::mat4 world_to_camera{1.0f};
+  float fov_degrees = 90.0f;
+  float screen_left = 0, screen_right = 0, screen_bottom = 0, screen_top = 0;
+  float clip_near = 0.01f;
+  float clip_far = 1.0e30f;
+};
+
+enum class PixelFilter { Box, Gaussian, Triangle };
+enum class BoundSplitMethod { Bounded, Breadth };
+
+struct RenderSettings {
+  int width = 640, height = 480;
+  float pixel_aspect = 1.0f;
+  // Crop (border) window in normalized [0,1] image coordinates, y down.
+  float crop_x0 = 0, crop_x1 = 1, crop_y0 = 0, crop_y1 = 1;
+  int samples_x = 4, samples_y = 4;            // stratified samples per pixel
+  float shading_rate = 1.0f;                   // micropolygon area in pixels
+  PixelFilter filter = PixelFilter::Gaussian;
+  float filter_width = 2.0f;                   // total width in pixels
+  BoundSplitMethod bound_split = BoundSplitMethod::Bounded;
+  float bound_split_memory_mib = 64.0f;        // budget of the bounded method
+  int max_grid_size = 16;                      // micropolygons per grid side
+  int max_split_depth = 26;                    // eye-split and runaway limit
+  bool backface_culling = true;                // for single-sided surfaces
+};
+
+struct Scene {
+  Camera camera;
+  RenderSettings settings;
+  std::vector<Material> materials;             // index 0 is the default
+  std::vector<Light> lights;
+  std::vector<Mesh> meshes;
+  std::vector<BezierPatches> bezier_patches;
+};
+
+// Checks indices, counts and finite values; throws mp::Error naming the object.
+void validate_scene(const Scene& scene);
+
+}  // namespace mp

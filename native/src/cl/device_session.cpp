@@ -1,0 +1,106 @@
+#include "cl/device_session.h"
+
+#include <cstdlib>
+
+#include "cl/program_cache.h"
+#include "micropoly/error.h"
+
+namespace mp {
+namespace {
+
+struct FoundDevice {
+  DeviceInfo info;
+  cl::Device device;
+};
+
+std::vector<FoundDevice> enumerate() {
+  std::vector<FoundDevice> out;
+  std::vector<cl::Platform> platforms;
+  try {
+    cl::Platform::get(&platforms);
+  } catch (const cl::Error&) {
+    return out;  // no ICD loader platforms at all
+  }
+  for (auto& platform : platforms) {
+    std::vector<cl::Device> devices;
+    try {
+      platform.getDevices(CL_DEVICE_TYPE_ALL, &devices);
+    } catch (const cl::Error&) {
+      continue;
+    }
+    for (auto& d : devices) {
+      FoundDevice f;
+      f.device = d;
+      f.info.index = static_cast<int>(out.size());
+      f.info.name = d.getInfo<CL_DEVICE_NAME>();
+      f.info.platform = platform.getInfo<CL_PLATFORM_NAME>();
+      f.info.version = d.getInfo<CL_DEVICE_VERSION>();
+      auto type = d.getInfo<CL_DEVICE_TYPE>();
+      f.info.type = (type & CL_DEVICE_TYPE_GPU) ? "gpu" : (type & CL_DEVICE_TYPE_CPU) ? "cpu" : "other";
+      out.push_back(f);
+    }
+  }
+  return out;
+}
+
+FoundDevice choose(const std::string& requested) {
+  std::string selector = requested;
+  if (selector.empty())
+    if (const char* env = std::getenv("MICROPOLY_DEVICE"); env && *env) selector = env;
+  auto devices = enumerate();
+  if (devices.empty())
+    throw Error("no OpenCL device found: install an OpenCL driver (e.g. Debian's pocl-opencl-icd for the CPU)");
+  auto first_of = [&](const std::string& type) -> const FoundDevice* {
+    for (auto& d : devices)
+      if (d.info.type == type) return &d;
+    return nullptr;
+  };
+  if (selector.empty()) {
+    if (auto* gpu = first_of("gpu")) return *gpu;
+    if (auto* cpu = first_of("cpu")) return *cpu;
+    return devices.front();
+  }
+  if (selector == "gpu" || selector == "cpu") {
+    if (auto* d = first_of(selector)) return *d;
+    throw Error("no OpenCL " + selector + " device found (" + std::to_string(devices.size()) +
+                " device(s) present; see --list-devices)");
+  }
+  char* end = nullptr;
+  long index = std::strtol(selector.c_str(), &end, 10);
+  if (end && *end == '\0' && !selector.empty()) {
+    if (index >= 0 && index < static_cast<long>(devices.size())) return devices[static_cast<size_t>(index)];
+    throw Error("OpenCL device index " + selector + " out of range (" + std::to_string(devices.size()) +
+                " device(s) present)");
+  }
+  throw Error("unknown device '" + selector + "': use cpu, gpu or a device index");
+}
+
+}  // namespace
+
+std::vector<DeviceInfo> list_devices() {
+  std::vector<DeviceInfo> out;
+  for (auto& d : enumerate()) out.push_back(d.info);
+  return out;
+}
+
+DeviceSession::DeviceSession(const std::string& selector) {
+  FoundDevice found = choose(selector);
+  info_ = found.info;
+  device_ = found.device;
+  try {
+    auto ext = device_.getInfo<CL_DEVICE_EXTENSIONS>();
+    if (ext.find("cl_khr_int64_extended_atomics") == std::string::npos)
+      throw Error("OpenCL device '" + info_.name + "' lacks cl_khr_int64_extended_atomics, which the rasteriser needs");
+    context_ = cl::Context(device_);
+    queue_ = cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE);
+    max_alloc_ = device_.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
+    auto built = build_program_cached(context_, device_, assemble_program_source(), "-cl-std=CL1.2");
+    program_ = built.program;
+    build_ms_ = built.build_ms;
+    cache_hit_ = built.from_cache;
+  } catch (const cl::Error& e) {
+    throw Error("OpenCL device '" + info_.name + "': " + describe_cl_error(e));
+  }
+}
+
+}  // namespace mp

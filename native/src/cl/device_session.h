@@ -1,0 +1,37 @@
+// A device session: the chosen OpenCL device with its context, in-order
+// profiling queue and the built Micropoly program (from the binary cache when
+// possible).
+#pragma once
+
+#include <string>
+
+#include "cl/cl.h"
+#include "micropoly/renderer.h"
+
+namespace mp {
+
+class DeviceSession {
+ public:
+  explicit DeviceSession(const std::string& selector);
+
+  const DeviceInfo& info() const { return info_; }
+  cl::Context& context() { return context_; }
+  cl::CommandQueue& queue() { return queue_; }
+  cl::Program& program() { return program_; }
+  cl::Device& device() { return device_; }
+  double program_build_ms() const { return build_ms_; }
+  bool program_cache_hit() const { return cache_hit_; }
+  size_t max_alloc_bytes() const { return max_alloc_; }
+
+ private:
+  DeviceInfo info_;
+  cl::Device device_;
+  cl::Context context_;
+  cl::CommandQueue queue_;
+  cl::Program program_;
+  double build_ms_ = 0;
+  bool cache_hit_ = false;
+  size_t max_alloc_ = 0;
+};
+
+}  // namespace mp

@@ -1,0 +1,137 @@
+#include "cl/program_cache.h"
+
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <unistd.h>
+
+#include "cl/embedded_kernels.h"
+#include "micropoly/error.h"
+
+namespace fs = std::filesystem;
+
+namespace mp {
+namespace {
+
+std::string expand_includes(const std::string& text, const std::map<std::string, std::string>& files, int depth) {
+  if (depth > 16) throw Error("kernel sources: #include nesting too deep");
+  std::istringstream in(text);
+  std::string line, out;
+  while (std::getline(in, line)) {
+    auto pos = line.find("#include \"");
+    if (pos != std::string::npos && line.find_first_not_of(" \t") == pos) {
+      auto start = pos + 10, end = line.find('"', start);
+      std::string name = line.substr(start, end - start);
+      auto it = files.find(name);
+      if (it == files.end()) throw Error("kernel sources: missing embedded header " + name);
+      out += expand_includes(it->second, files, depth + 1);
+    } else {
+      out += line;
+      out += '\n';
+    }
+  }
+  return out;
+}
+
+std::uint64_t fnv1a(const std::string& s, std::uint64_t h = 1469598103934665603ull) {
+  for (unsigned char c : s) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+fs::path cache_dir() {
+  if (const char* d = std::getenv("MICROPOLY_CACHE_DIR"); d && *d) return d;
+  if (const char* d = std::getenv("XDG_CACHE_HOME"); d && *d) return fs::path(d) / "micropoly";
+  if (const char* d = std::getenv("HOME"); d && *d) return fs::path(d) / ".cache" / "micropoly";
+  return {};
+}
+
+std::string build_log(const cl::Program& program, const cl::Device& device) {
+  try {
+    return program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device);
+  } catch (const cl::Error&) {
+    return "";
+  }
+}
+
+}  // namespace
+
+std::string assemble_program_source() {
+  std::map<std::string, std::string> files;
+  for (int i = 0; i < kEmbeddedKernelFileCount; ++i) files[kEmbeddedKernelFiles[i].name] = kEmbeddedKernelFiles[i].source;
+  std::string source;
+  for (const auto& [name, text] : files) {
+    if (name.size() > 3 && name.compare(name.size() - 3, 3, ".cl") == 0) {
+      source += "/* ---- " + name + " ---- */\n";
+      source += expand_includes(text, files, 0);
+    }
+  }
+  return source;
+}
+
+BuiltProgram build_program_cached(const cl::Context& context, const cl::Device& device, const std::string& source,
+                                  const std::string& options) {
+  auto t0 = std::chrono::steady_clock::now();
+  std::string identity = device.getInfo<CL_DEVICE_NAME>() + "|" + device.getInfo<CL_DEVICE_VERSION>() + "|" +
+                         device.getInfo<CL_DRIVER_VERSION>() + "|" +
+                         cl::Platform(device.getInfo<CL_DEVICE_PLATFORM>()).getInfo<CL_PLATFORM_NAME>() + "|" + options;
+  char key[32];
+  std::snprintf(key, sizeof key, "%016llx", static_cast<unsigned long long>(fnv1a(source, fnv1a(identity))));
+  fs::path dir = cache_dir();
+  fs::path file = dir.empty() ? fs::path() : dir / (std::string(key) + ".bin");
+  std::vector<cl::Device> devices{device};
+  auto elapsed = [&] { return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count(); };
+
+  if (!file.empty()) {
+    std::ifstream in(file, std::ios::binary);
+    std::vector<unsigned char> binary((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (!binary.empty()) {
+      try {
+        cl::Program::Binaries binaries{binary};
+        cl::Program program(context, devices, binaries);
+        program.build(devices, options.c_str());
+        return {program, true, elapsed()};
+      } catch (const cl::Error&) {
+        // A stale or foreign binary: fall through and rebuild from source.
+      }
+    }
+  }
+
+  cl::Program program(context, source);
+  try {
+    program.build(devices, options.c_str());
+  } catch (const cl::Error& e) {
+    std::string log = build_log(program, device);
+    if (log.size() > 4000) log = log.substr(0, 4000) + "\n...";
+    throw Error("the OpenCL kernels failed to build on " + device.getInfo<CL_DEVICE_NAME>() + ": " + log);
+  }
+  if (!file.empty()) {
+    try {
+      auto binaries = program.getInfo<CL_PROGRAM_BINARIES>();
+      if (!binaries.empty() && !binaries[0].empty()) {
+        std::error_code ec;
+        fs::create_directories(dir, ec);
+        fs::path tmp = file;
+        tmp += ".tmp" + std::to_string(::getpid());
+        {
+          std::ofstream out(tmp, std::ios::binary);
+          out.write(reinterpret_cast<const char*>(binaries[0].data()), static_cast<std::streamsize>(binaries[0].size()));
+        }
+        fs::rename(tmp, file, ec);  // atomic: concurrent renders never read half a file
+        if (ec) fs::remove(tmp, ec);
+      }
+    } catch (const std::exception&) {
+      // The cache is an optimisation only.
+    }
+  }
+  return {program, false, elapsed()};
+}
+
+}  // namespace mp

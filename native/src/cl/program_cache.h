@@ -1,0 +1,26 @@
+// Builds the embedded kernel sources into a program, caching the device
+// binary on disk per device, driver and source hash so a second run does not
+// recompile. Cache folder: $MICROPOLY_CACHE_DIR, else $XDG_CACHE_HOME/micropoly,
+// else ~/.cache/micropoly. A cache that cannot be read or written is ignored.
+#pragma once
+
+#include <string>
+
+#include "cl/cl.h"
+
+namespace mp {
+
+// The complete program source: every kernels/*.cl with its #include "..."
+// lines replaced by the embedded headers.
+std::string assemble_program_source();
+
+struct BuiltProgram {
+  cl::Program program;
+  bool from_cache = false;
+  double build_ms = 0;
+};
+
+BuiltProgram build_program_cached(const cl::Context& context, const cl::Device& device,
+                                  const std::string& source, const std::string& options);
+
+}  // namespace mp

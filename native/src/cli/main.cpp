@@ -1,0 +1,133 @@
+// micropoly-render: renders a RIB file to PNG or EXR.
+// Exit codes: 0 success, 1 rendering failed (device, memory), 2 bad usage or input.
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <string>
+
+#include "io/image_io.h"
+#include "micropoly/error.h"
+#include "micropoly/renderer.h"
+#include "micropoly/settings_util.h"
+#include "rib/rib_reader.h"
+
+namespace {
+
+const char* kUsage =
+    "usage: micropoly-render SCENE.rib -o OUT.(png|exr) [--spp N] [--shading-rate R]\n"
+    "                        [--device cpu|gpu|INDEX] [--bound-split bounded|breadth]\n"
+    "                        [--bound-split-memory MIB] [--stats FILE.json] [--repeat N]\n"
+    "       micropoly-render --list-devices\n";
+
+struct Options {
+  std::string scene, output, device, stats, bound_split;
+  int spp = 0, repeat = 1;
+  float shading_rate = 0, memory_mib = 0;
+  bool list_devices = false;
+};
+
+[[noreturn]] void usage_error(const std::string& why) {
+  std::fprintf(stderr, "micropoly-render: %s\n%s", why.c_str(), kUsage);
+  std::exit(2);
+}
+
+double parse_number(const std::string& flag, const char* text, double lo, double hi) {
+  char* end = nullptr;
+  double v = std::strtod(text, &end);
+  if (!end || *end != '\0' || !(v >= lo && v <= hi))
+    usage_error(flag + " expects a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got '" + text + "'");
+  return v;
+}
+
+Options parse(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    auto value = [&]() -> const char* {
+      if (i + 1 >= argc) usage_error(a + " needs a value");
+      return argv[++i];
+    };
+    if (a == "-h" || a == "--help") {
+      std::fputs(kUsage, stdout);
+      std::exit(0);
+    } else if (a == "-o") o.output = value();
+    else if (a == "--spp") o.spp = static_cast<int>(parse_number(a, value(), 1, 1024));
+    else if (a == "--shading-rate") o.shading_rate = static_cast<float>(parse_number(a, value(), 1e-3, 1e4));
+    else if (a == "--device") o.device = value();
+    else if (a == "--bound-split") {
+      o.bound_split = value();
+      if (o.bound_split != "bounded" && o.bound_split != "breadth") usage_error("--bound-split is bounded or breadth");
+    } else if (a == "--bound-split-memory") o.memory_mib = static_cast<float>(parse_number(a, value(), 0.01, 1 << 20));
+    else if (a == "--stats") o.stats = value();
+    else if (a == "--repeat") o.repeat = static_cast<int>(parse_number(a, value(), 1, 10000));
+    else if (a == "--list-devices") o.list_devices = true;
+    else if (!a.empty() && a[0] == '-') usage_error("unknown option " + a);
+    else if (o.scene.empty()) o.scene = a;
+    else usage_error("more than one scene file given");
+  }
+  return o;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o = parse(argc, argv);
+  try {
+    if (o.list_devices) {
+      auto devices = mp::list_devices();
+      if (devices.empty()) std::puts("no OpenCL devices found");
+      for (auto& d : devices)
+        std::printf("%d: %s [%s] (%s, %s)\n", d.index, d.name.c_str(), d.type.c_str(), d.platform.c_str(), d.version.c_str());
+      return 0;
+    }
+    if (o.scene.empty()) usage_error("no scene file given");
+    mp::RibResult rib;
+    try {
+      rib = mp::read_rib_file(o.scene);
+    } catch (const mp::Error& e) {
+      std::fprintf(stderr, "micropoly-render: %s\n", e.what());
+      return 2;
+    }
+    for (auto& w : rib.warnings) std::fprintf(stderr, "micropoly-render: warning: %s\n", w.c_str());
+    std::string output = o.output.empty() ? rib.display_name : o.output;
+    if (output.empty()) usage_error("no output file: give -o or a Display request");
+    mp::Scene& scene = rib.scene;
+    if (o.spp) mp::set_samples_per_pixel(scene.settings, o.spp);
+    if (o.shading_rate > 0) scene.settings.shading_rate = o.shading_rate;
+    if (!o.bound_split.empty())
+      scene.settings.bound_split = o.bound_split == "breadth" ? mp::BoundSplitMethod::Breadth : mp::BoundSplitMethod::Bounded;
+    if (o.memory_mib > 0) scene.settings.bound_split_memory_mib = o.memory_mib;
+    try {
+      mp::validate_scene(scene);
+    } catch (const mp::Error& e) {
+      std::fprintf(stderr, "micropoly-render: %s: %s\n", o.scene.c_str(), e.what());
+      return 2;
+    }
+    mp::Renderer renderer(o.device);
+    mp::RenderResult result;
+    std::string all_stats;
+    for (int i = 0; i < o.repeat; ++i) {
+      result = renderer.render(scene);
+      if (o.repeat > 1) all_stats += (i ? ",\n" : "[\n") + result.stats.to_json();
+    }
+    if (o.repeat > 1) all_stats += "]\n";
+    else all_stats = result.stats.to_json();
+    mp::write_image(output, result);
+    if (!o.stats.empty()) {
+      std::ofstream f(o.stats);
+      if (!f) throw mp::Error("cannot write stats file '" + o.stats + "'");
+      f << all_stats;
+    }
+    return 0;
+  } catch (const mp::Error& e) {
+    std::fprintf(stderr, "micropoly-render: %s\n", e.what());
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "micropoly-render: out of host memory\n");
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "micropoly-render: %s\n", e.what());
+    return 1;
+  }
+}

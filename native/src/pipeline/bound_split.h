@@ -1,0 +1,85 @@
+// Bound & split strategies. Both hand batches of diceable sub-patches
+// (SubPatch records, kernels/mp_types.h) to a sink, which dices, shades and
+// samples them before bound & split continues.
+#pragma once
+
+#include <algorithm>
+#include <functional>
+#include <utility>
+
+#include "cl/device_session.h"
+#include "micropoly/renderer.h"
+#include "pipeline/scene_buffers.h"
+#include "pipeline/stage_timer.h"
+
+namespace mp {
+
+// Receives `count` diceable sub-patches at the start of `buffer`; the buffer
+// may be reused as soon as the call returns (commands are in order).
+using DiceSink = std::function<void(const cl::Buffer& buffer, cl_uint count)>;
+
+struct BoundSplitResult {
+  size_t peak_bytes = 0;  // device memory the strategy held at its peak
+  size_t launches = 0;    // bound & split kernel launches
+  bool cancelled = false;
+};
+
+// Tallies the device memory a strategy holds, to report its peak.
+class MemoryTally {
+ public:
+  void add(size_t bytes) {
+    current_ += bytes;
+    if (current_ > peak_) peak_ = current_;
+  }
+  void remove(size_t bytes) { current_ -= bytes; }
+  size_t peak() const { return peak_; }
+
+ private:
+  size_t current_ = 0, peak_ = 0;
+};
+
+// A device buffer whose size is counted in a MemoryTally while it lives.
+class TalliedBuffer {
+ public:
+  TalliedBuffer(MemoryTally& tally) : tally_(&tally) {}
+  ~TalliedBuffer() { tally_->remove(bytes_); }
+  TalliedBuffer(const TalliedBuffer&) = delete;
+  TalliedBuffer& operator=(const TalliedBuffer&) = delete;
+  // Makes the buffer hold at least `bytes` (contents are not kept).
+  void reserve(cl::Context& context, size_t bytes) {
+    if (bytes <= bytes_ && bytes_ > 0) return;
+    tally_->remove(bytes_);
+    buffer_ = cl::Buffer();
+    bytes_ = std::max<size_t>(bytes, 16);
+    buffer_ = cl::Buffer(context, CL_MEM_READ_WRITE, bytes_);
+    tally_->add(bytes_);
+  }
+  void swap_with(TalliedBuffer& other) {
+    std::swap(buffer_, other.buffer_);
+    std::swap(bytes_, other.bytes_);
+  }
+  const cl::Buffer& get() const { return buffer_; }
+  size_t bytes() const { return bytes_; }
+
+ private:
+  MemoryTally* tally_;
+  cl::Buffer buffer_;
+  size_t bytes_ = 0;
+};
+
+struct BoundSplitContext {
+  DeviceSession& session;
+  const SceneBuffers& scene;
+  const FrameParams& frame;
+  StageTimer& timer;
+  const DiceSink& sink;
+  const ProgressCallback& progress;
+};
+
+// Weber, Wimmer & Owens 2015: fixed worker pool, depth-first per worker,
+// memory fixed by `budget_bytes` (never exceeded; throws if too small).
+BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes, cl_uint dice_capacity);
+// Patney & Owens 2008: whole queue per iteration, compacted by prefix sums.
+BoundSplitResult bound_split_breadth(BoundSplitContext& ctx, cl_uint dice_capacity);
+
+}  // namespace mp

@@ -1,0 +1,109 @@
+// Bounded-memory bound & split (Weber, Wimmer & Owens 2015). A fixed pool of
+// workers each processes sub-patches depth-first from its own stack, so a
+// worker never holds more than (split depth limit + 1) sub-patches. Workers
+// that run dry take whole patches from the input, or split children that busy
+// workers handed out through a ring buffer. Diceable sub-patches go to a fixed
+// buffer; when it is full, that batch is diced, shaded and sampled, and bound
+// & split resumes where it stopped. All memory is allocated up front from the
+// budget, so the peak is the budget's allocation, whatever the scene.
+#include <algorithm>
+#include <string>
+
+#include "micropoly/error.h"
+#include "pipeline/bound_split.h"
+
+namespace mp {
+namespace {
+
+// Counter slots, as BS_* in kernels/bound_split.cl.
+enum Counter { kPoolHead = 0, kPoolTail = 1, kNextPatch = 2, kDiceCount = 3, kBusy = 4, kIdle = 5, kCounters = 8 };
+constexpr cl_uint kStepsPerLaunch = 16;  // sub-patches a worker handles per launch
+constexpr size_t kMaxWorkers = size_t(1) << 20;
+
+}  // namespace
+
+BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes, cl_uint dice_capacity) {
+  DeviceSession& s = ctx.session;
+  cl::Context& context = s.context();
+  cl::CommandQueue& queue = s.queue();
+  const size_t rec = sizeof(SubPatch);
+  const cl_uint stack_depth = static_cast<cl_uint>(ctx.frame.max_depth) + 2;
+  const size_t fixed = static_cast<size_t>(dice_capacity) * rec + kCounters * sizeof(cl_uint);
+  // Per worker: its stack, its stack size and one ring slot.
+  const size_t per_worker = stack_depth * rec + sizeof(cl_uint) + rec;
+  const size_t min_workers = 64;
+  if (budget_bytes < fixed + min_workers * per_worker)
+    throw Error("bound & split memory budget of " + std::to_string(budget_bytes >> 10) + " KiB is too small; it needs at least " +
+                std::to_string((fixed + min_workers * per_worker + 1023) >> 10) + " KiB");
+  size_t workers = std::min(kMaxWorkers, (budget_bytes - fixed) / per_worker);
+  workers = std::max(min_workers, workers / 64 * 64);  // whole work-groups
+  const cl_uint ring_capacity = static_cast<cl_uint>(workers);
+
+  MemoryTally tally;
+  BoundSplitResult result;
+  {
+    TalliedBuffer stacks(tally), sizes(tally), ring(tally), diceable(tally), counters(tally);
+    stacks.reserve(context, workers * stack_depth * rec);
+    sizes.reserve(context, workers * sizeof(cl_uint));
+    ring.reserve(context, static_cast<size_t>(ring_capacity) * rec);
+    diceable.reserve(context, static_cast<size_t>(dice_capacity) * rec);
+    counters.reserve(context, kCounters * sizeof(cl_uint));
+    cl_uint zero = 0;
+    queue.enqueueFillBuffer(sizes.get(), zero, 0, workers * sizeof(cl_uint));
+
+    cl::Kernel step(s.program(), "bs_bounded_step");
+    step.setArg(0, ctx.scene.points);
+    step.setArg(1, ctx.scene.patch_info);
+    step.setArg(2, ctx.scene.patch_count);
+    step.setArg(3, ctx.frame);
+    step.setArg(4, stacks.get());
+    step.setArg(5, sizes.get());
+    step.setArg(6, stack_depth);
+    step.setArg(7, ring.get());
+    step.setArg(8, ring_capacity);
+    step.setArg(12, diceable.get());
+    step.setArg(13, dice_capacity);
+    step.setArg(14, counters.get());
+    step.setArg(15, kStepsPerLaunch);
+
+    cl_uint head = 0, tail = 0, next_patch = 0, dice_count = 0, hungry = static_cast<cl_uint>(workers);
+    const cl_uint patch_count = ctx.scene.patch_count;
+    for (;;) {
+      cl_uint c[kCounters] = {head, tail, next_patch, dice_count, 0, 0, 0, 0};
+      queue.enqueueWriteBuffer(counters.get(), CL_FALSE, 0, sizeof c, c);
+      step.setArg(9, head);
+      step.setArg(10, tail);
+      // Hand out at most as many children as there were idle workers.
+      step.setArg(11, hungry);
+      cl::Event e;
+      queue.enqueueNDRangeKernel(step, cl::NullRange, cl::NDRange(workers), cl::NDRange(64), nullptr, &e);
+      ctx.timer.add(Stage::BoundSplit, e);
+      ++result.launches;
+      queue.enqueueReadBuffer(counters.get(), CL_TRUE, 0, sizeof c, c);
+      ctx.timer.collect();
+
+      const cl_uint head0 = head;
+      head = std::min(c[kPoolHead], tail);
+      tail = std::min({c[kPoolTail], tail + hungry, head0 + ring_capacity});
+      next_patch = std::min(c[kNextPatch], patch_count);
+      dice_count = std::min(c[kDiceCount], dice_capacity);
+      hungry = c[kIdle];
+      if (head == tail) head = tail = 0;  // keep ring indices small
+      bool done = c[kBusy] == 0 && head == tail && next_patch >= patch_count;
+      if (dice_count == dice_capacity || (done && dice_count > 0)) {
+        ctx.sink(diceable.get(), dice_count);
+        dice_count = 0;
+      }
+      if (done) break;
+      if (ctx.progress && !ctx.progress(0.95f * static_cast<float>(next_patch) / static_cast<float>(std::max(patch_count, 1u)))) {
+        result.cancelled = true;
+        break;
+      }
+    }
+    queue.finish();
+  }
+  result.peak_bytes = tally.peak();
+  return result;
+}
+
+}  // namespace mp

@@ -1,0 +1,92 @@
+// Breadth-first bound & split (Patney & Owens 2008): every iteration
+// classifies the whole queue in parallel; exclusive prefix sums give each
+// diceable sub-patch its slot in the diceable list and each split sub-patch the
+// slots of its two children in the next queue. Memory follows the widest
+// level of the split tree, which is what the bounded method avoids.
+#include <algorithm>
+
+#include "pipeline/bound_split.h"
+#include "pipeline/prefix_sum.h"
+
+namespace mp {
+
+BoundSplitResult bound_split_breadth(BoundSplitContext& ctx, cl_uint dice_capacity) {
+  DeviceSession& s = ctx.session;
+  cl::Context& context = s.context();
+  cl::CommandQueue& queue = s.queue();
+  MemoryTally tally;
+  BoundSplitResult result;
+  {
+    TalliedBuffer queue_in(tally), queue_out(tally), decision(tally), dice_flag(tally), split_flag(tally);
+    TalliedBuffer diceable(tally), batch(tally);
+    PrefixSum scan(s, tally);
+    cl::Kernel init(s.program(), "bs_init_queue"), classify(s.program(), "bs_breadth_classify"),
+        scatter(s.program(), "bs_breadth_scatter");
+
+    cl_uint n = ctx.scene.patch_count;
+    const size_t rec = sizeof(SubPatch);
+    queue_in.reserve(context, n * rec);
+    init.setArg(0, queue_in.get());
+    init.setArg(1, n);
+    cl::Event e0;
+    queue.enqueueNDRangeKernel(init, cl::NullRange, round_up_range(n), cl::NDRange(64), nullptr, &e0);
+    ctx.timer.add(Stage::BoundSplit, e0);
+
+    for (int depth = 0; n > 0; ++depth) {
+      decision.reserve(context, n * sizeof(cl_uint));
+      dice_flag.reserve(context, (n + 1) * sizeof(cl_uint));
+      split_flag.reserve(context, (n + 1) * sizeof(cl_uint));
+      classify.setArg(0, queue_in.get());
+      classify.setArg(1, n);
+      classify.setArg(2, ctx.scene.points);
+      classify.setArg(3, ctx.scene.patch_info);
+      classify.setArg(4, ctx.frame);
+      classify.setArg(5, decision.get());
+      classify.setArg(6, dice_flag.get());
+      classify.setArg(7, split_flag.get());
+      cl::Event e1;
+      queue.enqueueNDRangeKernel(classify, cl::NullRange, round_up_range(n + 1), cl::NDRange(64), nullptr, &e1);
+      ctx.timer.add(Stage::BoundSplit, e1);
+      ++result.launches;
+
+      cl_uint dice_total = scan.exclusive_scan(dice_flag.get(), n, ctx.timer);
+      cl_uint split_total = scan.exclusive_scan(split_flag.get(), n, ctx.timer);
+      queue_out.reserve(context, static_cast<size_t>(split_total) * 2 * rec);
+      diceable.reserve(context, static_cast<size_t>(dice_total) * rec);
+
+      scatter.setArg(0, queue_in.get());
+      scatter.setArg(1, n);
+      scatter.setArg(2, decision.get());
+      scatter.setArg(3, dice_flag.get());
+      scatter.setArg(4, split_flag.get());
+      scatter.setArg(5, queue_out.get());
+      scatter.setArg(6, diceable.get());
+      cl::Event e2;
+      queue.enqueueNDRangeKernel(scatter, cl::NullRange, round_up_range(n), cl::NDRange(64), nullptr, &e2);
+      ctx.timer.add(Stage::BoundSplit, e2);
+
+      // Hand the diceable list on in batches the grid buffers can hold.
+      for (cl_uint first = 0; first < dice_total; first += dice_capacity) {
+        cl_uint count = std::min(dice_capacity, dice_total - first);
+        if (first == 0 && count == dice_total) {
+          ctx.sink(diceable.get(), count);
+        } else {
+          batch.reserve(context, static_cast<size_t>(dice_capacity) * rec);
+          queue.enqueueCopyBuffer(diceable.get(), batch.get(), first * rec, 0, count * rec);
+          ctx.sink(batch.get(), count);
+        }
+      }
+      queue_in.swap_with(queue_out);
+      n = split_total * 2;
+      if (ctx.progress && !ctx.progress(std::min(0.95f, 0.1f * static_cast<float>(depth + 1)))) {
+        result.cancelled = true;
+        break;
+      }
+    }
+    queue.finish();
+  }
+  result.peak_bytes = tally.peak();
+  return result;
+}
+
+}  // namespace mp

@@ -1,0 +1,156 @@
+#include "pipeline/micropolygon_stages.h"
+
+#include "micropoly/error.h"
+#include "mp_raster.h"
+
+namespace mp {
+namespace {
+
+cl::Buffer device_buffer(DeviceSession& s, size_t bytes, const char* what) {
+  if (bytes > s.max_alloc_bytes())
+    throw Error(std::string("the ") + what + " needs " + std::to_string(bytes >> 20) + " MiB in one buffer but the device '" +
+                s.info().name + "' allows " + std::to_string(s.max_alloc_bytes() >> 20) +
+                " MiB: lower the resolution or the samples per pixel");
+  return cl::Buffer(s.context(), CL_MEM_READ_WRITE, std::max<size_t>(bytes, 16));
+}
+
+}  // namespace
+
+GridBuffers::GridBuffers(DeviceSession& session, cl_uint cap, int max_grid)
+    : capacity(cap),
+      vertices_per_slot(static_cast<size_t>(max_grid + 1) * static_cast<size_t>(max_grid + 1)),
+      micropolygons_per_slot(static_cast<size_t>(max_grid) * static_cast<size_t>(max_grid)) {
+  size_t bytes = capacity * vertices_per_slot * sizeof(cl_float4);
+  p = device_buffer(session, bytes, "grid position buffer");
+  n = device_buffer(session, bytes, "grid normal buffer");
+  c = device_buffer(session, bytes, "grid color buffer");
+}
+
+DiceStage::DiceStage(DeviceSession& session) : session_(session), kernel_(session.program(), "dice_grids") {
+  counter_ = cl::Buffer(session.context(), CL_MEM_READ_WRITE, sizeof(cl_uint));
+  cl_uint zero = 0;
+  session.queue().enqueueFillBuffer(counter_, zero, 0, sizeof zero);
+}
+
+void DiceStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+                    GridBuffers& grids, StageTimer& timer) {
+  kernel_.setArg(0, diceable);
+  kernel_.setArg(1, count);
+  kernel_.setArg(2, scene.points);
+  kernel_.setArg(3, scene.patch_info);
+  kernel_.setArg(4, f);
+  kernel_.setArg(5, grids.p);
+  kernel_.setArg(6, grids.n);
+  kernel_.setArg(7, counter_);
+  cl::Event e;
+  session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(count * grids.vertices_per_slot),
+                                        cl::NDRange(64), nullptr, &e);
+  timer.add(Stage::Dice, e);
+}
+
+size_t DiceStage::micropolygons() {
+  cl_uint n = 0;
+  session_.queue().enqueueReadBuffer(counter_, CL_TRUE, 0, sizeof n, &n);
+  return n;
+}
+
+ShadeStage::ShadeStage(DeviceSession& session) : session_(session), kernel_(session.program(), "shade_grids") {}
+
+void ShadeStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+                     GridBuffers& grids, StageTimer& timer) {
+  kernel_.setArg(0, diceable);
+  kernel_.setArg(1, count);
+  kernel_.setArg(2, scene.patch_info);
+  kernel_.setArg(3, f);
+  kernel_.setArg(4, grids.p);
+  kernel_.setArg(5, grids.n);
+  kernel_.setArg(6, scene.materials);
+  kernel_.setArg(7, scene.lights);
+  kernel_.setArg(8, scene.light_count);
+  kernel_.setArg(9, grids.c);
+  cl::Event e;
+  session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(count * grids.vertices_per_slot),
+                                        cl::NDRange(64), nullptr, &e);
+  timer.add(Stage::Shade, e);
+}
+
+SampleStage::SampleStage(DeviceSession& session, const FrameParams& f, StageTimer& timer)
+    : session_(session), kernel_(session.program(), "sample_micropolygons") {
+  size_t samples = static_cast<size_t>(f.width) * static_cast<size_t>(f.height) * static_cast<size_t>(f.spp_x * f.spp_y);
+  keys_ = device_buffer(session, samples * sizeof(cl_ulong), "sample depth buffer");
+  colors_ = device_buffer(session, samples * 3 * sizeof(cl_float), "sample color buffer");
+  normals_ = device_buffer(session, samples * sizeof(cl_uint), "sample normal buffer");
+  cl::Kernel clear(session.program(), "clear_samples");
+  clear.setArg(0, keys_);
+  clear.setArg(1, static_cast<cl_ulong>(samples));
+  cl::Event e;
+  session.queue().enqueueNDRangeKernel(clear, cl::NullRange, round_up_range(samples, 256), cl::NDRange(256), nullptr, &e);
+  timer.add(Stage::Sample, e);
+}
+
+void SampleStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+                      GridBuffers& grids, StageTimer& timer) {
+  kernel_.setArg(0, diceable);
+  kernel_.setArg(1, count);
+  kernel_.setArg(2, scene.patch_info);
+  kernel_.setArg(3, f);
+  kernel_.setArg(4, grids.p);
+  kernel_.setArg(5, grids.c);
+  kernel_.setArg(6, grids.n);
+  kernel_.setArg(8, keys_);
+  kernel_.setArg(9, colors_);
+  kernel_.setArg(10, normals_);
+  // Pass 0 finds each sample's nearest key; pass 1 lets its owner write.
+  for (cl_uint pass = 0; pass < 2; ++pass) {
+    kernel_.setArg(7, pass);
+    cl::Event e;
+    session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(count * grids.micropolygons_per_slot),
+                                          cl::NDRange(64), nullptr, &e);
+    timer.add(Stage::Sample, e);
+  }
+}
+
+ResolveStage::ResolveStage(DeviceSession& session) : session_(session), kernel_(session.program(), "resolve_pixels") {}
+
+void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, PixelFilter filter, float filter_width,
+                       RenderResult& out, StageTimer& timer) {
+  const FrameParams& f = frame.params;
+  size_t pixels = static_cast<size_t>(f.width) * static_cast<size_t>(f.height);
+  cl::Buffer rgba(session_.context(), CL_MEM_WRITE_ONLY, pixels * sizeof(cl_float4));
+  cl::Buffer depth(session_.context(), CL_MEM_WRITE_ONLY, pixels * sizeof(cl_float));
+  cl::Buffer normal(session_.context(), CL_MEM_WRITE_ONLY, pixels * sizeof(cl_float4));
+  int type = filter == PixelFilter::Box ? MP_FILTER_BOX : filter == PixelFilter::Gaussian ? MP_FILTER_GAUSSIAN : MP_FILTER_TRIANGLE;
+  auto row = [&](int i) {
+    glm::vec3 r = glm::vec3(frame.camera_to_world[0][i], frame.camera_to_world[1][i], frame.camera_to_world[2][i]);
+    return cl_float4{{r.x, r.y, r.z, 0.0f}};
+  };
+  kernel_.setArg(0, f);
+  kernel_.setArg(1, type);
+  kernel_.setArg(2, std::max(filter_width, 1e-3f));
+  kernel_.setArg(3, samples.keys());
+  kernel_.setArg(4, samples.colors());
+  kernel_.setArg(5, samples.normals());
+  kernel_.setArg(6, row(0));
+  kernel_.setArg(7, row(1));
+  kernel_.setArg(8, row(2));
+  kernel_.setArg(9, rgba);
+  kernel_.setArg(10, depth);
+  kernel_.setArg(11, normal);
+  size_t gx = ((static_cast<size_t>(f.width) + 7) / 8) * 8, gy = ((static_cast<size_t>(f.height) + 7) / 8) * 8;
+  cl::Event e;
+  session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(gx, gy), cl::NDRange(8, 8), nullptr, &e);
+  timer.add(Stage::Resolve, e);
+  out.width = f.width;
+  out.height = f.height;
+  out.rgba.resize(pixels * 4);
+  out.depth.resize(pixels);
+  std::vector<float> n4(pixels * 4);
+  session_.queue().enqueueReadBuffer(rgba, CL_FALSE, 0, pixels * sizeof(cl_float4), out.rgba.data());
+  session_.queue().enqueueReadBuffer(depth, CL_FALSE, 0, pixels * sizeof(cl_float), out.depth.data());
+  session_.queue().enqueueReadBuffer(normal, CL_TRUE, 0, pixels * sizeof(cl_float4), n4.data());
+  out.normal.resize(pixels * 3);
+  for (size_t i = 0; i < pixels; ++i)
+    for (int k = 0; k < 3; ++k) out.normal[3 * i + k] = n4[4 * i + k];
+}
+
+}  // namespace mp

@@ -1,0 +1,73 @@
+// The stages after bound & split, run once per batch of diceable
+// sub-patches: dice -> shade -> sample (two passes), then resolve once per
+// frame. Grids live in fixed slots of (max_grid+1)^2 vertices.
+#pragma once
+
+#include "cl/device_session.h"
+#include "micropoly/renderer.h"
+#include "pipeline/frame_params.h"
+#include "pipeline/scene_buffers.h"
+#include "pipeline/stage_timer.h"
+
+namespace mp {
+
+struct GridBuffers {
+  GridBuffers(DeviceSession& session, cl_uint capacity, int max_grid);
+  cl::Buffer p, n, c;  // float4 per grid vertex
+  cl_uint capacity;    // sub-patches per batch
+  size_t vertices_per_slot;
+  size_t micropolygons_per_slot;
+};
+
+class DiceStage {
+ public:
+  explicit DiceStage(DeviceSession& session);
+  void run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+           GridBuffers& grids, StageTimer& timer);
+  size_t micropolygons();  // total so far (blocking read)
+
+ private:
+  DeviceSession& session_;
+  cl::Kernel kernel_;
+  cl::Buffer counter_;
+};
+
+class ShadeStage {
+ public:
+  explicit ShadeStage(DeviceSession& session);
+  void run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+           GridBuffers& grids, StageTimer& timer);
+
+ private:
+  DeviceSession& session_;
+  cl::Kernel kernel_;
+};
+
+class SampleStage {
+ public:
+  // Allocates and clears the sample buffers (key, color, normal per sample).
+  SampleStage(DeviceSession& session, const FrameParams& f, StageTimer& timer);
+  void run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+           GridBuffers& grids, StageTimer& timer);
+  const cl::Buffer& keys() const { return keys_; }
+  const cl::Buffer& colors() const { return colors_; }
+  const cl::Buffer& normals() const { return normals_; }
+
+ private:
+  DeviceSession& session_;
+  cl::Kernel kernel_;
+  cl::Buffer keys_, colors_, normals_;
+};
+
+class ResolveStage {
+ public:
+  explicit ResolveStage(DeviceSession& session);
+  void run(const SampleStage& samples, const FrameSetup& frame, PixelFilter filter, float filter_width,
+           RenderResult& out, StageTimer& timer);
+
+ private:
+  DeviceSession& session_;
+  cl::Kernel kernel_;
+};
+
+}  // namespace mp

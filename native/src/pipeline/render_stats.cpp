@@ -1,0 +1,56 @@
+#include <cstdio>
+#include <string>
+
+#include "micropoly/renderer.h"
+
+namespace mp {
+namespace {
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (unsigned char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += static_cast<char>(c);
+    } else if (c < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out + "\"";
+}
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3f", v);
+  return buf;
+}
+
+}  // namespace
+
+std::string RenderStats::to_json() const {
+  std::string j = "{\n";
+  j += "  \"device\": " + json_string(device) + ",\n";
+  j += "  \"width\": " + std::to_string(width) + ",\n";
+  j += "  \"height\": " + std::to_string(height) + ",\n";
+  j += "  \"spp\": " + std::to_string(spp) + ",\n";
+  j += "  \"patches\": " + std::to_string(patches) + ",\n";
+  j += "  \"subpatches_diced\": " + std::to_string(subpatches_diced) + ",\n";
+  j += "  \"micropolygons\": " + std::to_string(micropolygons) + ",\n";
+  j += "  \"bound_split_peak_bytes\": " + std::to_string(bound_split_peak_bytes) + ",\n";
+  j += "  \"bound_split_launches\": " + std::to_string(bound_split_launches) + ",\n";
+  j += "  \"batches\": " + std::to_string(batches) + ",\n";
+  j += "  \"program_build_ms\": " + num(program_build_ms) + ",\n";
+  j += "  \"program_cache_hit\": " + std::string(program_cache_hit ? "true" : "false") + ",\n";
+  j += "  \"cancelled\": " + std::string(cancelled ? "true" : "false") + ",\n";
+  j += "  \"timings_ms\": {\"upload\": " + num(timings_ms.upload) + ", \"bound_split\": " + num(timings_ms.bound_split) +
+       ", \"dice\": " + num(timings_ms.dice) + ", \"shade\": " + num(timings_ms.shade) + ", \"sample\": " +
+       num(timings_ms.sample) + ", \"resolve\": " + num(timings_ms.resolve) + ", \"total\": " + num(timings_ms.total) + "}\n";
+  j += "}\n";
+  return j;
+}
+
+}  // namespace mp

@@ -1,0 +1,107 @@
+// Renderer: validates the scene, uploads it, runs bound & split with batches
+// of dice -> shade -> sample, then resolves the pixels.
+#include "micropoly/renderer.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "cl/device_session.h"
+#include "micropoly/error.h"
+#include "pipeline/bound_split.h"
+#include "pipeline/frame_params.h"
+#include "pipeline/micropolygon_stages.h"
+#include "pipeline/scene_buffers.h"
+
+namespace mp {
+namespace {
+
+// Sub-patches per dice batch: grid buffers hold this many (max_grid+1)^2 grids.
+constexpr cl_uint kDiceBatch = 8192;
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+struct Renderer::Impl {
+  explicit Impl(const std::string& selector) : session(selector) {}
+  DeviceSession session;
+  bool first_render = true;
+};
+
+Renderer::Renderer(const std::string& selector) : impl_(std::make_unique<Impl>(selector)) {}
+Renderer::~Renderer() = default;
+
+const DeviceInfo& Renderer::device() const { return impl_->session.info(); }
+
+RenderResult Renderer::render(const Scene& scene, const ProgressCallback& progress) {
+  validate_scene(scene);
+  auto t_start = std::chrono::steady_clock::now();
+  DeviceSession& s = impl_->session;
+  RenderResult out;
+  RenderStats& st = out.stats;
+  st.device = s.info().name;
+  if (impl_->first_render) {
+    st.program_build_ms = s.program_build_ms();
+    st.program_cache_hit = s.program_cache_hit();
+    impl_->first_render = false;
+  }
+  FrameSetup frame = make_frame_setup(scene);
+  const FrameParams& f = frame.params;
+  st.width = f.width;
+  st.height = f.height;
+  st.spp = f.spp_x * f.spp_y;
+  try {
+    StageTimer timer;
+    auto t_upload = std::chrono::steady_clock::now();
+    HostSceneData host = prepare_scene_data(scene);
+    SceneBuffers buffers = upload_scene_data(s.context(), s.queue(), host);
+    st.timings_ms.upload = ms_since(t_upload);
+    st.patches = buffers.patch_count;
+
+    cl_uint capacity = std::max<cl_uint>(1, std::min<cl_uint>(kDiceBatch, std::max<cl_uint>(buffers.patch_count, 256)));
+    GridBuffers grids(s, capacity, f.max_grid);
+    DiceStage dice(s);
+    ShadeStage shade(s);
+    SampleStage sample(s, f, timer);
+    ResolveStage resolve(s);
+
+    DiceSink sink = [&](const cl::Buffer& diceable, cl_uint count) {
+      dice.run(diceable, count, buffers, f, grids, timer);
+      shade.run(diceable, count, buffers, f, grids, timer);
+      sample.run(diceable, count, buffers, f, grids, timer);
+      st.subpatches_diced += count;
+      ++st.batches;
+    };
+    BoundSplitContext ctx{s, buffers, f, timer, sink, progress};
+    BoundSplitResult bs;
+    if (buffers.patch_count > 0) {
+      if (scene.settings.bound_split == BoundSplitMethod::Bounded) {
+        size_t budget = static_cast<size_t>(std::max(0.0f, scene.settings.bound_split_memory_mib) * 1048576.0);
+        bs = bound_split_bounded(ctx, budget, capacity);
+      } else {
+        bs = bound_split_breadth(ctx, capacity);
+      }
+    }
+    st.bound_split_peak_bytes = bs.peak_bytes;
+    st.bound_split_launches = bs.launches;
+    st.cancelled = bs.cancelled;
+    resolve.run(sample, frame, scene.settings.filter, scene.settings.filter_width, out, timer);
+    s.queue().finish();
+    timer.collect();
+    st.micropolygons = dice.micropolygons();
+    st.timings_ms.bound_split = timer.ms(Stage::BoundSplit);
+    st.timings_ms.dice = timer.ms(Stage::Dice);
+    st.timings_ms.shade = timer.ms(Stage::Shade);
+    st.timings_ms.sample = timer.ms(Stage::Sample);
+    st.timings_ms.resolve = timer.ms(Stage::Resolve);
+  } catch (const cl::Error& e) {
+    throw Error("rendering on '" + s.info().name + "': " + describe_cl_error(e));
+  }
+  st.timings_ms.total = ms_since(t_start);
+  if (progress) progress(1.0f);
+  return out;
+}
+
+}  // namespace mp

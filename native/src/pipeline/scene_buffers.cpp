@@ -1,0 +1,82 @@
+#include "pipeline/scene_buffers.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mp {
+namespace {
+
+void put(float* dst, glm::vec3 v, float w) {
+  dst[0] = v.x, dst[1] = v.y, dst[2] = v.z, dst[3] = w;
+}
+
+DeviceMaterial to_device(const Material& m) {
+  DeviceMaterial d{};
+  float model = m.model == Material::Model::Constant ? 0.0f : m.model == Material::Model::Matte ? 1.0f : 2.0f;
+  put(d.color, m.color, model);
+  float avg = std::clamp((m.opacity.x + m.opacity.y + m.opacity.z) / 3.0f, 0.0f, 1.0f);
+  put(d.opacity, m.opacity, avg);
+  d.coeffs[0] = m.ka, d.coeffs[1] = m.kd, d.coeffs[2] = m.ks, d.coeffs[3] = m.roughness;
+  put(d.specular, m.specular_color, 0.0f);
+  put(d.emission, m.emission, 0.0f);
+  return d;
+}
+
+DeviceLight to_device(const Light& l, const glm::mat4& world_to_camera) {
+  DeviceLight d{};
+  int type = l.type == Light::Type::Ambient   ? MP_LIGHT_AMBIENT
+             : l.type == Light::Type::Distant ? MP_LIGHT_DISTANT
+             : l.type == Light::Type::Point   ? MP_LIGHT_POINT
+                                              : MP_LIGHT_SPOT;
+  put(d.color, l.color * l.intensity, static_cast<float>(type));
+  put(d.position, glm::vec3(world_to_camera * glm::vec4(l.position, 1.0f)), 1.0f);
+  glm::vec3 dir = glm::vec3(world_to_camera * glm::vec4(l.direction, 0.0f));
+  float len = glm::length(dir);
+  put(d.direction, len > 0.0f ? dir / len : glm::vec3(0, 0, -1), 0.0f);
+  float outer = std::clamp(l.cone_angle, 0.0f, 3.14159265f);
+  float inner = std::clamp(l.cone_angle - l.cone_delta_angle, 0.0f, outer);
+  d.cone[0] = std::cos(outer), d.cone[1] = std::cos(inner), d.cone[2] = l.beam_distribution, d.cone[3] = 0.0f;
+  return d;
+}
+
+template <typename T>
+cl::Buffer upload(cl::Context& context, cl::CommandQueue& queue, const std::vector<T>& v) {
+  size_t bytes = std::max<size_t>(v.size() * sizeof(T), 16);  // zero-sized buffers are invalid
+  cl::Buffer b(context, CL_MEM_READ_ONLY, bytes);
+  if (!v.empty()) queue.enqueueWriteBuffer(b, CL_FALSE, 0, v.size() * sizeof(T), v.data());
+  return b;
+}
+
+}  // namespace
+
+HostSceneData prepare_scene_data(const Scene& scene) {
+  HostSceneData out;
+  const glm::mat4& w2c = scene.camera.world_to_camera;
+  for (const Mesh& mesh : scene.meshes) {
+    glm::mat4 to_camera = w2c * mesh.object_to_world;
+    if (mesh.scheme == SubdivScheme::CatmullClark)
+      append_subdiv_patches(mesh, to_camera, out.patches);
+    else
+      append_polygon_patches(mesh, to_camera, out.patches);
+  }
+  for (const BezierPatches& set : scene.bezier_patches)
+    append_bezier_patches(set, w2c * set.object_to_world, out.patches);
+  if (scene.materials.empty()) out.materials.push_back(to_device(Material{}));
+  for (const Material& m : scene.materials) out.materials.push_back(to_device(m));
+  for (const Light& l : scene.lights) out.lights.push_back(to_device(l, w2c));
+  return out;
+}
+
+SceneBuffers upload_scene_data(cl::Context& context, cl::CommandQueue& queue, const HostSceneData& data) {
+  SceneBuffers b;
+  b.points = upload(context, queue, data.patches.points);
+  b.patch_info = upload(context, queue, data.patches.info);
+  b.materials = upload(context, queue, data.materials);
+  b.lights = upload(context, queue, data.lights);
+  b.patch_count = static_cast<cl_uint>(data.patches.size());
+  b.light_count = static_cast<cl_uint>(data.lights.size());
+  queue.finish();
+  return b;
+}
+
+}  // namespace mp

@@ -1,0 +1,32 @@
+// The scene on the device: patches (camera space), materials and lights.
+#pragma once
+
+#include <vector>
+
+#include "cl/cl.h"
+#include "micropoly/scene.h"
+#include "mp_types.h"
+#include "subdiv/patch_buffer.h"
+
+namespace mp {
+
+// Host side: every surface as device patches in camera space, plus materials
+// and lights in their device layout. Pure CPU work; no OpenCL involved.
+struct HostSceneData {
+  PatchBuffer patches;
+  std::vector<DeviceMaterial> materials;
+  std::vector<DeviceLight> lights;
+};
+HostSceneData prepare_scene_data(const Scene& scene);
+
+struct SceneBuffers {
+  cl::Buffer points;      // float4 x MP_PATCH_POINTS per patch
+  cl::Buffer patch_info;  // uint4 per patch
+  cl::Buffer materials;
+  cl::Buffer lights;
+  cl_uint patch_count = 0;
+  cl_uint light_count = 0;
+};
+SceneBuffers upload_scene_data(cl::Context& context, cl::CommandQueue& queue, const HostSceneData& data);
+
+}  // namespace mp

@@ -1,0 +1,271 @@
+// micropoly._native: builds a Scene from numpy arrays and renders it.
+// Every C++ error surfaces as micropoly._native.Error (a RuntimeError).
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+
+#include "micropoly/error.h"
+#include "micropoly/renderer.h"
+#include "micropoly/settings_util.h"
+#include "rib/rib_reader.h"
+
+namespace py = pybind11;
+using namespace mp;
+
+namespace {
+
+template <typename T>
+using Array = py::array_t<T, py::array::c_style | py::array::forcecast>;
+
+std::vector<glm::vec3> to_points(const Array<float>& a, const char* what) {
+  if (a.size() == 0) return {};
+  if (a.ndim() != 2 || a.shape(1) != 3) throw Error(std::string(what) + " must be an (N, 3) array");
+  std::vector<glm::vec3> out(static_cast<size_t>(a.shape(0)));
+  std::memcpy(out.data(), a.data(), out.size() * sizeof(glm::vec3));
+  return out;
+}
+
+template <typename T>
+std::vector<T> to_vector(const Array<T>& a) {
+  return std::vector<T>(a.data(), a.data() + a.size());
+}
+
+// Row-major 4x4 (numpy, Blender's Matrix) to GLM's column-major matrix.
+glm::mat4 to_matrix(const Array<float>& a, const char* what) {
+  if (a.size() == 0) return glm::mat4(1.0f);
+  if (a.ndim() != 2 || a.shape(0) != 4 || a.shape(1) != 4) throw Error(std::string(what) + " must be a (4, 4) array");
+  glm::mat4 m;
+  auto r = a.unchecked<2>();
+  for (int row = 0; row < 4; ++row)
+    for (int col = 0; col < 4; ++col) m[col][row] = r(row, col);
+  return m;
+}
+
+glm::vec3 to_vec3(const std::vector<float>& v, const char* what) {
+  if (v.size() != 3) throw Error(std::string(what) + " needs 3 values");
+  return {v[0], v[1], v[2]};
+}
+
+py::dict stats_dict(const RenderStats& s) {
+  py::dict d, t;
+  d["device"] = s.device;
+  d["width"] = s.width;
+  d["height"] = s.height;
+  d["spp"] = s.spp;
+  d["patches"] = s.patches;
+  d["subpatches_diced"] = s.subpatches_diced;
+  d["micropolygons"] = s.micropolygons;
+  d["bound_split_peak_bytes"] = s.bound_split_peak_bytes;
+  d["bound_split_launches"] = s.bound_split_launches;
+  d["batches"] = s.batches;
+  d["program_build_ms"] = s.program_build_ms;
+  d["program_cache_hit"] = s.program_cache_hit;
+  d["cancelled"] = s.cancelled;
+  t["upload"] = s.timings_ms.upload;
+  t["bound_split"] = s.timings_ms.bound_split;
+  t["dice"] = s.timings_ms.dice;
+  t["shade"] = s.timings_ms.shade;
+  t["sample"] = s.timings_ms.sample;
+  t["resolve"] = s.timings_ms.resolve;
+  t["total"] = s.timings_ms.total;
+  d["timings_ms"] = t;
+  return d;
+}
+
+py::dict result_dict(RenderResult&& r) {
+  py::dict d;
+  auto h = static_cast<py::ssize_t>(r.height), w = static_cast<py::ssize_t>(r.width);
+  d["rgba"] = Array<float>({h, w, py::ssize_t(4)}, r.rgba.data());
+  d["depth"] = Array<float>({h, w}, r.depth.data());
+  d["normal"] = Array<float>({h, w, py::ssize_t(3)}, r.normal.data());
+  d["stats"] = stats_dict(r.stats);
+  return d;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_native, m) {
+  m.doc() = "Micropoly native renderer";
+  m.attr("__version__") = MICROPOLY_VERSION;
+  py::register_exception<Error>(m, "Error", PyExc_RuntimeError);
+
+  py::enum_<PixelFilter>(m, "PixelFilter")
+      .value("BOX", PixelFilter::Box)
+      .value("GAUSSIAN", PixelFilter::Gaussian)
+      .value("TRIANGLE", PixelFilter::Triangle);
+  py::enum_<BoundSplitMethod>(m, "BoundSplitMethod")
+      .value("BOUNDED", BoundSplitMethod::Bounded)
+      .value("BREADTH", BoundSplitMethod::Breadth);
+
+  py::class_<RenderSettings>(m, "RenderSettings")
+      .def(py::init<>())
+      .def_readwrite("width", &RenderSettings::width)
+      .def_readwrite("height", &RenderSettings::height)
+      .def_readwrite("pixel_aspect", &RenderSettings::pixel_aspect)
+      .def_readwrite("crop_x0", &RenderSettings::crop_x0)
+      .def_readwrite("crop_x1", &RenderSettings::crop_x1)
+      .def_readwrite("crop_y0", &RenderSettings::crop_y0)
+      .def_readwrite("crop_y1", &RenderSettings::crop_y1)
+      .def_readwrite("samples_x", &RenderSettings::samples_x)
+      .def_readwrite("samples_y", &RenderSettings::samples_y)
+      .def_property(
+          "samples", [](const RenderSettings& s) { return s.samples_x * s.samples_y; },
+          [](RenderSettings& s, int n) { set_samples_per_pixel(s, n); })
+      .def_readwrite("shading_rate", &RenderSettings::shading_rate)
+      .def_readwrite("filter", &RenderSettings::filter)
+      .def_readwrite("filter_width", &RenderSettings::filter_width)
+      .def_readwrite("bound_split", &RenderSettings::bound_split)
+      .def_readwrite("bound_split_memory_mib", &RenderSettings::bound_split_memory_mib)
+      .def_readwrite("max_grid_size", &RenderSettings::max_grid_size)
+      .def_readwrite("max_split_depth", &RenderSettings::max_split_depth)
+      .def_readwrite("backface_culling", &RenderSettings::backface_culling);
+
+  py::class_<Scene>(m, "Scene")
+      .def(py::init<>())
+      .def_readwrite("settings", &Scene::settings)
+      .def(
+          "set_camera",
+          [](Scene& s, const Array<float>& world_to_camera, bool ortho, float fov_degrees, float clip_near, float clip_far,
+             std::vector<float> screen_window) {
+            s.camera.world_to_camera = to_matrix(world_to_camera, "world_to_camera");
+            s.camera.projection = ortho ? Camera::Projection::Orthographic : Camera::Projection::Perspective;
+            s.camera.fov_degrees = fov_degrees;
+            s.camera.clip_near = clip_near;
+            s.camera.clip_far = clip_far;
+            if (!screen_window.empty()) {
+              if (screen_window.size() != 4) throw Error("screen_window needs (left, right, bottom, top)");
+              s.camera.screen_left = screen_window[0], s.camera.screen_right = screen_window[1];
+              s.camera.screen_bottom = screen_window[2], s.camera.screen_top = screen_window[3];
+            }
+          },
+          py::arg("world_to_camera"), py::arg("orthographic") = false, py::arg("fov_degrees") = 90.0f,
+          py::arg("clip_near") = 0.01f, py::arg("clip_far") = 1e30f, py::arg("screen_window") = std::vector<float>{},
+          "Camera looking down -Z of its space (Blender's convention); world_to_camera is row-major.")
+      .def(
+          "add_material",
+          [](Scene& s, const std::string& name, const std::string& model, std::vector<float> color,
+             std::vector<float> opacity, float ka, float kd, float ks, float roughness, std::vector<float> specular_color,
+             std::vector<float> emission) {
+            Material mat;
+            mat.name = name;
+            if (model == "constant") mat.model = Material::Model::Constant;
+            else if (model == "matte") mat.model = Material::Model::Matte;
+            else if (model == "plastic") mat.model = Material::Model::Plastic;
+            else throw Error("unknown material model '" + model + "' (constant, matte, plastic)");
+            mat.color = to_vec3(color, "color");
+            mat.opacity = to_vec3(opacity, "opacity");
+            mat.ka = ka, mat.kd = kd, mat.ks = ks, mat.roughness = roughness;
+            mat.specular_color = to_vec3(specular_color, "specular_color");
+            mat.emission = to_vec3(emission, "emission");
+            s.materials.push_back(mat);
+            return s.materials.size() - 1;
+          },
+          py::arg("name") = "", py::arg("model") = "plastic", py::arg("color") = std::vector<float>{1, 1, 1},
+          py::arg("opacity") = std::vector<float>{1, 1, 1}, py::arg("ka") = 1.0f, py::arg("kd") = 0.5f,
+          py::arg("ks") = 0.5f, py::arg("roughness") = 0.1f, py::arg("specular_color") = std::vector<float>{1, 1, 1},
+          py::arg("emission") = std::vector<float>{0, 0, 0}, "Adds a material; returns its index.")
+      .def(
+          "add_light",
+          [](Scene& s, const std::string& type, std::vector<float> color, float intensity, std::vector<float> position,
+             std::vector<float> direction, float cone_angle, float cone_delta_angle, float beam_distribution) {
+            Light l;
+            if (type == "ambient") l.type = Light::Type::Ambient;
+            else if (type == "distant") l.type = Light::Type::Distant;
+            else if (type == "point") l.type = Light::Type::Point;
+            else if (type == "spot") l.type = Light::Type::Spot;
+            else throw Error("unknown light type '" + type + "' (ambient, distant, point, spot)");
+            l.color = to_vec3(color, "color");
+            l.intensity = intensity;
+            l.position = to_vec3(position, "position");
+            l.direction = to_vec3(direction, "direction");
+            l.cone_angle = cone_angle, l.cone_delta_angle = cone_delta_angle, l.beam_distribution = beam_distribution;
+            s.lights.push_back(l);
+          },
+          py::arg("type"), py::arg("color") = std::vector<float>{1, 1, 1}, py::arg("intensity") = 1.0f,
+          py::arg("position") = std::vector<float>{0, 0, 0}, py::arg("direction") = std::vector<float>{0, 0, -1},
+          py::arg("cone_angle") = 0.5235988f, py::arg("cone_delta_angle") = 0.0872665f, py::arg("beam_distribution") = 2.0f)
+      .def(
+          "add_mesh",
+          [](Scene& s, const std::string& name, const Array<float>& points, const Array<int>& face_vertex_counts,
+             const Array<int>& face_vertex_indices, bool subdivision, const Array<float>& object_to_world, int material,
+             const Array<int>& face_materials, const Array<int>& crease_vertices, const Array<float>& crease_sharpness,
+             const Array<int>& corner_vertices, const Array<float>& corner_sharpness, const Array<int>& hole_faces,
+             const std::string& boundary, bool double_sided) {
+            Mesh mesh;
+            mesh.name = name;
+            mesh.scheme = subdivision ? SubdivScheme::CatmullClark : SubdivScheme::None;
+            mesh.points = to_points(points, "points");
+            mesh.face_vertex_counts = to_vector(face_vertex_counts);
+            mesh.face_vertex_indices = to_vector(face_vertex_indices);
+            mesh.object_to_world = to_matrix(object_to_world, "object_to_world");
+            mesh.material = material;
+            mesh.face_materials = to_vector(face_materials);
+            mesh.crease_vertices = to_vector(crease_vertices);
+            mesh.crease_sharpness = to_vector(crease_sharpness);
+            mesh.corner_vertices = to_vector(corner_vertices);
+            mesh.corner_sharpness = to_vector(corner_sharpness);
+            mesh.hole_faces = to_vector(hole_faces);
+            if (boundary == "none") mesh.boundary = BoundaryInterpolation::None;
+            else if (boundary == "edge_only") mesh.boundary = BoundaryInterpolation::EdgeOnly;
+            else if (boundary == "edge_and_corner") mesh.boundary = BoundaryInterpolation::EdgeAndCorner;
+            else throw Error("unknown boundary interpolation '" + boundary + "'");
+            mesh.double_sided = double_sided;
+            s.meshes.push_back(std::move(mesh));
+          },
+          py::arg("name"), py::arg("points"), py::arg("face_vertex_counts"), py::arg("face_vertex_indices"),
+          py::arg("subdivision") = false, py::arg("object_to_world") = Array<float>(),
+          py::arg("material") = 0, py::arg("face_materials") = Array<int>(), py::arg("crease_vertices") = Array<int>(),
+          py::arg("crease_sharpness") = Array<float>(), py::arg("corner_vertices") = Array<int>(),
+          py::arg("corner_sharpness") = Array<float>(), py::arg("hole_faces") = Array<int>(),
+          py::arg("boundary") = "edge_and_corner", py::arg("double_sided") = true)
+      .def("validate", [](const Scene& s) { validate_scene(s); })
+      .def_property_readonly("mesh_count", [](const Scene& s) { return s.meshes.size(); })
+      .def_property_readonly("patch_set_count", [](const Scene& s) { return s.bezier_patches.size(); })
+      .def_property_readonly("material_count", [](const Scene& s) { return s.materials.size(); })
+      .def_property_readonly("light_count", [](const Scene& s) { return s.lights.size(); });
+
+  m.def("read_rib", [](const std::string& path) { return read_rib_file(path).scene; }, py::arg("path"),
+        "Reads a RIB file into a Scene.");
+
+  m.def("list_devices", [] {
+    py::list out;
+    for (auto& d : list_devices()) {
+      py::dict e;
+      e["index"] = d.index;
+      e["name"] = d.name;
+      e["platform"] = d.platform;
+      e["type"] = d.type;
+      e["version"] = d.version;
+      out.append(e);
+    }
+    return out;
+  });
+
+  py::class_<Renderer>(m, "Renderer")
+      .def(py::init<const std::string&>(), py::arg("device") = "", py::call_guard<py::gil_scoped_release>())
+      .def_property_readonly("device", [](const Renderer& r) { return r.device().name; })
+      .def(
+          "render",
+          [](Renderer& r, const Scene& scene, py::object progress) {
+            ProgressCallback cb;
+            if (!progress.is_none()) {
+              cb = [progress](float p) {
+                py::gil_scoped_acquire gil;
+                py::object ret = progress(p);
+                return ret.is_none() || ret.cast<bool>();
+              };
+            }
+            RenderResult result;
+            {
+              py::gil_scoped_release release;
+              result = r.render(scene, cb);
+            }
+            return result_dict(std::move(result));
+          },
+          py::arg("scene"), py::arg("progress") = py::none(),
+          "Renders the scene; returns dict(rgba=(H,W,4), depth=(H,W), normal=(H,W,3), stats=dict). Rows top first. "
+          "progress(p) may return False to cancel.");
+}

@@ -1,0 +1,513 @@
+// Request dispatch, block structure, options and camera requests.
+#include "rib/rib_parser.h"
+
+#include <cmath>
+
+#include <glm/gtc/matrix_inverse.hpp>
+
+#include "rib/rib_file.h"
+
+namespace mp::rib {
+
+size_t Primitive::elements() const {
+  if (kind == Kind::Patches) return patch_points.size();
+  return mesh.points.size() + mesh.face_vertex_indices.size() + mesh.face_vertex_counts.size();
+}
+
+Parser::Parser() {
+  // RenderMan's defaults where they differ from the Scene's (RI spec 3.2,
+  // tables 4.1 and 4.2): 640x480, PixelSamples 2 2, gaussian 2x2, fov 90.
+  RenderSettings& s = result_.scene.settings;
+  s.width = 640;
+  s.height = 480;
+  s.pixel_aspect = 1.0f;
+  s.samples_x = s.samples_y = 2;
+  s.filter = PixelFilter::Gaussian;
+  s.filter_width = 2.0f;
+  s.shading_rate = 1.0f;
+  Camera& c = result_.scene.camera;
+  c.projection = Camera::Projection::Perspective;
+  c.fov_degrees = 90.0f;
+  c.screen_left = c.screen_right = c.screen_bottom = c.screen_top = 0.0f;
+
+  // RenderMan's default surface ("defaultsurface", a headlight-lit matte) is
+  // approximated by matte with Ka = Kd = 1; it is always material 0.
+  Material def;
+  def.name = "defaultsurface";
+  def.model = Material::Model::Matte;
+  def.ka = 1.0f;
+  def.kd = 1.0f;
+  def.ks = 0.0f;
+  attrs_.surface = def;
+  attrs_.ubasis = attrs_.vbasis = bezier_basis();
+  result_.scene.materials.clear();
+  material_index(attrs_);
+}
+
+const std::unordered_map<std::string, Parser::Handler>& Parser::handlers() {
+  static const std::unordered_map<std::string, Handler> table = {
+      {"version", &Parser::req_version},
+      {"FrameBegin", &Parser::req_frame_begin},
+      {"FrameEnd", &Parser::req_frame_end},
+      {"WorldBegin", &Parser::req_world_begin},
+      {"WorldEnd", &Parser::req_world_end},
+      {"AttributeBegin", &Parser::req_attribute_begin},
+      {"AttributeEnd", &Parser::req_attribute_end},
+      {"TransformBegin", &Parser::req_transform_begin},
+      {"TransformEnd", &Parser::req_transform_end},
+      {"SolidBegin", &Parser::req_solid_begin},
+      {"SolidEnd", &Parser::req_solid_end},
+      {"MotionBegin", &Parser::req_motion_begin},
+      {"MotionEnd", &Parser::req_motion_begin},  // reports the unmatched MotionEnd
+      {"Format", &Parser::req_format},
+      {"Projection", &Parser::req_projection},
+      {"ScreenWindow", &Parser::req_screen_window},
+      {"CropWindow", &Parser::req_crop_window},
+      {"Clipping", &Parser::req_clipping},
+      {"PixelSamples", &Parser::req_pixel_samples},
+      {"PixelFilter", &Parser::req_pixel_filter},
+      {"ShadingRate", &Parser::req_shading_rate},
+      {"Display", &Parser::req_display},
+      {"Option", &Parser::req_option},
+      {"Attribute", &Parser::req_attribute},
+      {"Declare", &Parser::req_declare},
+      {"ReadArchive", &Parser::req_read_archive},
+      {"Bound", &Parser::req_ignore},         // a culling hint; bounds are computed
+      {"ErrorHandler", &Parser::req_ignore},  // errors always throw RibError
+      {"Identity", &Parser::req_identity},
+      {"Transform", &Parser::req_transform},
+      {"ConcatTransform", &Parser::req_concat_transform},
+      {"Translate", &Parser::req_translate},
+      {"Rotate", &Parser::req_rotate},
+      {"Scale", &Parser::req_scale},
+      {"CoordinateSystem", &Parser::req_coordinate_system},
+      {"CoordSysTransform", &Parser::req_coord_sys_transform},
+      {"Orientation", &Parser::req_orientation},
+      {"ReverseOrientation", &Parser::req_reverse_orientation},
+      {"Sides", &Parser::req_sides},
+      {"Color", &Parser::req_color},
+      {"Opacity", &Parser::req_opacity},
+      {"Surface", &Parser::req_surface},
+      {"LightSource", &Parser::req_light_source},
+      {"Illuminate", &Parser::req_illuminate},
+      {"Polygon", &Parser::req_polygon},
+      {"GeneralPolygon", &Parser::req_general_polygon},
+      {"PointsPolygons", &Parser::req_points_polygons},
+      {"PointsGeneralPolygons", &Parser::req_points_general_polygons},
+      {"SubdivisionMesh", &Parser::req_subdivision_mesh},
+      {"Patch", &Parser::req_patch},
+      {"PatchMesh", &Parser::req_patch_mesh},
+      {"Basis", &Parser::req_basis},
+      {"ObjectBegin", &Parser::req_object_begin},
+      {"ObjectEnd", &Parser::req_object_end},
+      {"ObjectInstance", &Parser::req_object_instance},
+  };
+  return table;
+}
+
+void Parser::parse(std::string_view text, const std::string& file, const std::string& base_dir,
+                   int depth) {
+  const Source src{&file, &base_dir, depth};
+  const Source* outer = source_;
+  source_ = &src;
+  Lexer lexer(text, file);
+  RequestReader reader(lexer);
+  Request req;
+  while (reader.next(req)) execute(req);
+  source_ = outer;
+}
+
+void Parser::execute(const Request& req) {
+  if (skipping_) return;  // later frames are tokenized (syntax-checked) only
+  if (motion_depth_ > 0) {
+    // Motion blur is not supported: the first request of each motion block
+    // (the state at the shutter open time) is used and the others dropped.
+    if (req.name == "MotionEnd") {
+      motion_depth_ = 0;
+      return;
+    }
+    if (req.name == "MotionBegin") fail(req.line, "MotionBegin: nested motion blocks");
+    if (motion_first_done_) return;
+    motion_first_done_ = true;
+  }
+  const auto& table = handlers();
+  auto it = table.find(req.name);
+  if (it == table.end()) {
+    warn_once("request:" + req.name, req.line,
+              "unsupported request '" + req.name + "' ignored (with its arguments)");
+    return;
+  }
+  ArgReader args(req, *source_->file);
+  (this->*(it->second))(args);
+}
+
+std::string Parser::where(int line) const {
+  return (source_ ? *source_->file : std::string("<rib>")) + ":" + std::to_string(line);
+}
+
+void Parser::warn(int line, const std::string& message) {
+  result_.warnings.push_back(where(line) + ": " + message);
+}
+
+void Parser::warn_once(const std::string& key, int line, const std::string& message) {
+  if (warned_.insert(key).second) warn(line, message);
+}
+
+void Parser::fail(int line, const std::string& reason) const {
+  throw RibError(where(line) + ": " + reason);
+}
+
+void Parser::charge(size_t elements, int line) {
+  elements_ += elements;
+  if (elements_ > Limits::kMaxSceneElements)
+    fail(line, "scene too large: more than " + std::to_string(Limits::kMaxSceneElements) +
+                   " points and indices in total");
+}
+
+const char* Parser::block_name(Block::Kind kind) {
+  switch (kind) {
+    case Block::Kind::Frame: return "FrameBegin";
+    case Block::Kind::World: return "WorldBegin";
+    case Block::Kind::Attribute: return "AttributeBegin";
+    case Block::Kind::Transform: return "TransformBegin";
+    case Block::Kind::Object: return "ObjectBegin";
+    case Block::Kind::Solid: return "SolidBegin";
+  }
+  return "Begin";
+}
+
+void Parser::push_block(Block::Kind kind, int line) {
+  if (blocks_.size() >= Limits::kMaxBlockDepth)
+    fail(line, std::string(block_name(kind)) + ": blocks nested deeper than " +
+                   std::to_string(Limits::kMaxBlockDepth));
+  blocks_.push_back(Block{kind, line, *source_->file, attrs_});
+}
+
+void Parser::pop_block(Block::Kind kind, ArgReader& args) {
+  args.done();
+  if (blocks_.empty() || blocks_.back().kind != kind) {
+    std::string why = std::string("without a matching ") + block_name(kind);
+    if (!blocks_.empty())
+      why += " (the innermost open block is " + std::string(block_name(blocks_.back().kind)) +
+             " at " + blocks_.back().file + ":" + std::to_string(blocks_.back().line) + ")";
+    args.fail(why);
+  }
+  // All blocks but TransformBegin/End save and restore the attributes
+  // (RI spec 3.2, section 4); TransformEnd restores only the transformation.
+  if (kind == Block::Kind::Transform)
+    attrs_.ctm = blocks_.back().saved.ctm;
+  else
+    attrs_ = std::move(blocks_.back().saved);
+  blocks_.pop_back();
+}
+
+std::string Parser::handle_key(ArgReader& args) {
+  // Handles are sequence numbers in RIB 3.2 and may be strings in later RIB.
+  const Arg& a = args.any();
+  if (a.kind == Arg::Kind::Number) {
+    int n = 0;
+    if (!to_int(a.numbers[0], -2147483647LL - 1, 2147483647LL, &n))
+      args.fail_at(a.line, "a numeric handle must be an integer");
+    return "#" + std::to_string(n);
+  }
+  if (a.kind == Arg::Kind::String) return "\"" + a.strings[0] + "\"";
+  args.fail_at(a.line, std::string("expected a handle (a number or a string), found ") + a.describe());
+}
+
+bool Parser::current_frame_is_left_handed() const {
+  // Camera space is left-handed; the current coordinate system is too unless
+  // the transformation to camera space mirrors (negative determinant).
+  const glm::mat4 full = in_world_ ? camera_ * attrs_.ctm : attrs_.ctm;
+  return glm::determinant(glm::mat3(full)) > 0.0f;
+}
+
+const glm::mat4& Parser::camera_inverse(int line) {
+  if (!camera_inv_valid_) fail(line, "the camera transformation is not known yet");
+  return camera_inv_;
+}
+
+// --- structure ------------------------------------------------------------------
+
+void Parser::req_version(ArgReader&) {}
+void Parser::req_ignore(ArgReader&) {}
+
+void Parser::req_frame_begin(ArgReader& args) {
+  if (world_done_) {
+    warn_once("frames", args.request().line,
+              "only the first frame is rendered; later frames are ignored");
+    skipping_ = true;
+    return;
+  }
+  if (!args.at_end()) args.integer(-2147483647LL - 1, 2147483647LL);
+  args.done();
+  for (const Block& b : blocks_)
+    if (b.kind == Block::Kind::Frame || b.kind == Block::Kind::World)
+      args.fail(std::string("FrameBegin inside ") + block_name(b.kind) + " at line " +
+                std::to_string(b.line));
+  push_block(Block::Kind::Frame, args.request().line);
+  frame_seen_ = true;
+}
+
+void Parser::req_frame_end(ArgReader& args) { pop_block(Block::Kind::Frame, args); }
+
+void Parser::req_world_begin(ArgReader& args) {
+  const int line = args.request().line;
+  if (world_done_) {
+    warn_once("frames", line, "only the first frame is rendered; later frames are ignored");
+    skipping_ = true;
+    return;
+  }
+  args.done();
+  if (in_world_) args.fail("nested WorldBegin");
+  if (defining_active_) args.fail("WorldBegin inside an object definition");
+  // The current transformation at WorldBegin is the world-to-camera transform.
+  camera_ = attrs_.ctm;
+  const float det = glm::determinant(camera_);
+  if (!std::isfinite(det) || std::fabs(det) < 1e-30f)
+    args.fail("the camera transformation is singular");
+  camera_inv_ = glm::inverse(camera_);
+  camera_inv_valid_ = true;
+  // RenderMan camera space is left-handed (+z forward); Micropoly's is
+  // right-handed looking down -z: mirror z.
+  const glm::mat4 mirror_z(glm::vec4(1, 0, 0, 0), glm::vec4(0, 1, 0, 0), glm::vec4(0, 0, -1, 0),
+                           glm::vec4(0, 0, 0, 1));
+  result_.scene.camera.world_to_camera = mirror_z * camera_;
+  push_block(Block::Kind::World, line);
+  attrs_.ctm = glm::mat4(1.0f);
+  in_world_ = true;
+  convert_camera_lights(line);
+}
+
+void Parser::req_world_end(ArgReader& args) {
+  pop_block(Block::Kind::World, args);
+  in_world_ = false;
+  world_done_ = true;
+  has_merge_target_ = false;
+}
+
+void Parser::req_attribute_begin(ArgReader& args) {
+  args.done();
+  push_block(Block::Kind::Attribute, args.request().line);
+}
+void Parser::req_attribute_end(ArgReader& args) { pop_block(Block::Kind::Attribute, args); }
+
+void Parser::req_transform_begin(ArgReader& args) {
+  args.done();
+  push_block(Block::Kind::Transform, args.request().line);
+}
+void Parser::req_transform_end(ArgReader& args) { pop_block(Block::Kind::Transform, args); }
+
+void Parser::req_solid_begin(ArgReader& args) {
+  args.string();
+  args.done();
+  warn_once("request:SolidBegin", args.request().line,
+            "SolidBegin: solid operations are not supported; the primitives are rendered as is");
+  push_block(Block::Kind::Solid, args.request().line);
+}
+void Parser::req_solid_end(ArgReader& args) { pop_block(Block::Kind::Solid, args); }
+
+void Parser::req_motion_begin(ArgReader& args) {
+  if (args.request().name == "MotionEnd") args.fail("without a matching MotionBegin");
+  args.number_array();
+  args.done();
+  warn_once("request:MotionBegin", args.request().line,
+            "motion blur is not supported: the first request of each motion block is used");
+  motion_depth_ = 1;
+  motion_first_done_ = false;
+}
+
+// --- options and camera -----------------------------------------------------------
+
+void Parser::req_format(ArgReader& args) {
+  RenderSettings& s = result_.scene.settings;
+  s.width = args.integer(1, Limits::kMaxResolution);
+  s.height = args.integer(1, Limits::kMaxResolution);
+  const double aspect = args.number();
+  args.done();
+  // A non-positive pixel aspect ratio asks for the default (square pixels).
+  s.pixel_aspect = aspect > 0 ? static_cast<float>(aspect) : 1.0f;
+}
+
+void Parser::req_projection(ArgReader& args) {
+  if (in_world_) args.fail("Projection inside the world block");
+  const std::string name = args.string();
+  ParamList params(args, decls_);
+  Camera& cam = result_.scene.camera;
+  if (name == "perspective") {
+    const float fov = params.get_float("fov", 90.0f);
+    if (!(fov > 0.0f && fov < 180.0f)) args.fail("fov must be in (0, 180) degrees");
+    cam.projection = Camera::Projection::Perspective;
+    cam.fov_degrees = fov;
+  } else if (name == "orthographic") {
+    cam.projection = Camera::Projection::Orthographic;
+  } else {
+    warn_once("projection:" + name, args.request().line,
+              "Projection \"" + name + "\" is not supported; using perspective");
+    cam.projection = Camera::Projection::Perspective;
+  }
+  // RiProjection defines camera space at the current transformation and
+  // resets it to the identity; a transformation before it (which would
+  // distort screen space) is not supported.
+  if (attrs_.ctm != glm::mat4(1.0f))
+    warn_once("pre-projection", args.request().line,
+              "transformations before Projection are ignored");
+  attrs_.ctm = glm::mat4(1.0f);
+}
+
+void Parser::req_screen_window(ArgReader& args) {
+  const std::vector<double> w = args.numbers(4);
+  args.done();
+  if (w[0] == w[1] || w[2] == w[3]) args.fail("empty screen window");
+  Camera& c = result_.scene.camera;
+  c.screen_left = static_cast<float>(w[0]);
+  c.screen_right = static_cast<float>(w[1]);
+  c.screen_bottom = static_cast<float>(w[2]);
+  c.screen_top = static_cast<float>(w[3]);
+}
+
+void Parser::req_crop_window(ArgReader& args) {
+  std::vector<double> w = args.numbers(4);
+  args.done();
+  for (double& v : w) v = std::min(1.0, std::max(0.0, v));  // clamped to [0,1] (RI spec)
+  if (!(w[0] < w[1]) || !(w[2] < w[3])) args.fail("empty crop window");
+  RenderSettings& s = result_.scene.settings;
+  s.crop_x0 = static_cast<float>(w[0]);
+  s.crop_x1 = static_cast<float>(w[1]);
+  s.crop_y0 = static_cast<float>(w[2]);
+  s.crop_y1 = static_cast<float>(w[3]);
+}
+
+void Parser::req_clipping(ArgReader& args) {
+  const double near_z = args.number();
+  const double far_z = args.number();
+  args.done();
+  if (!(near_z > 0.0) || !(far_z > near_z)) args.fail("needs 0 < near < far");
+  result_.scene.camera.clip_near = static_cast<float>(near_z);
+  result_.scene.camera.clip_far = static_cast<float>(far_z);
+}
+
+void Parser::req_pixel_samples(ArgReader& args) {
+  const double xs = args.number();
+  const double ys = args.number();
+  args.done();
+  auto count = [&](double v) {
+    if (v > Limits::kMaxPixelSamples)
+      args.fail("more than " + std::to_string(Limits::kMaxPixelSamples) + " samples per axis");
+    return std::max(1, static_cast<int>(std::ceil(v)));  // rounded up, at least 1
+  };
+  result_.scene.settings.samples_x = count(xs);
+  result_.scene.settings.samples_y = count(ys);
+}
+
+void Parser::req_pixel_filter(ArgReader& args) {
+  const std::string name = args.string();
+  const double xw = args.number();
+  const double yw = args.number();
+  args.done();
+  if (!(xw > 0 && xw <= 64 && yw > 0 && yw <= 64)) args.fail("filter widths must be in (0, 64]");
+  RenderSettings& s = result_.scene.settings;
+  if (name == "box") {
+    s.filter = PixelFilter::Box;
+  } else if (name == "gaussian") {
+    s.filter = PixelFilter::Gaussian;
+  } else if (name == "triangle") {
+    s.filter = PixelFilter::Triangle;
+  } else {
+    warn_once("filter:" + name, args.request().line,
+              "PixelFilter \"" + name + "\" is not supported; using gaussian");
+    s.filter = PixelFilter::Gaussian;
+  }
+  if (xw != yw)
+    warn_once("filter-aspect", args.request().line,
+              "PixelFilter: different x and y widths are averaged");
+  s.filter_width = static_cast<float>(0.5 * (xw + yw));
+}
+
+void Parser::req_shading_rate(ArgReader& args) {
+  const double rate = args.number();
+  args.done();
+  if (!(rate > 0.0 && rate <= 1e6)) args.fail("shading rate must be in (0, 1e6]");
+  result_.scene.settings.shading_rate = static_cast<float>(rate);
+}
+
+void Parser::req_display(ArgReader& args) {
+  const std::string name = args.string();
+  args.string();  // type ("file", "framebuffer", ...)
+  args.string();  // mode ("rgba", ...)
+  ParamList params(args, decls_);
+  // Additional displays ("+name") are secondary outputs: the first one counts.
+  if (result_.display_name.empty() && !name.empty() && name[0] != '+') result_.display_name = name;
+}
+
+void Parser::req_option(ArgReader& args) {
+  const std::string name = args.string();
+  ParamList params(args, decls_);
+  warn_once("option:" + name, args.request().line, "Option \"" + name + "\" is ignored");
+}
+
+void Parser::req_attribute(ArgReader& args) {
+  const std::string name = args.string();
+  ParamList params(args, decls_);
+  if (name == "identifier") {
+    attrs_.identifier = params.get_string("name", attrs_.identifier);
+    return;
+  }
+  warn_once("attribute:" + name, args.request().line, "Attribute \"" + name + "\" is ignored");
+}
+
+void Parser::req_declare(ArgReader& args) {
+  const std::string name = args.string();
+  const std::string text = args.string();
+  args.done();
+  if (name.empty() || name.find_first_of(" \t\n[]") != std::string::npos)
+    args.fail("invalid variable name \"" + name + "\"");
+  Declaration decl;
+  std::string unused;
+  if (!parse_declaration(text, false, &decl, &unused))
+    args.fail("malformed declaration \"" + text + "\"");
+  decls_.declare(name, decl);
+}
+
+void Parser::req_read_archive(ArgReader& args) {
+  const std::string name = args.string();
+  ParamList params(args, decls_);
+  const int line = args.request().line;
+  if (source_->depth + 1 > Limits::kMaxArchiveDepth)
+    args.fail("archives nested deeper than " + std::to_string(Limits::kMaxArchiveDepth) +
+              " (recursive ReadArchive?)");
+  if (++archives_read_ > Limits::kMaxArchives)
+    args.fail("more than " + std::to_string(Limits::kMaxArchives) + " archives read");
+  // Relative archive paths are relative to the including file.
+  const std::string path = resolve_path(*source_->base_dir, name);
+  std::string text, error;
+  if (!read_text_file(path, Limits::kMaxFileBytes, &text, &error))
+    fail(line, "ReadArchive: cannot read \"" + path + "\": " + error);
+  parse(text, path, directory_of(path), source_->depth + 1);
+}
+
+RibResult Parser::finish(const std::string& file) {
+  const Source top{&file, &file, 0};
+  source_ = &top;
+  if (!blocks_.empty()) {
+    const Block& b = blocks_.back();
+    throw RibError(b.file + ":" + std::to_string(b.line) + ": " + block_name(b.kind) +
+                   " is not closed before the end of the file");
+  }
+  if (motion_depth_ > 0) fail(0, "MotionBegin is not closed before the end of the file");
+  bool partial = false;
+  for (const LightRecord& rec : lights_) {
+    if (!rec.supported || !rec.on_some) continue;
+    result_.scene.lights.push_back(rec.light);
+    if (rec.off_some && !partial) {
+      partial = true;
+      result_.warnings.push_back(rec.where +
+                                 ": a light illuminates only some primitives; Micropoly's lights "
+                                 "are global, so it lights all of them");
+    }
+  }
+  if (!world_done_) result_.warnings.push_back(file + ": no WorldBegin/WorldEnd: the scene is empty");
+  source_ = nullptr;
+  return std::move(result_);
+}
+
+}  // namespace mp::rib

@@ -1,0 +1,244 @@
+// The RIB interpreter: executes requests against a graphics-state stack and
+// fills a Scene. Handlers are split by topic over several files:
+//   rib_parser.cpp    dispatch, blocks, options and camera, archives
+//   rib_transform.cpp transformations and named coordinate systems
+//   rib_shading.cpp   surfaces, colors, lights, materials
+//   rib_geometry.cpp  polygons, subdivision meshes, patches
+//   rib_objects.cpp   placing primitives in the scene, object instancing
+#pragma once
+
+#include <map>
+#include <set>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "rib/rib_basis.h"
+#include "rib/rib_params.h"
+#include "rib/rib_reader.h"
+#include "rib/rib_request.h"
+
+namespace mp::rib {
+
+// Limits that keep hostile input from exhausting memory or time.
+struct Limits {
+  static constexpr int kMaxArchiveDepth = 16;       // nested ReadArchive
+  static constexpr int kMaxArchives = 256;          // ReadArchive calls per file
+  static constexpr size_t kMaxFileBytes = size_t(1) << 30;
+  static constexpr size_t kMaxBlockDepth = 1000;    // nested Begin/End blocks
+  static constexpr int kMaxLights = 1024;
+  static constexpr size_t kMaxSceneElements = size_t(1) << 27;  // points + indices
+  static constexpr int kMaxResolution = 65536;
+  static constexpr int kMaxPixelSamples = 64;
+};
+
+// Graphics-state attributes (RI spec 3.2, section 4.2). The current
+// transformation is kept relative to the camera before WorldBegin and
+// relative to world space inside the world block, both in GLM's
+// column-vector convention (the transpose of RenderMan's row-vector matrices).
+struct Attributes {
+  glm::mat4 ctm{1.0f};
+  glm::vec3 color{1.0f};
+  glm::vec3 opacity{1.0f};
+  Material surface;           // model and shader parameters; color/opacity apply at emission
+  bool double_sided = true;   // Sides 2 is RenderMan's default
+  // True when the current orientation differs from the handedness of the
+  // current coordinate system, i.e. the primitives' normals are flipped. Both
+  // flip together under transformations, so only Orientation and
+  // ReverseOrientation change this.
+  bool inside_out = false;
+  std::vector<char> lights_on;  // by light index; lights past the end are off
+  Basis ubasis, vbasis;
+  std::string identifier;       // Attribute "identifier" "name"
+};
+
+// A primitive before it is placed: geometry in its own object space, vertex
+// order as in the file. Object definitions store these for ObjectInstance.
+struct Primitive {
+  enum class Kind { Mesh, Patches };
+  Kind kind = Kind::Mesh;
+  Mesh mesh;                             // Kind::Mesh
+  std::vector<glm::vec3> patch_points;   // Kind::Patches: Bezier nets, 16 per patch
+  glm::mat4 local{1.0f};                 // relative to the object definition's frame
+  bool mergeable = false;                // Polygon/Patch runs may share one scene object
+  std::string origin;                    // "Request (file:line)" for naming
+  size_t elements() const;
+};
+
+struct LightRecord {
+  bool supported = false;
+  Light light;               // position/direction in the frame below
+  glm::vec3 to_point{0.0f};  // the "to" point, for the direction after conversion
+  bool in_camera = false;    // declared before WorldBegin: converted at WorldBegin
+  bool on_some = false;      // illuminated at least one primitive
+  bool off_some = false;     // was off for at least one later primitive
+  std::string where;         // "file:line" of the LightSource request
+};
+
+class Parser {
+ public:
+  Parser();
+  // Executes the requests of one file (the top level or a ReadArchive).
+  void parse(std::string_view text, const std::string& file, const std::string& base_dir, int depth);
+  // Checks that every block is closed and returns the scene.
+  RibResult finish(const std::string& file);
+
+ private:
+  using Handler = void (Parser::*)(ArgReader&);
+  struct Source {
+    const std::string* file;
+    const std::string* base_dir;
+    int depth;
+  };
+  struct Block {
+    enum class Kind { Frame, World, Attribute, Transform, Object, Solid };
+    Kind kind;
+    int line;
+    std::string file;
+    Attributes saved;
+  };
+  struct CoordSys {
+    bool in_world;
+    glm::mat4 ctm;
+  };
+  struct ObjectDef {
+    std::vector<Primitive> prims;
+  };
+  struct MergeTarget {
+    Primitive::Kind kind;
+    size_t index;
+    glm::mat4 object_to_world;
+    int material;
+    bool double_sided;
+    std::string identifier;
+  };
+
+  static const std::unordered_map<std::string, Handler>& handlers();
+  void execute(const Request& req);
+  void warn(int line, const std::string& message);
+  void warn_once(const std::string& key, int line, const std::string& message);
+  [[noreturn]] void fail(int line, const std::string& reason) const;
+  std::string where(int line) const;
+  void charge(size_t elements, int line);
+  void push_block(Block::Kind kind, int line);
+  void pop_block(Block::Kind kind, ArgReader& args);
+  static const char* block_name(Block::Kind kind);
+  std::string handle_key(ArgReader& args);
+  bool current_frame_is_left_handed() const;
+  const glm::mat4& camera_inverse(int line);
+
+  // rib_parser.cpp: structure, options, camera
+  void req_version(ArgReader&);
+  void req_frame_begin(ArgReader&);
+  void req_frame_end(ArgReader&);
+  void req_world_begin(ArgReader&);
+  void req_world_end(ArgReader&);
+  void req_attribute_begin(ArgReader&);
+  void req_attribute_end(ArgReader&);
+  void req_transform_begin(ArgReader&);
+  void req_transform_end(ArgReader&);
+  void req_solid_begin(ArgReader&);
+  void req_solid_end(ArgReader&);
+  void req_motion_begin(ArgReader&);
+  void req_format(ArgReader&);
+  void req_projection(ArgReader&);
+  void req_screen_window(ArgReader&);
+  void req_crop_window(ArgReader&);
+  void req_clipping(ArgReader&);
+  void req_pixel_samples(ArgReader&);
+  void req_pixel_filter(ArgReader&);
+  void req_shading_rate(ArgReader&);
+  void req_display(ArgReader&);
+  void req_option(ArgReader&);
+  void req_attribute(ArgReader&);
+  void req_declare(ArgReader&);
+  void req_read_archive(ArgReader&);
+  void req_ignore(ArgReader&);
+
+  // rib_transform.cpp
+  void req_identity(ArgReader&);
+  void req_transform(ArgReader&);
+  void req_concat_transform(ArgReader&);
+  void req_translate(ArgReader&);
+  void req_rotate(ArgReader&);
+  void req_scale(ArgReader&);
+  void req_coordinate_system(ArgReader&);
+  void req_coord_sys_transform(ArgReader&);
+  void req_orientation(ArgReader&);
+  void req_reverse_orientation(ArgReader&);
+  void req_sides(ArgReader&);
+  glm::mat4 read_matrix(ArgReader& args);
+
+  // rib_shading.cpp
+  void req_color(ArgReader&);
+  void req_opacity(ArgReader&);
+  void req_surface(ArgReader&);
+  void req_light_source(ArgReader&);
+  void req_illuminate(ArgReader&);
+  int material_index(const Attributes& attrs);
+  void convert_camera_lights(int line);
+  void finish_light(LightRecord& rec, int line);
+
+  // rib_geometry.cpp
+  void req_polygon(ArgReader&);
+  void req_general_polygon(ArgReader&);
+  void req_points_polygons(ArgReader&);
+  void req_points_general_polygons(ArgReader&);
+  void req_subdivision_mesh(ArgReader&);
+  void req_patch(ArgReader&);
+  void req_patch_mesh(ArgReader&);
+  void req_basis(ArgReader&);
+  // Positions from "P" or "Pw"; false (with a warning) if the primitive must be skipped.
+  bool read_positions(ArgReader& args, const ParamList& params, bool patch,
+                      std::vector<glm::vec3>* out);
+  Primitive make_primitive(Primitive::Kind kind, const ArgReader& args) const;
+
+  // rib_objects.cpp
+  void req_object_begin(ArgReader&);
+  void req_object_end(ArgReader&);
+  void req_object_instance(ArgReader&);
+  // Places a primitive with the current state: into the open object
+  // definition, or into the scene (inside the world block only).
+  void place(Primitive prim, int line);
+  void add_to_scene(const Primitive& prim, const glm::mat4& xform, const Attributes& attrs, int line);
+  void account_lights(const Attributes& attrs);
+
+  // State.
+  RibResult result_;
+  DeclarationTable decls_;
+  Attributes attrs_;
+  std::vector<Block> blocks_;
+  const Source* source_ = nullptr;
+  std::set<std::string> warned_;
+
+  bool in_world_ = false;
+  bool world_done_ = false;    // the first world block has ended
+  bool skipping_ = false;      // later frames: requests are read but not executed
+  bool frame_seen_ = false;
+  int motion_depth_ = 0;       // inside MotionBegin/MotionEnd
+  bool motion_first_done_ = false;
+  glm::mat4 camera_{1.0f};     // RenderMan world-to-camera (column-vector convention)
+  glm::mat4 camera_inv_{1.0f};
+  bool camera_inv_valid_ = false;
+  int archives_read_ = 0;
+  size_t elements_ = 0;
+  size_t prims_emitted_ = 0;
+  bool shading_rate_used_ = false;
+  float shading_rate_at_use_ = 1.0f;
+
+  std::map<std::string, CoordSys> coord_systems_;
+  std::vector<LightRecord> lights_;
+  std::unordered_map<std::string, int> light_handles_;
+  std::unordered_map<std::string, ObjectDef> objects_;
+  std::string defining_;       // key of the object being defined, empty if none
+  bool defining_active_ = false;
+  ObjectDef definition_;
+  std::map<std::vector<float>, int> material_keys_;
+  bool has_merge_target_ = false;
+  MergeTarget merge_;
+};
+
+}  // namespace mp::rib

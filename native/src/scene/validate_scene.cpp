@@ -1,0 +1,122 @@
+// Scene validation: the one place bad input is caught, with a message that
+// names the object, so the pipeline never sees NaNs or out-of-range indices.
+#include <cmath>
+#include <string>
+
+#include "micropoly/error.h"
+#include "micropoly/scene.h"
+
+namespace mp {
+namespace {
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+bool finite(const glm::mat4& m) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(m[c][r])) return false;
+  return true;
+}
+
+[[noreturn]] void fail(const std::string& what, const std::string& name, const std::string& why) {
+  throw Error(what + " '" + name + "': " + why);
+}
+
+void check_material_index(int index, size_t count, const std::string& what, const std::string& name) {
+  size_t available = count == 0 ? 1 : count;
+  if (index < 0 || static_cast<size_t>(index) >= available)
+    fail(what, name, "material index " + std::to_string(index) + " out of range (" + std::to_string(available) + " materials)");
+}
+
+void validate_mesh(const Mesh& m, size_t materials) {
+  const char* what = "mesh";
+  if (!finite(m.object_to_world)) fail(what, m.name, "transform contains NaN or infinite values");
+  for (size_t i = 0; i < m.points.size(); ++i)
+    if (!finite(m.points[i]))
+      fail(what, m.name, "vertex " + std::to_string(i) + " has a NaN or infinite coordinate");
+  size_t total = 0;
+  for (size_t f = 0; f < m.face_vertex_counts.size(); ++f) {
+    int n = m.face_vertex_counts[f];
+    if (n < 3) fail(what, m.name, "face " + std::to_string(f) + " has " + std::to_string(n) + " vertices (at least 3 needed)");
+    total += static_cast<size_t>(n);
+  }
+  if (total != m.face_vertex_indices.size())
+    fail(what, m.name, "face vertex counts add up to " + std::to_string(total) + " but there are " +
+                           std::to_string(m.face_vertex_indices.size()) + " face vertex indices");
+  for (size_t i = 0; i < m.face_vertex_indices.size(); ++i) {
+    int v = m.face_vertex_indices[i];
+    if (v < 0 || static_cast<size_t>(v) >= m.points.size())
+      fail(what, m.name, "face vertex index " + std::to_string(v) + " out of range (" + std::to_string(m.points.size()) + " vertices)");
+  }
+  if (m.crease_vertices.size() != 2 * m.crease_sharpness.size())
+    fail(what, m.name, "crease data needs two vertex indices per sharpness value");
+  for (int v : m.crease_vertices)
+    if (v < 0 || static_cast<size_t>(v) >= m.points.size()) fail(what, m.name, "crease vertex index out of range");
+  if (m.corner_vertices.size() != m.corner_sharpness.size())
+    fail(what, m.name, "corner data needs one sharpness value per corner vertex");
+  for (int v : m.corner_vertices)
+    if (v < 0 || static_cast<size_t>(v) >= m.points.size()) fail(what, m.name, "corner vertex index out of range");
+  for (float s : m.crease_sharpness)
+    if (!std::isfinite(s) || s < 0) fail(what, m.name, "crease sharpness must be finite and >= 0");
+  for (float s : m.corner_sharpness)
+    if (!std::isfinite(s) || s < 0) fail(what, m.name, "corner sharpness must be finite and >= 0");
+  for (int h : m.hole_faces)
+    if (h < 0 || static_cast<size_t>(h) >= m.face_vertex_counts.size()) fail(what, m.name, "hole face index out of range");
+  check_material_index(m.material, materials, what, m.name);
+  if (!m.face_materials.empty()) {
+    if (m.face_materials.size() != m.face_vertex_counts.size())
+      fail(what, m.name, "needs one material index per face (" + std::to_string(m.face_vertex_counts.size()) + "), got " +
+                             std::to_string(m.face_materials.size()));
+    for (int idx : m.face_materials) check_material_index(idx, materials, what, m.name);
+  }
+}
+
+}  // namespace
+
+void validate_scene(const Scene& scene) {
+  const RenderSettings& s = scene.settings;
+  if (s.width < 1 || s.height < 1 || s.width > 65536 || s.height > 65536)
+    throw Error("image size " + std::to_string(s.width) + "x" + std::to_string(s.height) + " is out of range (1..65536)");
+  if (!(s.pixel_aspect > 0) || !std::isfinite(s.pixel_aspect)) throw Error("pixel aspect must be a positive number");
+  if (s.samples_x < 1 || s.samples_y < 1 || s.samples_x * s.samples_y > 1024)
+    throw Error("samples per pixel must be between 1 and 1024");
+  if (!(s.shading_rate > 0) || !std::isfinite(s.shading_rate)) throw Error("shading rate must be a positive number");
+  if (!(s.filter_width > 0) || s.filter_width > 16) throw Error("pixel filter width must be in (0, 16]");
+  if (!(s.crop_x0 < s.crop_x1) || !(s.crop_y0 < s.crop_y1) || s.crop_x0 < 0 || s.crop_y0 < 0 || s.crop_x1 > 1 || s.crop_y1 > 1)
+    throw Error("crop window must satisfy 0 <= min < max <= 1");
+  if (!(s.bound_split_memory_mib > 0) || !std::isfinite(s.bound_split_memory_mib))
+    throw Error("bound & split memory budget must be a positive number of MiB");
+
+  const Camera& c = scene.camera;
+  if (!finite(c.world_to_camera)) throw Error("camera transform contains NaN or infinite values");
+  if (std::abs(glm::determinant(glm::mat3(c.world_to_camera))) < 1e-12f) throw Error("camera transform is degenerate");
+  if (c.projection == Camera::Projection::Perspective && !(c.fov_degrees > 0 && c.fov_degrees < 180))
+    throw Error("camera field of view must be between 0 and 180 degrees");
+  if (!(c.clip_near >= 0) || !(c.clip_far > c.clip_near)) throw Error("camera clipping range must satisfy 0 <= near < far");
+  bool window_set = c.screen_right != c.screen_left || c.screen_top != c.screen_bottom;
+  if (window_set && !(c.screen_right > c.screen_left && c.screen_top > c.screen_bottom))
+    throw Error("camera screen window must have left < right and bottom < top");
+
+  for (size_t i = 0; i < scene.materials.size(); ++i) {
+    const Material& m = scene.materials[i];
+    if (!finite(m.color) || !finite(m.opacity) || !finite(m.specular_color) || !finite(m.emission) ||
+        !std::isfinite(m.ka + m.kd + m.ks + m.roughness))
+      fail("material", m.name.empty() ? std::to_string(i) : m.name, "has NaN or infinite values");
+  }
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const Light& l = scene.lights[i];
+    if (!finite(l.color) || !finite(l.position) || !finite(l.direction) || !std::isfinite(l.intensity) ||
+        !std::isfinite(l.cone_angle + l.cone_delta_angle + l.beam_distribution))
+      fail("light", std::to_string(i), "has NaN or infinite values");
+  }
+  for (const Mesh& m : scene.meshes) validate_mesh(m, scene.materials.size());
+  for (const BezierPatches& b : scene.bezier_patches) {
+    if (b.control_points.size() % 16 != 0) fail("patch set", b.name, "needs 16 control points per bicubic patch");
+    for (const glm::vec3& p : b.control_points)
+      if (!finite(p)) fail("patch set", b.name, "has a NaN or infinite control point");
+    if (!finite(b.object_to_world)) fail("patch set", b.name, "transform contains NaN or infinite values");
+    check_material_index(b.material, scene.materials.size(), "patch set", b.name);
+  }
+}
+
+}  // namespace mp

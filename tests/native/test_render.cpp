@@ -1,0 +1,189 @@
+// End-to-end renders through the OpenCL pipeline on the default device.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <numeric>
+
+#include "micropoly/error.h"
+#include "micropoly/renderer.h"
+#include "scene_fixtures.h"
+
+namespace mp::test {
+namespace {
+
+class RenderTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { renderer_ = std::make_unique<Renderer>(); }
+  static void TearDownTestSuite() { renderer_.reset(); }
+  static std::unique_ptr<Renderer> renderer_;
+};
+std::unique_ptr<Renderer> RenderTest::renderer_;
+
+double coverage(const RenderResult& r) {
+  double sum = 0;
+  for (size_t i = 0; i < static_cast<size_t>(r.width) * r.height; ++i) sum += r.rgba[4 * i + 3];
+  return sum;
+}
+
+// Raster position of a world point, as the renderer maps it (RenderMan screen
+// window: the shorter image side spans [-1, 1]).
+glm::vec2 project(const Scene& s, glm::vec3 p) {
+  glm::vec3 c = glm::vec3(s.camera.world_to_camera * glm::vec4(p, 1.0f));
+  float t = std::tan(glm::radians(s.camera.fov_degrees) * 0.5f);
+  float aspect = float(s.settings.width) / float(s.settings.height);
+  float sx = c.x / (-c.z * t), sy = c.y / (-c.z * t);
+  float l = aspect >= 1 ? -aspect : -1, r = -l, b = aspect >= 1 ? -1 : -1 / aspect, top = -b;
+  return {(sx - l) / (r - l) * s.settings.width, (top - sy) / (top - b) * s.settings.height};
+}
+
+double projected_area(const Scene& s, const std::vector<glm::vec3>& pts) {
+  double a = 0;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    glm::vec2 p = project(s, pts[i]), q = project(s, pts[(i + 1) % pts.size()]);
+    a += double(p.x) * q.y - double(q.x) * p.y;
+  }
+  return std::abs(a) * 0.5;
+}
+
+TEST_F(RenderTest, FlatPolygonCoverageMatchesProjectedArea) {
+  // A tilted quad, a triangle and a pentagon, each seen in perspective.
+  std::vector<std::vector<glm::vec3>> shapes = {
+      {{-1.2f, -0.8f, 0.3f}, {1.1f, -1.0f, -0.4f}, {0.9f, 1.1f, -0.2f}, {-1.0f, 0.7f, 0.5f}},
+      {{-1.0f, -1.0f, 0.0f}, {1.3f, -0.6f, -0.5f}, {-0.2f, 1.2f, 0.4f}},
+      {{0.0f, -1.2f, 0.0f}, {1.1f, -0.3f, 0.2f}, {0.7f, 1.0f, 0.0f}, {-0.7f, 1.0f, -0.3f}, {-1.1f, -0.3f, 0.1f}}};
+  for (const auto& pts : shapes) {
+    Scene s = base_scene(320, 240, 16);
+    s.camera = look_at({0.5f, 0.3f, 5.0f}, {0, 0, 0}, 40.0f);
+    s.meshes.push_back(polygon(pts));
+    RenderResult r = renderer_->render(s);
+    double expected = projected_area(s, pts);
+    ASSERT_GT(expected, 2000.0);
+    EXPECT_NEAR(coverage(r) / expected, 1.0, 0.005) << pts.size() << "-gon, expected " << expected << " px";
+  }
+}
+
+TEST_F(RenderTest, SameSceneRendersBitIdenticallyTwice) {
+  Scene s = base_scene(200, 150, 4);
+  s.camera = look_at({2.5f, 2.0f, 4.0f}, {0, 0, 0});
+  s.meshes.push_back(cube_mesh(SubdivScheme::CatmullClark));
+  RenderResult a = renderer_->render(s), b = renderer_->render(s);
+  ASSERT_GT(coverage(a), 1000.0);
+  EXPECT_EQ(a.rgba, b.rgba);
+  EXPECT_EQ(a.depth, b.depth);
+  EXPECT_EQ(a.normal, b.normal);
+}
+
+TEST_F(RenderTest, BoundedAndBreadthFirstProduceTheSameImage) {
+  Scene s = base_scene(256, 192, 4);
+  s.camera = look_at({0.0f, -3.0f, 2.5f}, {0, 0, 0}, 60.0f);
+  s.meshes.push_back(grid_mesh(12, 3.0f, SubdivScheme::CatmullClark));
+  s.meshes.push_back(cube_mesh(SubdivScheme::CatmullClark));
+  s.meshes.back().object_to_world = glm::scale(glm::translate(glm::mat4(1), {0.5f, 0.5f, 0.6f}), glm::vec3(0.5f));
+  s.settings.bound_split = BoundSplitMethod::Bounded;
+  s.settings.bound_split_memory_mib = 2.0f;
+  RenderResult bounded = renderer_->render(s);
+  s.settings.bound_split = BoundSplitMethod::Breadth;
+  RenderResult breadth = renderer_->render(s);
+  EXPECT_EQ(bounded.stats.subpatches_diced, breadth.stats.subpatches_diced);
+  EXPECT_EQ(bounded.stats.micropolygons, breadth.stats.micropolygons);
+  EXPECT_GT(bounded.stats.micropolygons, 10000u);
+  EXPECT_EQ(bounded.rgba, breadth.rgba);
+  EXPECT_EQ(bounded.depth, breadth.depth);
+}
+
+TEST_F(RenderTest, BoundedStaysWithinBudgetWhereBreadthFirstExceedsIt) {
+  // A large, finely split plane: the breadth-first queue gets wide.
+  Scene s = base_scene(640, 480, 1);
+  s.camera = look_at({0.0f, -6.0f, 1.2f}, {0, 2, 0}, 70.0f);
+  s.meshes.push_back(grid_mesh(100, 20.0f, SubdivScheme::None));
+  const float budget_mib = 0.5f;
+  s.settings.bound_split = BoundSplitMethod::Bounded;
+  s.settings.bound_split_memory_mib = budget_mib;
+  s.settings.shading_rate = 0.25f;
+  RenderResult bounded = renderer_->render(s);
+  s.settings.bound_split = BoundSplitMethod::Breadth;
+  RenderResult breadth = renderer_->render(s);
+  const size_t budget = static_cast<size_t>(budget_mib * 1048576);
+  EXPECT_LE(bounded.stats.bound_split_peak_bytes, budget);
+  EXPECT_GT(breadth.stats.bound_split_peak_bytes, budget);
+  EXPECT_EQ(bounded.stats.subpatches_diced, breadth.stats.subpatches_diced);
+  EXPECT_EQ(bounded.rgba, breadth.rgba);
+}
+
+TEST_F(RenderTest, PlaneThroughTheEyePlaneRendersInBoundedTimeAndMemory) {
+  // A ground plane running under and behind the camera: its patches straddle
+  // the eye plane and must be eye-split, then culled at the depth limit. A
+  // second plane passes through the eye itself.
+  Scene s = base_scene(320, 240, 4);
+  s.camera = look_at({0.0f, 0.0f, 0.5f}, {0.0f, 5.0f, 0.0f}, 60.0f);
+  s.meshes.push_back(grid_mesh(2, 50.0f, SubdivScheme::None));
+  Mesh through_eye = grid_mesh(1, 30.0f, SubdivScheme::None);
+  through_eye.object_to_world =
+      glm::translate(glm::mat4(1), {0.0f, 0.0f, 0.5f}) * glm::rotate(glm::mat4(1), glm::radians(90.0f), glm::vec3(0, 1, 0));
+  s.meshes.push_back(through_eye);
+  s.settings.bound_split_memory_mib = 4.0f;
+  auto t0 = std::chrono::steady_clock::now();
+  RenderResult r = renderer_->render(s);
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_LT(seconds, 60.0);
+  EXPECT_LE(r.stats.bound_split_peak_bytes, size_t(4) << 20);
+  // The ground fills the lower part of the frame up to the horizon.
+  EXPECT_GT(coverage(r), 0.4 * 320 * 240);
+  size_t bottom_centre = (239 * 320 + 160) * 4;
+  EXPECT_NEAR(r.rgba[bottom_centre + 3], 1.0f, 1e-6f);
+  for (float v : r.rgba) ASSERT_TRUE(std::isfinite(v));
+  s.settings.bound_split = BoundSplitMethod::Breadth;
+  RenderResult b = renderer_->render(s);
+  EXPECT_EQ(r.rgba, b.rgba);
+}
+
+TEST_F(RenderTest, SingleSidedBackFacesAreCulled) {
+  Scene s = base_scene(64, 64, 1);
+  s.camera = look_at({0, 0, 4}, {0, 0, 0});
+  Mesh front = polygon({{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}});
+  front.double_sided = false;
+  s.meshes.push_back(front);
+  EXPECT_GT(coverage(renderer_->render(s)), 500.0);
+  std::reverse(s.meshes[0].face_vertex_indices.begin(), s.meshes[0].face_vertex_indices.end());
+  EXPECT_EQ(coverage(renderer_->render(s)), 0.0);
+  s.meshes[0].double_sided = true;
+  EXPECT_GT(coverage(renderer_->render(s)), 500.0);
+}
+
+TEST_F(RenderTest, DepthAndNormalPassesDescribeAPlaneFacingTheCamera) {
+  Scene s = base_scene(64, 64, 4);
+  s.camera = look_at({0, 0, 5}, {0, 0, 0});
+  s.meshes.push_back(polygon({{-3, -3, 0}, {3, -3, 0}, {3, 3, 0}, {-3, 3, 0}}));
+  RenderResult r = renderer_->render(s);
+  size_t centre = 32 * 64 + 32;
+  EXPECT_NEAR(r.depth[centre], 5.0f, 1e-3f);
+  EXPECT_NEAR(r.normal[3 * centre + 2], 1.0f, 1e-3f);  // world +Z, towards the camera
+  EXPECT_NEAR(r.rgba[4 * centre + 3], 1.0f, 1e-6f);
+}
+
+TEST_F(RenderTest, EmptySceneGivesATransparentImage) {
+  Scene s = base_scene(32, 32, 1);
+  RenderResult r = renderer_->render(s);
+  EXPECT_EQ(coverage(r), 0.0);
+  EXPECT_EQ(r.stats.patches, 0u);
+}
+
+TEST_F(RenderTest, InvalidSceneIsRejectedWithTheObjectName) {
+  Scene s = base_scene(32, 32, 1);
+  Mesh m = polygon({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
+  m.name = "broken";
+  m.points[1].x = std::nanf("");
+  s.meshes.push_back(m);
+  try {
+    renderer_->render(s);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("broken"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace mp::test
