@@ -23,6 +23,7 @@ typedef glm::vec4 float4;
 typedef glm::vec2 float2;
 typedef std::uint32_t uint;
 typedef std::uint64_t ulong;
+typedef std::uint16_t ushort;
 #define MP_INLINE inline
 #define MP_GLOBAL
 #define MP_CONSTANT

@@ -22,15 +22,26 @@ typedef struct {
 
 MP_INLINE long mp_to_fixed(float r) { return (long)floor(r * (float)MP_SUBPIXEL_ONE + 0.5f); }
 
-/* Position of sample s of pixel (px, py), in fixed point: one jittered sample
- * per stratum of a spp_x x spp_y grid. */
-MP_INLINE MpFixed2 mp_sample_position(int px, int py, int s, FrameParams f) {
+/* Sample positions repeat over tiles of MP_SAMPLE_TILE x MP_SAMPLE_TILE
+ * pixels: one jittered sample per stratum of a spp_x x spp_y grid, offsets in
+ * 1/256 pixel packed as x | y << 8. The table is built on the host from this
+ * function and read by the sampler and the resolve pass, which must agree. */
+#define MP_SAMPLE_TILE 32
+
+MP_INLINE uint mp_sample_offset_packed(int tx, int ty, int s, FrameParams f) {
   int sx = s % f.spp_x, sy = s / f.spp_x;
-  uint h = mp_hash_combine(mp_hash_combine(mp_hash32((uint)px ^ f.seed), (uint)py), (uint)s);
+  uint h = mp_hash_combine(mp_hash_combine(mp_hash32((uint)tx ^ f.seed), (uint)ty), (uint)s);
   float jx = mp_hash_unit(h), jy = mp_hash_unit(mp_hash32(h));
+  uint ox = (uint)(((float)sx + jx) / (float)f.spp_x * (float)MP_SUBPIXEL_ONE);
+  uint oy = (uint)(((float)sy + jy) / (float)f.spp_y * (float)MP_SUBPIXEL_ONE);
+  return (ox < 255u ? ox : 255u) | ((oy < 255u ? oy : 255u) << 8);
+}
+
+MP_INLINE MpFixed2 mp_sample_position(int px, int py, int s, int spp, const MP_GLOBAL ushort* offsets) {
+  uint o = offsets[((py & (MP_SAMPLE_TILE - 1)) * MP_SAMPLE_TILE + (px & (MP_SAMPLE_TILE - 1))) * spp + s];
   MpFixed2 p;
-  p.x = (long)px * MP_SUBPIXEL_ONE + (long)(((float)sx + jx) / (float)f.spp_x * (float)MP_SUBPIXEL_ONE);
-  p.y = (long)py * MP_SUBPIXEL_ONE + (long)(((float)sy + jy) / (float)f.spp_y * (float)MP_SUBPIXEL_ONE);
+  p.x = (long)px * MP_SUBPIXEL_ONE + (long)(o & 0xffu);
+  p.y = (long)py * MP_SUBPIXEL_ONE + (long)(o >> 8);
   return p;
 }
 

@@ -15,7 +15,8 @@ __kernel void clear_samples(__global ulong* keys, ulong n) {
   if (i < n) keys[i] = (ulong)0xffffffffffffffffUL;
 }
 
-__kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width, __global const ulong* keys,
+__kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width, __global const ushort* offsets,
+                             __global const ulong* keys,
                              __global const float* colors, __global const uint* normals,
                              float4 cam_to_world_x, float4 cam_to_world_y, float4 cam_to_world_z,
                              __global float4* rgba, __global float* depth, __global float4* normal_out) {
@@ -29,7 +30,7 @@ __kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width,
   for (int qy = max(py - reach, 0); qy <= min(py + reach, f.height - 1); ++qy)
     for (int qx = max(px - reach, 0); qx <= min(px + reach, f.width - 1); ++qx)
       for (int s = 0; s < spp; ++s) {
-        MpFixed2 q = mp_sample_position(qx, qy, s, f);
+        MpFixed2 q = mp_sample_position(qx, qy, s, spp, offsets);
         float dx = (float)q.x / (float)MP_SUBPIXEL_ONE - cx, dy = (float)q.y / (float)MP_SUBPIXEL_ONE - cy;
         float w = mp_filter_weight(filter_type, dx, dy, filter_width);
         if (w <= 0.0f) continue;

@@ -39,43 +39,77 @@ inline MpRasterVertex mp_raster_vertex(float4 p, float4 c, float4 n, FrameParams
   return v;
 }
 
-inline void mp_raster_triangle(MpRasterVertex a, MpRasterVertex b, MpRasterVertex c, uint mp_id, float opacity,
-                               FrameParams f, uint pass, volatile __global ulong* keys,
-                               __global float* colors, __global uint* normals) {
+/* A triangle set up for coverage tests: vertices ordered so that inside
+ * means all three edge functions >= 0 (with the tie rule on ties). */
+typedef struct {
+  MpRasterVertex a, b, c;
+  int own0, own1, own2;
+  float inv_area;
+  int valid;
+} MpTriangle;
+
+inline MpTriangle mp_setup_triangle(MpRasterVertex a, MpRasterVertex b, MpRasterVertex c) {
+  MpTriangle t;
   long area = mp_edge(a.p, b.p, c.p);
-  if (area == 0) return;
+  t.valid = area != 0;
   if (area > 0) { /* make the orientation uniform; culling happened before */
-    MpRasterVertex t = b; b = c; c = t;
+    MpRasterVertex tmp = b; b = c; c = tmp;
     area = -area;
   }
-  int own0 = mp_edge_owns(b.p, c.p), own1 = mp_edge_owns(c.p, a.p), own2 = mp_edge_owns(a.p, b.p);
-  long xmin = min(a.p.x, min(b.p.x, c.p.x)), xmax = max(a.p.x, max(b.p.x, c.p.x));
-  long ymin = min(a.p.y, min(b.p.y, c.p.y)), ymax = max(a.p.y, max(b.p.y, c.p.y));
+  t.a = a; t.b = b; t.c = c;
+  t.own0 = mp_edge_owns(b.p, c.p);
+  t.own1 = mp_edge_owns(c.p, a.p);
+  t.own2 = mp_edge_owns(a.p, b.p);
+  t.inv_area = t.valid ? 1.0f / (float)(-area) : 0.0f;
+  return t;
+}
+
+/* Barycentrics of q if the triangle covers it. */
+inline int mp_triangle_covers(const MpTriangle* t, MpFixed2 q, float* la, float* lb, float* lc) {
+  if (!t->valid) return 0;
+  long e0 = -mp_edge(t->b.p, t->c.p, q), e1 = -mp_edge(t->c.p, t->a.p, q), e2 = -mp_edge(t->a.p, t->b.p, q);
+  if (!(mp_edge_inside(e0, t->own0) && mp_edge_inside(e1, t->own1) && mp_edge_inside(e2, t->own2))) return 0;
+  *la = (float)e0 * t->inv_area;
+  *lb = (float)e1 * t->inv_area;
+  *lc = (float)e2 * t->inv_area;
+  return 1;
+}
+
+inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVertex v11, MpRasterVertex v01, uint mp_id,
+                           float opacity, FrameParams f, __global const ushort* offsets, uint pass,
+                           volatile __global ulong* keys, __global float* colors, __global uint* normals) {
+  MpTriangle tris[2];
+  tris[0] = mp_setup_triangle(v00, v10, v11);
+  tris[1] = mp_setup_triangle(v00, v11, v01);
+  long xmin = min(min(v00.p.x, v10.p.x), min(v11.p.x, v01.p.x)), xmax = max(max(v00.p.x, v10.p.x), max(v11.p.x, v01.p.x));
+  long ymin = min(min(v00.p.y, v10.p.y), min(v11.p.y, v01.p.y)), ymax = max(max(v00.p.y, v10.p.y), max(v11.p.y, v01.p.y));
   int px0 = (int)max(xmin >> MP_SUBPIXEL_BITS, (long)0), px1 = (int)min(xmax >> MP_SUBPIXEL_BITS, (long)f.width - 1);
   int py0 = (int)max(ymin >> MP_SUBPIXEL_BITS, (long)0), py1 = (int)min(ymax >> MP_SUBPIXEL_BITS, (long)f.height - 1);
   int spp = f.spp_x * f.spp_y;
-  float inv_area = 1.0f / (float)(-area);
   for (int py = py0; py <= py1; ++py)
     for (int px = px0; px <= px1; ++px)
       for (int s = 0; s < spp; ++s) {
-        MpFixed2 q = mp_sample_position(px, py, s, f);
+        MpFixed2 q = mp_sample_position(px, py, s, spp, offsets);
         if (q.x < xmin || q.x > xmax || q.y < ymin || q.y > ymax) continue;
-        /* With the negative orientation, inside means all edges <= 0. */
-        long e0 = -mp_edge(b.p, c.p, q), e1 = -mp_edge(c.p, a.p, q), e2 = -mp_edge(a.p, b.p, q);
-        if (!(mp_edge_inside(e0, own0) && mp_edge_inside(e1, own1) && mp_edge_inside(e2, own2))) continue;
-        float la = (float)e0 * inv_area, lb = (float)e1 * inv_area, lc = (float)e2 * inv_area;
-        float inv_d = la * a.inv_d + lb * b.inv_d + lc * c.inv_d;
+        float la, lb, lc;
+        int k = 0;
+        if (!mp_triangle_covers(&tris[0], q, &la, &lb, &lc)) {
+          k = 1;
+          if (!mp_triangle_covers(&tris[1], q, &la, &lb, &lc)) continue;
+        }
+        const MpTriangle* t = &tris[k];
+        float inv_d = la * t->a.inv_d + lb * t->b.inv_d + lc * t->c.inv_d;
         float d = f.ortho ? inv_d : 1.0f / inv_d;
         if (!(d >= f.clip_near && d <= f.clip_far)) continue;
         ulong index = ((ulong)py * (ulong)f.width + (ulong)px) * (ulong)spp + (ulong)s;
         if (opacity < 1.0f && mp_hash_unit(mp_hash_combine(mp_id, (uint)index)) >= opacity) continue;
         ulong key = ((ulong)as_uint(d) << 32) | (ulong)mp_id;
         if (pass == MP_PASS_DEPTH) {
-          atom_min(&keys[index], key);
+          if (key < keys[index]) atom_min(&keys[index], key);
         } else if (keys[index] == key) {
           float w = f.ortho ? 1.0f : d;
-          float3 col = (la * a.c_over_d + lb * b.c_over_d + lc * c.c_over_d) * w;
-          float3 nrm = (la * a.n_over_d + lb * b.n_over_d + lc * c.n_over_d) * w;
+          float3 col = (la * t->a.c_over_d + lb * t->b.c_over_d + lc * t->c.c_over_d) * w;
+          float3 nrm = (la * t->a.n_over_d + lb * t->b.n_over_d + lc * t->c.n_over_d) * w;
           vstore3(col, index, colors);
           normals[index] = mp_encode_normal(normalize(nrm));
         }
@@ -84,7 +118,8 @@ inline void mp_raster_triangle(MpRasterVertex a, MpRasterVertex b, MpRasterVerte
 
 __kernel void sample_micropolygons(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
                                    FrameParams f, __global const float4* grid_p, __global const float4* grid_c,
-                                   __global const float4* grid_n, uint pass, volatile __global ulong* keys,
+                                   __global const float4* grid_n, __global const ushort* offsets, uint pass,
+                                   volatile __global ulong* keys,
                                    __global float* colors, __global uint* normals) {
   uint mg = (uint)f.max_grid;
   uint gid = get_global_id(0);
@@ -114,6 +149,5 @@ __kernel void sample_micropolygons(__global const SubPatch* diceable, uint count
   grid_id = mp_hash_combine(mp_hash_combine(grid_id, as_uint(sp.u1)), as_uint(sp.v1));
   uint mp_id = mp_hash_combine(grid_id, local_index);
   float opacity = grid_c[i00].w;
-  mp_raster_triangle(v00, v10, v11, mp_id, opacity, f, pass, keys, colors, normals);
-  mp_raster_triangle(v00, v11, v01, mp_id, opacity, f, pass, keys, colors, normals);
+  mp_raster_quad(v00, v10, v11, v01, mp_id, opacity, f, offsets, pass, keys, colors, normals);
 }

@@ -13,6 +13,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <opensubdiv/far/patchTable.h>
 
+#include "micropoly/error.h"
 #include "mp_compat.h"
 #include "mp_patch.h"
 #include "mp_patch_eval.h"

@@ -10,6 +10,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "micropoly/error.h"
 #include "mp_compat.h"
 #include "mp_patch.h"
 #include "mp_patch_eval.h"

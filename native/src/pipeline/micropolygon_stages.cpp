@@ -80,6 +80,16 @@ SampleStage::SampleStage(DeviceSession& session, const FrameParams& f, StageTime
   keys_ = device_buffer(session, samples * sizeof(cl_ulong), "sample depth buffer");
   colors_ = device_buffer(session, samples * 3 * sizeof(cl_float), "sample color buffer");
   normals_ = device_buffer(session, samples * sizeof(cl_uint), "sample normal buffer");
+  // Sample positions of one tile (kernels/mp_raster.h), computed here once.
+  const int spp = f.spp_x * f.spp_y;
+  std::vector<cl_ushort> offsets(static_cast<size_t>(MP_SAMPLE_TILE) * MP_SAMPLE_TILE * spp);
+  for (int ty = 0; ty < MP_SAMPLE_TILE; ++ty)
+    for (int tx = 0; tx < MP_SAMPLE_TILE; ++tx)
+      for (int s = 0; s < spp; ++s)
+        offsets[(static_cast<size_t>(ty) * MP_SAMPLE_TILE + tx) * spp + s] =
+            static_cast<cl_ushort>(mp_sample_offset_packed(tx, ty, s, f));
+  offsets_ = cl::Buffer(session.context(), CL_MEM_READ_ONLY, offsets.size() * sizeof(cl_ushort));
+  session.queue().enqueueWriteBuffer(offsets_, CL_TRUE, 0, offsets.size() * sizeof(cl_ushort), offsets.data());
   cl::Kernel clear(session.program(), "clear_samples");
   clear.setArg(0, keys_);
   clear.setArg(1, static_cast<cl_ulong>(samples));
@@ -97,12 +107,13 @@ void SampleStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuff
   kernel_.setArg(4, grids.p);
   kernel_.setArg(5, grids.c);
   kernel_.setArg(6, grids.n);
-  kernel_.setArg(8, keys_);
-  kernel_.setArg(9, colors_);
-  kernel_.setArg(10, normals_);
+  kernel_.setArg(7, offsets_);
+  kernel_.setArg(9, keys_);
+  kernel_.setArg(10, colors_);
+  kernel_.setArg(11, normals_);
   // Pass 0 finds each sample's nearest key; pass 1 lets its owner write.
   for (cl_uint pass = 0; pass < 2; ++pass) {
-    kernel_.setArg(7, pass);
+    kernel_.setArg(8, pass);
     cl::Event e;
     session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(count * grids.micropolygons_per_slot),
                                           cl::NDRange(64), nullptr, &e);
@@ -127,15 +138,16 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
   kernel_.setArg(0, f);
   kernel_.setArg(1, type);
   kernel_.setArg(2, std::max(filter_width, 1e-3f));
-  kernel_.setArg(3, samples.keys());
-  kernel_.setArg(4, samples.colors());
-  kernel_.setArg(5, samples.normals());
-  kernel_.setArg(6, row(0));
-  kernel_.setArg(7, row(1));
-  kernel_.setArg(8, row(2));
-  kernel_.setArg(9, rgba);
-  kernel_.setArg(10, depth);
-  kernel_.setArg(11, normal);
+  kernel_.setArg(3, samples.offsets());
+  kernel_.setArg(4, samples.keys());
+  kernel_.setArg(5, samples.colors());
+  kernel_.setArg(6, samples.normals());
+  kernel_.setArg(7, row(0));
+  kernel_.setArg(8, row(1));
+  kernel_.setArg(9, row(2));
+  kernel_.setArg(10, rgba);
+  kernel_.setArg(11, depth);
+  kernel_.setArg(12, normal);
   size_t gx = ((static_cast<size_t>(f.width) + 7) / 8) * 8, gy = ((static_cast<size_t>(f.height) + 7) / 8) * 8;
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(gx, gy), cl::NDRange(8, 8), nullptr, &e);

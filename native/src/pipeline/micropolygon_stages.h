@@ -52,11 +52,12 @@ class SampleStage {
   const cl::Buffer& keys() const { return keys_; }
   const cl::Buffer& colors() const { return colors_; }
   const cl::Buffer& normals() const { return normals_; }
+  const cl::Buffer& offsets() const { return offsets_; }
 
  private:
   DeviceSession& session_;
   cl::Kernel kernel_;
-  cl::Buffer keys_, colors_, normals_;
+  cl::Buffer keys_, colors_, normals_, offsets_;
 };
 
 class ResolveStage {

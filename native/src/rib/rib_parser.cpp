@@ -1,9 +1,8 @@
 // Request dispatch, block structure, options and camera requests.
 #include "rib/rib_parser.h"
 
+#include <algorithm>
 #include <cmath>
-
-#include <glm/gtc/matrix_inverse.hpp>
 
 #include "rib/rib_file.h"
 

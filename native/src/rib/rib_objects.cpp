@@ -1,0 +1,183 @@
+// Placing primitives into the Scene, and retained objects (ObjectBegin/End,
+// ObjectInstance; RI spec 3.2, section 5.8).
+//
+// Orientation: a Scene mesh's front side is the one from which its faces
+// appear counter-clockwise under the right-hand rule in its own object
+// coordinates; the renderer keeps that side in front under mirroring
+// transformations. RenderMan's front side is, in the same object
+// coordinates, the side its normal dPdu x dPdv (for polygons: the plane
+// normal towards a viewer who sees the vertices clockwise in left-handed
+// terms, i.e. the same cross product) points to, flipped when the current
+// orientation differs from the coordinate system's handedness. Both
+// conventions compute the same cross product of the same numbers, so faces
+// keep their order unless the RenderMan normal is flipped ("inside_out"),
+// in which case face loops are reversed (and patches mirrored in u).
+#include <algorithm>
+
+#include "rib/rib_parser.h"
+
+namespace mp::rib {
+namespace {
+
+void reverse_faces(Mesh& mesh, size_t first_face, size_t first_index) {
+  size_t offset = first_index;
+  for (size_t f = first_face; f < mesh.face_vertex_counts.size(); ++f) {
+    const size_t n = static_cast<size_t>(mesh.face_vertex_counts[f]);
+    std::reverse(mesh.face_vertex_indices.begin() + static_cast<long>(offset),
+                 mesh.face_vertex_indices.begin() + static_cast<long>(offset + n));
+    offset += n;
+  }
+}
+
+// Mirrors each 4x4 net in u, which negates dPdu and so the normal.
+void mirror_patches_u(std::vector<glm::vec3>& cps, size_t first) {
+  for (size_t p = first; p + 16 <= cps.size(); p += 16)
+    for (size_t j = 0; j < 4; ++j) {
+      std::swap(cps[p + 4 * j + 0], cps[p + 4 * j + 3]);
+      std::swap(cps[p + 4 * j + 1], cps[p + 4 * j + 2]);
+    }
+}
+
+}  // namespace
+
+void Parser::place(Primitive prim, int line) {
+  if (defining_active_) {
+    // Stored relative to the object definition's own coordinate system.
+    prim.local = attrs_.ctm * prim.local;
+    charge(prim.elements(), line);
+    definition_.prims.push_back(std::move(prim));
+    return;
+  }
+  if (!in_world_) fail(line, prim.origin.substr(0, prim.origin.find(' ')) +
+                                 ": geometry outside WorldBegin/WorldEnd");
+  add_to_scene(prim, attrs_.ctm, attrs_, line);
+}
+
+void Parser::account_lights(const Attributes& attrs) {
+  for (size_t i = 0; i < lights_.size(); ++i) {
+    if (i < attrs.lights_on.size() && attrs.lights_on[i])
+      lights_[i].on_some = true;
+    else
+      lights_[i].off_some = true;
+  }
+}
+
+void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const Attributes& attrs,
+                          int line) {
+  charge(prim.elements(), line);
+  const glm::mat4 object_to_world = xform * prim.local;
+  const int material = material_index(attrs);
+  account_lights(attrs);
+  ++prims_emitted_;
+  // ShadingRate is an attribute in RenderMan but one global setting here.
+  const float rate = result_.scene.settings.shading_rate;
+  if (!shading_rate_used_) {
+    shading_rate_used_ = true;
+    shading_rate_at_use_ = rate;
+  } else if (rate != shading_rate_at_use_) {
+    warn_once("shading-rate", line,
+              "ShadingRate differs between primitives; one rate (the last one set) is used");
+  }
+  const bool flip = attrs.inside_out;
+  const std::string name = attrs.identifier.empty() ? prim.origin : attrs.identifier;
+  Scene& scene = result_.scene;
+
+  // Runs of Polygon or Patch requests with the same state share one object.
+  const bool merge = prim.mergeable && has_merge_target_ && merge_.kind == prim.kind &&
+                     merge_.object_to_world == object_to_world && merge_.material == material &&
+                     merge_.double_sided == attrs.double_sided &&
+                     merge_.identifier == attrs.identifier;
+  if (prim.kind == Primitive::Kind::Mesh) {
+    if (merge) {
+      Mesh& dst = scene.meshes[merge_.index];
+      const int base = static_cast<int>(dst.points.size());
+      const size_t first_face = dst.face_vertex_counts.size();
+      const size_t first_index = dst.face_vertex_indices.size();
+      dst.points.insert(dst.points.end(), prim.mesh.points.begin(), prim.mesh.points.end());
+      dst.face_vertex_counts.insert(dst.face_vertex_counts.end(),
+                                    prim.mesh.face_vertex_counts.begin(),
+                                    prim.mesh.face_vertex_counts.end());
+      for (int i : prim.mesh.face_vertex_indices) dst.face_vertex_indices.push_back(base + i);
+      if (flip) reverse_faces(dst, first_face, first_index);
+      return;
+    }
+    Mesh mesh = prim.mesh;
+    mesh.name = name;
+    mesh.object_to_world = object_to_world;
+    mesh.material = material;
+    mesh.double_sided = attrs.double_sided;
+    if (flip) reverse_faces(mesh, 0, 0);
+    scene.meshes.push_back(std::move(mesh));
+  } else {
+    if (merge) {
+      BezierPatches& dst = scene.bezier_patches[merge_.index];
+      const size_t first = dst.control_points.size();
+      dst.control_points.insert(dst.control_points.end(), prim.patch_points.begin(),
+                                prim.patch_points.end());
+      if (flip) mirror_patches_u(dst.control_points, first);
+      return;
+    }
+    BezierPatches set;
+    set.name = name;
+    set.control_points = prim.patch_points;
+    set.object_to_world = object_to_world;
+    set.material = material;
+    set.double_sided = attrs.double_sided;
+    if (flip) mirror_patches_u(set.control_points, 0);
+    scene.bezier_patches.push_back(std::move(set));
+  }
+  has_merge_target_ = prim.mergeable;
+  if (prim.mergeable) {
+    merge_.kind = prim.kind;
+    merge_.index = prim.kind == Primitive::Kind::Mesh ? scene.meshes.size() - 1
+                                                      : scene.bezier_patches.size() - 1;
+    merge_.object_to_world = object_to_world;
+    merge_.material = material;
+    merge_.double_sided = attrs.double_sided;
+    merge_.identifier = attrs.identifier;
+  }
+}
+
+void Parser::req_object_begin(ArgReader& args) {
+  const std::string key = handle_key(args);
+  args.done();
+  if (defining_active_) args.fail("nested ObjectBegin");
+  push_block(Block::Kind::Object, args.request().line);
+  defining_active_ = true;
+  defining_ = key;
+  definition_ = ObjectDef{};
+  // The object is defined in its own coordinate system; ObjectInstance
+  // places it with the transformation current at the instance.
+  attrs_.ctm = glm::mat4(1.0f);
+}
+
+void Parser::req_object_end(ArgReader& args) {
+  pop_block(Block::Kind::Object, args);
+  objects_[defining_] = std::move(definition_);
+  definition_ = ObjectDef{};
+  defining_active_ = false;
+}
+
+void Parser::req_object_instance(ArgReader& args) {
+  const std::string key = handle_key(args);
+  args.done();
+  const int line = args.request().line;
+  auto it = objects_.find(key);
+  if (it == objects_.end()) args.fail("unknown object handle " + key);
+  const std::vector<Primitive>& prims = it->second.prims;
+  if (defining_active_) {
+    // An instance inside a definition: copy, composing the transformations.
+    for (const Primitive& p : prims) {
+      Primitive copy = p;
+      copy.local = attrs_.ctm * p.local;
+      charge(copy.elements(), line);
+      definition_.prims.push_back(std::move(copy));
+    }
+    return;
+  }
+  if (!in_world_) args.fail("ObjectInstance outside WorldBegin/WorldEnd");
+  // Instances take the attributes (material, sides, orientation) current here.
+  for (const Primitive& p : prims) add_to_scene(p, attrs_.ctm, attrs_, line);
+}
+
+}  // namespace mp::rib

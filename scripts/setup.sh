@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Installs what Micropoly needs on Debian 12, builds it, and then
+#   demo: renders the demo scene to demo.png
+#   test: runs every test (ctest: GoogleTest, pytest, Blender tests)
+#   build: stops after building (and installing into build/install)
+# Usage: scripts/setup.sh [demo|test|build]   (as root, or through sudo)
+set -euo pipefail
+mode=${1:-build}
+here=$(cd "$(dirname "$0")/.." && pwd)
+cd "$here"
+
+packages=(
+  build-essential cmake pkg-config git
+  ocl-icd-opencl-dev opencl-headers pocl-opencl-icd clinfo
+  libglm-dev pybind11-dev libosd-dev libgtest-dev libgmock-dev
+  libpng-dev libopenexr-dev
+  python3 python3-dev python3-numpy python3-pytest
+  blender
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  echo "== installing: ${missing[*]}"
+  $sudo apt-get update -q
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+jobs=$(nproc)
+echo "== building"
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
+cmake --build build -j "$jobs"
+cmake --install build --prefix build/install >/dev/null
+
+case "$mode" in
+  build) ;;
+  demo)
+    echo "== rendering the demo scene"
+    build/install/bin/micropoly-render tests/scenes/teapot.rib -o demo.png --spp 16 --stats demo-stats.json
+    echo "wrote $here/demo.png"
+    ;;
+  test)
+    echo "== running tests"
+    cd build
+    ctest --output-on-failure -j 1
+    ;;
+  *) echo "unknown mode '$mode' (demo, test or build)" >&2; exit 2 ;;
+esac
