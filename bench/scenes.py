@@ -103,13 +103,11 @@ def depth_stack(w=1920, h=1080, spp=4, rate=1.0, layers=16):
 def write_all(folder, teapot_source):
     """Writes every scene into `folder`; returns {name: path}."""
     os.makedirs(folder, exist_ok=True)
+    # The teapot's 32 patches, taken from the test scene.
     with open(teapot_source) as f:
-        text = f.read()
-    # Keep only the teapot's geometry block from the test scene.
-    start = text.index("##TEAPOT-BEGIN")
-    end = text.index("##TEAPOT-END")
+        patches = [line.strip() for line in f if line.strip().startswith("Patch ")]
     with open(os.path.join(folder, "teapot_patches.rib"), "w") as f:
-        f.write(text[start:end])
+        f.write("\n".join(patches) + "\n")
     scenes = {
         "dense_subdiv": dense_subdiv(),
         "teapot": teapot(),

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -120,10 +121,6 @@ void add_crease(mp::Mesh& m, int a, int b, float s) {
 
 struct Coverage {
   int regular = 0, regular_with_boundary = 0, gregory = 0, non_quad_root = 0;
-};
-
-struct Vec3d {
-  double v[3] = {0, 0, 0};
 };
 
 const std::vector<double> kSamples = {0.0, 0.13, 0.25, 0.5, 0.71, 0.9, 1.0};

@@ -100,7 +100,7 @@ void Parser::req_polygon(ArgReader& args) {
   for (size_t i = 0; i < n; ++i) indices[i] = static_cast<int>(i);
   fill_polygons(prim.mesh, {static_cast<int>(n)}, std::move(indices));
   prim.mergeable = true;
-  place(std::move(prim), args.request().line);
+  place(std::move(prim), args);
 }
 
 void Parser::req_general_polygon(ArgReader& args) {
@@ -124,7 +124,7 @@ void Parser::req_general_polygon(ArgReader& args) {
   for (int i = 0; i < n; ++i) indices[static_cast<size_t>(i)] = i;
   fill_polygons(prim.mesh, {n}, std::move(indices));
   prim.mergeable = true;
-  place(std::move(prim), args.request().line);
+  place(std::move(prim), args);
 }
 
 void Parser::req_points_polygons(ArgReader& args) {
@@ -141,7 +141,7 @@ void Parser::req_points_polygons(ArgReader& args) {
   if (!read_positions(args, params, false, &prim.mesh.points)) return;
   check_indices(args, verts_arg, indices, prim.mesh.points.size());
   fill_polygons(prim.mesh, std::move(counts), std::move(indices));
-  place(std::move(prim), args.request().line);
+  place(std::move(prim), args);
 }
 
 void Parser::req_points_general_polygons(ArgReader& args) {
@@ -178,7 +178,7 @@ void Parser::req_points_general_polygons(ArgReader& args) {
     warn_once("holes", args.request().line,
               "holes in general polygons are not supported; only the outer loop is rendered");
   fill_polygons(prim.mesh, std::move(outer_counts), std::move(outer_indices));
-  place(std::move(prim), args.request().line);
+  place(std::move(prim), args);
 }
 
 // --- subdivision meshes -----------------------------------------------------------
@@ -316,7 +316,7 @@ void Parser::req_subdivision_mesh(ArgReader& args) {
       }
     }
   }
-  place(std::move(prim), line);
+  place(std::move(prim), args);
 }
 
 // --- patches ------------------------------------------------------------------------
@@ -363,7 +363,7 @@ void Parser::req_patch(ArgReader& args) {
     bilinear_to_bezier(points.data(), net);
   prim.patch_points.assign(net, net + 16);
   prim.mergeable = true;
-  place(std::move(prim), args.request().line);
+  place(std::move(prim), args);
 }
 
 void Parser::req_patch_mesh(ArgReader& args) {
@@ -403,7 +403,7 @@ void Parser::req_patch_mesh(ArgReader& args) {
   patch_mesh_to_bezier(bicubic, nu, uper, nv, vper, attrs_.ubasis, attrs_.vbasis, points,
                        prim.patch_points);
   prim.mergeable = true;
-  place(std::move(prim), args.request().line);
+  place(std::move(prim), args);
 }
 
 }  // namespace mp::rib

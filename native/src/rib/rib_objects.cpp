@@ -40,7 +40,8 @@ void mirror_patches_u(std::vector<glm::vec3>& cps, size_t first) {
 
 }  // namespace
 
-void Parser::place(Primitive prim, int line) {
+void Parser::place(Primitive prim, const ArgReader& args) {
+  const int line = args.request().line;
   if (defining_active_) {
     // Stored relative to the object definition's own coordinate system.
     prim.local = attrs_.ctm * prim.local;
@@ -48,8 +49,7 @@ void Parser::place(Primitive prim, int line) {
     definition_.prims.push_back(std::move(prim));
     return;
   }
-  if (!in_world_) fail(line, prim.origin.substr(0, prim.origin.find(' ')) +
-                                 ": geometry outside WorldBegin/WorldEnd");
+  if (!in_world_) args.fail("geometry outside WorldBegin/WorldEnd");
   add_to_scene(prim, attrs_.ctm, attrs_, line);
 }
 

@@ -57,7 +57,7 @@ const std::unordered_map<std::string, Parser::Handler>& Parser::handlers() {
       {"SolidBegin", &Parser::req_solid_begin},
       {"SolidEnd", &Parser::req_solid_end},
       {"MotionBegin", &Parser::req_motion_begin},
-      {"MotionEnd", &Parser::req_motion_begin},  // reports the unmatched MotionEnd
+      {"MotionEnd", &Parser::req_motion_end},
       {"Format", &Parser::req_format},
       {"Projection", &Parser::req_projection},
       {"ScreenWindow", &Parser::req_screen_window},
@@ -244,7 +244,6 @@ void Parser::req_frame_begin(ArgReader& args) {
       args.fail(std::string("FrameBegin inside ") + block_name(b.kind) + " at line " +
                 std::to_string(b.line));
   push_block(Block::Kind::Frame, args.request().line);
-  frame_seen_ = true;
 }
 
 void Parser::req_frame_end(ArgReader& args) { pop_block(Block::Kind::Frame, args); }
@@ -305,8 +304,12 @@ void Parser::req_solid_begin(ArgReader& args) {
 }
 void Parser::req_solid_end(ArgReader& args) { pop_block(Block::Kind::Solid, args); }
 
+void Parser::req_motion_end(ArgReader& args) {
+  // Inside a motion block execute() consumes MotionEnd; here it is unmatched.
+  args.fail("without a matching MotionBegin");
+}
+
 void Parser::req_motion_begin(ArgReader& args) {
-  if (args.request().name == "MotionEnd") args.fail("without a matching MotionBegin");
   args.number_array();
   args.done();
   warn_once("request:MotionBegin", args.request().line,
@@ -392,7 +395,7 @@ void Parser::req_pixel_samples(ArgReader& args) {
   auto count = [&](double v) {
     if (v > Limits::kMaxPixelSamples)
       args.fail("more than " + std::to_string(Limits::kMaxPixelSamples) + " samples per axis");
-    return std::max(1, static_cast<int>(std::ceil(v)));  // rounded up, at least 1
+    return v < 1.0 ? 1 : static_cast<int>(std::ceil(v));  // rounded up, at least 1
   };
   result_.scene.settings.samples_x = count(xs);
   result_.scene.settings.samples_y = count(ys);

@@ -143,6 +143,7 @@ class Parser {
   void req_solid_begin(ArgReader&);
   void req_solid_end(ArgReader&);
   void req_motion_begin(ArgReader&);
+  void req_motion_end(ArgReader&);
   void req_format(ArgReader&);
   void req_projection(ArgReader&);
   void req_screen_window(ArgReader&);
@@ -202,7 +203,7 @@ class Parser {
   void req_object_instance(ArgReader&);
   // Places a primitive with the current state: into the open object
   // definition, or into the scene (inside the world block only).
-  void place(Primitive prim, int line);
+  void place(Primitive prim, const ArgReader& args);
   void add_to_scene(const Primitive& prim, const glm::mat4& xform, const Attributes& attrs, int line);
   void account_lights(const Attributes& attrs);
 
@@ -217,7 +218,6 @@ class Parser {
   bool in_world_ = false;
   bool world_done_ = false;    // the first world block has ended
   bool skipping_ = false;      // later frames: requests are read but not executed
-  bool frame_seen_ = false;
   int motion_depth_ = 0;       // inside MotionBegin/MotionEnd
   bool motion_first_done_ = false;
   glm::mat4 camera_{1.0f};     // RenderMan world-to-camera (column-vector convention)

@@ -10,9 +10,9 @@
 // centroid c, one per vertex v_i: (c, m_{i-1,i}, v_i, m_{i,i+1}) with m the
 // edge midpoints. For a counter-clockwise face each quad is counter-clockwise
 // too, so cross(dP/du, dP/dv) keeps pointing to the face's front, and for a
-// planar convex face the quads tile it exactly. This is the same split the
-// first Catmull-Clark step makes, so polygon and subdivision meshes share
-// their parameterization style.
+// planar convex face the quads tile it exactly. These are the quads the
+// first Catmull-Clark step makes of a non-quad face (there with the vertex at
+// (0,0)), so flat and subdivided versions of a mesh split faces alike.
 #include <vector>
 
 #include "subdiv/patch_buffer.h"
