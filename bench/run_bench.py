@@ -73,10 +73,11 @@ def main():
     sweep = {}
     if not args.skip_sweep:
         for scene in ("dense_subdiv", "eye_split_plane"):
-            for label, extra in [(f"bounded {m} MiB", ["--bound-split", "bounded", "--bound-split-memory", str(m)])
-                                 for m in (4, 16, 64, 256)] + [("breadth-first", ["--bound-split", "breadth"])]:
-                runs = render(args.cli, paths[scene], args.out, f"{scene}_{label.split()[0]}_{label.split()[1]}",
-                              args.repeat, args.device, extra)
+            for label, tag, extra in [(f"bounded {m} MiB", f"bounded{m}",
+                                       ["--bound-split", "bounded", "--bound-split-memory", str(m)])
+                                      for m in (4, 16, 64, 256)] + [("breadth-first", "breadth",
+                                                                     ["--bound-split", "breadth"])]:
+                runs = render(args.cli, paths[scene], args.out, f"{scene}_{tag}", args.repeat, args.device, extra)
                 sweep[f"{scene} / {label}"] = summarise(runs)
 
     print("\n| scene | micropolygons | frame ms (median) | " + " | ".join(s + " ms" for s in STAGES) +

@@ -1,5 +1,7 @@
 #include "pipeline/micropolygon_stages.h"
 
+#include <vector>
+
 #include "micropoly/error.h"
 #include "mp_raster.h"
 
@@ -28,8 +30,11 @@ GridBuffers::GridBuffers(DeviceSession& session, cl_uint cap, int max_grid)
 
 DiceStage::DiceStage(DeviceSession& session) : session_(session), kernel_(session.program(), "dice_grids") {
   counter_ = cl::Buffer(session.context(), CL_MEM_READ_WRITE, sizeof(cl_uint));
+}
+
+void DiceStage::begin_frame() {
   cl_uint zero = 0;
-  session.queue().enqueueFillBuffer(counter_, zero, 0, sizeof zero);
+  session_.queue().enqueueFillBuffer(counter_, zero, 0, sizeof zero);
 }
 
 void DiceStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
@@ -74,27 +79,36 @@ void ShadeStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffe
   timer.add(Stage::Shade, e);
 }
 
-SampleStage::SampleStage(DeviceSession& session, const FrameParams& f, StageTimer& timer)
-    : session_(session), kernel_(session.program(), "sample_micropolygons") {
-  size_t samples = static_cast<size_t>(f.width) * static_cast<size_t>(f.height) * static_cast<size_t>(f.spp_x * f.spp_y);
-  keys_ = device_buffer(session, samples * sizeof(cl_ulong), "sample depth buffer");
-  colors_ = device_buffer(session, samples * 3 * sizeof(cl_float), "sample color buffer");
-  normals_ = device_buffer(session, samples * sizeof(cl_uint), "sample normal buffer");
-  // Sample positions of one tile (kernels/mp_raster.h), computed here once.
+SampleStage::SampleStage(DeviceSession& session)
+    : session_(session), kernel_(session.program(), "sample_micropolygons"), clear_(session.program(), "clear_samples") {}
+
+void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer) {
   const int spp = f.spp_x * f.spp_y;
-  std::vector<cl_ushort> offsets(static_cast<size_t>(MP_SAMPLE_TILE) * MP_SAMPLE_TILE * spp);
-  for (int ty = 0; ty < MP_SAMPLE_TILE; ++ty)
-    for (int tx = 0; tx < MP_SAMPLE_TILE; ++tx)
-      for (int s = 0; s < spp; ++s)
-        offsets[(static_cast<size_t>(ty) * MP_SAMPLE_TILE + tx) * spp + s] =
-            static_cast<cl_ushort>(mp_sample_offset_packed(tx, ty, s, f));
-  offsets_ = cl::Buffer(session.context(), CL_MEM_READ_ONLY, offsets.size() * sizeof(cl_ushort));
-  session.queue().enqueueWriteBuffer(offsets_, CL_TRUE, 0, offsets.size() * sizeof(cl_ushort), offsets.data());
-  cl::Kernel clear(session.program(), "clear_samples");
-  clear.setArg(0, keys_);
-  clear.setArg(1, static_cast<cl_ulong>(samples));
+  size_t samples = static_cast<size_t>(f.width) * static_cast<size_t>(f.height) * static_cast<size_t>(spp);
+  if (samples != samples_) {
+    keys_ = colors_ = normals_ = cl::Buffer();  // release before allocating anew
+    keys_ = device_buffer(session_, samples * sizeof(cl_ulong), "sample depth buffer");
+    colors_ = device_buffer(session_, samples * 3 * sizeof(cl_float), "sample color buffer");
+    normals_ = device_buffer(session_, samples * sizeof(cl_uint), "sample normal buffer");
+    samples_ = samples;
+  }
+  if (f.spp_x != spp_x_ || f.spp_y != spp_y_) {
+    // Sample positions of one tile (kernels/mp_raster.h), computed here once.
+    std::vector<cl_ushort> offsets(static_cast<size_t>(MP_SAMPLE_TILE) * MP_SAMPLE_TILE * spp);
+    for (int ty = 0; ty < MP_SAMPLE_TILE; ++ty)
+      for (int tx = 0; tx < MP_SAMPLE_TILE; ++tx)
+        for (int s = 0; s < spp; ++s)
+          offsets[(static_cast<size_t>(ty) * MP_SAMPLE_TILE + tx) * spp + s] =
+              static_cast<cl_ushort>(mp_sample_offset_packed(tx, ty, s, f));
+    offsets_ = cl::Buffer(session_.context(), CL_MEM_READ_ONLY, offsets.size() * sizeof(cl_ushort));
+    session_.queue().enqueueWriteBuffer(offsets_, CL_TRUE, 0, offsets.size() * sizeof(cl_ushort), offsets.data());
+    spp_x_ = f.spp_x;
+    spp_y_ = f.spp_y;
+  }
+  clear_.setArg(0, keys_);
+  clear_.setArg(1, static_cast<cl_ulong>(samples));
   cl::Event e;
-  session.queue().enqueueNDRangeKernel(clear, cl::NullRange, round_up_range(samples, 256), cl::NDRange(256), nullptr, &e);
+  session_.queue().enqueueNDRangeKernel(clear_, cl::NullRange, round_up_range(samples, 256), cl::NDRange(256), nullptr, &e);
   timer.add(Stage::Sample, e);
 }
 
@@ -127,9 +141,12 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
                        RenderResult& out, StageTimer& timer) {
   const FrameParams& f = frame.params;
   size_t pixels = static_cast<size_t>(f.width) * static_cast<size_t>(f.height);
-  cl::Buffer rgba(session_.context(), CL_MEM_WRITE_ONLY, pixels * sizeof(cl_float4));
-  cl::Buffer depth(session_.context(), CL_MEM_WRITE_ONLY, pixels * sizeof(cl_float));
-  cl::Buffer normal(session_.context(), CL_MEM_WRITE_ONLY, pixels * sizeof(cl_float4));
+  if (pixels != pixels_) {
+    rgba_ = cl::Buffer(session_.context(), CL_MEM_WRITE_ONLY, pixels * sizeof(cl_float4));
+    depth_ = cl::Buffer(session_.context(), CL_MEM_WRITE_ONLY, pixels * sizeof(cl_float));
+    normal_ = cl::Buffer(session_.context(), CL_MEM_WRITE_ONLY, pixels * sizeof(cl_float4));
+    pixels_ = pixels;
+  }
   int type = filter == PixelFilter::Box ? MP_FILTER_BOX : filter == PixelFilter::Gaussian ? MP_FILTER_GAUSSIAN : MP_FILTER_TRIANGLE;
   auto row = [&](int i) {
     glm::vec3 r = glm::vec3(frame.camera_to_world[0][i], frame.camera_to_world[1][i], frame.camera_to_world[2][i]);
@@ -145,9 +162,9 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
   kernel_.setArg(7, row(0));
   kernel_.setArg(8, row(1));
   kernel_.setArg(9, row(2));
-  kernel_.setArg(10, rgba);
-  kernel_.setArg(11, depth);
-  kernel_.setArg(12, normal);
+  kernel_.setArg(10, rgba_);
+  kernel_.setArg(11, depth_);
+  kernel_.setArg(12, normal_);
   size_t gx = ((static_cast<size_t>(f.width) + 7) / 8) * 8, gy = ((static_cast<size_t>(f.height) + 7) / 8) * 8;
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(gx, gy), cl::NDRange(8, 8), nullptr, &e);
@@ -157,9 +174,9 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
   out.rgba.resize(pixels * 4);
   out.depth.resize(pixels);
   std::vector<float> n4(pixels * 4);
-  session_.queue().enqueueReadBuffer(rgba, CL_FALSE, 0, pixels * sizeof(cl_float4), out.rgba.data());
-  session_.queue().enqueueReadBuffer(depth, CL_FALSE, 0, pixels * sizeof(cl_float), out.depth.data());
-  session_.queue().enqueueReadBuffer(normal, CL_TRUE, 0, pixels * sizeof(cl_float4), n4.data());
+  session_.queue().enqueueReadBuffer(rgba_, CL_FALSE, 0, pixels * sizeof(cl_float4), out.rgba.data());
+  session_.queue().enqueueReadBuffer(depth_, CL_FALSE, 0, pixels * sizeof(cl_float), out.depth.data());
+  session_.queue().enqueueReadBuffer(normal_, CL_TRUE, 0, pixels * sizeof(cl_float4), n4.data());
   out.normal.resize(pixels * 3);
   for (size_t i = 0; i < pixels; ++i)
     for (int k = 0; k < 3; ++k) out.normal[3 * i + k] = n4[4 * i + k];

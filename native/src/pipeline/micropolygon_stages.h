@@ -24,7 +24,8 @@ class DiceStage {
   explicit DiceStage(DeviceSession& session);
   void run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
            GridBuffers& grids, StageTimer& timer);
-  size_t micropolygons();  // total so far (blocking read)
+  void begin_frame();      // resets the micropolygon counter
+  size_t micropolygons();  // total this frame (blocking read)
 
  private:
   DeviceSession& session_;
@@ -45,8 +46,10 @@ class ShadeStage {
 
 class SampleStage {
  public:
-  // Allocates and clears the sample buffers (key, color, normal per sample).
-  SampleStage(DeviceSession& session, const FrameParams& f, StageTimer& timer);
+  explicit SampleStage(DeviceSession& session);
+  // Makes the sample buffers (key, color, normal per sample) fit the frame,
+  // reusing them when the size is unchanged, and clears them.
+  void begin_frame(const FrameParams& f, StageTimer& timer);
   void run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
            GridBuffers& grids, StageTimer& timer);
   const cl::Buffer& keys() const { return keys_; }
@@ -57,7 +60,10 @@ class SampleStage {
  private:
   DeviceSession& session_;
   cl::Kernel kernel_;
+  cl::Kernel clear_;
   cl::Buffer keys_, colors_, normals_, offsets_;
+  size_t samples_ = 0;
+  int spp_x_ = 0, spp_y_ = 0;
 };
 
 class ResolveStage {
@@ -69,6 +75,8 @@ class ResolveStage {
  private:
   DeviceSession& session_;
   cl::Kernel kernel_;
+  cl::Buffer rgba_, depth_, normal_;
+  size_t pixels_ = 0;
 };
 
 }  // namespace mp

@@ -24,9 +24,17 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 
 }  // namespace
 
+// Everything that outlives one frame: the device session, the stages' kernels
+// and the buffers whose size does not depend on the scene.
 struct Renderer::Impl {
-  explicit Impl(const std::string& selector) : session(selector) {}
+  explicit Impl(const std::string& selector)
+      : session(selector), dice(session), shade(session), sample(session), resolve(session) {}
   DeviceSession session;
+  DiceStage dice;
+  ShadeStage shade;
+  SampleStage sample;
+  ResolveStage resolve;
+  std::unique_ptr<GridBuffers> grids;
   bool first_render = true;
 };
 
@@ -60,12 +68,18 @@ RenderResult Renderer::render(const Scene& scene, const ProgressCallback& progre
     st.timings_ms.upload = ms_since(t_upload);
     st.patches = buffers.patch_count;
 
-    cl_uint capacity = std::max<cl_uint>(1, std::min<cl_uint>(kDiceBatch, std::max<cl_uint>(buffers.patch_count, 256)));
-    GridBuffers grids(s, capacity, f.max_grid);
-    DiceStage dice(s);
-    ShadeStage shade(s);
-    SampleStage sample(s, f, timer);
-    ResolveStage resolve(s);
+    if (!impl_->grids || impl_->grids->vertices_per_slot != static_cast<size_t>(f.max_grid + 1) * (f.max_grid + 1)) {
+      impl_->grids.reset();
+      impl_->grids = std::make_unique<GridBuffers>(s, kDiceBatch, f.max_grid);
+    }
+    GridBuffers& grids = *impl_->grids;
+    const cl_uint capacity = grids.capacity;
+    DiceStage& dice = impl_->dice;
+    ShadeStage& shade = impl_->shade;
+    SampleStage& sample = impl_->sample;
+    ResolveStage& resolve = impl_->resolve;
+    dice.begin_frame();
+    sample.begin_frame(f, timer);
 
     DiceSink sink = [&](const cl::Buffer& diceable, cl_uint count) {
       dice.run(diceable, count, buffers, f, grids, timer);
