@@ -19,7 +19,7 @@ __kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width,
                              __global const ulong* keys,
                              __global const float* colors, __global const uint* normals,
                              float4 cam_to_world_x, float4 cam_to_world_y, float4 cam_to_world_z,
-                             __global float4* rgba, __global float* depth, __global float4* normal_out) {
+                             __global float4* rgba, __global float* depth, __global float* normal_out, int want_passes) {
   int px = get_global_id(0), py = get_global_id(1);
   if (px >= f.width || py >= f.height) return;
   int spp = f.spp_x * f.spp_y;
@@ -40,6 +40,7 @@ __kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width,
       }
   ulong pixel = (ulong)py * (ulong)f.width + (ulong)px;
   rgba[pixel] = wsum > 0.0f ? sum / wsum : (float4)(0.0f);
+  if (!want_passes) return;
 
   float zmin = MP_NO_DEPTH;
   float3 nsum = (float3)(0.0f);
@@ -51,5 +52,5 @@ __kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width,
     nsum += (float3)(dot(cam_to_world_x.xyz, n), dot(cam_to_world_y.xyz, n), dot(cam_to_world_z.xyz, n));
   }
   depth[pixel] = zmin;
-  normal_out[pixel] = (float4)(nsum / (float)spp, 0.0f);
+  vstore3(nsum / (float)spp, pixel, normal_out);
 }

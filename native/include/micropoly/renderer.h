@@ -23,8 +23,11 @@ struct DeviceInfo {
 // All OpenCL devices on all platforms, in a stable order.
 std::vector<DeviceInfo> list_devices();
 
+// Device time per stage (OpenCL profiling) except `upload` (host patch
+// building and transfer), `readback` (wall time of resolve plus the copy of
+// the image to the host) and `total` (wall time of the whole render call).
 struct StageTimings {
-  double upload = 0, bound_split = 0, dice = 0, shade = 0, sample = 0, resolve = 0, total = 0;
+  double upload = 0, bound_split = 0, dice = 0, shade = 0, sample = 0, resolve = 0, readback = 0, total = 0;
 };
 
 struct RenderStats {
@@ -45,7 +48,8 @@ struct RenderStats {
 
 // Pixels are stored top row first. rgba: 4 floats per pixel, premultiplied,
 // scene-linear; depth: camera-space depth (1e10 where empty); normal: 3 floats
-// per pixel, world space.
+// per pixel, world space. depth and normal are empty when the settings turn
+// those passes off.
 struct RenderResult {
   int width = 0, height = 0;
   std::vector<float> rgba, depth, normal;

@@ -105,6 +105,7 @@ struct RenderSettings {
   int max_grid_size = 16;                      // micropolygons per grid side
   int max_split_depth = 26;                    // eye-split and runaway limit
   bool backface_culling = true;                // for single-sided surfaces
+  bool depth_and_normal_passes = true;         // resolve and return Depth and Normal
 };
 
 struct Scene {

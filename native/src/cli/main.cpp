@@ -98,6 +98,10 @@ int main(int argc, char** argv) {
     if (!o.bound_split.empty())
       scene.settings.bound_split = o.bound_split == "breadth" ? mp::BoundSplitMethod::Breadth : mp::BoundSplitMethod::Bounded;
     if (o.memory_mib > 0) scene.settings.bound_split_memory_mib = o.memory_mib;
+    // Only EXR files hold the Depth and Normal passes.
+    auto dot = output.find_last_of('.');
+    std::string ext = dot == std::string::npos ? "" : output.substr(dot + 1);
+    scene.settings.depth_and_normal_passes = ext == "exr" || ext == "EXR";
     try {
       mp::validate_scene(scene);
     } catch (const mp::Error& e) {

@@ -76,9 +76,19 @@ struct BoundSplitContext {
   const ProgressCallback& progress;
 };
 
+// Device buffers of the bounded method, kept between frames so a renderer
+// that draws many frames with one budget allocates them once. Each buffer is
+// reallocated whenever its size changes, so what is held is exactly what the
+// current budget asks for.
+struct BoundedWorkspace {
+  cl::Buffer stacks, sizes, ring, diceable, counters;
+  size_t stacks_bytes = 0, sizes_bytes = 0, ring_bytes = 0, diceable_bytes = 0, counters_bytes = 0;
+};
+
 // Weber, Wimmer & Owens 2015: fixed worker pool, depth-first per worker,
 // memory fixed by `budget_bytes` (never exceeded; throws if too small).
-BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes, cl_uint dice_capacity);
+BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes, cl_uint dice_capacity,
+                                     BoundedWorkspace& workspace);
 // Patney & Owens 2008: whole queue per iteration, compacted by prefix sums.
 BoundSplitResult bound_split_breadth(BoundSplitContext& ctx, cl_uint dice_capacity);
 

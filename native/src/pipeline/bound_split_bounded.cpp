@@ -20,9 +20,17 @@ enum Counter { kPoolHead = 0, kPoolTail = 1, kNextPatch = 2, kDiceCount = 3, kBu
 constexpr cl_uint kStepsPerLaunch = 16;  // sub-patches a worker handles per launch
 constexpr size_t kMaxWorkers = size_t(1) << 20;
 
+void ensure(cl::Context& context, cl::Buffer& buffer, size_t& held, size_t bytes) {
+  if (held == bytes) return;
+  buffer = cl::Buffer();
+  buffer = cl::Buffer(context, CL_MEM_READ_WRITE, bytes);
+  held = bytes;
+}
+
 }  // namespace
 
-BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes, cl_uint dice_capacity) {
+BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes, cl_uint dice_capacity,
+                                     BoundedWorkspace& ws) {
   DeviceSession& s = ctx.session;
   cl::Context& context = s.context();
   cl::CommandQueue& queue = s.queue();
@@ -39,38 +47,37 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
   workers = std::max(min_workers, workers / 64 * 64);  // whole work-groups
   const cl_uint ring_capacity = static_cast<cl_uint>(workers);
 
-  MemoryTally tally;
   BoundSplitResult result;
   {
-    TalliedBuffer stacks(tally), sizes(tally), ring(tally), diceable(tally), counters(tally);
-    stacks.reserve(context, workers * stack_depth * rec);
-    sizes.reserve(context, workers * sizeof(cl_uint));
-    ring.reserve(context, static_cast<size_t>(ring_capacity) * rec);
-    diceable.reserve(context, static_cast<size_t>(dice_capacity) * rec);
-    counters.reserve(context, kCounters * sizeof(cl_uint));
+    ensure(context, ws.stacks, ws.stacks_bytes, workers * stack_depth * rec);
+    ensure(context, ws.sizes, ws.sizes_bytes, workers * sizeof(cl_uint));
+    ensure(context, ws.ring, ws.ring_bytes, static_cast<size_t>(ring_capacity) * rec);
+    ensure(context, ws.diceable, ws.diceable_bytes, static_cast<size_t>(dice_capacity) * rec);
+    ensure(context, ws.counters, ws.counters_bytes, kCounters * sizeof(cl_uint));
+    result.peak_bytes = ws.stacks_bytes + ws.sizes_bytes + ws.ring_bytes + ws.diceable_bytes + ws.counters_bytes;
     cl_uint zero = 0;
-    queue.enqueueFillBuffer(sizes.get(), zero, 0, workers * sizeof(cl_uint));
+    queue.enqueueFillBuffer(ws.sizes, zero, 0, workers * sizeof(cl_uint));
 
     cl::Kernel step(s.program(), "bs_bounded_step");
     step.setArg(0, ctx.scene.points);
     step.setArg(1, ctx.scene.patch_info);
     step.setArg(2, ctx.scene.patch_count);
     step.setArg(3, ctx.frame);
-    step.setArg(4, stacks.get());
-    step.setArg(5, sizes.get());
+    step.setArg(4, ws.stacks);
+    step.setArg(5, ws.sizes);
     step.setArg(6, stack_depth);
-    step.setArg(7, ring.get());
+    step.setArg(7, ws.ring);
     step.setArg(8, ring_capacity);
-    step.setArg(12, diceable.get());
+    step.setArg(12, ws.diceable);
     step.setArg(13, dice_capacity);
-    step.setArg(14, counters.get());
+    step.setArg(14, ws.counters);
     step.setArg(15, kStepsPerLaunch);
 
     cl_uint head = 0, tail = 0, next_patch = 0, dice_count = 0, hungry = static_cast<cl_uint>(workers);
     const cl_uint patch_count = ctx.scene.patch_count;
     for (;;) {
       cl_uint c[kCounters] = {head, tail, next_patch, dice_count, 0, 0, 0, 0};
-      queue.enqueueWriteBuffer(counters.get(), CL_FALSE, 0, sizeof c, c);
+      queue.enqueueWriteBuffer(ws.counters, CL_FALSE, 0, sizeof c, c);
       step.setArg(9, head);
       step.setArg(10, tail);
       // Hand out at most as many children as there were idle workers.
@@ -79,7 +86,7 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
       queue.enqueueNDRangeKernel(step, cl::NullRange, cl::NDRange(workers), cl::NDRange(64), nullptr, &e);
       ctx.timer.add(Stage::BoundSplit, e);
       ++result.launches;
-      queue.enqueueReadBuffer(counters.get(), CL_TRUE, 0, sizeof c, c);
+      queue.enqueueReadBuffer(ws.counters, CL_TRUE, 0, sizeof c, c);
       ctx.timer.collect();
 
       const cl_uint head0 = head;
@@ -91,7 +98,7 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
       if (head == tail) head = tail = 0;  // keep ring indices small
       bool done = c[kBusy] == 0 && head == tail && next_patch >= patch_count;
       if (dice_count == dice_capacity || (done && dice_count > 0)) {
-        ctx.sink(diceable.get(), dice_count);
+        ctx.sink(ws.diceable, dice_count);
         dice_count = 0;
       }
       if (done) break;
@@ -102,7 +109,6 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
     }
     queue.finish();
   }
-  result.peak_bytes = tally.peak();
   return result;
 }
 

@@ -1,5 +1,6 @@
 #include "pipeline/micropolygon_stages.h"
 
+#include <cstring>
 #include <vector>
 
 #include "micropoly/error.h"
@@ -135,16 +136,29 @@ void SampleStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuff
   }
 }
 
-ResolveStage::ResolveStage(DeviceSession& session) : session_(session), kernel_(session.program(), "resolve_pixels") {}
+ResolveStage::ResolveStage(DeviceSession& session) : session_(session), kernel_(session.program(), "resolve_pixels") {
+  use_pinned_ = !session.device().getInfo<CL_DEVICE_HOST_UNIFIED_MEMORY>();
+}
+
+ResolveStage::~ResolveStage() {
+  if (pinned_ptr_) {
+    try {
+      session_.queue().enqueueUnmapMemObject(pinned_, pinned_ptr_);
+      session_.queue().finish();
+    } catch (const cl::Error&) {
+      // The context goes away with the session; nothing else to release.
+    }
+  }
+}
 
 void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, PixelFilter filter, float filter_width,
-                       RenderResult& out, StageTimer& timer) {
+                       bool passes, RenderResult& out, StageTimer& timer) {
   const FrameParams& f = frame.params;
   size_t pixels = static_cast<size_t>(f.width) * static_cast<size_t>(f.height);
   if (pixels != pixels_) {
     rgba_ = cl::Buffer(session_.context(), CL_MEM_WRITE_ONLY, pixels * sizeof(cl_float4));
     depth_ = cl::Buffer(session_.context(), CL_MEM_WRITE_ONLY, pixels * sizeof(cl_float));
-    normal_ = cl::Buffer(session_.context(), CL_MEM_WRITE_ONLY, pixels * sizeof(cl_float4));
+    normal_ = cl::Buffer(session_.context(), CL_MEM_WRITE_ONLY, pixels * 3 * sizeof(cl_float));
     pixels_ = pixels;
   }
   int type = filter == PixelFilter::Box ? MP_FILTER_BOX : filter == PixelFilter::Gaussian ? MP_FILTER_GAUSSIAN : MP_FILTER_TRIANGLE;
@@ -165,6 +179,7 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
   kernel_.setArg(10, rgba_);
   kernel_.setArg(11, depth_);
   kernel_.setArg(12, normal_);
+  kernel_.setArg(13, passes ? 1 : 0);
   size_t gx = ((static_cast<size_t>(f.width) + 7) / 8) * 8, gy = ((static_cast<size_t>(f.height) + 7) / 8) * 8;
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(gx, gy), cl::NDRange(8, 8), nullptr, &e);
@@ -172,14 +187,27 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
   out.width = f.width;
   out.height = f.height;
   out.rgba.resize(pixels * 4);
-  out.depth.resize(pixels);
-  std::vector<float> n4(pixels * 4);
-  session_.queue().enqueueReadBuffer(rgba_, CL_FALSE, 0, pixels * sizeof(cl_float4), out.rgba.data());
-  session_.queue().enqueueReadBuffer(depth_, CL_FALSE, 0, pixels * sizeof(cl_float), out.depth.data());
-  session_.queue().enqueueReadBuffer(normal_, CL_TRUE, 0, pixels * sizeof(cl_float4), n4.data());
-  out.normal.resize(pixels * 3);
-  for (size_t i = 0; i < pixels; ++i)
-    for (int k = 0; k < 3; ++k) out.normal[3 * i + k] = n4[4 * i + k];
+  const size_t rgba_bytes = pixels * sizeof(cl_float4);
+  if (use_pinned_) {
+    if (pinned_bytes_ != rgba_bytes) {
+      if (pinned_ptr_) session_.queue().enqueueUnmapMemObject(pinned_, pinned_ptr_);
+      pinned_ = cl::Buffer(session_.context(), CL_MEM_READ_WRITE | CL_MEM_ALLOC_HOST_PTR, rgba_bytes);
+      pinned_ptr_ = static_cast<float*>(
+          session_.queue().enqueueMapBuffer(pinned_, CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0, rgba_bytes));
+      pinned_bytes_ = rgba_bytes;
+    }
+    session_.queue().enqueueReadBuffer(rgba_, CL_FALSE, 0, rgba_bytes, pinned_ptr_);
+  } else {
+    session_.queue().enqueueReadBuffer(rgba_, CL_FALSE, 0, rgba_bytes, out.rgba.data());
+  }
+  if (passes) {
+    out.depth.resize(pixels);
+    out.normal.resize(pixels * 3);
+    session_.queue().enqueueReadBuffer(depth_, CL_FALSE, 0, pixels * sizeof(cl_float), out.depth.data());
+    session_.queue().enqueueReadBuffer(normal_, CL_FALSE, 0, pixels * 3 * sizeof(cl_float), out.normal.data());
+  }
+  session_.queue().finish();
+  if (use_pinned_) std::memcpy(out.rgba.data(), pinned_ptr_, rgba_bytes);
 }
 
 }  // namespace mp

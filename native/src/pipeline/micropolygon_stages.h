@@ -69,7 +69,11 @@ class SampleStage {
 class ResolveStage {
  public:
   explicit ResolveStage(DeviceSession& session);
-  void run(const SampleStage& samples, const FrameSetup& frame, PixelFilter filter, float filter_width,
+  ~ResolveStage();
+  ResolveStage(const ResolveStage&) = delete;
+  ResolveStage& operator=(const ResolveStage&) = delete;
+  // Resolves pixels and reads them back; Depth and Normal only if `passes`.
+  void run(const SampleStage& samples, const FrameSetup& frame, PixelFilter filter, float filter_width, bool passes,
            RenderResult& out, StageTimer& timer);
 
  private:
@@ -77,6 +81,12 @@ class ResolveStage {
   cl::Kernel kernel_;
   cl::Buffer rgba_, depth_, normal_;
   size_t pixels_ = 0;
+  // On discrete GPUs the image is read back through a pinned (page-locked)
+  // staging buffer, which the driver copies into at full bus speed.
+  bool use_pinned_ = false;
+  cl::Buffer pinned_;
+  float* pinned_ptr_ = nullptr;
+  size_t pinned_bytes_ = 0;
 };
 
 }  // namespace mp

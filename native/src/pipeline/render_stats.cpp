@@ -48,7 +48,7 @@ std::string RenderStats::to_json() const {
   j += "  \"cancelled\": " + std::string(cancelled ? "true" : "false") + ",\n";
   j += "  \"timings_ms\": {\"upload\": " + num(timings_ms.upload) + ", \"bound_split\": " + num(timings_ms.bound_split) +
        ", \"dice\": " + num(timings_ms.dice) + ", \"shade\": " + num(timings_ms.shade) + ", \"sample\": " +
-       num(timings_ms.sample) + ", \"resolve\": " + num(timings_ms.resolve) + ", \"total\": " + num(timings_ms.total) + "}\n";
+       num(timings_ms.sample) + ", \"resolve\": " + num(timings_ms.resolve) + ", \"readback\": " + num(timings_ms.readback) + ", \"total\": " + num(timings_ms.total) + "}\n";
   j += "}\n";
   return j;
 }

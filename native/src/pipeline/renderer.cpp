@@ -35,6 +35,7 @@ struct Renderer::Impl {
   SampleStage sample;
   ResolveStage resolve;
   std::unique_ptr<GridBuffers> grids;
+  BoundedWorkspace bounded;
   bool first_render = true;
 };
 
@@ -93,7 +94,7 @@ RenderResult Renderer::render(const Scene& scene, const ProgressCallback& progre
     if (buffers.patch_count > 0) {
       if (scene.settings.bound_split == BoundSplitMethod::Bounded) {
         size_t budget = static_cast<size_t>(std::max(0.0f, scene.settings.bound_split_memory_mib) * 1048576.0);
-        bs = bound_split_bounded(ctx, budget, capacity);
+        bs = bound_split_bounded(ctx, budget, capacity, impl_->bounded);
       } else {
         bs = bound_split_breadth(ctx, capacity);
       }
@@ -101,8 +102,10 @@ RenderResult Renderer::render(const Scene& scene, const ProgressCallback& progre
     st.bound_split_peak_bytes = bs.peak_bytes;
     st.bound_split_launches = bs.launches;
     st.cancelled = bs.cancelled;
-    resolve.run(sample, frame, scene.settings.filter, scene.settings.filter_width, out, timer);
-    s.queue().finish();
+    auto t_resolve = std::chrono::steady_clock::now();
+    resolve.run(sample, frame, scene.settings.filter, scene.settings.filter_width, scene.settings.depth_and_normal_passes,
+                out, timer);
+    st.timings_ms.readback = ms_since(t_resolve);
     timer.collect();
     st.micropolygons = dice.micropolygons();
     st.timings_ms.bound_split = timer.ms(Stage::BoundSplit);

@@ -70,6 +70,7 @@ py::dict stats_dict(const RenderStats& s) {
   t["shade"] = s.timings_ms.shade;
   t["sample"] = s.timings_ms.sample;
   t["resolve"] = s.timings_ms.resolve;
+  t["readback"] = s.timings_ms.readback;
   t["total"] = s.timings_ms.total;
   d["timings_ms"] = t;
   return d;
@@ -79,8 +80,8 @@ py::dict result_dict(RenderResult&& r) {
   py::dict d;
   auto h = static_cast<py::ssize_t>(r.height), w = static_cast<py::ssize_t>(r.width);
   d["rgba"] = Array<float>({h, w, py::ssize_t(4)}, r.rgba.data());
-  d["depth"] = Array<float>({h, w}, r.depth.data());
-  d["normal"] = Array<float>({h, w, py::ssize_t(3)}, r.normal.data());
+  if (!r.depth.empty()) d["depth"] = Array<float>({h, w}, r.depth.data());
+  if (!r.normal.empty()) d["normal"] = Array<float>({h, w, py::ssize_t(3)}, r.normal.data());
   d["stats"] = stats_dict(r.stats);
   return d;
 }
@@ -121,7 +122,8 @@ PYBIND11_MODULE(_native, m) {
       .def_readwrite("bound_split_memory_mib", &RenderSettings::bound_split_memory_mib)
       .def_readwrite("max_grid_size", &RenderSettings::max_grid_size)
       .def_readwrite("max_split_depth", &RenderSettings::max_split_depth)
-      .def_readwrite("backface_culling", &RenderSettings::backface_culling);
+      .def_readwrite("backface_culling", &RenderSettings::backface_culling)
+      .def_readwrite("depth_and_normal_passes", &RenderSettings::depth_and_normal_passes);
 
   py::class_<Scene>(m, "Scene")
       .def(py::init<>())

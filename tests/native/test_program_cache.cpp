@@ -1,0 +1,97 @@
+// Kernels are embedded at build time, built once per device and cached on
+// disk; a kernel that fails to build gives a clear error.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "cl/device_session.h"
+#include "cl/program_cache.h"
+#include "micropoly/error.h"
+
+namespace mp {
+namespace {
+
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const std::string& value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old, had_ = true;
+    setenv(name, value.c_str(), 1);
+  }
+  ~ScopedEnv() {
+    if (had_)
+      setenv(name_, old_.c_str(), 1);
+    else
+      unsetenv(name_);
+  }
+
+ private:
+  const char* name_;
+  std::string old_;
+  bool had_ = false;
+};
+
+std::filesystem::path fresh_dir(const char* name) {
+  auto dir = std::filesystem::temp_directory_path() / (std::string(name) + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+
+TEST(ProgramCache, SecondSessionLoadsTheCachedBinary) {
+  auto dir = fresh_dir("micropoly-cache-test-");
+  ScopedEnv env("MICROPOLY_CACHE_DIR", dir.string());
+  DeviceSession first("");
+  EXPECT_FALSE(first.program_cache_hit());
+  ASSERT_TRUE(std::filesystem::exists(dir));
+  EXPECT_FALSE(std::filesystem::is_empty(dir));
+  DeviceSession second("");
+  EXPECT_TRUE(second.program_cache_hit());
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ProgramCache, CorruptCacheEntriesAreRebuilt) {
+  auto dir = fresh_dir("micropoly-cache-corrupt-");
+  ScopedEnv env("MICROPOLY_CACHE_DIR", dir.string());
+  { DeviceSession warm(""); }
+  for (auto& entry : std::filesystem::directory_iterator(dir)) {
+    std::FILE* f = std::fopen(entry.path().c_str(), "wb");
+    std::fputs("not a program binary", f);
+    std::fclose(f);
+  }
+  DeviceSession session("");
+  EXPECT_FALSE(session.program_cache_hit());
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ProgramCache, KernelBuildFailureIsAClearError) {
+  DeviceSession session("");
+  try {
+    build_program_cached(session.context(), session.device(), "__kernel void broken(__global float* x) { x[0] = y; }",
+                         "-cl-std=CL1.2");
+    FAIL() << "expected a build error";
+  } catch (const Error& e) {
+    std::string msg = e.what();
+    EXPECT_NE(msg.find("failed to build"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("y"), std::string::npos) << msg;
+  }
+}
+
+TEST(ProgramCache, EmbeddedSourcesResolveEveryInclude) {
+  std::string source = assemble_program_source();
+  EXPECT_EQ(source.find("#include \""), std::string::npos);
+  for (const char* kernel : {"bs_bounded_step", "bs_breadth_classify", "scan_blocks", "dice_grids", "shade_grids",
+                             "sample_micropolygons", "resolve_pixels"})
+    EXPECT_NE(source.find(kernel), std::string::npos) << kernel;
+}
+
+TEST(DeviceChoice, UnknownSelectorsAreRejected) {
+  EXPECT_THROW(DeviceSession("banana"), Error);
+  EXPECT_THROW(DeviceSession("99"), Error);
+  ScopedEnv env("MICROPOLY_DEVICE", "cpu");
+  DeviceSession cpu("");
+  EXPECT_EQ(cpu.info().type, "cpu");
+}
+
+}  // namespace
+}  // namespace mp
