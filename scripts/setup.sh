@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs what Micropoly needs on Debian 12, builds it, and then
-#   demo: renders the demo scene to demo.png
+#   demo: renders the demo scene through headless Blender to demo.png
+#         (and the Utah teapot RIB through micropoly-render to teapot.png)
 #   test: runs every test (ctest: GoogleTest, pytest, Blender tests)
 #   build: stops after building (and installing into build/install)
 # Usage: scripts/setup.sh [demo|test|build]   (as root, or through sudo)
@@ -38,9 +39,14 @@ cmake --install build --prefix build/install >/dev/null
 case "$mode" in
   build) ;;
   demo)
-    echo "== rendering the demo scene"
-    build/install/bin/micropoly-render tests/scenes/teapot.rib -o demo.png --spp 16 --stats demo-stats.json
-    echo "wrote $here/demo.png"
+    echo "== rendering the demo scene through headless Blender"
+    rm -f demo.png
+    BLENDER_USER_SCRIPTS="$here/build/install" blender -b --factory-startup --python-exit-code 1 \
+      --python scripts/demo_scene.py -- "$here/demo.png" 2>&1 | grep -E "wrote|Error|error" || true
+    [ -s demo.png ] || { echo "the demo render failed" >&2; exit 1; }
+    echo "== and the Utah teapot through the command line renderer"
+    build/install/bin/micropoly-render tests/scenes/teapot.rib -o teapot.png --spp 16 --stats teapot-stats.json
+    echo "wrote $here/demo.png and $here/teapot.png"
     ;;
   test)
     echo "== running tests"
