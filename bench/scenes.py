@@ -110,6 +110,9 @@ def write_all(folder, teapot_source):
         f.write("\n".join(patches) + "\n")
     scenes = {
         "dense_subdiv": dense_subdiv(),
+        # For the bound & split memory sweep: a 262k-face mesh at 4K, whose
+        # widest split level is wide enough to show breadth-first's memory.
+        "wide_subdiv_4k": dense_subdiv(w=3840, h=2160, spp=1, n=512),
         "teapot": teapot(),
         "eye_split_plane": eye_split_plane(),
         "depth_stack_16": depth_stack(),

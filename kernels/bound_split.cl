@@ -73,6 +73,7 @@ __kernel void bs_breadth_scatter(__global const SubPatch* queue, uint n, __globa
 #define BS_DICE_COUNT 3  /* diceable sub-patches written */
 #define BS_BUSY 4        /* workers left with work after this launch */
 #define BS_IDLE 5        /* workers that ran out of work in this launch */
+#define BS_MAX_BUSY 6    /* 1 + highest index of a worker left with work */
 #define BS_COUNTERS 8
 
 __kernel void bs_bounded_step(__global const float4* points, __global const uint* patch_info,
@@ -131,4 +132,5 @@ __kernel void bs_bounded_step(__global const float4* points, __global const uint
   }
   stack_sizes[w] = size;
   atomic_inc(&counters[size > 0u ? BS_BUSY : BS_IDLE]);
+  if (size > 0u) atomic_max(&counters[BS_MAX_BUSY], w + 1u);
 }

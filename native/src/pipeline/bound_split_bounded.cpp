@@ -6,6 +6,11 @@
 // buffer; when it is full, that batch is diced, shaded and sampled, and bound
 // & split resumes where it stopped. All memory is allocated up front from the
 // budget, so the peak is the budget's allocation, whatever the scene.
+//
+// Each launch runs only as many workers as can have work: those still holding
+// sub-patches, plus room to double, so the active pool ramps up as the split
+// tree widens (a few big patches at first) and a large budget costs no time on
+// scenes that cannot use all its workers.
 #include <algorithm>
 #include <string>
 
@@ -16,7 +21,7 @@ namespace mp {
 namespace {
 
 // Counter slots, as BS_* in kernels/bound_split.cl.
-enum Counter { kPoolHead = 0, kPoolTail = 1, kNextPatch = 2, kDiceCount = 3, kBusy = 4, kIdle = 5, kCounters = 8 };
+enum Counter { kPoolHead = 0, kPoolTail = 1, kNextPatch = 2, kDiceCount = 3, kBusy = 4, kIdle = 5, kMaxBusy = 6, kCounters = 8 };
 constexpr cl_uint kStepsPerLaunch = 16;  // sub-patches a worker handles per launch
 constexpr size_t kMaxWorkers = size_t(1) << 20;
 
@@ -73,17 +78,19 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
     step.setArg(14, ws.counters);
     step.setArg(15, kStepsPerLaunch);
 
-    cl_uint head = 0, tail = 0, next_patch = 0, dice_count = 0, hungry = static_cast<cl_uint>(workers);
+    auto whole_groups = [&](size_t n) { return std::min(workers, std::max<size_t>(64, (n + 63) / 64 * 64)); };
     const cl_uint patch_count = ctx.scene.patch_count;
+    size_t launch = whole_groups(patch_count);
+    cl_uint head = 0, tail = 0, next_patch = 0, dice_count = 0, hungry = static_cast<cl_uint>(launch);
     for (;;) {
       cl_uint c[kCounters] = {head, tail, next_patch, dice_count, 0, 0, 0, 0};
       queue.enqueueWriteBuffer(ws.counters, CL_FALSE, 0, sizeof c, c);
       step.setArg(9, head);
       step.setArg(10, tail);
-      // Hand out at most as many children as there were idle workers.
+      // Hand out at most as many children as there will be idle workers.
       step.setArg(11, hungry);
       cl::Event e;
-      queue.enqueueNDRangeKernel(step, cl::NullRange, cl::NDRange(workers), cl::NDRange(64), nullptr, &e);
+      queue.enqueueNDRangeKernel(step, cl::NullRange, cl::NDRange(launch), cl::NDRange(64), nullptr, &e);
       ctx.timer.add(Stage::BoundSplit, e);
       ++result.launches;
       queue.enqueueReadBuffer(ws.counters, CL_TRUE, 0, sizeof c, c);
@@ -94,9 +101,12 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
       tail = std::min({c[kPoolTail], tail + hungry, head0 + ring_capacity});
       next_patch = std::min(c[kNextPatch], patch_count);
       dice_count = std::min(c[kDiceCount], dice_capacity);
-      hungry = c[kIdle];
+      const size_t busy = c[kBusy];
+      const size_t pending = (tail - head) + (patch_count - next_patch);
+      launch = whole_groups(std::max<size_t>(c[kMaxBusy], 2 * busy + pending));
+      hungry = static_cast<cl_uint>(launch > busy ? launch - busy : 0);
       if (head == tail) head = tail = 0;  // keep ring indices small
-      bool done = c[kBusy] == 0 && head == tail && next_patch >= patch_count;
+      bool done = busy == 0 && head == tail && next_patch >= patch_count;
       if (dice_count == dice_capacity || (done && dice_count > 0)) {
         ctx.sink(ws.diceable, dice_count);
         dice_count = 0;
