@@ -71,6 +71,9 @@ class Renderer {
 
   const DeviceInfo& device() const;
   RenderResult render(const Scene& scene, const ProgressCallback& progress = {});
+  // Same, into `out`, reusing its memory: a caller that renders many frames
+  // of one size pays for allocating (and faulting in) the image only once.
+  void render(const Scene& scene, RenderResult& out, const ProgressCallback& progress = {});
 
  private:
   struct Impl;

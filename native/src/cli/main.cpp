@@ -112,7 +112,7 @@ int main(int argc, char** argv) {
     mp::RenderResult result;
     std::string all_stats;
     for (int i = 0; i < o.repeat; ++i) {
-      result = renderer.render(scene);
+      renderer.render(scene, result);  // reuses the image memory across --repeat
       if (o.repeat > 1) all_stats += (i ? ",\n" : "[\n") + result.stats.to_json();
     }
     if (o.repeat > 1) all_stats += "]\n";

@@ -200,7 +200,10 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
   } else {
     session_.queue().enqueueReadBuffer(rgba_, CL_FALSE, 0, rgba_bytes, out.rgba.data());
   }
-  if (passes) {
+  if (!passes) {
+    out.depth.clear();
+    out.normal.clear();
+  } else {
     out.depth.resize(pixels);
     out.normal.resize(pixels * 3);
     session_.queue().enqueueReadBuffer(depth_, CL_FALSE, 0, pixels * sizeof(cl_float), out.depth.data());

@@ -45,10 +45,16 @@ Renderer::~Renderer() = default;
 const DeviceInfo& Renderer::device() const { return impl_->session.info(); }
 
 RenderResult Renderer::render(const Scene& scene, const ProgressCallback& progress) {
+  RenderResult out;
+  render(scene, out, progress);
+  return out;
+}
+
+void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallback& progress) {
   validate_scene(scene);
   auto t_start = std::chrono::steady_clock::now();
   DeviceSession& s = impl_->session;
-  RenderResult out;
+  out.stats = RenderStats{};
   RenderStats& st = out.stats;
   st.device = s.info().name;
   if (impl_->first_render) {
@@ -118,7 +124,6 @@ RenderResult Renderer::render(const Scene& scene, const ProgressCallback& progre
   }
   st.timings_ms.total = ms_since(t_start);
   if (progress) progress(1.0f);
-  return out;
 }
 
 }  // namespace mp
