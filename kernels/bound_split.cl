@@ -87,6 +87,9 @@ __kernel void bs_bounded_step(__global const float4* points, __global const uint
   __global SubPatch* stack = stacks + (ulong)w * stack_depth;
   uint size = stack_sizes[w];
   for (uint step = 0; step < steps; ++step) {
+    /* Once this batch of diceable sub-patches is full, stop before doing work
+     * that would only be repeated after the flush. */
+    if (counters[BS_DICE_COUNT] >= dice_capacity) break;
     if (size == 0u) {
       /* Refill: first from work that others handed out, then from the input. */
       uint r = atomic_inc(&counters[BS_POOL_HEAD]);

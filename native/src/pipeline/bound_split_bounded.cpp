@@ -79,8 +79,11 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
     step.setArg(15, kStepsPerLaunch);
 
     auto whole_groups = [&](size_t n) { return std::min(workers, std::max<size_t>(64, (n + 63) / 64 * 64)); };
+    // More workers than a few dice batches' worth would mostly hold work they
+    // cannot hand on until the next flush, so growth stops there.
+    const size_t useful = 4 * static_cast<size_t>(dice_capacity);
     const cl_uint patch_count = ctx.scene.patch_count;
-    size_t launch = whole_groups(patch_count);
+    size_t launch = whole_groups(std::min<size_t>(patch_count, useful));
     cl_uint head = 0, tail = 0, next_patch = 0, dice_count = 0, hungry = static_cast<cl_uint>(launch);
     for (;;) {
       cl_uint c[kCounters] = {head, tail, next_patch, dice_count, 0, 0, 0, 0};
@@ -103,7 +106,7 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
       dice_count = std::min(c[kDiceCount], dice_capacity);
       const size_t busy = c[kBusy];
       const size_t pending = (tail - head) + (patch_count - next_patch);
-      launch = whole_groups(std::max<size_t>(c[kMaxBusy], 2 * busy + pending));
+      launch = whole_groups(std::max<size_t>(c[kMaxBusy], std::min(2 * busy + pending, useful)));
       hungry = static_cast<cl_uint>(launch > busy ? launch - busy : 0);
       if (head == tail) head = tail = 0;  // keep ring indices small
       bool done = busy == 0 && head == tail && next_patch >= patch_count;
