@@ -27,16 +27,10 @@ __kernel void dice_grids(__global const SubPatch* diceable, uint count,
                          __global const float4* points, __global const uint* patch_info,
                          FrameParams f, __global float4* grid_p, __global float4* grid_n,
                          volatile __global uint* micropolygon_count) {
-  uint stride = (uint)f.max_grid + 1u;
-  uint slot_size = stride * stride;
-  uint gid = get_global_id(0);
-  uint slot = gid / slot_size;
-  if (slot >= count) return;
-  uint local_index = gid - slot * slot_size;
-  uint i = local_index % stride, j = local_index / stride;
-  SubPatch sp = diceable[slot];
+  uint gid = get_global_id(0), i, j;
+  SubPatch sp;
+  if (!mp_grid_vertex(gid, count, f.max_grid, diceable, &sp, &i, &j)) return;
   uint nu = MP_INFO_NU(sp.info), nv = MP_INFO_NV(sp.info);
-  if (i > nu || j > nv) return;
   if (i == 0u && j == 0u) atomic_add(micropolygon_count, nu * nv);
   float u = i == nu ? sp.u1 : sp.u0 + (sp.u1 - sp.u0) * ((float)i / (float)nu);
   float v = j == nv ? sp.v1 : sp.v0 + (sp.v1 - sp.v0) * ((float)j / (float)nv);
