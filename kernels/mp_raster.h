@@ -37,8 +37,9 @@ MP_INLINE uint mp_sample_offset_packed(int tx, int ty, int s, FrameParams f) {
   return (ox < 255u ? ox : 255u) | ((oy < 255u ? oy : 255u) << 8);
 }
 
-MP_INLINE MpFixed2 mp_sample_position(int px, int py, int s, int spp, const MP_GLOBAL ushort* offsets) {
-  uint o = offsets[((py & (MP_SAMPLE_TILE - 1)) * MP_SAMPLE_TILE + (px & (MP_SAMPLE_TILE - 1))) * spp + s];
+MP_INLINE MpFixed2 mp_sample_position(int px, int py, int s, int spp, FrameParams f, const MP_GLOBAL ushort* offsets) {
+  int tx = (px + f.crop_x0) & (MP_SAMPLE_TILE - 1), ty = (py + f.crop_y0) & (MP_SAMPLE_TILE - 1);
+  uint o = offsets[(ty * MP_SAMPLE_TILE + tx) * spp + s];
   MpFixed2 p;
   p.x = (long)px * MP_SUBPIXEL_ONE + (long)(o & 0xffu);
   p.y = (long)py * MP_SUBPIXEL_ONE + (long)(o >> 8);

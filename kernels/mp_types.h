@@ -54,6 +54,7 @@ typedef struct {
   float eye_epsilon;        /* bounds nearer than this straddle the eye plane */
   int backface_culling;
   uint seed;
+  int crop_x0, crop_y0;     /* crop origin in the whole image: sample patterns follow whole-image pixels */
 } FrameParams;
 
 /* Materials (see scene.h): color.w = model (0 constant, 1 matte, 2 plastic). */

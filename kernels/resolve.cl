@@ -30,7 +30,7 @@ __kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width,
   for (int qy = max(py - reach, 0); qy <= min(py + reach, f.height - 1); ++qy)
     for (int qx = max(px - reach, 0); qx <= min(px + reach, f.width - 1); ++qx)
       for (int s = 0; s < spp; ++s) {
-        MpFixed2 q = mp_sample_position(qx, qy, s, spp, offsets);
+        MpFixed2 q = mp_sample_position(qx, qy, s, spp, f, offsets);
         float dx = (float)q.x / (float)MP_SUBPIXEL_ONE - cx, dy = (float)q.y / (float)MP_SUBPIXEL_ONE - cy;
         float w = mp_filter_weight(filter_type, dx, dy, filter_width);
         if (w <= 0.0f) continue;

@@ -89,7 +89,7 @@ inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVerte
   for (int py = py0; py <= py1; ++py)
     for (int px = px0; px <= px1; ++px)
       for (int s = 0; s < spp; ++s) {
-        MpFixed2 q = mp_sample_position(px, py, s, spp, offsets);
+        MpFixed2 q = mp_sample_position(px, py, s, spp, f, offsets);
         if (q.x < xmin || q.x > xmax || q.y < ymin || q.y > ymax) continue;
         float la, lb, lc;
         int k = 0;

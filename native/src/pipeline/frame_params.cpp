@@ -52,6 +52,8 @@ FrameSetup make_frame_setup(const Scene& scene) {
   f.eye_epsilon = std::max(0.5f * f.clip_near, 1e-6f);
   f.backface_culling = s.backface_culling ? 1 : 0;
   f.seed = 0u;
+  f.crop_x0 = out.crop_x0;
+  f.crop_y0 = out.crop_y0;
   out.camera_to_world = glm::transpose(glm::mat3(cam.world_to_camera));  // rotation part inverse
   return out;
 }
