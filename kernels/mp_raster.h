@@ -97,6 +97,14 @@ MP_INLINE float3 mp_decode_normal(uint e) {
 #define MP_FILTER_BOX 0
 #define MP_FILTER_GAUSSIAN 1
 #define MP_FILTER_TRIANGLE 2
+#define MP_FILTER_BLACKMAN_HARRIS 3
+
+/* Blackman-Harris window over [-width/2, width/2] (Harris 1978), the pixel
+ * filter Cycles uses by default; separable. */
+MP_INLINE float mp_blackman_harris(float x, float width) {
+  float t = 2.0f * 3.14159265f * (x / width + 0.5f);
+  return 0.35875f - 0.48829f * cos(t) + 0.14128f * cos(2.0f * t) - 0.01168f * cos(3.0f * t);
+}
 
 MP_INLINE float mp_filter_weight(int type, float x, float y, float width) {
   float h = 0.5f * width;
@@ -106,6 +114,7 @@ MP_INLINE float mp_filter_weight(int type, float x, float y, float width) {
     return exp(-2.0f * (sx * sx + sy * sy));
   }
   if (type == MP_FILTER_TRIANGLE) return (1.0f - fabs(x) / h) * (1.0f - fabs(y) / h);
+  if (type == MP_FILTER_BLACKMAN_HARRIS) return mp_blackman_harris(x, width) * mp_blackman_harris(y, width);
   return 1.0f;
 }
 

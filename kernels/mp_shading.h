@@ -1,11 +1,17 @@
-/* Surface shading after RenderMan's standard shaders (RenderMan Interface
- * Specification 3.2, appendix A: constant, matte, plastic) and its light
- * shaders (ambientlight, distantlight, pointlight, spotlight). Camera space. */
+/* Surface shading. Constant, matte and plastic follow RenderMan's standard
+ * shaders (RenderMan Interface Specification 3.2, appendix A) and its light
+ * shaders; principled follows Blender's Principled BSDF in physical units
+ * (Lambert + GGX with Smith masking and Schlick Fresnel; Walter et al. 2007).
+ * Everything is in camera space. */
 #ifndef MP_SHADING_H
 #define MP_SHADING_H
 
 #include "mp_compat.h"
 #include "mp_types.h"
+
+#define MP_PI 3.14159265358979f
+#define MP_AREA_MAX_VERTICES 18  /* a 16-gon plus one vertex from horizon clipping, plus slack */
+#define MP_ELLIPSE_SIDES 16
 
 MP_INLINE float mp_smoothstep(float e0, float e1, float x) {
   if (e1 <= e0) return x >= e1 ? 1.0f : 0.0f;
@@ -13,49 +19,135 @@ MP_INLINE float mp_smoothstep(float e0, float e1, float x) {
   return t * t * (3.0f - 2.0f * t);
 }
 
-/* Radiance-like color leaving point p with normal n towards the eye. */
+MP_INLINE float3 mp_light_f3(const MP_GLOBAL float* v) { return MP_F3(v[0], v[1], v[2]); }
+
+/* Irradiance factor of a uniformly emitting polygon seen from a point with
+ * normal n (vertices relative to the point): the polygon's projected solid
+ * angle, by Lambert's formula, after clipping the polygon to the hemisphere
+ * above the surface. Multiplied by the emitted radiance it is the irradiance. */
+MP_INLINE float mp_polygon_irradiance(float3 n, float3* v, int count) {
+  float3 clipped[MP_AREA_MAX_VERTICES];
+  int m = 0;
+  for (int i = 0; i < count; ++i) {
+    float3 a = v[i], b = v[(i + 1) % count];
+    float da = dot(n, a), db = dot(n, b);
+    if (da >= 0.0f && m < MP_AREA_MAX_VERTICES) clipped[m++] = a;
+    if ((da >= 0.0f) != (db >= 0.0f) && m < MP_AREA_MAX_VERTICES) clipped[m++] = a + (b - a) * (da / (da - db));
+  }
+  if (m < 3) return 0.0f;
+  float sum = 0.0f;
+  for (int i = 0; i < m; ++i) {
+    float la = length(clipped[i]), lb = length(clipped[(i + 1) % m]);
+    if (!(la > 0.0f) || !(lb > 0.0f)) continue;
+    float3 ua = clipped[i] / la, ub = clipped[(i + 1) % m] / lb;
+    float3 c = cross(ua, ub);
+    float lc = length(c);
+    if (!(lc > 1e-12f)) continue;
+    float angle = acos(clamp(dot(ua, ub), -1.0f, 1.0f));
+    sum += angle * dot(n, c / lc);
+  }
+  return 0.5f * fabs(sum);
+}
+
+/* Irradiance at p (normal n) from an area light, and the direction to its centre. */
+MP_INLINE float mp_area_irradiance(MP_GLOBAL const DeviceLight* lt, float3 p, float3 n, float3* to_centre) {
+  float3 c = mp_light_f3(lt->position), dir = mp_light_f3(lt->direction);
+  float3 u = mp_light_f3(lt->axis_u), w = mp_light_f3(lt->axis_v);
+  *to_centre = normalize(c - p);
+  if (dot(p - c, dir) <= 0.0f) return 0.0f; /* behind the emitting side */
+  float3 verts[MP_AREA_MAX_VERTICES];
+  int count;
+  if (lt->axis_u[3] == (float)MP_AREA_ELLIPSE) {
+    /* A 16-gon with the ellipse's area. */
+    float k = sqrt(MP_PI / (0.5f * (float)MP_ELLIPSE_SIDES * sin(2.0f * MP_PI / (float)MP_ELLIPSE_SIDES)));
+    for (int i = 0; i < MP_ELLIPSE_SIDES; ++i) {
+      float a = 2.0f * MP_PI * (float)i / (float)MP_ELLIPSE_SIDES;
+      verts[i] = c + k * (cos(a) * u + sin(a) * w) - p;
+    }
+    count = MP_ELLIPSE_SIDES;
+  } else {
+    verts[0] = c - u - w - p;
+    verts[1] = c + u - w - p;
+    verts[2] = c + u + w - p;
+    verts[3] = c - u + w - p;
+    count = 4;
+  }
+  return mp_polygon_irradiance(n, verts, count);
+}
+
+/* GGX / Trowbridge-Reitz with Smith's separable masking-shadowing. */
+MP_INLINE float mp_ggx_specular(float3 n, float3 l, float3 v, float alpha) {
+  float3 h = normalize(l + v);
+  float nh = fmax(dot(n, h), 0.0f), nl = fmax(dot(n, l), 1e-6f), nv = fmax(dot(n, v), 1e-6f);
+  float a2 = fmax(alpha * alpha, 1e-7f);
+  float d = nh * nh * (a2 - 1.0f) + 1.0f;
+  float D = a2 / (MP_PI * d * d);
+  float gl = 2.0f * nl / (nl + sqrt(a2 + (1.0f - a2) * nl * nl));
+  float gv = 2.0f * nv / (nv + sqrt(a2 + (1.0f - a2) * nv * nv));
+  return D * gl * gv / (4.0f * nl * nv);
+}
+
+/* Radiance leaving point p with normal n towards the eye. */
 MP_INLINE float3 mp_shade(float3 p, float3 n, int ortho, MP_GLOBAL const DeviceMaterial* m,
                           MP_GLOBAL const DeviceLight* lights, uint light_count) {
   float3 cs = MP_F3(m->color[0], m->color[1], m->color[2]);
   float3 emission = MP_F3(m->emission[0], m->emission[1], m->emission[2]);
   int model = (int)m->color[3];
-  if (model == 0) return cs + emission;
+  if (model == MP_MODEL_CONSTANT) return cs + emission;
   float3 v = ortho ? MP_F3(0.0f, 0.0f, 1.0f) : normalize(-p);
   float3 nf = dot(n, v) < 0.0f ? -n : n; /* faceforward */
-  float ka = m->coeffs[0], kd = m->coeffs[1], ks = m->coeffs[2];
-  float inv_roughness = 1.0f / fmax(m->coeffs[3], 1e-4f);
+  float ka = m->coeffs[0], kd = m->coeffs[1], ks = m->coeffs[2], roughness = m->coeffs[3];
+  float inv_roughness = 1.0f / fmax(roughness, 1e-4f);
+  float metallic = m->principled[0];
+  float alpha = fmax(roughness * roughness, 1e-3f);
+  float3 f0 = (1.0f - metallic) * MP_F3(0.08f, 0.08f, 0.08f) * m->principled[1] + metallic * cs;
   float3 ambient = MP_F3(0.0f, 0.0f, 0.0f), diffuse = ambient, specular = ambient;
   for (uint k = 0; k < light_count; ++k) {
     MP_GLOBAL const DeviceLight* lt = lights + k;
-    float3 cl = MP_F3(lt->color[0], lt->color[1], lt->color[2]);
+    float3 cl = mp_light_f3(lt->color);
     int type = (int)lt->color[3];
     if (type == MP_LIGHT_AMBIENT) {
       ambient += cl;
       continue;
     }
     float3 l;
-    if (type == MP_LIGHT_DISTANT) {
-      l = -MP_F3(lt->direction[0], lt->direction[1], lt->direction[2]);
+    float3 e; /* light color times cos(incidence), i.e. irradiance for physical lights */
+    if (type == MP_LIGHT_AREA) {
+      e = cl * mp_area_irradiance(lt, p, nf, &l);
     } else {
-      float3 to_light = MP_F3(lt->position[0], lt->position[1], lt->position[2]) - p;
-      float d2 = fmax(dot(to_light, to_light), 1e-20f);
-      l = to_light / sqrt(d2);
-      float atten = 1.0f / d2;
-      if (type == MP_LIGHT_SPOT) {
-        float cosangle = -dot(l, MP_F3(lt->direction[0], lt->direction[1], lt->direction[2]));
-        atten *= cosangle > 0.0f ? pow(cosangle, lt->cone[2]) : 0.0f;
-        atten *= mp_smoothstep(lt->cone[0], lt->cone[1], cosangle);
+      if (type == MP_LIGHT_DISTANT) {
+        l = -mp_light_f3(lt->direction);
+      } else {
+        float3 to_light = mp_light_f3(lt->position) - p;
+        float d2 = fmax(dot(to_light, to_light), 1e-20f);
+        l = to_light / sqrt(d2);
+        float atten = 1.0f / d2;
+        if (type == MP_LIGHT_SPOT) {
+          float cosangle = -dot(l, mp_light_f3(lt->direction));
+          atten *= cosangle > 0.0f ? pow(cosangle, lt->cone[2]) : 0.0f;
+          atten *= mp_smoothstep(lt->cone[0], lt->cone[1], cosangle);
+        }
+        cl *= atten;
       }
-      cl *= atten;
+      e = cl * fmax(dot(nf, l), 0.0f);
     }
-    float ndotl = dot(nf, l);
-    if (ndotl <= 0.0f) continue;
-    diffuse += cl * ndotl;
-    float3 h = normalize(l + v);
-    specular += cl * pow(fmax(dot(nf, h), 0.0f), inv_roughness);
+    if (!(e.x > 0.0f || e.y > 0.0f || e.z > 0.0f)) continue;
+    diffuse += e;
+    if (model == MP_MODEL_PRINCIPLED) {
+      float vh = fmax(dot(v, normalize(l + v)), 0.0f);
+      float3 fresnel = f0 + (MP_F3(1.0f, 1.0f, 1.0f) - f0) * pow(1.0f - vh, 5.0f);
+      specular += e * fresnel * mp_ggx_specular(nf, l, v, alpha);
+    } else
+      specular += (e / fmax(dot(nf, l), 1e-6f)) * pow(fmax(dot(nf, normalize(l + v)), 0.0f), inv_roughness);
+  }
+  if (model == MP_MODEL_PRINCIPLED) {
+    /* Lambert: albedo / pi per unit irradiance; a uniform ambient radiance A
+     * gives irradiance pi A, so the diffuse response to it is albedo * A. */
+    float3 albedo = cs * (1.0f - metallic);
+    return albedo * (diffuse * (1.0f / MP_PI) + ambient) + specular + f0 * ambient + emission;
   }
   float3 c = cs * (ka * ambient + kd * diffuse);
-  if (model == 2) c += MP_F3(m->specular[0], m->specular[1], m->specular[2]) * (ks * specular);
+  if (model == MP_MODEL_PLASTIC) c += MP_F3(m->specular[0], m->specular[1], m->specular[2]) * (ks * specular);
   return c + emission;
 }
 

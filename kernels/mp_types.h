@@ -57,26 +57,36 @@ typedef struct {
   int crop_x0, crop_y0;     /* crop origin in the whole image: sample patterns follow whole-image pixels */
 } FrameParams;
 
-/* Materials (see scene.h): color.w = model (0 constant, 1 matte, 2 plastic). */
+/* Materials (see scene.h): color.w = model. */
+#define MP_MODEL_CONSTANT 0
+#define MP_MODEL_MATTE 1
+#define MP_MODEL_PLASTIC 2
+#define MP_MODEL_PRINCIPLED 3
 typedef struct {
   float color[4];
   float opacity[4];         /* rgb, w = average used for stochastic coverage */
   float coeffs[4];          /* ka, kd, ks, roughness */
-  float specular[4];
+  float specular[4];        /* specular color (plastic) */
   float emission[4];
+  float principled[4];      /* metallic, specular, 0, 0 */
 } DeviceMaterial;
 
 #define MP_LIGHT_AMBIENT 0
 #define MP_LIGHT_DISTANT 1
 #define MP_LIGHT_POINT 2
 #define MP_LIGHT_SPOT 3
+#define MP_LIGHT_AREA 4
+#define MP_AREA_RECTANGLE 0
+#define MP_AREA_ELLIPSE 1
 
-/* Lights in camera space. */
+/* Lights in camera space (units: scene.h). */
 typedef struct {
   float color[4];           /* rgb * intensity, w = type */
   float position[4];
   float direction[4];       /* unit direction the light travels */
   float cone[4];            /* cos(outer), cos(inner), beam distribution, 0 */
+  float axis_u[4];          /* area: half extent along u, w = shape */
+  float axis_v[4];          /* area: half extent along v */
 } DeviceLight;
 
 #endif

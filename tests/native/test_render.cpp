@@ -16,11 +16,22 @@ namespace {
 
 class RenderTest : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() { renderer_ = std::make_unique<Renderer>(); }
+  // One renderer (one kernel build) for the suite. A failure to create it must
+  // fail every test, not skip them.
+  static void SetUpTestSuite() {
+    try {
+      renderer_ = std::make_unique<Renderer>();
+    } catch (const std::exception& e) {
+      setup_error_ = e.what();
+    }
+  }
   static void TearDownTestSuite() { renderer_.reset(); }
+  void SetUp() override { ASSERT_TRUE(renderer_) << "no renderer: " << setup_error_; }
   static std::unique_ptr<Renderer> renderer_;
+  static std::string setup_error_;
 };
 std::unique_ptr<Renderer> RenderTest::renderer_;
+std::string RenderTest::setup_error_;
 
 double coverage(const RenderResult& r) {
   double sum = 0;

@@ -43,25 +43,37 @@ struct BezierPatches {
   bool double_sided = true;
 };
 
-// Shading follows RenderMan's shaders: constant (Cs), matte (Ka, Kd) and
-// plastic (Ka, Kd, Ks, roughness, specularcolor); emission is added as is.
+// Materials. Constant, Matte and Plastic follow RenderMan's shaders (Cs,
+// Ka, Kd, Ks, roughness, specularcolor; no 1/pi in the diffuse term).
+// Principled follows Blender's Principled BSDF in physical units: a
+// Lambertian lobe of albedo color * (1 - metallic) (1/pi included) and a GGX
+// lobe with Schlick Fresnel, F0 = 0.08 * specular for dielectrics, tinted by
+// color for metals, alpha = roughness^2. Emission is added as is (radiance).
 struct Material {
-  enum class Model { Constant, Matte, Plastic };
+  enum class Model { Constant, Matte, Plastic, Principled };
   std::string name;
   Model model = Model::Plastic;
   glm::vec3 color{1.0f};
   glm::vec3 opacity{1.0f};
   float ka = 1.0f, kd = 0.5f, ks = 0.5f, roughness = 0.1f;
   glm::vec3 specular_color{1.0f};
+  float metallic = 0.0f;   // Principled only
+  float specular = 0.5f;   // Principled only
   glm::vec3 emission{0.0f};
 };
 
-// Light sources in world space, with RenderMan's light shader semantics:
-// point and spot fall off with 1/d^2; the spot cone blends from cone_angle -
-// cone_delta_angle to cone_angle (half-angles, radians) and is raised to
-// beam_distribution.
+// Light sources in world space. For point and spot lights color * intensity
+// is the radiant intensity (the 1/d^2 falloff is applied); for distant lights
+// the irradiance on a surface facing them; for ambient lights the incoming
+// radiance from every direction; for area lights the radiance leaving the
+// emitting side (the side `direction` points to). The spot cone blends
+// smoothly from cone_angle - cone_delta_angle to cone_angle (half-angles,
+// radians) and is raised to beam_distribution, as RenderMan's spotlight.
+// Area lights are rectangles or ellipses centred on `position`, with
+// `size_u` along `axis_u` and `size_v` along direction x axis_u.
 struct Light {
-  enum class Type { Ambient, Distant, Point, Spot };
+  enum class Type { Ambient, Distant, Point, Spot, Area };
+  enum class Shape { Rectangle, Ellipse };
   Type type = Type::Point;
   glm::vec3 color{1.0f};
   float intensity = 1.0f;
@@ -70,6 +82,9 @@ struct Light {
   float cone_angle = 0.5235988f;           // 30 degrees
   float cone_delta_angle = 0.0872665f;     // 5 degrees
   float beam_distribution = 2.0f;
+  Shape shape = Shape::Rectangle;          // area lights
+  glm::vec3 axis_u{1.0f, 0.0f, 0.0f};
+  float size_u = 1.0f, size_v = 1.0f;
 };
 
 // Camera: right-handed camera space, looking down -Z with +Y up (Blender's
@@ -88,7 +103,7 @@ struct Camera {
   float clip_far = 1.0e30f;
 };
 
-enum class PixelFilter { Box, Gaussian, Triangle };
+enum class PixelFilter { Box, Gaussian, Triangle, BlackmanHarris };
 enum class BoundSplitMethod { Bounded, Breadth };
 
 struct RenderSettings {

@@ -161,7 +161,10 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
     normal_ = cl::Buffer(session_.context(), CL_MEM_WRITE_ONLY, pixels * 3 * sizeof(cl_float));
     pixels_ = pixels;
   }
-  int type = filter == PixelFilter::Box ? MP_FILTER_BOX : filter == PixelFilter::Gaussian ? MP_FILTER_GAUSSIAN : MP_FILTER_TRIANGLE;
+  int type = filter == PixelFilter::Box        ? MP_FILTER_BOX
+             : filter == PixelFilter::Gaussian ? MP_FILTER_GAUSSIAN
+             : filter == PixelFilter::Triangle ? MP_FILTER_TRIANGLE
+                                               : MP_FILTER_BLACKMAN_HARRIS;
   auto row = [&](int i) {
     glm::vec3 r = glm::vec3(frame.camera_to_world[0][i], frame.camera_to_world[1][i], frame.camera_to_world[2][i]);
     return cl_float4{{r.x, r.y, r.z, 0.0f}};

@@ -12,13 +12,18 @@ void put(float* dst, glm::vec3 v, float w) {
 
 DeviceMaterial to_device(const Material& m) {
   DeviceMaterial d{};
-  float model = m.model == Material::Model::Constant ? 0.0f : m.model == Material::Model::Matte ? 1.0f : 2.0f;
+  float model = m.model == Material::Model::Constant ? MP_MODEL_CONSTANT
+                : m.model == Material::Model::Matte  ? MP_MODEL_MATTE
+                : m.model == Material::Model::Plastic ? MP_MODEL_PLASTIC
+                                                      : MP_MODEL_PRINCIPLED;
   put(d.color, m.color, model);
   float avg = std::clamp((m.opacity.x + m.opacity.y + m.opacity.z) / 3.0f, 0.0f, 1.0f);
   put(d.opacity, m.opacity, avg);
   d.coeffs[0] = m.ka, d.coeffs[1] = m.kd, d.coeffs[2] = m.ks, d.coeffs[3] = m.roughness;
   put(d.specular, m.specular_color, 0.0f);
   put(d.emission, m.emission, 0.0f);
+  d.principled[0] = std::clamp(m.metallic, 0.0f, 1.0f);
+  d.principled[1] = std::max(m.specular, 0.0f);
   return d;
 }
 
@@ -27,7 +32,8 @@ DeviceLight to_device(const Light& l, const glm::mat4& world_to_camera) {
   int type = l.type == Light::Type::Ambient   ? MP_LIGHT_AMBIENT
              : l.type == Light::Type::Distant ? MP_LIGHT_DISTANT
              : l.type == Light::Type::Point   ? MP_LIGHT_POINT
-                                              : MP_LIGHT_SPOT;
+             : l.type == Light::Type::Spot    ? MP_LIGHT_SPOT
+                                              : MP_LIGHT_AREA;
   put(d.color, l.color * l.intensity, static_cast<float>(type));
   put(d.position, glm::vec3(world_to_camera * glm::vec4(l.position, 1.0f)), 1.0f);
   glm::vec3 dir = glm::vec3(world_to_camera * glm::vec4(l.direction, 0.0f));
@@ -36,6 +42,18 @@ DeviceLight to_device(const Light& l, const glm::mat4& world_to_camera) {
   float outer = std::clamp(l.cone_angle, 0.0f, 3.14159265f);
   float inner = std::clamp(l.cone_angle - l.cone_delta_angle, 0.0f, outer);
   d.cone[0] = std::cos(outer), d.cone[1] = std::cos(inner), d.cone[2] = l.beam_distribution, d.cone[3] = 0.0f;
+  if (l.type == Light::Type::Area) {
+    // Half extents in camera space; v completes a right-handed frame with the
+    // emission direction.
+    glm::vec3 n = glm::normalize(glm::vec3(l.direction));
+    glm::vec3 u = l.axis_u - n * glm::dot(l.axis_u, n);
+    u = glm::length(u) > 0.0f ? glm::normalize(u) : glm::normalize(glm::cross(n, glm::vec3(n.z, n.x, n.y)));
+    glm::vec3 v = glm::cross(n, u);
+    glm::vec3 hu = glm::vec3(world_to_camera * glm::vec4(u * (0.5f * l.size_u), 0.0f));
+    glm::vec3 hv = glm::vec3(world_to_camera * glm::vec4(v * (0.5f * l.size_v), 0.0f));
+    put(d.axis_u, hu, l.shape == Light::Shape::Ellipse ? float(MP_AREA_ELLIPSE) : float(MP_AREA_RECTANGLE));
+    put(d.axis_v, hv, 0.0f);
+  }
   return d;
 }
 

@@ -15,6 +15,9 @@
 namespace py = pybind11;
 using namespace mp;
 
+// Bindings kept in files of their own (native/src/python/bind_*.cpp).
+void bind_rib(py::module_& m);
+
 namespace {
 
 template <typename T>
@@ -96,7 +99,8 @@ PYBIND11_MODULE(_native, m) {
   py::enum_<PixelFilter>(m, "PixelFilter")
       .value("BOX", PixelFilter::Box)
       .value("GAUSSIAN", PixelFilter::Gaussian)
-      .value("TRIANGLE", PixelFilter::Triangle);
+      .value("TRIANGLE", PixelFilter::Triangle)
+      .value("BLACKMAN_HARRIS", PixelFilter::BlackmanHarris);
   py::enum_<BoundSplitMethod>(m, "BoundSplitMethod")
       .value("BOUNDED", BoundSplitMethod::Bounded)
       .value("BREADTH", BoundSplitMethod::Breadth);
@@ -150,35 +154,46 @@ PYBIND11_MODULE(_native, m) {
           "add_material",
           [](Scene& s, const std::string& name, const std::string& model, std::vector<float> color,
              std::vector<float> opacity, float ka, float kd, float ks, float roughness, std::vector<float> specular_color,
-             std::vector<float> emission) {
+             std::vector<float> emission, float metallic, float specular) {
             Material mat;
             mat.name = name;
             if (model == "constant") mat.model = Material::Model::Constant;
             else if (model == "matte") mat.model = Material::Model::Matte;
             else if (model == "plastic") mat.model = Material::Model::Plastic;
-            else throw Error("unknown material model '" + model + "' (constant, matte, plastic)");
+            else if (model == "principled") mat.model = Material::Model::Principled;
+            else throw Error("unknown material model '" + model + "' (constant, matte, plastic, principled)");
             mat.color = to_vec3(color, "color");
             mat.opacity = to_vec3(opacity, "opacity");
             mat.ka = ka, mat.kd = kd, mat.ks = ks, mat.roughness = roughness;
             mat.specular_color = to_vec3(specular_color, "specular_color");
             mat.emission = to_vec3(emission, "emission");
+            mat.metallic = metallic;
+            mat.specular = specular;
             s.materials.push_back(mat);
             return s.materials.size() - 1;
           },
           py::arg("name") = "", py::arg("model") = "plastic", py::arg("color") = std::vector<float>{1, 1, 1},
           py::arg("opacity") = std::vector<float>{1, 1, 1}, py::arg("ka") = 1.0f, py::arg("kd") = 0.5f,
           py::arg("ks") = 0.5f, py::arg("roughness") = 0.1f, py::arg("specular_color") = std::vector<float>{1, 1, 1},
-          py::arg("emission") = std::vector<float>{0, 0, 0}, "Adds a material; returns its index.")
+          py::arg("emission") = std::vector<float>{0, 0, 0}, py::arg("metallic") = 0.0f, py::arg("specular") = 0.5f,
+          "Adds a material (constant, matte, plastic or principled; see scene.h); returns its index.")
       .def(
           "add_light",
           [](Scene& s, const std::string& type, std::vector<float> color, float intensity, std::vector<float> position,
-             std::vector<float> direction, float cone_angle, float cone_delta_angle, float beam_distribution) {
+             std::vector<float> direction, float cone_angle, float cone_delta_angle, float beam_distribution,
+             const std::string& shape, std::vector<float> axis_u, float size_u, float size_v) {
             Light l;
             if (type == "ambient") l.type = Light::Type::Ambient;
             else if (type == "distant") l.type = Light::Type::Distant;
             else if (type == "point") l.type = Light::Type::Point;
             else if (type == "spot") l.type = Light::Type::Spot;
-            else throw Error("unknown light type '" + type + "' (ambient, distant, point, spot)");
+            else if (type == "area") l.type = Light::Type::Area;
+            else throw Error("unknown light type '" + type + "' (ambient, distant, point, spot, area)");
+            if (shape == "rectangle") l.shape = Light::Shape::Rectangle;
+            else if (shape == "ellipse") l.shape = Light::Shape::Ellipse;
+            else throw Error("unknown area light shape '" + shape + "' (rectangle, ellipse)");
+            l.axis_u = to_vec3(axis_u, "axis_u");
+            l.size_u = size_u, l.size_v = size_v;
             l.color = to_vec3(color, "color");
             l.intensity = intensity;
             l.position = to_vec3(position, "position");
@@ -188,7 +203,9 @@ PYBIND11_MODULE(_native, m) {
           },
           py::arg("type"), py::arg("color") = std::vector<float>{1, 1, 1}, py::arg("intensity") = 1.0f,
           py::arg("position") = std::vector<float>{0, 0, 0}, py::arg("direction") = std::vector<float>{0, 0, -1},
-          py::arg("cone_angle") = 0.5235988f, py::arg("cone_delta_angle") = 0.0872665f, py::arg("beam_distribution") = 2.0f)
+          py::arg("cone_angle") = 0.5235988f, py::arg("cone_delta_angle") = 0.0872665f, py::arg("beam_distribution") = 2.0f,
+          py::arg("shape") = "rectangle", py::arg("axis_u") = std::vector<float>{1, 0, 0}, py::arg("size_u") = 1.0f,
+          py::arg("size_v") = 1.0f, "Adds a light in world space (units: scene.h).")
       .def(
           "add_mesh",
           [](Scene& s, const std::string& name, const Array<float>& points, const Array<int>& face_vertex_counts,
@@ -229,8 +246,7 @@ PYBIND11_MODULE(_native, m) {
       .def_property_readonly("material_count", [](const Scene& s) { return s.materials.size(); })
       .def_property_readonly("light_count", [](const Scene& s) { return s.lights.size(); });
 
-  m.def("read_rib", [](const std::string& path) { return read_rib_file(path).scene; }, py::arg("path"),
-        "Reads a RIB file into a Scene.");
+  bind_rib(m);
 
   m.def("list_devices", [] {
     py::list out;

@@ -100,13 +100,14 @@ void validate_scene(const Scene& scene) {
   for (size_t i = 0; i < scene.materials.size(); ++i) {
     const Material& m = scene.materials[i];
     if (!finite(m.color) || !finite(m.opacity) || !finite(m.specular_color) || !finite(m.emission) ||
-        !std::isfinite(m.ka + m.kd + m.ks + m.roughness))
+        !std::isfinite(m.ka + m.kd + m.ks + m.roughness + m.metallic + m.specular))
       fail("material", m.name.empty() ? std::to_string(i) : m.name, "has NaN or infinite values");
   }
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     const Light& l = scene.lights[i];
     if (!finite(l.color) || !finite(l.position) || !finite(l.direction) || !std::isfinite(l.intensity) ||
-        !std::isfinite(l.cone_angle + l.cone_delta_angle + l.beam_distribution))
+        !std::isfinite(l.cone_angle + l.cone_delta_angle + l.beam_distribution) || !finite(l.axis_u) ||
+        !std::isfinite(l.size_u + l.size_v) || l.size_u < 0 || l.size_v < 0)
       fail("light", std::to_string(i), "has NaN or infinite values");
   }
   for (const Mesh& m : scene.meshes) validate_mesh(m, scene.materials.size());
