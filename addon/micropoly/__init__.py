@@ -17,14 +17,20 @@ bl_info = {
     "category": "Render",
 }
 
+_MODULES = ("properties", "preferences", "engine", "ui", "operators")
+
+
+def _modules():
+    import importlib
+
+    return [importlib.import_module(f".{name}", __package__) for name in _MODULES]
+
 
 def register():
-    from . import engine
-
-    engine.register()
+    for module in _modules():
+        module.register()
 
 
 def unregister():
-    from . import engine
-
-    engine.unregister()
+    for module in reversed(_modules()):
+        module.unregister()

@@ -1,18 +1,119 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""The Micropoly render engine as Blender sees it (registered by __init__)."""
+"""The Micropoly render engine as Blender sees it. The work happens in
+export.py (scene -> native arrays) and the native module; this file runs a
+render on a worker thread, keeps Blender informed, and writes the passes."""
+
+import threading
+import time
 
 import bpy
+import numpy as np
+
+from . import export, preferences
+
+PASSES = (("Depth", 1, "Z", "VALUE"), ("Normal", 3, "XYZ", "VECTOR"))
 
 
 class MicropolyRenderEngine(bpy.types.RenderEngine):
     bl_idname = "MICROPOLY"
     bl_label = "Micropoly"
     bl_use_preview = False
+    bl_use_postprocess = True
+
+    def update_render_passes(self, scene=None, renderlayer=None):
+        self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
+        if renderlayer.use_pass_z:
+            self.register_pass(scene, renderlayer, "Depth", 1, "Z", "VALUE")
+        if renderlayer.use_pass_normal:
+            self.register_pass(scene, renderlayer, "Normal", 3, "XYZ", "VECTOR")
 
     def render(self, depsgraph):
-        from . import render_session
+        try:
+            from . import _native
+        except ImportError as e:
+            self.report({"ERROR"}, f"Micropoly: the native module did not load: {e}")
+            return
+        scene = depsgraph.scene
+        view_layer = depsgraph.view_layer
+        try:
+            exported = export.export_scene(depsgraph, final=True)
+        except export.ExportError as e:
+            self.report({"ERROR"}, f"Micropoly: {e}")
+            return
+        for warning in exported.warnings:
+            self.report({"WARNING"}, f"Micropoly: {warning}")
+        native_scene = exported.scene
+        native_scene.settings.depth_and_normal_passes = view_layer.use_pass_z or view_layer.use_pass_normal
+        try:
+            renderer = _native.Renderer(preferences.device_selector(bpy.context))
+        except RuntimeError as e:
+            self.report({"ERROR"}, f"Micropoly: {e}")
+            return
+        self.update_stats("", f"Micropoly | {renderer.device} | {exported.summary}")
 
-        render_session.render_final(self, depsgraph)
+        outcome = {}
+        progress = {"value": 0.0}
+        cancel = threading.Event()
+
+        def on_progress(value):
+            progress["value"] = value
+            return not cancel.is_set()
+
+        def work():
+            try:
+                outcome["result"] = renderer.render(native_scene, on_progress)
+            except Exception as e:  # reported on the render thread below
+                outcome["error"] = e
+
+        worker = threading.Thread(target=work, name="micropoly-render", daemon=True)
+        started = time.perf_counter()
+        worker.start()
+        while worker.is_alive():
+            worker.join(0.05)
+            if self.test_break():
+                cancel.set()
+            self.update_progress(progress["value"])
+        if "error" in outcome:
+            self.report({"ERROR"}, f"Micropoly: {outcome['error']}")
+            return
+        result = outcome["result"]
+        stats = result["stats"]
+        if stats["cancelled"] or self.test_break():
+            return
+        self._write_result(scene, view_layer, exported, result)
+        mib = stats["bound_split_peak_bytes"] / 2**20
+        self.update_stats("", f"Micropoly | {stats['device']} | {stats['micropolygons']:,} micropolygons | "
+                              f"bound & split {mib:.1f} MiB | {time.perf_counter() - started:.2f} s")
+
+    def _write_result(self, scene, view_layer, exported, result):
+        rgba = result["rgba"]
+        height, width = rgba.shape[:2]
+        if not scene.render.film_transparent:
+            # An opaque film shows the world color behind objects, as Cycles does.
+            alpha = rgba[..., 3:4]
+            rgba = np.concatenate([rgba[..., :3] + (1.0 - alpha) * exported.background,
+                                   np.ones_like(alpha)], axis=-1)
+        x0, y0 = exported.crop_origin_bottom_left(width, height)
+        render_result = self.begin_result(x0, y0, width, height, layer=view_layer.name)
+        layer = render_result.layers[0]
+        _set_pass(layer, "Combined", rgba)
+        if view_layer.use_pass_z and "depth" in result:
+            _set_pass(layer, "Depth", result["depth"][..., None])
+        if view_layer.use_pass_normal and "normal" in result:
+            _set_pass(layer, "Normal", result["normal"])
+        self.end_result(render_result)
+
+
+def _set_pass(layer, name, pixels):
+    """Writes top-row-first pixels into a pass (Blender's rows run bottom up)."""
+    render_pass = layer.passes.find_by_name(name, "")
+    if render_pass is None:
+        return
+    flat = np.ascontiguousarray(pixels[::-1], dtype=np.float32).reshape(-1)
+    try:
+        render_pass.rect.foreach_set(flat)
+    except (AttributeError, TypeError):
+        render_pass.rect = flat.reshape(-1, pixels.shape[-1])
 
 
 def register():

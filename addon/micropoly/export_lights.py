@@ -1,0 +1,67 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Blender lights and world -> native lights, in Cycles' units.
+
+Native lights carry radiant intensity (point, spot), irradiance (sun) and
+radiance (area, ambient); the Principled material applies albedo / pi.
+Cycles: a point or spot light of power P emits P / (4 pi) W/sr; a sun of
+strength S gives irradiance S; an area light of power P and area A emits
+radiance P / (pi A) from its front (-Z) side. See docs/blender.md."""
+
+import math
+
+import numpy as np
+from mathutils import Vector
+
+
+def export_world(native_scene, world):
+    """The world's color as uniform ambient light; returns the background color."""
+    if world is None:
+        return np.zeros(3, dtype=np.float32)
+    color = np.array(list(world.color)[:3], dtype=np.float32)
+    if world.use_nodes and world.node_tree is not None:
+        background = next((n for n in world.node_tree.nodes if n.type == "BACKGROUND"), None)
+        if background is not None and not background.inputs["Color"].is_linked:
+            color = np.array(list(background.inputs["Color"].default_value)[:3], dtype=np.float32)
+            color *= float(background.inputs["Strength"].default_value)
+    if np.any(color > 0):
+        native_scene.add_light("ambient", color=color.tolist(), intensity=1.0)
+    return color
+
+
+def _spot_cone(spot_size, spot_blend):
+    """Cycles' spot mask: smoothstep from cos(size/2) over a blend of
+    (1 - cos(size/2)) * blend, written as RenderMan-style cone angles."""
+    outer = spot_size / 2.0
+    cos_outer = math.cos(outer)
+    cos_inner = min(1.0, cos_outer + (1.0 - cos_outer) * spot_blend)
+    return outer, outer - math.acos(cos_inner)
+
+
+def export_light(native_scene, obj, matrix, warnings):
+    light = obj.data
+    color = list(light.color)
+    position = list(matrix.translation)
+    rotation = matrix.to_3x3()
+    direction = list((rotation @ Vector((0.0, 0.0, -1.0))).normalized())
+    power = float(light.energy)
+    if light.type == "SUN":
+        native_scene.add_light("distant", color=color, intensity=power, direction=direction)
+    elif light.type == "POINT":
+        native_scene.add_light("point", color=color, intensity=power / (4.0 * math.pi), position=position)
+    elif light.type == "SPOT":
+        cone, delta = _spot_cone(light.spot_size, light.spot_blend)
+        native_scene.add_light("spot", color=color, intensity=power / (4.0 * math.pi), position=position,
+                               direction=direction, cone_angle=cone, cone_delta_angle=delta,
+                               beam_distribution=0.0)
+    elif light.type == "AREA":
+        scale = matrix.to_scale()
+        size_u = light.size * abs(scale.x)
+        size_v = (light.size_y if light.shape in ("RECTANGLE", "ELLIPSE") else light.size) * abs(scale.y)
+        area = size_u * size_v * (math.pi / 4.0 if light.shape in ("DISK", "ELLIPSE") else 1.0)
+        if area <= 0.0:
+            warnings.append(f"area light '{obj.name}' has no area and is skipped")
+            return
+        axis_u = list((rotation @ Vector((1.0, 0.0, 0.0))).normalized())
+        native_scene.add_light("area", color=color, intensity=power / (math.pi * area), position=position,
+                               direction=direction, shape="ellipse" if light.shape in ("DISK", "ELLIPSE")
+                               else "rectangle", axis_u=axis_u, size_u=size_u, size_v=size_v)

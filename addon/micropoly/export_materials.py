@@ -1,0 +1,73 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Blender materials -> native Principled materials.
+
+The node connected to the active Material Output's Surface socket decides:
+Principled BSDF and Diffuse BSDF give their constant inputs, an Emission
+shader gives emission; anything else falls back to the material's viewport
+color, metallic and roughness."""
+
+
+def _input(node, *names, default=None):
+    for name in names:
+        socket = node.inputs.get(name)
+        if socket is not None:
+            return socket.default_value
+    return default
+
+
+def _surface_node(material):
+    if not material.use_nodes or material.node_tree is None:
+        return None
+    outputs = [n for n in material.node_tree.nodes if n.type == "OUTPUT_MATERIAL"]
+    active = [n for n in outputs if n.is_active_output] or outputs
+    if not active:
+        return None
+    links = active[0].inputs["Surface"].links
+    return links[0].from_node if links else None
+
+
+def material_parameters(material):
+    """dict of add_material keyword arguments for a Blender material."""
+    params = dict(model="principled", color=[0.8, 0.8, 0.8], metallic=0.0, roughness=0.5, specular=0.5,
+                  emission=[0.0, 0.0, 0.0])
+    if material is None:
+        return params
+    node = _surface_node(material)
+    if node is None:
+        params.update(color=list(material.diffuse_color)[:3], metallic=float(material.metallic),
+                      roughness=float(material.roughness))
+    elif node.type == "BSDF_PRINCIPLED":
+        strength = float(_input(node, "Emission Strength", default=1.0))
+        emission = _input(node, "Emission Color", "Emission", default=(0, 0, 0, 1))
+        params.update(color=list(_input(node, "Base Color"))[:3], metallic=float(_input(node, "Metallic")),
+                      roughness=float(_input(node, "Roughness")),
+                      specular=float(_input(node, "Specular IOR Level", "Specular", default=0.5)),
+                      emission=[c * strength for c in list(emission)[:3]])
+    elif node.type == "BSDF_DIFFUSE":
+        params.update(color=list(_input(node, "Color"))[:3], specular=0.0, roughness=1.0)
+    elif node.type == "EMISSION":
+        strength = float(_input(node, "Strength", default=1.0))
+        params.update(color=[0.0, 0.0, 0.0], specular=0.0,
+                      emission=[c * strength for c in list(_input(node, "Color"))[:3]])
+    else:
+        params.update(color=list(material.diffuse_color)[:3], metallic=float(material.metallic),
+                      roughness=float(material.roughness))
+    return params
+
+
+class MaterialTable:
+    """One native material per Blender material; index 0 is Blender's default grey."""
+
+    def __init__(self, native_scene):
+        self.native = native_scene
+        self.index = {}
+        native_scene.add_material(name="default", **material_parameters(None))
+
+    def get(self, material):
+        if material is None:
+            return 0
+        key = material.name_full if hasattr(material, "name_full") else material.name
+        if key not in self.index:
+            self.native.add_material(name=key, **material_parameters(material))
+            self.index[key] = self.native.material_count - 1
+        return self.index[key]

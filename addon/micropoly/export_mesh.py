@@ -1,0 +1,121 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Mesh objects -> native meshes, through foreach_get and numpy only.
+
+An object whose last render-enabled modifier is a Catmull-Clark Subdivision
+Surface is rendered as the exact limit surface of the mesh under that
+modifier; its boundary setting and (when enabled) the mesh's edge and vertex
+creases are passed on. Everything else renders as flat polygons."""
+
+import numpy as np
+
+# Blender's crease values in [0, 1] become OpenSubdiv sharpness as Blender's
+# own OpenSubdiv integration maps them (docs/blender.md).
+CREASE_SHARPNESS_SCALE = 10.0
+
+
+def crease_to_sharpness(crease):
+    return crease * crease * CREASE_SHARPNESS_SCALE
+
+
+def _float_attribute(mesh, name, legacy_collection, legacy_property, size):
+    """A float attribute by its 4.x name, else through the 3.x property."""
+    attributes = getattr(mesh, "attributes", None)
+    attr = attributes.get(name) if attributes is not None else None
+    out = np.zeros(size, dtype=np.float32)
+    if attr is not None and attr.data_type == "FLOAT" and len(attr.data) == size:
+        attr.data.foreach_get("value", out)
+        return out
+    collection = legacy_collection(mesh)
+    if collection is not None and size:
+        try:
+            collection.foreach_get(legacy_property, out)
+            return out
+        except (AttributeError, TypeError, RuntimeError):
+            pass
+    return out
+
+
+def _vertex_crease_layer(mesh):
+    layers = getattr(mesh, "vertex_creases", None)  # Blender 3.x
+    return layers[0].data if layers else None
+
+
+def subdivision_modifier(obj):
+    """(modifier, is_only_modifier) when the object ends in a Catmull-Clark
+    Subdivision Surface modifier enabled for rendering, else (None, False)."""
+    original = obj.original
+    mods = [m for m in original.modifiers if m.show_render]
+    if mods and mods[-1].type == "SUBSURF" and mods[-1].subdivision_type == "CATMULL_CLARK":
+        return mods[-1], len(mods) == 1
+    return None, False
+
+
+class MeshCache:
+    """Arrays per mesh data-block, so instances of one mesh export it once."""
+
+    def __init__(self):
+        self.arrays = {}
+
+
+def _mesh_arrays(mesh, with_creases):
+    n_verts, n_polys, n_loops, n_edges = len(mesh.vertices), len(mesh.polygons), len(mesh.loops), len(mesh.edges)
+    points = np.empty(n_verts * 3, dtype=np.float32)
+    mesh.vertices.foreach_get("co", points)
+    counts = np.empty(n_polys, dtype=np.int32)
+    mesh.polygons.foreach_get("loop_total", counts)
+    indices = np.empty(n_loops, dtype=np.int32)
+    mesh.loops.foreach_get("vertex_index", indices)
+    material_index = np.empty(n_polys, dtype=np.int32)
+    mesh.polygons.foreach_get("material_index", material_index)
+    arrays = dict(points=points.reshape(-1, 3), counts=counts, indices=indices, material_index=material_index)
+    if with_creases:
+        edge_crease = _float_attribute(mesh, "crease_edge", lambda m: m.edges, "crease", n_edges)
+        creased = np.nonzero(edge_crease > 0.0)[0]
+        if creased.size:
+            edges = np.empty(n_edges * 2, dtype=np.int32)
+            mesh.edges.foreach_get("vertices", edges)
+            arrays["crease_vertices"] = edges.reshape(-1, 2)[creased].reshape(-1)
+            arrays["crease_sharpness"] = crease_to_sharpness(edge_crease[creased])
+        vertex_crease = _float_attribute(mesh, "crease_vert", _vertex_crease_layer, "value", n_verts)
+        cornered = np.nonzero(vertex_crease > 0.0)[0].astype(np.int32)
+        if cornered.size:
+            arrays["corner_vertices"] = cornered
+            arrays["corner_sharpness"] = crease_to_sharpness(vertex_crease[cornered])
+    return arrays
+
+
+def export_object(native_scene, materials, cache, obj, matrix, warnings):
+    """Adds one mesh instance; returns False when it has no faces."""
+    subsurf, only = subdivision_modifier(obj)
+    if subsurf is not None and not only:
+        warnings.append(f"'{obj.name}' renders its subdivided mesh as polygons: Micropoly renders the exact "
+                        "limit surface only when the Subdivision Surface modifier is the only modifier")
+        subsurf = None
+    cage = obj.original.data if subsurf is not None else None
+    key = ("cage", cage.name_full) if cage is not None else None
+    arrays = cache.arrays.get(key) if key else None
+    if arrays is None:
+        mesh = cage if cage is not None else obj.to_mesh()
+        try:
+            arrays = _mesh_arrays(mesh, with_creases=subsurf is not None and subsurf.use_creases)
+        finally:
+            if cage is None:
+                obj.to_mesh_clear()
+        if key:
+            cache.arrays[key] = arrays
+    if arrays["counts"].size == 0:
+        return False
+    slots = [materials.get(slot.material) for slot in obj.material_slots] or [0]
+    lut = np.array(slots, dtype=np.int32)
+    face_materials = lut[np.clip(arrays["material_index"], 0, len(lut) - 1)]
+    boundary = "edge_and_corner"
+    if subsurf is not None and subsurf.boundary_smooth == "ALL":
+        boundary = "edge_only"
+    empty_i, empty_f = np.zeros(0, dtype=np.int32), np.zeros(0, dtype=np.float32)
+    native_scene.add_mesh(
+        obj.name, arrays["points"], arrays["counts"], arrays["indices"], subdivision=subsurf is not None,
+        object_to_world=matrix, face_materials=face_materials,
+        crease_vertices=arrays.get("crease_vertices", empty_i), crease_sharpness=arrays.get("crease_sharpness", empty_f),
+        corner_vertices=arrays.get("corner_vertices", empty_i), corner_sharpness=arrays.get("corner_sharpness", empty_f),
+        boundary=boundary, double_sided=True)
+    return True

@@ -1,0 +1,43 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Micropoly's settings, stored on the scene as scene.micropoly."""
+
+import bpy
+from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty
+
+FILTERS = [
+    ("BLACKMAN_HARRIS", "Blackman-Harris", "Blackman-Harris window, as Cycles uses"),
+    ("GAUSSIAN", "Gaussian", "RenderMan's Gaussian filter"),
+    ("BOX", "Box", "Box filter: each pixel averages its own samples"),
+    ("TRIANGLE", "Triangle", "Tent filter"),
+]
+
+BOUND_SPLIT = [
+    ("BOUNDED", "Bounded Memory", "Depth-first workers within a fixed memory budget (Weber et al. 2015)"),
+    ("BREADTH", "Breadth-First", "Whole queue per pass, memory grows with the scene (Patney & Owens 2008)"),
+]
+
+
+class MicropolySceneSettings(bpy.types.PropertyGroup):
+    samples: IntProperty(name="Samples", description="Samples per pixel for final renders",
+                         default=16, min=1, max=1024)
+    shading_rate: FloatProperty(name="Shading Rate", description="Area of a micropolygon in pixels; "
+                                "smaller is finer and slower", default=1.0, min=0.05, max=64.0)
+    max_grid_size: IntProperty(name="Split Limit", description="Largest grid, in micropolygons per side, "
+                               "that a sub-patch is diced into before it is split instead",
+                               default=16, min=2, max=32)
+    bound_split_method: EnumProperty(name="Bound & Split", items=BOUND_SPLIT, default="BOUNDED")
+    bound_split_memory: FloatProperty(name="Memory Budget", description="Device memory for bound & split, "
+                                      "in MiB (bounded method)", default=64.0, min=0.25, max=65536.0)
+    filter_type: EnumProperty(name="Pixel Filter", items=FILTERS, default="BLACKMAN_HARRIS")
+    filter_width: FloatProperty(name="Filter Width", description="Pixel filter width in pixels",
+                                default=1.5, min=0.5, max=8.0, subtype="PIXEL")
+
+
+def register():
+    bpy.utils.register_class(MicropolySceneSettings)
+    bpy.types.Scene.micropoly = PointerProperty(type=MicropolySceneSettings)
+
+
+def unregister():
+    del bpy.types.Scene.micropoly
+    bpy.utils.unregister_class(MicropolySceneSettings)

@@ -1,0 +1,103 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Render properties panels, and the standard Blender panels Micropoly uses."""
+
+import bpy
+
+ENGINE = "MICROPOLY"
+
+# Built-in panels that apply unchanged to this engine (dimensions, output,
+# color management, camera, light and material basics).
+STANDARD_PANELS = (
+    "RENDER_PT_format", "RENDER_PT_frame_range", "RENDER_PT_time_stretching", "RENDER_PT_stereoscopy",
+    "RENDER_PT_output", "RENDER_PT_output_views", "RENDER_PT_encoding", "RENDER_PT_encoding_video",
+    "RENDER_PT_encoding_audio", "RENDER_PT_color_management", "RENDER_PT_color_management_curves",
+    "RENDER_PT_post_processing", "RENDER_PT_stamp", "RENDER_PT_stamp_note", "RENDER_PT_stamp_burn",
+    "DATA_PT_context_camera", "DATA_PT_lens", "DATA_PT_camera", "DATA_PT_camera_display",
+    "DATA_PT_context_light", "DATA_PT_light", "DATA_PT_EEVEE_light", "DATA_PT_EEVEE_light_distance",
+    "DATA_PT_spot", "DATA_PT_area", "MATERIAL_PT_preview", "EEVEE_MATERIAL_PT_context_material",
+    "EEVEE_MATERIAL_PT_surface", "MATERIAL_PT_viewport", "WORLD_PT_context_world", "EEVEE_WORLD_PT_surface",
+    "WORLD_PT_viewport_display", "VIEWLAYER_PT_layer", "VIEWLAYER_PT_layer_passes",
+    "VIEWLAYER_PT_eevee_layer_passes_data", "DATA_PT_context_mesh", "DATA_PT_normals", "DATA_PT_uv_texture",
+    "DATA_PT_vertex_groups", "DATA_PT_shape_keys", "DATA_PT_customdata",
+)
+
+
+class MicropolyPanel:
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "render"
+    COMPAT_ENGINES = {ENGINE}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES
+
+
+class MICROPOLY_PT_sampling(MicropolyPanel, bpy.types.Panel):
+    bl_label = "Sampling"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        settings = context.scene.micropoly
+        layout.prop(settings, "samples")
+        layout.prop(settings, "filter_type")
+        layout.prop(settings, "filter_width")
+
+
+class MICROPOLY_PT_dicing(MicropolyPanel, bpy.types.Panel):
+    bl_label = "Dicing"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        settings = context.scene.micropoly
+        layout.prop(settings, "shading_rate")
+        layout.prop(settings, "max_grid_size")
+
+
+class MICROPOLY_PT_bound_split(MicropolyPanel, bpy.types.Panel):
+    bl_label = "Bound & Split"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        settings = context.scene.micropoly
+        layout.prop(settings, "bound_split_method")
+        row = layout.row()
+        row.enabled = settings.bound_split_method == "BOUNDED"
+        row.prop(settings, "bound_split_memory")
+
+
+class MICROPOLY_PT_film(MicropolyPanel, bpy.types.Panel):
+    bl_label = "Film"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.prop(context.scene.render, "film_transparent")
+
+
+CLASSES = (MICROPOLY_PT_sampling, MICROPOLY_PT_dicing, MICROPOLY_PT_bound_split, MICROPOLY_PT_film)
+
+
+def _standard_panels():
+    for name in STANDARD_PANELS:
+        panel = getattr(bpy.types, name, None)
+        if panel is not None and hasattr(panel, "COMPAT_ENGINES"):
+            yield panel
+
+
+def register():
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+    for panel in _standard_panels():
+        panel.COMPAT_ENGINES.add(ENGINE)
+
+
+def unregister():
+    for panel in _standard_panels():
+        panel.COMPAT_ENGINES.discard(ENGINE)
+    for cls in reversed(CLASSES):
+        bpy.utils.unregister_class(cls)
