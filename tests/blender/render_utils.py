@@ -1,0 +1,154 @@
+"""Helpers for blender -b tests: build scenes, render with an engine, read
+float passes back (through the compositor's File Output node, which works the
+same in Blender 3.4 and 4.x)."""
+
+import math
+import os
+import tempfile
+
+import bpy
+import numpy as np
+from mathutils import Vector
+
+
+_registered = []
+
+
+def enable_addon():
+    """Registers the add-on from MICROPOLY_ADDON_DIR (the build tree's addons/)."""
+    import sys
+
+    folder = os.environ.get("MICROPOLY_ADDON_DIR")
+    if folder and folder not in sys.path:
+        sys.path.insert(0, folder)
+    import micropoly
+
+    micropoly.register()
+    _registered.append(micropoly)
+
+
+def reset_scene():
+    """A fresh, empty scene with the add-on registered and a black world."""
+    while _registered:
+        _registered.pop().unregister()
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    enable_addon()
+    scene = bpy.context.scene
+    world = bpy.data.worlds.new("World")
+    world.color = (0.0, 0.0, 0.0)
+    scene.world = world
+    return scene
+
+
+def add_camera(scene, location, target, lens=50.0, ortho_scale=None, shift=(0.0, 0.0)):
+    cam_data = bpy.data.cameras.new("Camera")
+    cam_data.lens = lens
+    cam_data.shift_x, cam_data.shift_y = shift
+    if ortho_scale is not None:
+        cam_data.type = "ORTHO"
+        cam_data.ortho_scale = ortho_scale
+    cam = bpy.data.objects.new("Camera", cam_data)
+    scene.collection.objects.link(cam)
+    cam.location = location
+    cam.rotation_euler = (Vector(location) - Vector(target)).to_track_quat("Z", "Y").to_euler()
+    scene.camera = cam
+    return cam
+
+
+def diffuse_material(name, color):
+    m = bpy.data.materials.new(name)
+    m.use_nodes = True
+    nodes = m.node_tree.nodes
+    for n in list(nodes):
+        if n.type != "OUTPUT_MATERIAL":
+            nodes.remove(n)
+    bsdf = nodes.new("ShaderNodeBsdfDiffuse")
+    bsdf.inputs["Color"].default_value = (*color, 1.0)
+    out = next(n for n in nodes if n.type == "OUTPUT_MATERIAL")
+    m.node_tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
+    return m
+
+
+def setup_cycles(scene, samples=64, adaptive_subdivision=True):
+    scene.render.engine = "CYCLES"
+    c = scene.cycles
+    c.device = "CPU"
+    c.samples = samples
+    if hasattr(c, "use_adaptive_sampling"):
+        c.use_adaptive_sampling = False
+    if hasattr(c, "use_denoising"):
+        c.use_denoising = False
+    c.max_bounces = 0
+    c.diffuse_bounces = 0
+    c.glossy_bounces = 0
+    c.transmission_bounces = 0
+    if adaptive_subdivision:
+        c.feature_set = "EXPERIMENTAL"
+        c.dicing_rate = 1.0
+        for obj in scene.objects:
+            if obj.type == "MESH" and obj.modifiers and obj.modifiers[-1].type == "SUBSURF":
+                if hasattr(obj, "cycles") and hasattr(obj.cycles, "use_adaptive_subdivision"):
+                    obj.cycles.use_adaptive_subdivision = True
+    for obj in scene.objects:
+        if obj.type == "LIGHT":
+            if hasattr(obj.data, "cycles") and hasattr(obj.data.cycles, "cast_shadow"):
+                obj.data.cycles.cast_shadow = False
+            if hasattr(obj.data, "use_shadow"):
+                obj.data.use_shadow = False
+            if hasattr(obj, "visible_shadow"):
+                pass
+
+
+def render_passes(scene, engine, width, height, samples=16, transparent=True):
+    """Renders and returns dict(rgba=(H,W,4), depth=(H,W), normal=(H,W,3)),
+    rows top first, as float arrays."""
+    scene.render.engine = engine
+    scene.render.resolution_x, scene.render.resolution_y = width, height
+    scene.render.resolution_percentage = 100
+    scene.render.film_transparent = transparent
+    if engine == "MICROPOLY":
+        scene.micropoly.samples = samples
+    view_layer = scene.view_layers[0]
+    view_layer.use_pass_z = True
+    view_layer.use_pass_normal = True
+    scene.display_settings.display_device = "sRGB"
+    scene.view_settings.view_transform = "Standard"
+    scene.use_nodes = True
+    tree = scene.node_tree
+    for n in list(tree.nodes):
+        tree.nodes.remove(n)
+    layers = tree.nodes.new("CompositorNodeRLayers")
+    composite = tree.nodes.new("CompositorNodeComposite")
+    tree.links.new(layers.outputs["Image"], composite.inputs["Image"])
+    folder = tempfile.mkdtemp(prefix=f"mp-{engine.lower()}-")
+    out = tree.nodes.new("CompositorNodeOutputFile")
+    out.base_path = folder
+    out.format.file_format = "OPEN_EXR"
+    out.format.color_depth = "32"
+    out.file_slots.clear()
+    for name in ("Image", "Depth", "Normal"):
+        out.file_slots.new(name)
+        tree.links.new(layers.outputs[name], out.inputs[name])
+    bpy.ops.render.render(write_still=False)
+    frame = scene.frame_current
+    result = {}
+    for name, key, channels in (("Image", "rgba", 4), ("Depth", "depth", 1), ("Normal", "normal", 3)):
+        path = os.path.join(folder, f"{name}{frame:04d}.exr")
+        image = bpy.data.images.load(path)
+        image.colorspace_settings.name = "Non-Color" if name != "Image" else image.colorspace_settings.name
+        px = np.array(image.pixels[:], dtype=np.float32).reshape(height, width, 4)[::-1]
+        bpy.data.images.remove(image)
+        result[key] = px[..., :channels] if channels > 1 else px[..., 0]
+    return result
+
+
+def iou(a, b, threshold=0.5):
+    ma, mb = a > threshold, b > threshold
+    union = np.logical_or(ma, mb).sum()
+    return 1.0 if union == 0 else np.logical_and(ma, mb).sum() / union
+
+
+def psnr(a, b, peak=None):
+    mse = float(np.mean((a - b) ** 2))
+    peak = float(max(a.max(), b.max())) if peak is None else peak
+    return math.inf if mse == 0 else 10.0 * math.log10(peak * peak / mse)
