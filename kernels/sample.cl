@@ -116,16 +116,16 @@ inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVerte
       }
 }
 
-__kernel void sample_micropolygons(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
+__kernel void sample_micropolygons(__global const SubPatch* diceable, uint first, uint count, __global const uint* patch_info,
                                    FrameParams f, __global const float4* grid_p, __global const float4* grid_c,
                                    __global const float4* grid_n, __global const ushort* offsets, uint pass,
                                    volatile __global ulong* keys,
                                    __global float* colors, __global uint* normals) {
   uint mg = (uint)f.max_grid;
   uint gid = get_global_id(0);
-  uint slot = gid / (mg * mg);
+  uint slot = first + gid / (mg * mg);
   if (slot >= count) return;
-  uint local_index = gid - slot * mg * mg;
+  uint local_index = gid % (mg * mg);
   uint i = local_index % mg, j = local_index / mg;
   SubPatch sp = diceable[slot];
   if (i >= MP_INFO_NU(sp.info) || j >= MP_INFO_NV(sp.info)) return;

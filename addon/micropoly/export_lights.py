@@ -5,10 +5,12 @@ Native lights carry radiant intensity (point, spot), irradiance (sun) and
 radiance (area, ambient); the Principled material applies albedo / pi.
 Cycles: a point or spot light of power P emits P / (4 pi) W/sr; a sun of
 strength S gives irradiance S; an area light of power P and area A emits
-radiance P / (4 A) from its front (-Z) side (measured against Cycles: not the
-P / (pi A) of a Lambertian emitter). See docs/blender.md."""
+radiance P / (pi A) from its front (-Z) side since Blender 4.0, and P / (4 A)
+before (both measured against Cycles). See docs/blender.md."""
 
 import math
+
+import bpy
 
 import numpy as np
 from mathutils import Vector
@@ -63,6 +65,8 @@ def export_light(native_scene, obj, matrix, warnings):
             warnings.append(f"area light '{obj.name}' has no area and is skipped")
             return
         axis_u = list((rotation @ Vector((1.0, 0.0, 0.0))).normalized())
-        native_scene.add_light("area", color=color, intensity=power / (4.0 * area), position=position,
+        # Cycles changed its area light normalisation in Blender 4.0.
+        radiance = power / ((math.pi if bpy.app.version >= (4, 0, 0) else 4.0) * area)
+        native_scene.add_light("area", color=color, intensity=radiance, position=position,
                                direction=direction, shape="ellipse" if light.shape in ("DISK", "ELLIPSE")
                                else "rectangle", axis_u=axis_u, size_u=size_u, size_v=size_v)

@@ -23,6 +23,8 @@ def enable_addon():
         sys.path.insert(0, folder)
     import micropoly
 
+    if hasattr(bpy.types.Scene, "micropoly"):
+        return  # still registered (opening a file keeps registered classes)
     micropoly.register()
     _registered.append(micropoly)
 
@@ -83,11 +85,19 @@ def setup_cycles(scene, samples=64, adaptive_subdivision=True):
     c.glossy_bounces = 0
     c.transmission_bounces = 0
     if adaptive_subdivision:
-        c.feature_set = "EXPERIMENTAL"
+        # Blender 3.x/4.x: experimental feature set and a per-object switch;
+        # 5.0: a setting of the Subdivision Surface modifier itself.
+        if hasattr(c, "feature_set"):
+            c.feature_set = "EXPERIMENTAL"
         c.dicing_rate = 1.0
         for obj in scene.objects:
             if obj.type == "MESH" and obj.modifiers and obj.modifiers[-1].type == "SUBSURF":
-                if hasattr(obj, "cycles") and hasattr(obj.cycles, "use_adaptive_subdivision"):
+                mod = obj.modifiers[-1]
+                if hasattr(mod, "use_adaptive_subdivision"):
+                    mod.use_adaptive_subdivision = True
+                    mod.adaptive_space = "PIXEL"
+                    mod.adaptive_pixel_size = 1.0
+                elif hasattr(obj, "cycles") and hasattr(obj.cycles, "use_adaptive_subdivision"):
                     obj.cycles.use_adaptive_subdivision = True
     for obj in scene.objects:
         if obj.type == "LIGHT":
@@ -99,9 +109,17 @@ def setup_cycles(scene, samples=64, adaptive_subdivision=True):
                 pass
 
 
+def _load_exr(path, height, width):
+    image = bpy.data.images.load(path)
+    px = np.array(image.pixels[:], dtype=np.float32).reshape(height, width, 4)[::-1]
+    bpy.data.images.remove(image)
+    return px
+
+
 def render_passes(scene, engine, width, height, samples=16, transparent=True):
     """Renders and returns dict(rgba=(H,W,4), depth=(H,W), normal=(H,W,3)),
-    rows top first, as float arrays."""
+    rows top first, as float arrays. Blender 5.0 replaced the compositor's
+    scene node tree; there only rgba is read back (depth and normal are None)."""
     scene.render.engine = engine
     scene.render.resolution_x, scene.render.resolution_y = width, height
     scene.render.resolution_percentage = 100
@@ -113,6 +131,13 @@ def render_passes(scene, engine, width, height, samples=16, transparent=True):
     view_layer.use_pass_normal = True
     scene.display_settings.display_device = "sRGB"
     scene.view_settings.view_transform = "Standard"
+    folder = tempfile.mkdtemp(prefix=f"mp-{engine.lower()}-")
+    if not hasattr(scene, "node_tree"):
+        scene.render.image_settings.file_format = "OPEN_EXR"
+        scene.render.image_settings.color_depth = "32"
+        scene.render.filepath = os.path.join(folder, "combined.exr")
+        bpy.ops.render.render(write_still=True)
+        return {"rgba": _load_exr(scene.render.filepath, height, width), "depth": None, "normal": None}
     scene.use_nodes = True
     tree = scene.node_tree
     for n in list(tree.nodes):
@@ -120,7 +145,6 @@ def render_passes(scene, engine, width, height, samples=16, transparent=True):
     layers = tree.nodes.new("CompositorNodeRLayers")
     composite = tree.nodes.new("CompositorNodeComposite")
     tree.links.new(layers.outputs["Image"], composite.inputs["Image"])
-    folder = tempfile.mkdtemp(prefix=f"mp-{engine.lower()}-")
     out = tree.nodes.new("CompositorNodeOutputFile")
     out.base_path = folder
     out.format.file_format = "OPEN_EXR"
@@ -133,11 +157,7 @@ def render_passes(scene, engine, width, height, samples=16, transparent=True):
     frame = scene.frame_current
     result = {}
     for name, key, channels in (("Image", "rgba", 4), ("Depth", "depth", 1), ("Normal", "normal", 3)):
-        path = os.path.join(folder, f"{name}{frame:04d}.exr")
-        image = bpy.data.images.load(path)
-        image.colorspace_settings.name = "Non-Color" if name != "Image" else image.colorspace_settings.name
-        px = np.array(image.pixels[:], dtype=np.float32).reshape(height, width, 4)[::-1]
-        bpy.data.images.remove(image)
+        px = _load_exr(os.path.join(folder, f"{name}{frame:04d}.exr"), height, width)
         result[key] = px[..., :channels] if channels > 1 else px[..., 0]
     return result
 

@@ -113,22 +113,23 @@ void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer) {
   timer.add(Stage::Sample, e);
 }
 
-void SampleStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
-                      GridBuffers& grids, StageTimer& timer) {
+void SampleStage::run(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
+                      const FrameParams& f, GridBuffers& grids, StageTimer& timer) {
   kernel_.setArg(0, diceable);
-  kernel_.setArg(1, count);
-  kernel_.setArg(2, scene.patch_info);
-  kernel_.setArg(3, f);
-  kernel_.setArg(4, grids.p);
-  kernel_.setArg(5, grids.c);
-  kernel_.setArg(6, grids.n);
-  kernel_.setArg(7, offsets_);
-  kernel_.setArg(9, keys_);
-  kernel_.setArg(10, colors_);
-  kernel_.setArg(11, normals_);
+  kernel_.setArg(1, first);
+  kernel_.setArg(2, first + count);
+  kernel_.setArg(3, scene.patch_info);
+  kernel_.setArg(4, f);
+  kernel_.setArg(5, grids.p);
+  kernel_.setArg(6, grids.c);
+  kernel_.setArg(7, grids.n);
+  kernel_.setArg(8, offsets_);
+  kernel_.setArg(10, keys_);
+  kernel_.setArg(11, colors_);
+  kernel_.setArg(12, normals_);
   // Pass 0 finds each sample's nearest key; pass 1 lets its owner write.
   for (cl_uint pass = 0; pass < 2; ++pass) {
-    kernel_.setArg(8, pass);
+    kernel_.setArg(9, pass);
     cl::Event e;
     session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(count * grids.micropolygons_per_slot),
                                           cl::NDRange(64), nullptr, &e);

@@ -50,7 +50,8 @@ class SampleStage {
   // Makes the sample buffers (key, color, normal per sample) fit the frame,
   // reusing them when the size is unchanged, and clears them.
   void begin_frame(const FrameParams& f, StageTimer& timer);
-  void run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+  // Samples the grids of diceable sub-patches [first, first + count).
+  void run(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
            GridBuffers& grids, StageTimer& timer);
   const cl::Buffer& keys() const { return keys_; }
   const cl::Buffer& colors() const { return colors_; }

@@ -17,6 +17,8 @@ namespace {
 
 // Sub-patches per dice batch: grid buffers hold this many (max_grid+1)^2 grids.
 constexpr cl_uint kDiceBatch = 8192;
+// Sub-patches sampled per launch when the caller can cancel.
+constexpr cl_uint kSampleChunk = 1024;
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -88,14 +90,32 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     dice.begin_frame();
     sample.begin_frame(f, timer);
 
+    // Cancellation: the caller's progress callback is asked between bound &
+    // split launches and between sample chunks, so a cancel takes effect within
+    // one chunk's worth of device work.
+    bool cancelled = false;
+    float last_progress = 0.0f;
+    ProgressCallback keep_going = [&](float p) {
+      last_progress = p;
+      if (!cancelled && progress && !progress(p)) cancelled = true;
+      return !cancelled;
+    };
     DiceSink sink = [&](const cl::Buffer& diceable, cl_uint count) {
+      if (cancelled) return;
       dice.run(diceable, count, buffers, f, grids, timer);
       shade.run(diceable, count, buffers, f, grids, timer);
-      sample.run(diceable, count, buffers, f, grids, timer);
+      const cl_uint chunk = progress ? kSampleChunk : count;
+      for (cl_uint first = 0; first < count && !cancelled; first += chunk) {
+        sample.run(diceable, first, std::min(chunk, count - first), buffers, f, grids, timer);
+        if (progress) {
+          s.queue().finish();
+          keep_going(last_progress);
+        }
+      }
       st.subpatches_diced += count;
       ++st.batches;
     };
-    BoundSplitContext ctx{s, buffers, f, timer, sink, progress};
+    BoundSplitContext ctx{s, buffers, f, timer, sink, keep_going};
     BoundSplitResult bs;
     if (buffers.patch_count > 0) {
       if (scene.settings.bound_split == BoundSplitMethod::Bounded) {
@@ -105,9 +125,16 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
         bs = bound_split_breadth(ctx, capacity);
       }
     }
+    if (cancelled || bs.cancelled) {
+      s.queue().finish();
+      st.cancelled = true;
+      st.timings_ms.total = ms_since(t_start);
+      out.width = out.height = 0;
+      out.rgba.clear(), out.depth.clear(), out.normal.clear();
+      return;
+    }
     st.bound_split_peak_bytes = bs.peak_bytes;
     st.bound_split_launches = bs.launches;
-    st.cancelled = bs.cancelled;
     auto t_resolve = std::chrono::steady_clock::now();
     resolve.run(sample, frame, scene.settings.filter, scene.settings.filter_width, scene.settings.depth_and_normal_passes,
                 out, timer);

@@ -1,0 +1,192 @@
+"""The add-on's behaviour in Blender (run by blender -b, or a Python with the
+bpy module): bad input gives a clear error naming the object and never a
+crash, cancelling returns quickly, old .blend files render, and the exported
+RIB renders in micropoly-render to the same image as F12. Exits non-zero on failure."""
+
+import glob
+import os
+import subprocess
+import sys
+import tempfile
+import time
+import traceback
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+import render_utils as ru  # noqa: E402
+
+RESULTS = []
+
+
+def check(name, condition, detail=""):
+    RESULTS.append(bool(condition))
+    print(f"{'ok  ' if condition else 'FAIL'} {name}" + (f": {detail}" if detail else ""))
+
+
+def render_error():
+    """Runs F12; returns the error message Blender raised, or None."""
+    try:
+        bpy.ops.render.render()
+    except RuntimeError as e:
+        return str(e)
+    return None
+
+
+def test_nan_mesh():
+    scene = ru.reset_scene()
+    mesh = bpy.data.meshes.new("bad")
+    mesh.from_pydata([(0, 0, 0), (1, 0, 0), (float("nan"), 1, 0)], [], [(0, 1, 2)])
+    obj = bpy.data.objects.new("BrokenMesh", mesh)
+    scene.collection.objects.link(obj)
+    ru.add_camera(scene, (0, -5, 0), (0, 0, 0))
+    scene.render.engine = "MICROPOLY"
+    scene.render.resolution_x, scene.render.resolution_y = 64, 48
+    error = render_error()
+    check("NaN coordinates are reported, naming the object", error and "BrokenMesh" in error, error)
+
+
+def test_empty_scene():
+    scene = ru.reset_scene()
+    ru.add_camera(scene, (0, -5, 0), (0, 0, 0))
+    passes = ru.render_passes(scene, "MICROPOLY", 64, 48, samples=4)
+    check("an empty scene renders a transparent image", float(passes["rgba"][..., 3].sum()) == 0.0)
+
+
+def test_camera_inside_object():
+    scene = ru.reset_scene()
+    bpy.ops.mesh.primitive_cube_add(size=4.0)
+    bpy.context.object.modifiers.new("Subdivision", "SUBSURF")
+    ru.add_camera(scene, (0.2, -0.3, 0.1), (0, 0, 0))
+    ld = bpy.data.lights.new("sun", "SUN")
+    scene.collection.objects.link(bpy.data.objects.new("sun", ld))
+    started = time.perf_counter()
+    passes = ru.render_passes(scene, "MICROPOLY", 96, 64, samples=4)
+    elapsed = time.perf_counter() - started
+    covered = float(passes["rgba"][..., 3].mean())
+    check("a camera inside an object renders the inside", covered > 0.99 and elapsed < 60, f"coverage {covered:.3f}, {elapsed:.1f} s")
+
+
+def test_cancel_is_quick():
+    from micropoly import engine
+
+    scene = ru.reset_scene()
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32, radius=1.0)
+    bpy.context.object.modifiers.new("Subdivision", "SUBSURF")
+    ru.add_camera(scene, (0, -3.2, 0), (0, 0, 0))
+    scene.render.engine = "MICROPOLY"
+    scene.render.resolution_x, scene.render.resolution_y = 1920, 1080
+    scene.micropoly.samples = 64
+    scene.micropoly.shading_rate = 0.25
+    flipped = {}
+
+    def should_cancel(self):  # Esc pressed 0.5 s into the render
+        if "at" not in flipped and time.perf_counter() - flipped.setdefault("start", time.perf_counter()) > 0.5:
+            flipped["at"] = time.perf_counter()
+        return "at" in flipped
+
+    original = engine.MicropolyRenderEngine.should_cancel
+    engine.MicropolyRenderEngine.should_cancel = should_cancel
+    try:
+        started = time.perf_counter()
+        render_error()
+        ended = time.perf_counter()
+    finally:
+        engine.MicropolyRenderEngine.should_cancel = original
+    latency = ended - flipped.get("at", ended)
+    check("cancelling returns within 1 s", "at" in flipped and latency < 1.0,
+          f"returned {latency:.2f} s after the break, render ran {ended - started:.2f} s")
+
+
+def test_old_blend_files():
+    pattern = os.path.join(os.path.dirname(bpy.app.binary_path or "/"), "..", "share", "blender", "scripts",
+                           "addons", "materials_library_vx", "*.blend")
+    files = sorted(glob.glob("/usr/share/blender/scripts/addons/materials_library_vx/*.blend") or glob.glob(pattern))
+    if not files:
+        print("skip old .blend files: none shipped with this Blender")
+        return
+    for path in files:
+        bpy.ops.wm.open_mainfile(filepath=path, load_ui=False)
+        ru.enable_addon()
+        scene = bpy.context.scene
+        version = ".".join(map(str, bpy.data.version))
+        if scene.camera is None:
+            ru.add_camera(scene, (6, -6, 5), (0, 0, 0))
+        scene.render.engine = "MICROPOLY"
+        scene.render.resolution_x, scene.render.resolution_y = 64, 48
+        scene.render.resolution_percentage = 100
+        error = render_error()
+        check(f"{os.path.basename(path)} (Blender {version}) renders", error is None, error or "")
+
+
+def test_rib_export_matches_f12():
+    from micropoly import operators
+
+    cli = os.environ.get("MICROPOLY_CLI")
+    if not cli or not hasattr(__import__("micropoly._native", fromlist=["_"]), "write_rib"):
+        print("skip RIB export: no CLI or writer")
+        return
+    scene = ru.reset_scene()
+    bpy.ops.mesh.primitive_monkey_add(size=2.0)
+    bpy.context.object.modifiers.new("Subdivision", "SUBSURF")
+    bpy.context.object.data.materials.append(ru.diffuse_material("red", (0.8, 0.2, 0.1)))
+    bpy.ops.mesh.primitive_plane_add(size=6.0, location=(0, 0, -1))
+    for kind, energy in (("POINT", 400.0), ("SUN", 2.0), ("SPOT", 600.0), ("AREA", 200.0)):
+        data = bpy.data.lights.new(kind, kind)
+        data.energy = energy
+        obj = bpy.data.objects.new(kind, data)
+        scene.collection.objects.link(obj)
+        obj.location = (2.0, -3.0, 3.0)
+        obj.rotation_euler = (0.8, 0.0, 0.5)
+    ru.add_camera(scene, (1.0, -6.0, 2.0), (0, 0, 0), shift=(0.05, 0.0))
+    # Both sides write 8-bit sRGB PNGs with straight alpha; Blender's dithering
+    # is turned off so the only difference left is the renders'.
+    folder = tempfile.mkdtemp(prefix="mp-rib-")
+    r = scene.render
+    r.engine = "MICROPOLY"
+    r.resolution_x, r.resolution_y, r.resolution_percentage = 120, 90, 100
+    r.film_transparent = True
+    r.dither_intensity = 0.0
+    r.image_settings.file_format = "PNG"
+    r.image_settings.color_mode = "RGBA"
+    r.image_settings.color_depth = "8"
+    scene.view_settings.view_transform = "Standard"
+    scene.micropoly.samples = 4
+    r.filepath = os.path.join(folder, "f12.png")
+    bpy.ops.render.render(write_still=True)
+    rib, png = os.path.join(folder, "scene.rib"), os.path.join(folder, "cli.png")
+    operators.export_rib(bpy.context.evaluated_depsgraph_get(), rib)
+    proc = subprocess.run([cli, rib, "-o", png], capture_output=True, text=True)
+    if proc.returncode != 0:
+        check("micropoly-render renders the exported RIB", False, proc.stderr.strip())
+        return
+    a, b = bpy.data.images.load(r.filepath), bpy.data.images.load(png)
+    pa = np.array(a.pixels[:], dtype=np.float32)
+    pb = np.array(b.pixels[:], dtype=np.float32)
+    same_size = tuple(a.size) == tuple(b.size) == (120, 90)
+    diff = float(np.abs(pa - pb).max()) if same_size else 1.0
+    covered = float(pa.reshape(-1, 4)[:, 3].mean())
+    check("exported RIB renders in micropoly-render like F12 (within 1/255)",
+          same_size and covered > 0.2 and diff <= 1.0 / 255.0 + 1e-6, f"max diff {diff * 255:.2f}/255, coverage {covered:.2f}")
+
+
+def main():
+    print(f"Blender {bpy.app.version_string}")
+    for test in (test_nan_mesh, test_empty_scene, test_camera_inside_object, test_cancel_is_quick,
+                 test_rib_export_matches_f12, test_old_blend_files):
+        try:
+            test()
+        except Exception:
+            traceback.print_exc()
+            RESULTS.append(False)
+    failed = RESULTS.count(False)
+    print(f"{len(RESULTS) - failed} passed, {failed} failed")
+    return 1 if failed or not RESULTS else 0
+
+
+if __name__ == "__main__":
+    code = main()
+    sys.stdout.flush()
+    os._exit(code)
