@@ -15,8 +15,12 @@ __kernel void clear_samples(__global ulong* keys, ulong n) {
   if (i < n) keys[i] = (ulong)0xffffffffffffffffUL;
 }
 
+/* `weights`, when use_weights is set, holds the filter weight of every sample
+ * of every neighbour for each of the 32x32 positions a pixel can have in the
+ * repeating sample tile (built on the host from the same functions), so the
+ * filter is not re-evaluated per sample. */
 __kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width, __global const ushort* offsets,
-                             __global const ulong* keys,
+                             __global const float* weights, int use_weights, __global const ulong* keys,
                              __global const float* colors, __global const uint* normals,
                              float4 cam_to_world_x, float4 cam_to_world_y, float4 cam_to_world_z,
                              __global float4* rgba, __global float* depth, __global float* normal_out, int want_passes) {
@@ -27,17 +31,27 @@ __kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width,
   float4 sum = (float4)(0.0f);
   float wsum = 0.0f;
   float cx = (float)px + 0.5f, cy = (float)py + 0.5f;
+  int side = 2 * reach + 1;
+  int tile = ((py + f.crop_y0) & (MP_SAMPLE_TILE - 1)) * MP_SAMPLE_TILE + ((px + f.crop_x0) & (MP_SAMPLE_TILE - 1));
   for (int qy = max(py - reach, 0); qy <= min(py + reach, f.height - 1); ++qy)
-    for (int qx = max(px - reach, 0); qx <= min(px + reach, f.width - 1); ++qx)
+    for (int qx = max(px - reach, 0); qx <= min(px + reach, f.width - 1); ++qx) {
+      __global const float* wrow = weights + ((ulong)tile * (ulong)(side * side) +
+                                              (ulong)((qy - py + reach) * side + (qx - px + reach))) * (ulong)spp;
       for (int s = 0; s < spp; ++s) {
-        MpFixed2 q = mp_sample_position(qx, qy, s, spp, f, offsets);
-        float dx = (float)q.x / (float)MP_SUBPIXEL_ONE - cx, dy = (float)q.y / (float)MP_SUBPIXEL_ONE - cy;
-        float w = mp_filter_weight(filter_type, dx, dy, filter_width);
+        float w;
+        if (use_weights) {
+          w = wrow[s];
+        } else {
+          MpFixed2 q = mp_sample_position(qx, qy, s, spp, f, offsets);
+          float dx = (float)q.x / (float)MP_SUBPIXEL_ONE - cx, dy = (float)q.y / (float)MP_SUBPIXEL_ONE - cy;
+          w = mp_filter_weight(filter_type, dx, dy, filter_width);
+        }
         if (w <= 0.0f) continue;
         ulong index = ((ulong)qy * (ulong)f.width + (ulong)qx) * (ulong)spp + (ulong)s;
         wsum += w;
         if (keys[index] != (ulong)0xffffffffffffffffUL) sum += w * (float4)(vload3(index, colors), 1.0f);
       }
+    }
   ulong pixel = (ulong)py * (ulong)f.width + (ulong)px;
   rgba[pixel] = wsum > 0.0f ? sum / wsum : (float4)(0.0f);
   if (!want_passes) return;

@@ -15,7 +15,7 @@ packages=(
   ocl-icd-opencl-dev opencl-headers pocl-opencl-icd clinfo
   libglm-dev pybind11-dev libosd-dev libgtest-dev libgmock-dev
   libpng-dev libopenexr-dev
-  python3 python3-dev python3-numpy python3-pytest
+  python3 python3-dev python3-numpy python3-pytest python3-venv
   blender
 )
 missing=()
@@ -28,6 +28,23 @@ if [ ${#missing[@]} -gt 0 ]; then
   echo "== installing: ${missing[*]}"
   $sudo apt-get update -q
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+# Blender as a Python module (the bpy wheels): the newest release whose wheel
+# installs for this Python, and the 4.x LTS. Only the tests need them.
+BPY_VERSIONS=${MICROPOLY_BPY_VERSIONS:-"4.5.15 5.0.1"}
+if [ "$mode" = test ]; then
+  mkdir -p build
+  for v in $BPY_VERSIONS; do
+    venv="build/bpy-$v"
+    if ! "$venv/bin/python3" -c "import bpy" >/dev/null 2>&1; then
+      echo "== installing the bpy $v module into $venv"
+      rm -rf "$venv"
+      /usr/bin/python3 -m venv "$venv"
+      "$venv/bin/python3" -m pip install -q --disable-pip-version-check "bpy==$v" ||
+        { echo "bpy $v did not install" >&2; rm -rf "$venv"; exit 1; }
+    fi
+  done
 fi
 
 jobs=$(nproc)

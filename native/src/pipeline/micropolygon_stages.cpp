@@ -1,5 +1,6 @@
 #include "pipeline/micropolygon_stages.h"
 
+#include <cmath>
 #include <cstring>
 #include <vector>
 
@@ -170,20 +171,48 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
     glm::vec3 r = glm::vec3(frame.camera_to_world[0][i], frame.camera_to_world[1][i], frame.camera_to_world[2][i]);
     return cl_float4{{r.x, r.y, r.z, 0.0f}};
   };
+  filter_width = std::max(filter_width, 1e-3f);
+  if (type != weights_type_ || filter_width != weights_width_ || f.spp_x != weights_spp_x_ || f.spp_y != weights_spp_y_) {
+    const int reach = static_cast<int>(std::ceil(0.5f * filter_width - 0.5f)), side = 2 * reach + 1;
+    const int spp = f.spp_x * f.spp_y;
+    const size_t count = size_t(MP_SAMPLE_TILE) * MP_SAMPLE_TILE * side * side * spp;
+    use_weights_ = count * sizeof(float) <= (size_t(64) << 20);
+    std::vector<float> w(use_weights_ ? count : 1, 0.0f);
+    if (use_weights_) {
+      size_t i = 0;
+      for (int ty = 0; ty < MP_SAMPLE_TILE; ++ty)
+        for (int tx = 0; tx < MP_SAMPLE_TILE; ++tx)
+          for (int dy = -reach; dy <= reach; ++dy)
+            for (int dx = -reach; dx <= reach; ++dx) {
+              int nx = (tx + dx) & (MP_SAMPLE_TILE - 1), ny = (ty + dy) & (MP_SAMPLE_TILE - 1);
+              for (int s = 0; s < spp; ++s) {
+                uint o = mp_sample_offset_packed(nx, ny, s, f);
+                float sx = float(dx) + float(o & 0xffu) / MP_SUBPIXEL_ONE - 0.5f;
+                float sy = float(dy) + float(o >> 8) / MP_SUBPIXEL_ONE - 0.5f;
+                w[i++] = mp_filter_weight(type, sx, sy, filter_width);
+              }
+            }
+    }
+    weights_ = cl::Buffer(session_.context(), CL_MEM_READ_ONLY, w.size() * sizeof(float));
+    session_.queue().enqueueWriteBuffer(weights_, CL_TRUE, 0, w.size() * sizeof(float), w.data());
+    weights_type_ = type, weights_width_ = filter_width, weights_spp_x_ = f.spp_x, weights_spp_y_ = f.spp_y;
+  }
   kernel_.setArg(0, f);
   kernel_.setArg(1, type);
-  kernel_.setArg(2, std::max(filter_width, 1e-3f));
+  kernel_.setArg(2, filter_width);
   kernel_.setArg(3, samples.offsets());
-  kernel_.setArg(4, samples.keys());
-  kernel_.setArg(5, samples.colors());
-  kernel_.setArg(6, samples.normals());
-  kernel_.setArg(7, row(0));
-  kernel_.setArg(8, row(1));
-  kernel_.setArg(9, row(2));
-  kernel_.setArg(10, rgba_);
-  kernel_.setArg(11, depth_);
-  kernel_.setArg(12, normal_);
-  kernel_.setArg(13, passes ? 1 : 0);
+  kernel_.setArg(4, weights_);
+  kernel_.setArg(5, use_weights_ ? 1 : 0);
+  kernel_.setArg(6, samples.keys());
+  kernel_.setArg(7, samples.colors());
+  kernel_.setArg(8, samples.normals());
+  kernel_.setArg(9, row(0));
+  kernel_.setArg(10, row(1));
+  kernel_.setArg(11, row(2));
+  kernel_.setArg(12, rgba_);
+  kernel_.setArg(13, depth_);
+  kernel_.setArg(14, normal_);
+  kernel_.setArg(15, passes ? 1 : 0);
   size_t gx = ((static_cast<size_t>(f.width) + 7) / 8) * 8, gy = ((static_cast<size_t>(f.height) + 7) / 8) * 8;
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(gx, gy), cl::NDRange(8, 8), nullptr, &e);

@@ -82,6 +82,12 @@ class ResolveStage {
   cl::Kernel kernel_;
   cl::Buffer rgba_, depth_, normal_;
   size_t pixels_ = 0;
+  // Filter weights per tile position, neighbour and sample (see resolve.cl),
+  // rebuilt when the filter or the sampling pattern changes.
+  cl::Buffer weights_;
+  bool use_weights_ = false;
+  int weights_type_ = -1, weights_spp_x_ = 0, weights_spp_y_ = 0;
+  float weights_width_ = 0;
   // On discrete GPUs the image is read back through a pinned (page-locked)
   // staging buffer, which the driver copies into at full bus speed.
   bool use_pinned_ = false;

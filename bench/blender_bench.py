@@ -1,0 +1,117 @@
+"""Micropoly, Cycles and EEVEE rendering one scene side by side, plus the
+export time of a 1M-face mesh. Run with Blender (or a Python with bpy):
+
+  MICROPOLY_ADDON_DIR=build/addons blender -b --factory-startup --python bench/blender_bench.py -- [--repeat 3] [--quick]
+
+Scene: six subdivided Suzannes (Subdivision Surface, rendered by Micropoly as
+limit surfaces and by Cycles with adaptive subdivision at 1 px) on a floor,
+sun + point + area light, 1920x1080, 16 samples for every engine. Cycles uses
+its default light paths with denoising off; EEVEE its defaults with 16 samples.
+Prints the wall time of each F12 render (median of --repeat) and the ratios."""
+
+import json
+import math
+import os
+import statistics
+import sys
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "blender"))
+
+import bpy  # noqa: E402
+
+import render_utils as ru  # noqa: E402
+
+args = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+REPEAT = int(args[args.index("--repeat") + 1]) if "--repeat" in args else 3
+QUICK = "--quick" in args
+W, H = (480, 270) if QUICK else (1920, 1080)
+SAMPLES = 16
+
+
+def build_scene():
+    scene = ru.reset_scene()
+    scene.world.color = (0.05, 0.05, 0.06)
+    for i in range(6):
+        x, y = (i % 3 - 1) * 2.6, (i // 3) * 2.6
+        bpy.ops.mesh.primitive_monkey_add(size=2.0, location=(x, y, 0.0), rotation=(0.0, 0.0, math.radians(20 * i)))
+        obj = bpy.context.object
+        obj.modifiers.new("Subdivision", "SUBSURF").render_levels = 2
+        bpy.ops.object.shade_smooth()
+        obj.data.materials.append(ru.diffuse_material(f"m{i}", (0.2 + 0.12 * i, 0.5, 0.8 - 0.1 * i)))
+    bpy.ops.mesh.primitive_plane_add(size=30.0, location=(0, 0, -1.0))
+    for kind, energy, loc in (("SUN", 3.0, (3, -3, 6)), ("POINT", 1000.0, (-4, -4, 4)), ("AREA", 500.0, (0, -6, 5))):
+        data = bpy.data.lights.new(kind, kind)
+        data.energy = energy
+        obj = bpy.data.objects.new(kind, data)
+        scene.collection.objects.link(obj)
+        obj.location = loc
+        obj.rotation_euler = (math.radians(40), 0.0, math.radians(20))
+    ru.add_camera(scene, (0.0, -11.0, 5.0), (0.0, 1.3, 0.0), lens=35.0)
+    r = scene.render
+    r.resolution_x, r.resolution_y, r.resolution_percentage = W, H, 100
+    return scene
+
+
+def time_engine(scene, engine):
+    scene.render.engine = engine
+    if engine == "MICROPOLY":
+        scene.micropoly.samples = SAMPLES
+    elif engine == "CYCLES":
+        ru.setup_cycles(scene, samples=SAMPLES)
+        c = scene.cycles
+        c.max_bounces, c.diffuse_bounces, c.glossy_bounces = 12, 4, 4  # Cycles' defaults
+        scene.render.engine = "CYCLES"
+    else:
+        eevee = scene.eevee
+        eevee.taa_render_samples = SAMPLES
+    times = []
+    for _ in range(REPEAT):
+        started = time.perf_counter()
+        bpy.ops.render.render()
+        times.append(time.perf_counter() - started)
+    return times
+
+
+def export_time():
+    from micropoly import export
+
+    scene = ru.reset_scene()
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=1001, y_subdivisions=1001, size=10.0)
+    faces = len(bpy.context.object.data.polygons)
+    ru.add_camera(scene, (0, -10, 10), (0, 0, 0))
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    times = []
+    for _ in range(REPEAT):
+        started = time.perf_counter()
+        export.export_scene(depsgraph)
+        times.append(time.perf_counter() - started)
+    return faces, times
+
+
+def main():
+    engines = ("MICROPOLY", "CYCLES", "BLENDER_EEVEE_NEXT" if bpy.app.version >= (4, 2, 0) else "BLENDER_EEVEE")
+    results = {}
+    for engine in engines:
+        scene = build_scene()
+        try:
+            results[engine] = time_engine(scene, engine)
+        except Exception as e:  # EEVEE needs an OpenGL context some machines lack
+            print(f"{engine}: could not render ({e})")
+    faces, export_times = export_time()
+    print(f"\nBlender {bpy.app.version_string}, {W}x{H}, {SAMPLES} samples, median of {REPEAT} F12 renders")
+    micro = statistics.median(results["MICROPOLY"])
+    print("| engine | F12 s (median) | runs | time / Micropoly's |")
+    print("|---|---|---|---|")
+    for engine, times in results.items():
+        med = statistics.median(times)
+        print(f"| {engine} | {med:.2f} | {', '.join(f'{t:.2f}' for t in times)} | {med / micro:.1f}x |")
+    print(f"\nexport of a {faces:,}-face mesh: median {statistics.median(export_times):.3f} s "
+          f"({', '.join(f'{t:.3f}' for t in export_times)})")
+    print(json.dumps({"version": bpy.app.version_string, "width": W, "height": H, "renders": results,
+                      "export_faces": faces, "export_s": export_times}))
+
+
+main()
+sys.stdout.flush()
+os._exit(0)
