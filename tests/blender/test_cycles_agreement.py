@@ -129,7 +129,35 @@ def case_disk_light():
     return compare("disk area light", scene, {"psnr"})
 
 
-CASES = [case_subdivided_suzanne, case_polygon_mesh, case_orthographic, case_shifted_camera, case_disk_light]
+def case_instances():
+    """A collection instanced three times and a linked duplicate (one mesh,
+    several objects): every instance must render, where Cycles shows it."""
+    scene = ru.reset_scene()
+    collection = bpy.data.collections.new("Source")
+    scene.collection.children.link(collection)
+    obj = suzanne(scene)
+    for c in list(obj.users_collection):
+        c.objects.unlink(obj)
+    collection.objects.link(obj)
+    collection.hide_render = False
+    for i, x in enumerate((-3.0, 0.0, 3.0)):
+        empty = bpy.data.objects.new(f"instance{i}", None)
+        empty.instance_type = "COLLECTION"
+        empty.instance_collection = collection
+        empty.location = (x, 2.0 * i, 0.0)
+        scene.collection.objects.link(empty)
+    duplicate = bpy.data.objects.new("duplicate", obj.data)
+    duplicate.modifiers.new("Subdivision", "SUBSURF").render_levels = 2
+    duplicate.location = (0.0, -2.0, 1.8)
+    scene.collection.objects.link(duplicate)
+    # The source collection itself stays out of the view layer, as usual for instancing.
+    scene.view_layers[0].layer_collection.children["Source"].exclude = True
+    light(scene, "SUN", energy=3.0)
+    ru.add_camera(scene, (0.0, -14.0, 4.0), (0.0, 1.5, 0.0))
+    return compare("collection instances and linked duplicates, sun light", scene, set())
+
+
+CASES = [case_instances, case_subdivided_suzanne, case_polygon_mesh, case_orthographic, case_shifted_camera, case_disk_light]
 
 
 def main():
