@@ -53,9 +53,10 @@ def export_light(native_scene, obj, matrix, warnings):
         native_scene.add_light("point", color=color, intensity=power / (4.0 * math.pi), position=position)
     elif light.type == "SPOT":
         cone, delta = _spot_cone(light.spot_size, light.spot_blend)
+        # Cycles in Blender 3.x also weights the cone by cos(angle to the axis).
         native_scene.add_light("spot", color=color, intensity=power / (4.0 * math.pi), position=position,
                                direction=direction, cone_angle=cone, cone_delta_angle=delta,
-                               beam_distribution=0.0)
+                               beam_distribution=1.0 if bpy.app.version < (4, 0, 0) else 0.0)
     elif light.type == "AREA":
         scale = matrix.to_scale()
         size_u = light.size * abs(scale.x)

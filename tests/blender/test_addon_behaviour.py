@@ -100,6 +100,35 @@ def test_cancel_is_quick():
           f"returned {latency:.2f} s after the break, render ran {ended - started:.2f} s")
 
 
+def test_animation():
+    scene = ru.reset_scene()
+    bpy.ops.mesh.primitive_cube_add()
+    cube = bpy.context.object
+    cube.location = (0.0, 0.0, 0.0)
+    cube.keyframe_insert("location", frame=1)
+    cube.location = (1.5, 0.0, 0.0)
+    cube.keyframe_insert("location", frame=3)
+    ru.add_camera(scene, (0, -8, 0), (0, 0, 0))
+    r = scene.render
+    r.engine = "MICROPOLY"
+    r.resolution_x, r.resolution_y, r.resolution_percentage = 64, 48, 100
+    r.image_settings.file_format = "PNG"
+    r.film_transparent = True
+    r.image_settings.color_mode = "RGBA"
+    folder = tempfile.mkdtemp(prefix="mp-anim-")
+    r.filepath = os.path.join(folder, "frame_")
+    scene.frame_start, scene.frame_end = 1, 3
+    bpy.ops.render.render(animation=True)
+    frames = sorted(glob.glob(os.path.join(folder, "frame_*.png")))
+    sums = []
+    for path in frames:
+        image = bpy.data.images.load(path)
+        px = np.array(image.pixels[:], dtype=np.float32).reshape(48, 64, 4)
+        sums.append(float((px[..., 3] * np.arange(64)[None, :]).sum() / max(px[..., 3].sum(), 1e-6)))
+    moving = len(sums) == 3 and sums[0] < sums[1] < sums[2]
+    check("an animation renders every frame, following the keyframes", moving, f"alpha centroids {sums}")
+
+
 def test_old_blend_files():
     pattern = os.path.join(os.path.dirname(bpy.app.binary_path or "/"), "..", "share", "blender", "scripts",
                            "addons", "materials_library_vx", "*.blend")
@@ -175,7 +204,7 @@ def test_rib_export_matches_f12():
 def main():
     print(f"Blender {bpy.app.version_string}")
     for test in (test_nan_mesh, test_empty_scene, test_camera_inside_object, test_cancel_is_quick,
-                 test_rib_export_matches_f12, test_old_blend_files):
+                 test_rib_export_matches_f12, test_animation, test_old_blend_files):
         try:
             test()
         except Exception:
