@@ -44,6 +44,12 @@ inline int clamp(int x, int a, int b) { return std::min(std::max(x, a), b); }
 inline float mix(float a, float b, float t) { return a + (b - a) * t; }
 inline glm::vec3 mix(glm::vec3 a, glm::vec3 b, float t) { return a + (b - a) * t; }
 inline uint as_uint(float f) { uint u; std::memcpy(&u, &f, 4); return u; }
+// OpenCL's float overloads (the C library's take and return double).
+inline float pow(float x, float y) { return std::pow(x, y); }
+inline float cos(float x) { return std::cos(x); }
+inline float sin(float x) { return std::sin(x); }
+inline float acos(float x) { return std::acos(x); }
+inline float exp(float x) { return std::exp(x); }
 }  // namespace mp_compat
 #include <cstring>
 using namespace mp_compat;

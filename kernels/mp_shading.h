@@ -62,7 +62,7 @@ MP_INLINE float mp_area_irradiance(MP_GLOBAL const DeviceLight* lt, float3 p, fl
     float k = sqrt(MP_PI / (0.5f * (float)MP_ELLIPSE_SIDES * sin(2.0f * MP_PI / (float)MP_ELLIPSE_SIDES)));
     for (int i = 0; i < MP_ELLIPSE_SIDES; ++i) {
       float a = 2.0f * MP_PI * (float)i / (float)MP_ELLIPSE_SIDES;
-      verts[i] = c + k * (cos(a) * u + sin(a) * w) - p;
+      verts[i] = c + k * ((float)cos(a) * u + (float)sin(a) * w) - p;
     }
     count = MP_ELLIPSE_SIDES;
   } else {

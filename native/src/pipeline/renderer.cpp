@@ -18,7 +18,7 @@ namespace {
 // Sub-patches per dice batch: grid buffers hold this many (max_grid+1)^2 grids.
 constexpr cl_uint kDiceBatch = 8192;
 // Sub-patches sampled per launch when the caller can cancel.
-constexpr cl_uint kSampleChunk = 1024;
+constexpr cl_uint kSampleChunk = 256;
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -88,6 +88,12 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     SampleStage& sample = impl_->sample;
     ResolveStage& resolve = impl_->resolve;
     dice.begin_frame();
+    if (progress && !progress(0.0f)) {  // cancelled before the frame's buffers are set up
+      st.cancelled = true;
+      out.width = out.height = 0;
+      out.rgba.clear(), out.depth.clear(), out.normal.clear();
+      return;
+    }
     sample.begin_frame(f, timer);
 
     // Cancellation: the caller's progress callback is asked between bound &
@@ -115,9 +121,13 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       st.subpatches_diced += count;
       ++st.batches;
     };
+    if (progress) {
+      s.queue().finish();  // clearing a large sample buffer takes a while: look again
+      keep_going(0.0f);
+    }
     BoundSplitContext ctx{s, buffers, f, timer, sink, keep_going};
     BoundSplitResult bs;
-    if (buffers.patch_count > 0) {
+    if (buffers.patch_count > 0 && !cancelled) {
       if (scene.settings.bound_split == BoundSplitMethod::Bounded) {
         size_t budget = static_cast<size_t>(std::max(0.0f, scene.settings.bound_split_memory_mib) * 1048576.0);
         bs = bound_split_bounded(ctx, budget, capacity, impl_->bounded);

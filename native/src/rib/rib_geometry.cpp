@@ -47,7 +47,7 @@ bool Parser::read_positions(ArgReader& args, const ParamList& params, bool patch
                             std::vector<glm::vec3>* out) {
   const int line = args.request().line;
   for (const Param& p : params.params())
-    if (p.name != "P" && p.name != "Pw" && p.name != "Pz")
+    if (p.name != "P" && p.name != "Pw" && p.name != "Pz" && p.name != "micropoly:material")
       warn_once("primvar:" + p.name, p.line, "primitive variable \"" + p.name + "\" is ignored");
   const Param* P = params.find("P");
   const Param* Pw = params.find("Pw");
@@ -140,6 +140,7 @@ void Parser::req_points_polygons(ArgReader& args) {
   Primitive prim = make_primitive(Primitive::Kind::Mesh, args);
   if (!read_positions(args, params, false, &prim.mesh.points)) return;
   check_indices(args, verts_arg, indices, prim.mesh.points.size());
+  read_face_materials(args, params, counts.size(), &prim.mesh.face_materials);
   fill_polygons(prim.mesh, std::move(counts), std::move(indices));
   place(std::move(prim), args);
 }
@@ -177,6 +178,7 @@ void Parser::req_points_general_polygons(ArgReader& args) {
   if (holes)
     warn_once("holes", args.request().line,
               "holes in general polygons are not supported; only the outer loop is rendered");
+  read_face_materials(args, params, loops.size(), &prim.mesh.face_materials);
   fill_polygons(prim.mesh, std::move(outer_counts), std::move(outer_indices));
   place(std::move(prim), args);
 }
@@ -227,6 +229,7 @@ void Parser::req_subdivision_mesh(ArgReader& args) {
   const size_t npoints = mesh.points.size();
   const size_t nfaces = counts.size();
   check_indices(args, verts_arg, indices, npoints);
+  read_face_materials(args, params, nfaces, &mesh.face_materials);
   fill_polygons(mesh, std::move(counts), std::move(indices));
 
   // RenderMan's default without an "interpolateboundary" tag is no boundary

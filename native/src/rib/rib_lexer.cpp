@@ -40,9 +40,9 @@ void Lexer::fail(int line, const std::string& reason) const {
   throw RibError(file_ + ":" + std::to_string(line) + ": " + reason);
 }
 
-size_t Lexer::utf8_length(size_t pos) const {
+size_t utf8_sequence_length(std::string_view text, size_t pos) {
   auto byte = [&](size_t i) -> int {
-    return i < text_.size() ? static_cast<unsigned char>(text_[i]) : -1;
+    return i < text.size() ? static_cast<unsigned char>(text[i]) : -1;
   };
   auto cont = [&](size_t i, int lo = 0x80, int hi = 0xBF) {
     int b = byte(i);

@@ -19,6 +19,12 @@ struct Token {
   std::string text;     // TokenKind::Name and TokenKind::String (escapes resolved)
 };
 
+// Length of the valid UTF-8 sequence starting at text[pos] (1 for ASCII), or 0
+// if the bytes there are not valid UTF-8 (overlong forms, surrogates and code
+// points above U+10FFFF are invalid). Shared with the writer, which must
+// escape exactly the bytes the lexer would refuse.
+size_t utf8_sequence_length(std::string_view text, size_t pos);
+
 class Lexer {
  public:
   // `text` must outlive the lexer; `file` names it in error messages.
@@ -35,8 +41,7 @@ class Lexer {
   Token lex_string();
   Token lex_number();
   Token lex_name();
-  // Length of the valid UTF-8 sequence starting at `pos`, or 0 if invalid.
-  size_t utf8_length(size_t pos) const;
+  size_t utf8_length(size_t pos) const { return utf8_sequence_length(text_, pos); }
 
   std::string_view text_;
   std::string file_;
@@ -46,5 +51,6 @@ class Lexer {
 
 // Human-readable description of a token for error messages ("a number").
 const char* describe(TokenKind kind);
+
 
 }  // namespace mp::rib

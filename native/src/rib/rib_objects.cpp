@@ -79,14 +79,15 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
               "ShadingRate differs between primitives; one rate (the last one set) is used");
   }
   const bool flip = attrs.inside_out;
-  const std::string name = attrs.identifier.empty() ? prim.origin : attrs.identifier;
+  const std::string name = attrs.has_identifier ? attrs.identifier : prim.origin;
   Scene& scene = result_.scene;
 
   // Runs of Polygon or Patch requests with the same state share one object.
   const bool merge = prim.mergeable && has_merge_target_ && merge_.kind == prim.kind &&
                      merge_.object_to_world == object_to_world && merge_.material == material &&
                      merge_.double_sided == attrs.double_sided &&
-                     merge_.identifier == attrs.identifier;
+                     merge_.identifier == attrs.identifier &&
+                     merge_.has_identifier == attrs.has_identifier;
   if (prim.kind == Primitive::Kind::Mesh) {
     if (merge) {
       Mesh& dst = scene.meshes[merge_.index];
@@ -135,6 +136,7 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
     merge_.material = material;
     merge_.double_sided = attrs.double_sided;
     merge_.identifier = attrs.identifier;
+    merge_.has_identifier = attrs.has_identifier;
   }
 }
 

@@ -283,11 +283,17 @@ void Parser::req_world_end(ArgReader& args) {
   has_merge_target_ = false;
 }
 
+// An attribute block is a separate object: Polygon/Patch runs do not merge
+// across its boundaries (the writer relies on this to keep patch sets apart).
 void Parser::req_attribute_begin(ArgReader& args) {
   args.done();
   push_block(Block::Kind::Attribute, args.request().line);
+  has_merge_target_ = false;
 }
-void Parser::req_attribute_end(ArgReader& args) { pop_block(Block::Kind::Attribute, args); }
+void Parser::req_attribute_end(ArgReader& args) {
+  pop_block(Block::Kind::Attribute, args);
+  has_merge_target_ = false;
+}
 
 void Parser::req_transform_begin(ArgReader& args) {
   args.done();
@@ -414,6 +420,8 @@ void Parser::req_pixel_filter(ArgReader& args) {
     s.filter = PixelFilter::Gaussian;
   } else if (name == "triangle") {
     s.filter = PixelFilter::Triangle;
+  } else if (name == "blackman-harris") {
+    s.filter = PixelFilter::BlackmanHarris;
   } else {
     warn_once("filter:" + name, args.request().line,
               "PixelFilter \"" + name + "\" is not supported; using gaussian");
@@ -444,6 +452,7 @@ void Parser::req_display(ArgReader& args) {
 void Parser::req_option(ArgReader& args) {
   const std::string name = args.string();
   ParamList params(args, decls_);
+  if (name == "micropoly") return micropoly_option(args, params);
   warn_once("option:" + name, args.request().line, "Option \"" + name + "\" is ignored");
 }
 
@@ -451,9 +460,13 @@ void Parser::req_attribute(ArgReader& args) {
   const std::string name = args.string();
   ParamList params(args, decls_);
   if (name == "identifier") {
-    attrs_.identifier = params.get_string("name", attrs_.identifier);
+    if (params.find("name")) {
+      attrs_.identifier = params.get_string("name", attrs_.identifier);
+      attrs_.has_identifier = true;
+    }
     return;
   }
+  if (name == "micropoly") return micropoly_attribute(args, params);
   warn_once("attribute:" + name, args.request().line, "Attribute \"" + name + "\" is ignored");
 }
 

@@ -5,6 +5,8 @@
 //   rib_shading.cpp   surfaces, colors, lights, materials
 //   rib_geometry.cpp  polygons, subdivision meshes, patches
 //   rib_objects.cpp   placing primitives in the scene, object instancing
+//   rib_micropoly.cpp the "micropoly" options, attributes and parameters
+//                     (Micropoly's extensions, written by rib_writer.cpp)
 #pragma once
 
 #include <map>
@@ -53,6 +55,10 @@ struct Attributes {
   std::vector<char> lights_on;  // by light index; lights past the end are off
   Basis ubasis, vbasis;
   std::string identifier;       // Attribute "identifier" "name"
+  bool has_identifier = false;  // given, even if empty
+  // Scene material chosen by Attribute "micropoly" "integer material"; -1:
+  // none (the shading state above picks one). Surface, Color and Opacity reset it.
+  int material_slot = -1;
 };
 
 // A primitive before it is placed: geometry in its own object space, vertex
@@ -71,7 +77,7 @@ struct Primitive {
 struct LightRecord {
   bool supported = false;
   Light light;               // position/direction in the frame below
-  glm::vec3 to_point{0.0f};  // the "to" point, for the direction after conversion
+  glm::vec3 direction{0.0f};  // "to" - "from" in the frame below, not yet normalised
   bool in_camera = false;    // declared before WorldBegin: converted at WorldBegin
   bool on_some = false;      // illuminated at least one primitive
   bool off_some = false;     // was off for at least one later primitive
@@ -114,6 +120,7 @@ class Parser {
     int material;
     bool double_sided;
     std::string identifier;
+    bool has_identifier;
   };
 
   static const std::unordered_map<std::string, Handler>& handlers();
@@ -180,6 +187,7 @@ class Parser {
   void req_light_source(ArgReader&);
   void req_illuminate(ArgReader&);
   int material_index(const Attributes& attrs);
+  static std::vector<float> material_key(const Material& m);
   void convert_camera_lights(int line);
   void finish_light(LightRecord& rec, int line);
 
@@ -206,6 +214,15 @@ class Parser {
   void place(Primitive prim, const ArgReader& args);
   void add_to_scene(const Primitive& prim, const glm::mat4& xform, const Attributes& attrs, int line);
   void account_lights(const Attributes& attrs);
+
+  // rib_micropoly.cpp
+  void micropoly_option(ArgReader& args, const ParamList& params);
+  void micropoly_attribute(ArgReader& args, const ParamList& params);
+  void define_material(int index, const std::string& name);
+  // Per-face Scene material indices ("uniform integer micropoly:material"),
+  // left empty when the parameter is absent.
+  void read_face_materials(ArgReader& args, const ParamList& params, size_t faces,
+                           std::vector<int>* out) const;
 
   // State.
   RibResult result_;

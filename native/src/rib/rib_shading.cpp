@@ -1,6 +1,11 @@
 // Surfaces, colors and light sources, following the standard RenderMan
 // shaders (RI spec 3.2, appendix A): constant, matte, plastic; ambientlight,
-// distantlight, pointlight, spotlight, with their parameter defaults.
+// distantlight, pointlight, spotlight, with their parameter defaults. Two
+// Micropoly shader names map to the Scene's own models:
+// "micropoly_principled" (Material::Model::Principled) and
+// "micropoly_arealight" (Light::Type::Area); every surface also takes
+// "color emission". See docs/rib.md.
+#include <cfloat>
 #include <cmath>
 #include <functional>
 #include <initializer_list>
@@ -24,17 +29,24 @@ void warn_unknown_params(const ParamList& params, std::initializer_list<const ch
 
 }  // namespace
 
+std::vector<float> Parser::material_key(const Material& m) {
+  // Equal shading states share one material; the name is not part of it.
+  return {static_cast<float>(m.model),
+          m.color.x, m.color.y, m.color.z,
+          m.opacity.x, m.opacity.y, m.opacity.z,
+          m.ka, m.kd, m.ks, m.roughness,
+          m.specular_color.x, m.specular_color.y, m.specular_color.z,
+          m.emission.x, m.emission.y, m.emission.z,
+          m.metallic, m.specular};
+}
+
 int Parser::material_index(const Attributes& attrs) {
+  // A material chosen by index (Attribute "micropoly" "integer material").
+  if (attrs.material_slot >= 0) return attrs.material_slot;
   Material m = attrs.surface;
   m.color = attrs.color;
   m.opacity = attrs.opacity;
-  // Equal shading states share one material; the name is not part of it.
-  const std::vector<float> key = {static_cast<float>(m.model),
-                                  m.color.x, m.color.y, m.color.z,
-                                  m.opacity.x, m.opacity.y, m.opacity.z,
-                                  m.ka, m.kd, m.ks, m.roughness,
-                                  m.specular_color.x, m.specular_color.y, m.specular_color.z,
-                                  m.emission.x, m.emission.y, m.emission.z};
+  const std::vector<float> key = material_key(m);
   auto it = material_keys_.find(key);
   if (it != material_keys_.end()) return it->second;
   const int index = static_cast<int>(result_.scene.materials.size());
@@ -47,12 +59,14 @@ void Parser::req_color(ArgReader& args) {
   const std::vector<double> c = args.numbers(3);
   args.done();
   attrs_.color = glm::vec3(c[0], c[1], c[2]);
+  attrs_.material_slot = -1;  // the shading state changed
 }
 
 void Parser::req_opacity(ArgReader& args) {
   const std::vector<double> o = args.numbers(3);
   args.done();
   attrs_.opacity = glm::vec3(o[0], o[1], o[2]);
+  attrs_.material_slot = -1;
 }
 
 void Parser::req_surface(ArgReader& args) {
@@ -64,18 +78,33 @@ void Parser::req_surface(ArgReader& args) {
   };
   Material m;
   m.name = name;
+  // Emitted radiance added to the shaded color: a Micropoly extension that
+  // every supported surface takes.
+  auto read_emission = [&] { params.get_floats("emission", &m.emission.x, 3); };
   if (name == "constant") {
     m.model = Material::Model::Constant;
     m.ka = 1.0f;
     m.kd = 0.0f;
     m.ks = 0.0f;
-    warn_unknown_params(params, {}, "Surface \"constant\"", warn_param);
+    read_emission();
+    warn_unknown_params(params, {"emission"}, "Surface \"constant\"", warn_param);
   } else if (name == "matte" || name == "defaultsurface") {
     m.model = Material::Model::Matte;
     m.ka = params.get_float("Ka", 1.0f);
     m.kd = params.get_float("Kd", 1.0f);
     m.ks = 0.0f;
-    warn_unknown_params(params, {"Ka", "Kd"}, "Surface \"" + name + "\"", warn_param);
+    read_emission();
+    warn_unknown_params(params, {"Ka", "Kd", "emission"}, "Surface \"" + name + "\"", warn_param);
+  } else if (name == "micropoly_principled") {
+    // Blender's Principled BSDF in the Scene's terms; Color is the base color.
+    // Defaults are the Scene's (Material{}).
+    m.model = Material::Model::Principled;
+    m.metallic = params.get_float("metallic", m.metallic);
+    m.roughness = params.get_float("roughness", m.roughness);
+    m.specular = params.get_float("specular", m.specular);
+    read_emission();
+    warn_unknown_params(params, {"metallic", "roughness", "specular", "emission"},
+                        "Surface \"micropoly_principled\"", warn_param);
   } else {
     // plastic, and the fallback for any other shader with plastic's defaults.
     m.model = Material::Model::Plastic;
@@ -90,7 +119,8 @@ void Parser::req_surface(ArgReader& args) {
       m.ks = params.get_float("Ks", m.ks);
       m.roughness = params.get_float("roughness", m.roughness);
       params.get_floats("specularcolor", &m.specular_color.x, 3);
-      warn_unknown_params(params, {"Ka", "Kd", "Ks", "roughness", "specularcolor"},
+      read_emission();
+      warn_unknown_params(params, {"Ka", "Kd", "Ks", "roughness", "specularcolor", "emission"},
                           "Surface \"plastic\"", warn_param);
     } else {
       warn_once("surface:" + name, line,
@@ -98,6 +128,7 @@ void Parser::req_surface(ArgReader& args) {
     }
   }
   attrs_.surface = m;
+  attrs_.material_slot = -1;
 }
 
 void Parser::req_light_source(ArgReader& args) {
@@ -128,6 +159,8 @@ void Parser::req_light_source(ArgReader& args) {
     light.type = Light::Type::Point;
   } else if (shader == "spotlight") {
     light.type = Light::Type::Spot;
+  } else if (shader == "micropoly_arealight") {
+    light.type = Light::Type::Area;
   } else {
     rec.supported = false;
     warn_once("light:" + shader, line,
@@ -168,13 +201,40 @@ void Parser::req_light_source(ArgReader& args) {
                              "conedeltaangle", "beamdistribution"},
                             what, warn_param);
         break;
+      case Light::Type::Area: {
+        // A rectangle or ellipse centred on "from", emitting towards "to";
+        // "width" along "axis", "height" across it.
+        params.get_floats("from", &from.x, 3);
+        params.get_floats("to", &to.x, 3);
+        const std::string shape = params.get_string("shape", "rectangle");
+        if (shape == "ellipse")
+          light.shape = Light::Shape::Ellipse;
+        else if (shape == "rectangle")
+          light.shape = Light::Shape::Rectangle;
+        else
+          args.fail("\"shape\" must be \"rectangle\" or \"ellipse\", not \"" + shape + "\"");
+        glm::vec3 axis(1.0f, 0.0f, 0.0f);
+        params.get_floats("axis", &axis.x, 3);
+        light.axis_u = glm::vec3(attrs_.ctm * glm::vec4(axis, 0.0f));
+        light.size_u = params.get_float("width", 1.0f);
+        light.size_v = params.get_float("height", 1.0f);
+        if (!(light.size_u >= 0.0f && light.size_v >= 0.0f)) args.fail("negative area light size");
+        warn_unknown_params(params,
+                            {"intensity", "lightcolor", "from", "to", "shape", "axis", "width", "height"},
+                            what, warn_param);
+        break;
+      }
     }
-    if ((light.type == Light::Type::Distant || light.type == Light::Type::Spot) && from == to)
+    if ((light.type == Light::Type::Distant || light.type == Light::Type::Spot ||
+         light.type == Light::Type::Area) && from == to)
       args.fail("\"from\" and \"to\" coincide: the light has no direction");
     // Light positions are given in the current coordinate system (the
     // shader space at declaration): camera space before WorldBegin.
     light.position = glm::vec3(attrs_.ctm * glm::vec4(from, 1.0f));
-    rec.to_point = glm::vec3(attrs_.ctm * glm::vec4(to, 1.0f));
+    // The direction is transformed as a vector (the same as the difference of
+    // the transformed points for the affine transformations lights live in),
+    // so "from" [0 0 0] "to" d under a Translate gives back d exactly.
+    rec.direction = glm::vec3(attrs_.ctm * glm::vec4(to - from, 0.0f));
     rec.in_camera = !in_world_;
   }
   const int index = static_cast<int>(lights_.size());
@@ -193,15 +253,20 @@ void Parser::finish_light(LightRecord& rec, int line) {
   if (rec.in_camera) {
     const glm::mat4& to_world = camera_inverse(line);
     light.position = glm::vec3(to_world * glm::vec4(light.position, 1.0f));
-    rec.to_point = glm::vec3(to_world * glm::vec4(rec.to_point, 1.0f));
+    rec.direction = glm::vec3(to_world * glm::vec4(rec.direction, 0.0f));
+    if (light.type == Light::Type::Area) light.axis_u = glm::vec3(to_world * glm::vec4(light.axis_u, 0.0f));
     rec.in_camera = false;
   }
-  if (light.type == Light::Type::Distant || light.type == Light::Type::Spot) {
-    const glm::vec3 d = rec.to_point - light.position;
+  if (light.type == Light::Type::Distant || light.type == Light::Type::Spot ||
+      light.type == Light::Type::Area) {
+    const glm::vec3 d = rec.direction;
     const float len = glm::length(d);
     if (!(len > 0.0f) || !std::isfinite(len))
       throw RibError(rec.where + ": LightSource: the light direction is degenerate after transformation");
-    light.direction = d / len;
+    // Normalised; a direction already of unit length to float precision is
+    // kept bit for bit (normalising again would only add rounding), so that
+    // written scenes read back exactly.
+    light.direction = std::fabs(len - 1.0f) <= 4.0f * FLT_EPSILON ? d : d / len;
   }
 }
 

@@ -1,0 +1,127 @@
+// Micropoly's RIB extensions, all under the name "micropoly" so other
+// renderers skip them (docs/rib.md, "Micropoly extensions"). They carry what
+// standard RIB cannot say about a Scene, so that rib_writer.cpp's files read
+// back into the same Scene:
+//   Option "micropoly"     render settings without a RenderMan request
+//   Attribute "micropoly"  the shading state as Scene material number i
+//   "uniform integer micropoly:material"  per-face material numbers
+#include <algorithm>
+#include <climits>
+#include <functional>
+#include <initializer_list>
+#include <string>
+
+#include "rib/rib_parser.h"
+
+namespace mp::rib {
+namespace {
+
+// One integer parameter in [lo, hi]; `out` is unchanged when it is absent.
+void get_int(ArgReader& args, const ParamList& params, const char* name, long long lo, long long hi,
+             int* out) {
+  const Param* p = params.find(name);
+  if (!p) return;
+  if (p->decl.is_string() || p->value->numbers.size() != 1 || !to_int(p->value->numbers[0], lo, hi, out))
+    args.fail_at(p->line, std::string("parameter \"") + name + "\" expects one integer in [" +
+                              std::to_string(lo) + ", " + std::to_string(hi) + "]");
+}
+
+void warn_unknown(const ParamList& params, std::initializer_list<const char*> known,
+                  const std::function<void(const std::string&)>& warn) {
+  for (const Param& p : params.params()) {
+    bool ok = false;
+    for (const char* k : known) ok = ok || p.name == k;
+    if (!ok) warn(p.name);
+  }
+}
+
+}  // namespace
+
+void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
+  RenderSettings& s = result_.scene.settings;
+  const std::string method = params.get_string("boundsplit", "");
+  if (method == "bounded")
+    s.bound_split = BoundSplitMethod::Bounded;
+  else if (method == "breadth")
+    s.bound_split = BoundSplitMethod::Breadth;
+  else if (!method.empty())
+    args.fail("\"boundsplit\" must be \"bounded\" or \"breadth\", not \"" + method + "\"");
+  const float memory = params.get_float("boundsplitmemory", s.bound_split_memory_mib);
+  if (!(memory > 0.0f)) args.fail("\"boundsplitmemory\" must be a positive number of MiB");
+  s.bound_split_memory_mib = memory;
+  // Grid size and split depth are clamped by the renderer; any int is kept.
+  get_int(args, params, "maxgridsize", INT_MIN, INT_MAX, &s.max_grid_size);
+  get_int(args, params, "maxsplitdepth", INT_MIN, INT_MAX, &s.max_split_depth);
+  int flag = s.backface_culling ? 1 : 0;
+  get_int(args, params, "backfaceculling", 0, 1, &flag);
+  s.backface_culling = flag != 0;
+  flag = s.depth_and_normal_passes ? 1 : 0;
+  get_int(args, params, "depthandnormal", 0, 1, &flag);
+  s.depth_and_normal_passes = flag != 0;
+  const int line = args.request().line;
+  warn_unknown(params,
+               {"boundsplit", "boundsplitmemory", "maxgridsize", "maxsplitdepth", "backfaceculling",
+                "depthandnormal"},
+               [&](const std::string& name) {
+                 warn_once("option-micropoly:" + name, line,
+                           "Option \"micropoly\": parameter \"" + name + "\" is ignored");
+               });
+}
+
+void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
+  const int line = args.request().line;
+  warn_unknown(params, {"material", "materialname"}, [&](const std::string& name) {
+    warn_once("attribute-micropoly:" + name, line,
+              "Attribute \"micropoly\": parameter \"" + name + "\" is ignored");
+  });
+  if (!params.find("material")) {
+    if (params.find("materialname"))
+      warn_once("attribute-micropoly:materialname", line,
+                "Attribute \"micropoly\": \"materialname\" without \"material\" is ignored");
+    return;
+  }
+  // Materials are numbered densely: an index may replace an existing
+  // material (0 replaces the default surface) or add the next one.
+  const long long count = static_cast<long long>(result_.scene.materials.size());
+  int index = 0;
+  get_int(args, params, "material", 0, std::min<long long>(count, INT_MAX), &index);
+  define_material(index, params.get_string("materialname", attrs_.surface.name));
+}
+
+void Parser::define_material(int index, const std::string& name) {
+  // The current shading state becomes material `index` and is selected for
+  // the following primitives of the attribute block. Redefining a material
+  // changes it for every primitive that uses it (the writer always repeats
+  // the same state).
+  Material m = attrs_.surface;
+  m.color = attrs_.color;
+  m.opacity = attrs_.opacity;
+  m.name = name;
+  std::vector<Material>& materials = result_.scene.materials;
+  const size_t i = static_cast<size_t>(index);
+  if (i == materials.size()) {
+    materials.push_back(m);
+  } else {
+    // Shading states that led to the old material must not find it any more.
+    auto it = material_keys_.find(material_key(materials[i]));
+    if (it != material_keys_.end() && it->second == index) material_keys_.erase(it);
+    materials[i] = m;
+  }
+  material_keys_.emplace(material_key(m), index);  // keeps an earlier equal material
+  attrs_.material_slot = index;
+}
+
+void Parser::read_face_materials(ArgReader& args, const ParamList& params, size_t faces,
+                                 std::vector<int>* out) const {
+  out->clear();
+  const Param* p = params.find("micropoly:material");
+  if (!p) return;
+  if (p->decl.is_string() || p->value->numbers.size() != faces)
+    args.fail_at(p->line, "\"micropoly:material\" needs one material index per face (" +
+                              std::to_string(faces) + "), found " + std::to_string(p->value->size()) +
+                              " values");
+  const long long count = static_cast<long long>(result_.scene.materials.size());
+  *out = args.int_array(*p->value, 0, count - 1, "micropoly:material");
+}
+
+}  // namespace mp::rib

@@ -1,0 +1,497 @@
+// Scene -> RIB. Every value is written so that the reader (rib_reader.h)
+// reproduces it bit for bit: floats in a form that reads back to the same
+// float, transformations as whole matrices (no decomposition), face loops in
+// their original order (the reader keeps the order unless the orientation is
+// flipped, which the writer never does), and materials as an indexed table
+// (Attribute "micropoly" "integer material") so that indices, duplicates and
+// unused entries survive. The standard shading requests are written too, so
+// other RenderMan renderers see the same surfaces.
+#include "rib/rib_writer.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <ostream>
+
+#include "micropoly/error.h"
+#include "rib/rib_lexer.h"
+
+namespace mp {
+namespace {
+
+// --- values -------------------------------------------------------------------
+
+void put_float(std::string& out, float v) {
+  // The shortest decimal that names v, unless reading it as the reader does
+  // (to double, then rounded to float) would land on a neighbour; 9
+  // significant digits always read back exactly (they lie far from the
+  // midpoints between floats, so the double step cannot tip them over).
+  char buf[48];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  double back = 0.0;
+  std::from_chars(buf, r.ptr, back);
+  if (static_cast<float>(back) != v) r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::general, 9);
+  out.append(buf, r.ptr);
+}
+
+void put_int(std::string& out, long long v) {
+  char buf[24];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, r.ptr);
+}
+
+void put_octal(std::string& out, unsigned char c) {
+  // Always three digits, so a digit that follows is not read as part of it.
+  out += '\\';
+  out += static_cast<char>('0' + ((c >> 6) & 7));
+  out += static_cast<char>('0' + ((c >> 3) & 7));
+  out += static_cast<char>('0' + (c & 7));
+}
+
+// A quoted RIB string. Valid UTF-8 is kept as is; quotes, backslashes and
+// control characters are escaped, and bytes that are not valid UTF-8 are
+// written as octal escapes (which the reader takes as raw bytes). NUL has no
+// escape in RIB (\000 is invalid) and is dropped.
+void put_string(std::string& out, std::string_view s) {
+  out += '"';
+  for (size_t i = 0; i < s.size();) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    if (c >= 0x80) {
+      const size_t n = rib::utf8_sequence_length(s, i);
+      if (n == 0) {
+        put_octal(out, c);
+        ++i;
+      } else {
+        out.append(s.substr(i, n));
+        i += n;
+      }
+      continue;
+    }
+    ++i;
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      case '\r': out += "\\r"; break;
+      case '\b': out += "\\b"; break;
+      case '\f': out += "\\f"; break;
+      case 0: break;
+      default:
+        if (c < 0x20 || c == 0x7F)
+          put_octal(out, c);
+        else
+          out += static_cast<char>(c);
+    }
+  }
+  out += '"';
+}
+
+void put_floats(std::string& out, const float* v, size_t n) {
+  out += '[';
+  for (size_t i = 0; i < n; ++i) {
+    if (i) out += ' ';
+    put_float(out, v[i]);
+  }
+  out += ']';
+}
+
+void put_vec3(std::string& out, const glm::vec3& v) { put_floats(out, &v.x, 3); }
+
+void put_points(std::string& out, const std::vector<glm::vec3>& pts) {
+  // Long arrays are broken into lines of a few points to stay readable.
+  out += '[';
+  for (size_t i = 0; i < pts.size(); ++i) {
+    if (i) out += (i % 4 == 0) ? "\n    " : "  ";
+    for (int k = 0; k < 3; ++k) {
+      if (k) out += ' ';
+      put_float(out, pts[i][k]);
+    }
+  }
+  out += ']';
+}
+
+void put_ints(std::string& out, const std::vector<int>& v) {
+  out += '[';
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (i) out += (i % 32 == 0) ? "\n    " : " ";
+    put_int(out, v[i]);
+  }
+  out += ']';
+}
+
+// A matrix as RIB's 16 numbers. GLM stores columns; RenderMan writes rows of
+// its row-vector matrix, which is the transpose: the same 16 floats in order.
+void put_matrix(std::string& out, const glm::mat4& m) {
+  out += '[';
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) {
+      if (c || r) out += ' ';
+      put_float(out, m[c][r]);
+    }
+  out += ']';
+}
+
+// "name" [value] pairs.
+void param(std::string& out, const char* name, float v) {
+  out += " \"";
+  out += name;
+  out += "\" ";
+  put_floats(out, &v, 1);
+}
+void param(std::string& out, const char* name, const glm::vec3& v) {
+  out += " \"";
+  out += name;
+  out += "\" ";
+  put_vec3(out, v);
+}
+void param(std::string& out, const char* name, long long v) {
+  out += " \"";
+  out += name;
+  out += "\" [";
+  put_int(out, v);
+  out += ']';
+}
+void param(std::string& out, const char* name, std::string_view v) {
+  out += " \"";
+  out += name;
+  out += "\" [";
+  put_string(out, v);
+  out += ']';
+}
+
+// --- scene parts --------------------------------------------------------------------
+
+const char* filter_name(PixelFilter f) {
+  switch (f) {
+    case PixelFilter::Box: return "box";
+    case PixelFilter::Gaussian: return "gaussian";
+    case PixelFilter::Triangle: return "triangle";
+    case PixelFilter::BlackmanHarris: return "blackman-harris";
+  }
+  return "gaussian";
+}
+
+void write_options(std::string& o, const RenderSettings& s) {
+  // Settings with no RenderMan request (docs/rib.md, "Option micropoly").
+  o += "Option \"micropoly\"";
+  param(o, "string boundsplit", s.bound_split == BoundSplitMethod::Breadth ? "breadth" : "bounded");
+  param(o, "float boundsplitmemory", s.bound_split_memory_mib);
+  param(o, "integer maxgridsize", static_cast<long long>(s.max_grid_size));
+  param(o, "integer maxsplitdepth", static_cast<long long>(s.max_split_depth));
+  param(o, "integer backfaceculling", static_cast<long long>(s.backface_culling ? 1 : 0));
+  param(o, "integer depthandnormal", static_cast<long long>(s.depth_and_normal_passes ? 1 : 0));
+  o += '\n';
+}
+
+void write_image_and_camera(std::string& o, const Scene& scene) {
+  const RenderSettings& s = scene.settings;
+  const Camera& c = scene.camera;
+  o += "Format ";
+  put_int(o, s.width);
+  o += ' ';
+  put_int(o, s.height);
+  o += ' ';
+  put_float(o, s.pixel_aspect);
+  o += "\nCropWindow ";
+  const float crop[4] = {s.crop_x0, s.crop_x1, s.crop_y0, s.crop_y1};
+  put_floats(o, crop, 4);
+  o += "\nPixelSamples ";
+  put_int(o, s.samples_x);
+  o += ' ';
+  put_int(o, s.samples_y);
+  o += "\nPixelFilter ";
+  put_string(o, filter_name(s.filter));
+  o += ' ';
+  put_float(o, s.filter_width);
+  o += ' ';
+  put_float(o, s.filter_width);
+  o += "\nShadingRate ";
+  put_float(o, s.shading_rate);
+  // RenderMan needs a positive near plane; a Scene may use 0, for which the
+  // smallest positive float behaves the same (nothing lies closer).
+  o += "\nClipping ";
+  put_float(o, c.clip_near > 0.0f ? c.clip_near : std::numeric_limits<float>::denorm_min());
+  o += ' ';
+  put_float(o, c.clip_far);
+  o += '\n';
+  if (c.projection == Camera::Projection::Perspective) {
+    o += "Projection \"perspective\"";
+    param(o, "fov", c.fov_degrees);
+    o += '\n';
+  } else {
+    o += "Projection \"orthographic\"\n";
+  }
+  // left == right (or bottom == top) means "derived from the aspect ratio":
+  // the reader's default when no ScreenWindow is given.
+  if (c.screen_left != c.screen_right || c.screen_bottom != c.screen_top) {
+    o += "ScreenWindow ";
+    const float w[4] = {c.screen_left, c.screen_right, c.screen_bottom, c.screen_top};
+    put_floats(o, w, 4);
+    o += '\n';
+  }
+  // The reader takes the transformation at WorldBegin as RenderMan's
+  // left-handed world-to-camera and mirrors z into the Scene's right-handed
+  // camera space; mirroring here first gives back the same matrix (negating
+  // a row is exact).
+  glm::mat4 rm = c.world_to_camera;
+  for (int col = 0; col < 4; ++col) rm[col][2] = rm[col][2] == 0.0f ? 0.0f : -rm[col][2];  // no "-0"
+  o += "# world to camera, z mirrored into RenderMan's left-handed camera space\nTransform ";
+  put_matrix(o, rm);
+  o += '\n';
+}
+
+void write_light(std::string& o, const Light& l, int handle) {
+  // Lights with a direction are declared at the origin of a translated frame
+  // with "to" = the direction: the reader takes the direction as the
+  // transformed "to" - "from" = the written vector, exactly (and keeps a
+  // unit-length one as is), and the position as the translation, exactly.
+  const bool directed = l.type == Light::Type::Distant || l.type == Light::Type::Spot ||
+                        l.type == Light::Type::Area;
+  if (directed) {
+    o += "TransformBegin\n  Translate";
+    for (int k = 0; k < 3; ++k) {
+      o += ' ';
+      put_float(o, l.position[k]);
+    }
+    o += "\n  ";
+  }
+  o += "LightSource ";
+  switch (l.type) {
+    case Light::Type::Ambient: o += "\"ambientlight\" "; break;
+    case Light::Type::Distant: o += "\"distantlight\" "; break;
+    case Light::Type::Point: o += "\"pointlight\" "; break;
+    case Light::Type::Spot: o += "\"spotlight\" "; break;
+    case Light::Type::Area: o += "\"micropoly_arealight\" "; break;
+  }
+  put_int(o, handle);
+  param(o, "intensity", l.intensity);
+  param(o, "lightcolor", l.color);
+  if (l.type == Light::Type::Point) param(o, "from", l.position);
+  if (directed) {
+    // A zero direction (the renderer falls back to -z) is not valid RIB.
+    const glm::vec3 d = glm::length(l.direction) > 0.0f ? l.direction : glm::vec3(0.0f, 0.0f, -1.0f);
+    param(o, "from", glm::vec3(0.0f));
+    param(o, "to", d);
+  }
+  if (l.type == Light::Type::Spot) {
+    param(o, "coneangle", l.cone_angle);
+    param(o, "conedeltaangle", l.cone_delta_angle);
+    param(o, "beamdistribution", l.beam_distribution);
+  } else if (l.type == Light::Type::Area) {
+    param(o, "string shape", l.shape == Light::Shape::Ellipse ? "ellipse" : "rectangle");
+    param(o, "vector axis", l.axis_u);
+    param(o, "float width", l.size_u);
+    param(o, "float height", l.size_v);
+  }
+  o += directed ? "\nTransformEnd\n" : "\n";
+}
+
+// The standard shading requests for a material, then the micropoly
+// attribute that makes that state Scene material `index` (with its name).
+void write_material(std::string& o, const Material& m, int index, const char* indent) {
+  o += indent;
+  o += "Color ";
+  put_vec3(o, m.color);
+  o += '\n';
+  o += indent;
+  o += "Opacity ";
+  put_vec3(o, m.opacity);
+  o += '\n';
+  o += indent;
+  o += "Surface ";
+  switch (m.model) {
+    case Material::Model::Constant: o += "\"constant\""; break;
+    case Material::Model::Matte:
+      o += "\"matte\"";
+      param(o, "Ka", m.ka);
+      param(o, "Kd", m.kd);
+      break;
+    case Material::Model::Plastic:
+      o += "\"plastic\"";
+      param(o, "Ka", m.ka);
+      param(o, "Kd", m.kd);
+      param(o, "Ks", m.ks);
+      param(o, "roughness", m.roughness);
+      param(o, "specularcolor", m.specular_color);
+      break;
+    case Material::Model::Principled:
+      o += "\"micropoly_principled\"";
+      param(o, "float metallic", m.metallic);
+      param(o, "roughness", m.roughness);
+      param(o, "float specular", m.specular);
+      break;
+  }
+  // Emission is a Micropoly extension on every surface; omitted when black
+  // so plain materials stay standard RIB.
+  if (m.emission != glm::vec3(0.0f)) param(o, "color emission", m.emission);
+  o += '\n';
+  o += indent;
+  o += "Attribute \"micropoly\"";
+  param(o, "integer material", static_cast<long long>(index));
+  param(o, "string materialname", m.name);
+  o += '\n';
+}
+
+// Name, placement, sides and material: what a mesh and a patch set share.
+void write_object_state(std::string& o, const std::string& name, const glm::mat4& object_to_world,
+                        bool double_sided, const std::vector<Material>& materials, int material) {
+  o += "  Attribute \"identifier\"";
+  param(o, "name", name);
+  o += "\n  Transform ";
+  put_matrix(o, object_to_world);
+  o += double_sided ? "\n  Sides 2\n" : "\n  Sides 1\n";
+  write_material(o, materials[static_cast<size_t>(material)], material, "  ");
+}
+
+void write_mesh(std::string& o, const Mesh& m, const std::vector<Material>& materials) {
+  o += "AttributeBegin\n";
+  write_object_state(o, m.name, m.object_to_world, m.double_sided, materials, m.material);
+  if (m.scheme == SubdivScheme::CatmullClark) {
+    o += "  SubdivisionMesh \"catmull-clark\" ";
+    put_ints(o, m.face_vertex_counts);
+    o += ' ';
+    put_ints(o, m.face_vertex_indices);
+    // Tags: interpolateboundary always (RenderMan's default differs from the
+    // Scene's), one crease per edge (keeps each edge's sharpness), then all
+    // corners and all holes in one tag each.
+    std::vector<std::string> tags = {"interpolateboundary"};
+    std::vector<int> nargs, ints;
+    std::vector<float> floats;
+    const int mode = m.boundary == BoundaryInterpolation::None       ? 0
+                     : m.boundary == BoundaryInterpolation::EdgeOnly ? 2
+                                                                     : 1;
+    nargs.insert(nargs.end(), {1, 0});
+    ints.push_back(mode);
+    for (size_t e = 0; e < m.crease_sharpness.size(); ++e) {
+      tags.push_back("crease");
+      nargs.insert(nargs.end(), {2, 1});
+      ints.insert(ints.end(), {m.crease_vertices[2 * e], m.crease_vertices[2 * e + 1]});
+      floats.push_back(m.crease_sharpness[e]);
+    }
+    if (!m.corner_vertices.empty()) {
+      tags.push_back("corner");
+      nargs.insert(nargs.end(), {static_cast<int>(m.corner_vertices.size()), static_cast<int>(m.corner_sharpness.size())});
+      ints.insert(ints.end(), m.corner_vertices.begin(), m.corner_vertices.end());
+      floats.insert(floats.end(), m.corner_sharpness.begin(), m.corner_sharpness.end());
+    }
+    if (!m.hole_faces.empty()) {
+      tags.push_back("hole");
+      nargs.insert(nargs.end(), {static_cast<int>(m.hole_faces.size()), 0});
+      ints.insert(ints.end(), m.hole_faces.begin(), m.hole_faces.end());
+    }
+    o += "\n    [";
+    for (size_t t = 0; t < tags.size(); ++t) {
+      if (t) o += ' ';
+      put_string(o, tags[t]);
+    }
+    o += "] ";
+    put_ints(o, nargs);
+    o += ' ';
+    put_ints(o, ints);
+    o += ' ';
+    put_floats(o, floats.data(), floats.size());
+  } else {
+    // Catmull-Clark tags have no effect on polygon meshes and are not written.
+    o += "  PointsPolygons ";
+    put_ints(o, m.face_vertex_counts);
+    o += ' ';
+    put_ints(o, m.face_vertex_indices);
+  }
+  o += "\n    \"P\" ";
+  put_points(o, m.points);
+  if (!m.face_materials.empty()) {
+    o += "\n    \"uniform integer micropoly:material\" ";
+    put_ints(o, m.face_materials);
+  }
+  o += "\nAttributeEnd\n";
+}
+
+void write_patches(std::string& o, const BezierPatches& b, const std::vector<Material>& materials) {
+  // One Patch request per 4x4 net in the default Bezier basis (step 3); the
+  // reader joins consecutive patches of one attribute block into one set.
+  o += "AttributeBegin\n";
+  write_object_state(o, b.name, b.object_to_world, b.double_sided, materials, b.material);
+  o += "  Basis \"bezier\" 3 \"bezier\" 3\n";
+  for (size_t p = 0; p + 16 <= b.control_points.size(); p += 16) {
+    o += "  Patch \"bicubic\" \"P\" ";
+    put_points(o, std::vector<glm::vec3>(b.control_points.begin() + static_cast<long>(p),
+                                         b.control_points.begin() + static_cast<long>(p + 16)));
+    o += '\n';
+  }
+  o += "AttributeEnd\n";
+}
+
+void flush(std::ostream& out, std::string& text) {
+  out.write(text.data(), static_cast<std::streamsize>(text.size()));
+  text.clear();
+  if (!out) throw Error("writing RIB failed (stream error)");
+}
+
+// write_rib() after validation.
+void write_valid_scene(const Scene& scene, std::ostream& out, const std::string& display_name) {
+  // A Scene without materials renders with Material{}: write that as material 0.
+  std::vector<Material> materials = scene.materials;
+  if (materials.empty()) materials.emplace_back();
+
+  std::string o;
+  o += "##RenderMan RIB\n# Written by Micropoly ";
+  o += MICROPOLY_VERSION;
+  o += "; the micropoly extensions are described in docs/rib.md.\nversion 3.04\n";
+  write_options(o, scene.settings);
+  o += "FrameBegin 1\n";
+  if (!display_name.empty()) {
+    o += "Display ";
+    put_string(o, display_name);
+    o += " \"file\" \"rgba\"\n";
+  }
+  write_image_and_camera(o, scene);
+  o += "WorldBegin\n";
+  // Lights first, at the world's top level: on for every primitive, in order.
+  for (size_t i = 0; i < scene.lights.size(); ++i) write_light(o, scene.lights[i], static_cast<int>(i) + 1);
+  // The material table, in index order (index 0 replaces the default surface).
+  for (size_t i = 0; i < materials.size(); ++i) {
+    o += "AttributeBegin\n";
+    write_material(o, materials[i], static_cast<int>(i), "  ");
+    o += "AttributeEnd\n";
+  }
+  flush(out, o);
+  for (const Mesh& m : scene.meshes) {
+    write_mesh(o, m, materials);
+    flush(out, o);
+  }
+  for (const BezierPatches& b : scene.bezier_patches) {
+    write_patches(o, b, materials);
+    flush(out, o);
+  }
+  o += "WorldEnd\nFrameEnd\n";
+  flush(out, o);
+  out.flush();
+  if (!out) throw Error("writing RIB failed (stream error)");
+}
+
+}  // namespace
+
+void write_rib(const Scene& scene, std::ostream& out, const std::string& display_name) {
+  validate_scene(scene);
+  write_valid_scene(scene, out, display_name);
+}
+
+void write_rib_file(const Scene& scene, const std::string& path, const std::string& display_name) {
+  validate_scene(scene);  // before the file is created or truncated
+  std::ofstream file(path, std::ios::binary | std::ios::trunc);
+  if (!file) throw Error("cannot open '" + path + "' for writing: " + std::strerror(errno));
+  try {
+    write_valid_scene(scene, file, display_name);
+    file.close();
+  } catch (const Error& e) {
+    throw Error("cannot write '" + path + "': " + e.what());
+  }
+  if (!file) throw Error("cannot write '" + path + "': " + std::strerror(errno));
+}
+
+}  // namespace mp

@@ -1,0 +1,625 @@
+// RIB writer: Scene -> RIB -> Scene gives the same Scene (field by field,
+// exact where floats are printed to read back exactly), and renders the same
+// image. Also the reader's side of the "micropoly" extensions the writer uses.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "micropoly/error.h"
+#include "micropoly/renderer.h"
+#include "rib/rib_reader.h"
+#include "rib/rib_writer.h"
+#include "scene_fixtures.h"
+
+namespace mp::test {
+namespace {
+
+std::string to_rib(const Scene& scene) {
+  std::ostringstream out;
+  write_rib(scene, out);
+  return out.str();
+}
+
+// Writes and reads back; the file must read without warnings (a warning
+// means something was dropped).
+Scene round_trip(const Scene& scene) {
+  const std::string text = to_rib(scene);
+  RibResult r = read_rib_string(text, "written.rib");
+  for (const std::string& w : r.warnings) ADD_FAILURE() << "warning: " << w << "\n" << text;
+  return std::move(r.scene);
+}
+
+// --- field-by-field comparison ---------------------------------------------------
+
+void expect_same_settings(const RenderSettings& a, const RenderSettings& b) {
+  EXPECT_EQ(a.width, b.width);
+  EXPECT_EQ(a.height, b.height);
+  EXPECT_EQ(a.pixel_aspect, b.pixel_aspect);
+  EXPECT_EQ(a.crop_x0, b.crop_x0);
+  EXPECT_EQ(a.crop_x1, b.crop_x1);
+  EXPECT_EQ(a.crop_y0, b.crop_y0);
+  EXPECT_EQ(a.crop_y1, b.crop_y1);
+  EXPECT_EQ(a.samples_x, b.samples_x);
+  EXPECT_EQ(a.samples_y, b.samples_y);
+  EXPECT_EQ(a.shading_rate, b.shading_rate);
+  EXPECT_EQ(a.filter, b.filter);
+  EXPECT_EQ(a.filter_width, b.filter_width);
+  EXPECT_EQ(a.bound_split, b.bound_split);
+  EXPECT_EQ(a.bound_split_memory_mib, b.bound_split_memory_mib);
+  EXPECT_EQ(a.max_grid_size, b.max_grid_size);
+  EXPECT_EQ(a.max_split_depth, b.max_split_depth);
+  EXPECT_EQ(a.backface_culling, b.backface_culling);
+  EXPECT_EQ(a.depth_and_normal_passes, b.depth_and_normal_passes);
+}
+
+void expect_same_camera(const Camera& a, const Camera& b) {
+  EXPECT_EQ(a.projection, b.projection);
+  EXPECT_EQ(a.world_to_camera, b.world_to_camera);  // exact, all 16 floats
+  if (a.projection == Camera::Projection::Perspective) EXPECT_EQ(a.fov_degrees, b.fov_degrees);
+  if (a.screen_left != a.screen_right || a.screen_bottom != a.screen_top) {
+    EXPECT_EQ(a.screen_left, b.screen_left);
+    EXPECT_EQ(a.screen_right, b.screen_right);
+    EXPECT_EQ(a.screen_bottom, b.screen_bottom);
+    EXPECT_EQ(a.screen_top, b.screen_top);
+  } else {
+    EXPECT_EQ(b.screen_left, b.screen_right);  // still "derive from the aspect ratio"
+  }
+  // RenderMan needs near > 0: 0 comes back as the smallest positive float.
+  EXPECT_EQ(a.clip_near > 0 ? a.clip_near : std::numeric_limits<float>::denorm_min(), b.clip_near);
+  EXPECT_EQ(a.clip_far, b.clip_far);
+}
+
+// The fields each model shades with (scene.h); the others have no effect.
+void expect_same_material(const Material& a, const Material& b) {
+  SCOPED_TRACE("material '" + a.name + "'");
+  EXPECT_EQ(a.name, b.name);
+  EXPECT_EQ(a.model, b.model);
+  EXPECT_EQ(a.color, b.color);
+  EXPECT_EQ(a.opacity, b.opacity);
+  EXPECT_EQ(a.emission, b.emission);
+  switch (a.model) {
+    case Material::Model::Constant: break;
+    case Material::Model::Plastic:
+      EXPECT_EQ(a.ks, b.ks);
+      EXPECT_EQ(a.roughness, b.roughness);
+      EXPECT_EQ(a.specular_color, b.specular_color);
+      [[fallthrough]];
+    case Material::Model::Matte:
+      EXPECT_EQ(a.ka, b.ka);
+      EXPECT_EQ(a.kd, b.kd);
+      break;
+    case Material::Model::Principled:
+      EXPECT_EQ(a.metallic, b.metallic);
+      EXPECT_EQ(a.roughness, b.roughness);
+      EXPECT_EQ(a.specular, b.specular);
+      break;
+  }
+}
+
+void expect_same_light(const Light& a, const Light& b) {
+  EXPECT_EQ(a.type, b.type);
+  EXPECT_EQ(a.color, b.color);
+  EXPECT_EQ(a.intensity, b.intensity);
+  if (a.type == Light::Type::Ambient) return;
+  EXPECT_EQ(a.position, b.position);
+  if (a.type == Light::Type::Point) return;
+  // Unit-length directions come back exactly, others normalised.
+  if (std::fabs(glm::length(a.direction) - 1.0f) < 1e-6f) {
+    EXPECT_EQ(a.direction, b.direction);
+  } else {
+    const glm::vec3 d = glm::normalize(a.direction);
+    EXPECT_NEAR(b.direction.x, d.x, 1e-7f);
+    EXPECT_NEAR(b.direction.y, d.y, 1e-7f);
+    EXPECT_NEAR(b.direction.z, d.z, 1e-7f);
+  }
+  if (a.type == Light::Type::Spot) {
+    EXPECT_EQ(a.cone_angle, b.cone_angle);
+    EXPECT_EQ(a.cone_delta_angle, b.cone_delta_angle);
+    EXPECT_EQ(a.beam_distribution, b.beam_distribution);
+  }
+  if (a.type == Light::Type::Area) {
+    EXPECT_EQ(a.shape, b.shape);
+    EXPECT_EQ(a.axis_u, b.axis_u);
+    EXPECT_EQ(a.size_u, b.size_u);
+    EXPECT_EQ(a.size_v, b.size_v);
+  }
+}
+
+void expect_same_mesh(const Mesh& a, const Mesh& b) {
+  SCOPED_TRACE("mesh '" + a.name + "'");
+  EXPECT_EQ(a.name, b.name);
+  EXPECT_EQ(a.scheme, b.scheme);
+  EXPECT_EQ(a.points, b.points);
+  EXPECT_EQ(a.face_vertex_counts, b.face_vertex_counts);
+  EXPECT_EQ(a.face_vertex_indices, b.face_vertex_indices);  // same winding: same front side
+  if (a.scheme == SubdivScheme::CatmullClark) {
+    EXPECT_EQ(a.crease_vertices, b.crease_vertices);
+    EXPECT_EQ(a.crease_sharpness, b.crease_sharpness);
+    EXPECT_EQ(a.corner_vertices, b.corner_vertices);
+    EXPECT_EQ(a.corner_sharpness, b.corner_sharpness);
+    EXPECT_EQ(a.hole_faces, b.hole_faces);
+    EXPECT_EQ(a.boundary, b.boundary);
+  }
+  EXPECT_EQ(a.material, b.material);
+  EXPECT_EQ(a.face_materials, b.face_materials);
+  EXPECT_EQ(a.object_to_world, b.object_to_world);
+  EXPECT_EQ(a.double_sided, b.double_sided);
+}
+
+void expect_same_scene(const Scene& a, const Scene& b) {
+  expect_same_settings(a.settings, b.settings);
+  expect_same_camera(a.camera, b.camera);
+  if (a.materials.empty()) {
+    // Rendered with Material{}, which comes back as material 0.
+    ASSERT_EQ(b.materials.size(), 1u);
+    expect_same_material(Material{}, b.materials[0]);
+  } else {
+    ASSERT_EQ(a.materials.size(), b.materials.size());
+    for (size_t i = 0; i < a.materials.size(); ++i) expect_same_material(a.materials[i], b.materials[i]);
+  }
+  ASSERT_EQ(a.lights.size(), b.lights.size());
+  for (size_t i = 0; i < a.lights.size(); ++i) {
+    SCOPED_TRACE("light " + std::to_string(i));
+    expect_same_light(a.lights[i], b.lights[i]);
+  }
+  ASSERT_EQ(a.meshes.size(), b.meshes.size());
+  for (size_t i = 0; i < a.meshes.size(); ++i) expect_same_mesh(a.meshes[i], b.meshes[i]);
+  ASSERT_EQ(a.bezier_patches.size(), b.bezier_patches.size());
+  for (size_t i = 0; i < a.bezier_patches.size(); ++i) {
+    const BezierPatches &p = a.bezier_patches[i], &q = b.bezier_patches[i];
+    SCOPED_TRACE("patch set '" + p.name + "'");
+    EXPECT_EQ(p.name, q.name);
+    EXPECT_EQ(p.control_points, q.control_points);
+    EXPECT_EQ(p.material, q.material);
+    EXPECT_EQ(p.object_to_world, q.object_to_world);
+    EXPECT_EQ(p.double_sided, q.double_sided);
+  }
+}
+
+// --- scenes -----------------------------------------------------------------------
+
+Material material(const char* name, Material::Model model, glm::vec3 color) {
+  Material m;
+  m.name = name;
+  m.model = model;
+  m.color = color;
+  return m;
+}
+
+// A bumpy 4x4 Bezier net over [x0, x0+2] x [-1, 1].
+std::vector<glm::vec3> bezier_net(float x0, float bump) {
+  std::vector<glm::vec3> cps;
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i)
+      cps.push_back({x0 + 2.0f * i / 3.0f, -1.0f + 2.0f * j / 3.0f, (i % 3 && j % 3) ? bump : 0.0f});
+  return cps;
+}
+
+// Every Scene feature, in view of a perspective camera, with values that do
+// not print exactly in decimal (0.1, 1/3, ...).
+Scene full_scene() {
+  Scene s;
+  RenderSettings& st = s.settings;
+  st.width = 64;
+  st.height = 48;
+  st.pixel_aspect = 1.1f;
+  st.crop_x0 = 0.05f, st.crop_x1 = 0.9f, st.crop_y0 = 1.0f / 3.0f, st.crop_y1 = 0.95f;
+  st.samples_x = 2, st.samples_y = 2;
+  st.shading_rate = 0.7f;
+  st.filter = PixelFilter::BlackmanHarris;
+  st.filter_width = 3.3f;
+  st.bound_split = BoundSplitMethod::Breadth;
+  st.bound_split_memory_mib = 48.5f;
+  st.max_grid_size = 12;
+  st.max_split_depth = 22;
+  st.backface_culling = true;
+  st.depth_and_normal_passes = false;
+
+  s.camera = look_at({1.3f, 2.1f, 7.7f}, {0.1f, 0.2f, 0.0f}, 47.3f);
+  s.camera.screen_left = -1.4f, s.camera.screen_right = 1.3f;
+  s.camera.screen_bottom = -0.9f, s.camera.screen_top = 1.1f;
+  s.camera.clip_near = 0.1f, s.camera.clip_far = 123.4f;
+
+  // Material 0 is not RenderMan's default; 4 repeats 1 under another name;
+  // 6 is unused.
+  s.materials.push_back(material("base", Material::Model::Matte, {0.7f, 0.6f, 0.5f}));
+  s.materials[0].ka = 0.3f, s.materials[0].kd = 0.9f;
+  Material plastic = material("red plastic", Material::Model::Plastic, {0.9f, 0.1f, 0.1f});
+  plastic.ka = 0.2f, plastic.kd = 0.6f, plastic.ks = 0.7f, plastic.roughness = 0.05f;
+  plastic.specular_color = {1.0f, 0.9f, 0.8f};
+  plastic.emission = {0.01f, 0.0f, 0.02f};
+  s.materials.push_back(plastic);
+  Material principled = material("gold", Material::Model::Principled, {1.0f, 0.766f, 0.336f});
+  principled.metallic = 0.9f, principled.roughness = 0.35f, principled.specular = 0.45f;
+  principled.opacity = glm::vec3(0.75f);
+  s.materials.push_back(principled);
+  Material glow = material("glow", Material::Model::Constant, {0.2f, 0.3f, 0.4f});
+  glow.emission = {0.5f, 0.25f, 0.125f};
+  s.materials.push_back(glow);
+  Material twin = plastic;
+  twin.name = "red plastic copy";
+  s.materials.push_back(twin);
+  Material rough = material("rough principled", Material::Model::Principled, {0.2f, 0.5f, 0.3f});
+  rough.roughness = 0.8f, rough.specular = 0.6f, rough.emission = {0.0f, 0.05f, 0.0f};
+  s.materials.push_back(rough);
+  s.materials.push_back(material("unused", Material::Model::Matte, {0.1f, 0.2f, 0.3f}));
+
+  Light ambient;
+  ambient.type = Light::Type::Ambient;
+  ambient.intensity = 0.15f;
+  ambient.color = {0.9f, 0.95f, 1.0f};
+  s.lights.push_back(ambient);
+  Light sun;
+  sun.type = Light::Type::Distant;
+  sun.intensity = 0.8f;
+  sun.position = {3.0f, 9.0f, 1.0f};
+  sun.direction = glm::normalize(glm::vec3(-0.3f, -0.5f, -1.0f));
+  s.lights.push_back(sun);
+  Light point;
+  point.type = Light::Type::Point;
+  point.position = {-2.5f, 3.1f, 2.2f};
+  point.intensity = 9.0f;
+  point.color = {1.0f, 0.8f, 0.6f};
+  s.lights.push_back(point);
+  Light spot;
+  spot.type = Light::Type::Spot;
+  spot.position = {0.3f, 5.0f, 40.0f};  // far away: the direction must stay accurate
+  spot.direction = glm::vec3(0.0f, -5.0f, -40.0f);  // not normalised
+  spot.intensity = 900.0f;
+  spot.cone_angle = 0.2f, spot.cone_delta_angle = 0.05f, spot.beam_distribution = 1.5f;
+  s.lights.push_back(spot);
+  Light rect;
+  rect.type = Light::Type::Area;
+  rect.shape = Light::Shape::Rectangle;
+  rect.position = {0.5f, 3.0f, 1.5f};
+  rect.direction = glm::normalize(glm::vec3(0.1f, -1.0f, -0.2f));
+  rect.axis_u = {1.0f, 0.1f, 0.0f};
+  rect.size_u = 1.5f, rect.size_v = 0.7f;
+  rect.intensity = 2.5f;
+  rect.color = {0.6f, 0.7f, 1.0f};
+  s.lights.push_back(rect);
+  Light disk = rect;
+  disk.shape = Light::Shape::Ellipse;
+  disk.position = {-1.0f, 0.5f, 3.0f};
+  disk.direction = {0.2f, 0.0f, -1.0f};
+  disk.axis_u = {0.0f, 1.0f, 0.0f};
+  disk.size_u = 0.9f, disk.size_v = 1.3f;
+  s.lights.push_back(disk);
+
+  // Catmull-Clark cube: creases, corners, a hole, edge-only boundary, a
+  // per-face material and a rotation.
+  Mesh cube = cube_mesh(SubdivScheme::CatmullClark);
+  cube.name = "subdiv cube";
+  cube.crease_vertices = {0, 1, 1, 2, 4, 5};
+  cube.crease_sharpness = {2.5f, 10.0f, 0.3f};
+  cube.corner_vertices = {6, 7};
+  cube.corner_sharpness = {1.7f, 4.0f};
+  cube.hole_faces = {3};
+  cube.boundary = BoundaryInterpolation::EdgeOnly;
+  cube.material = 1;
+  cube.face_materials = {1, 1, 2, 1, 5, 1};
+  cube.object_to_world = glm::rotate(glm::scale(glm::mat4(1.0f), glm::vec3(0.6f)), 0.4f, glm::vec3(0.2f, 1.0f, 0.1f));
+  s.meshes.push_back(cube);
+
+  // Polygon floor with several face materials, single-sided.
+  Mesh floor = grid_mesh(3, 2.5f, SubdivScheme::None);
+  floor.name = "floor";
+  floor.material = 0;
+  floor.face_materials = {0, 2, 0, 5, 0, 2, 1, 0, 4};
+  floor.object_to_world = glm::translate(glm::rotate(glm::mat4(1.0f), -1.2f, glm::vec3(1, 0, 0)), glm::vec3(0, 0, -0.8f));
+  floor.double_sided = false;
+  s.meshes.push_back(floor);
+
+  // Mirrored (negative determinant), single-sided: the same faces stay front.
+  Mesh mirrored = cube_mesh(SubdivScheme::None);
+  mirrored.name = "mirrored";
+  mirrored.material = 3;
+  mirrored.double_sided = false;
+  mirrored.object_to_world = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(-1.8f, 0.3f, 0.5f)), glm::vec3(-0.3f, 0.4f, 0.35f));
+  s.meshes.push_back(mirrored);
+
+  // Catmull-Clark with the other boundary modes and a pentagon.
+  Mesh sheet = grid_mesh(2, 0.5f, SubdivScheme::CatmullClark);
+  sheet.name = "";  // an empty name stays empty
+  sheet.boundary = BoundaryInterpolation::None;
+  sheet.material = 2;
+  sheet.object_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(1.6f, 0.9f, 0.4f));
+  s.meshes.push_back(sheet);
+  Mesh sheet2 = sheet;
+  sheet2.name = "corner sheet";
+  sheet2.boundary = BoundaryInterpolation::EdgeAndCorner;
+  sheet2.object_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(1.6f, -0.5f, 0.4f));
+  s.meshes.push_back(sheet2);
+  Mesh pentagon;
+  pentagon.name = "pentagon";
+  for (int i = 0; i < 5; ++i) {
+    const float a = 0.3f + 1.2566371f * i;
+    pentagon.points.push_back({1.9f + 0.4f * std::cos(a), 1.6f + 0.4f * std::sin(a), 0.2f});
+  }
+  pentagon.points.push_back({9.0f, 9.0f, 9.0f});  // unused points are kept
+  pentagon.face_vertex_counts = {5};
+  pentagon.face_vertex_indices = {0, 1, 2, 3, 4};
+  pentagon.material = 4;
+  s.meshes.push_back(pentagon);
+
+  // Two patch sets with identical state: they must stay two sets.
+  BezierPatches patches;
+  patches.name = "patches";
+  patches.control_points = bezier_net(-2.6f, 0.8f);
+  const std::vector<glm::vec3> second = bezier_net(-0.6f, -0.5f);
+  patches.control_points.insert(patches.control_points.end(), second.begin(), second.end());
+  patches.material = 5;
+  patches.double_sided = false;
+  patches.object_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, -1.1f, 1.0f));
+  s.bezier_patches.push_back(patches);
+  patches.control_points = bezier_net(1.4f, 0.3f);
+  s.bezier_patches.push_back(patches);
+  BezierPatches mirrored_patch;
+  mirrored_patch.name = "mirrored patch";
+  mirrored_patch.control_points = bezier_net(0.0f, 0.6f);
+  mirrored_patch.material = 2;
+  mirrored_patch.object_to_world = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(0.3f, 1.8f, 0.0f)), glm::vec3(-0.5f, 0.5f, 0.5f));
+  s.bezier_patches.push_back(mirrored_patch);
+  validate_scene(s);
+  return s;
+}
+
+// An orthographic camera with an explicit screen window, near plane 0, no
+// materials (Material{} is used), default settings otherwise.
+Scene ortho_scene() {
+  Scene s;
+  s.settings.width = 64;
+  s.settings.height = 48;
+  s.settings.samples_x = s.settings.samples_y = 2;
+  s.settings.filter = PixelFilter::Triangle;
+  s.settings.filter_width = 1.5f;
+  s.camera = look_at({0.0f, 0.0f, 10.0f}, {0.0f, 0.0f, 0.0f});
+  s.camera.projection = Camera::Projection::Orthographic;
+  s.camera.fov_degrees = 30.0f;  // unused by orthographic cameras
+  s.camera.screen_left = -2.2f, s.camera.screen_right = 2.0f;
+  s.camera.screen_bottom = -1.3f, s.camera.screen_top = 1.7f;
+  s.camera.clip_near = 0.0f;
+  Light key;
+  key.type = Light::Type::Distant;
+  key.direction = {-0.2f, -0.3f, -1.0f};
+  s.lights.push_back(key);
+  Mesh cube = cube_mesh(SubdivScheme::CatmullClark);
+  cube.object_to_world = glm::rotate(glm::mat4(1.0f), 0.6f, glm::vec3(1.0f, 1.0f, 0.0f));
+  s.meshes.push_back(cube);
+  s.settings.crop_x0 = 0.25f;
+  return s;
+}
+
+// --- tests ---------------------------------------------------------------------------
+
+TEST(RibWriter, FullSceneRoundTripsFieldByField) {
+  const Scene s = full_scene();
+  expect_same_scene(s, round_trip(s));
+}
+
+TEST(RibWriter, OrthographicSceneWithoutMaterialsRoundTrips) {
+  const Scene s = ortho_scene();
+  expect_same_scene(s, round_trip(s));
+}
+
+TEST(RibWriter, DefaultSceneRoundTrips) {
+  Scene s;
+  s.meshes.push_back(polygon({{0, 0, -2}, {1, 0, -2}, {0, 1, -2}}));
+  expect_same_scene(s, round_trip(s));
+}
+
+TEST(RibWriter, EveryFilterAndBoundSplitMethod) {
+  for (PixelFilter f : {PixelFilter::Box, PixelFilter::Gaussian, PixelFilter::Triangle, PixelFilter::BlackmanHarris})
+    for (BoundSplitMethod m : {BoundSplitMethod::Bounded, BoundSplitMethod::Breadth}) {
+      Scene s = ortho_scene();
+      s.settings.filter = f;
+      s.settings.bound_split = m;
+      s.settings.backface_culling = false;
+      s.settings.depth_and_normal_passes = true;
+      expect_same_settings(s.settings, round_trip(s).settings);
+    }
+}
+
+TEST(RibWriter, FloatsReadBackExactly) {
+  // Awkward values: many digits, tiny, huge, denormal, negative zero.
+  const float values[] = {0.1f, 1.0f / 3.0f, 2.0f / 3.0f, 3.14159274f, 1e-7f, 1.17549435e-38f,
+                          1e-40f, 3.0e38f, -123456.789f, 16777217.0f, -0.0f, 0.30000001f};
+  Scene s;
+  Mesh m = polygon({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
+  for (float v : values) m.points.push_back({v, -v, v * 0.5f});
+  for (int i = 0; i < 1000; ++i) {
+    // Pseudo-random floats over many binades.
+    const float v = std::ldexp(static_cast<float>((i * 2654435761u) % 16777216u) / 16777216.0f + 0.5f, (i % 60) - 30);
+    m.points.push_back({v, 1.0f / (v + 1.0f), -v * 7.0f});
+  }
+  s.meshes.push_back(m);
+  EXPECT_EQ(round_trip(s).meshes.at(0).points, m.points);
+}
+
+TEST(RibWriter, NamesAreEscaped) {
+  // Quotes, backslashes, newlines, tabs, other control characters, UTF-8
+  // and a byte that is not UTF-8 all come back; the file stays valid.
+  const std::string names[] = {"say \"hi\"", "back\\slash\\", "two\nlines\r\n", "tab\there",
+                               std::string("bell\x07 del\x7f esc\x1b"), "caf\xc3\xa9 \xe2\x82\xac",
+                               std::string("bad \xff\xc3 byte"), "\\\"\\n", "# not a comment [ ]"};
+  Scene s;
+  for (const std::string& name : names) {
+    Mesh m = polygon({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
+    m.name = name;
+    s.meshes.push_back(m);
+    Material mat;
+    mat.name = name;
+    s.materials.push_back(mat);
+  }
+  const Scene back = round_trip(s);
+  ASSERT_EQ(back.meshes.size(), s.meshes.size());
+  for (size_t i = 0; i < s.meshes.size(); ++i) {
+    EXPECT_EQ(back.meshes[i].name, s.meshes[i].name);
+    EXPECT_EQ(back.materials[i].name, s.materials[i].name);
+  }
+  // Raw control characters never reach the file.
+  const std::string text = to_rib(s);
+  for (char c : text) EXPECT_TRUE(c == '\n' || static_cast<unsigned char>(c) >= 0x20) << int(c);
+}
+
+TEST(RibWriter, DisplayNameAndFileErrors) {
+  Scene s = ortho_scene();
+  std::ostringstream out;
+  write_rib(s, out, "image \"1\".exr");
+  const RibResult r = read_rib_string(out.str(), "display.rib");
+  EXPECT_EQ(r.display_name, "image \"1\".exr");
+
+  EXPECT_THROW(write_rib_file(s, "/nonexistent-directory/scene.rib"), Error);
+  Scene bad = s;
+  bad.meshes[0].face_vertex_indices[0] = 99;  // invalid scenes are refused
+  EXPECT_THROW(write_rib(bad, out), Error);
+  const std::string path = ::testing::TempDir() + "/rib_writer_file.rib";
+  write_rib_file(s, path);
+  expect_same_scene(s, read_rib_file(path).scene);
+}
+
+// --- the reader's side of the extensions -------------------------------------------------
+
+RibResult parse(const std::string& body) {
+  return read_rib_string("WorldBegin\n" + body + "\nWorldEnd\n", "ext.rib");
+}
+
+TEST(RibWriterExtensions, MaterialTableIndicesAndNames) {
+  const RibResult r = parse(
+      "Surface \"plastic\" \"Ks\" 0.25\n"
+      "Attribute \"micropoly\" \"integer material\" 0 \"string materialname\" \"zero\"\n"
+      "Color [1 0 0]\n"
+      "Attribute \"micropoly\" \"integer material\" 1\n"
+      "Polygon \"P\" [0 0 0 1 0 0 0 1 0]\n"
+      "Color [0 1 0]\n"  // changes the state: back to a deduplicated material
+      "Polygon \"P\" [0 0 0 1 0 0 0 1 0]\n");
+  const Scene& s = r.scene;
+  ASSERT_EQ(s.materials.size(), 3u);
+  EXPECT_EQ(s.materials[0].name, "zero");
+  EXPECT_EQ(s.materials[0].ks, 0.25f);
+  EXPECT_EQ(s.materials[1].name, "plastic");  // the shader name without materialname
+  EXPECT_EQ(s.materials[1].color, glm::vec3(1, 0, 0));
+  ASSERT_EQ(s.meshes.size(), 2u);
+  EXPECT_EQ(s.meshes[0].material, 1);
+  EXPECT_EQ(s.meshes[1].material, 2);
+  EXPECT_EQ(s.materials[2].color, glm::vec3(0, 1, 0));
+  EXPECT_TRUE(r.warnings.empty());
+}
+
+TEST(RibWriterExtensions, BadValuesAreErrors) {
+  auto expect_error = [](const std::string& text, const std::string& fragment) {
+    try {
+      read_rib_string(text, "bad.rib");
+      ADD_FAILURE() << "no error for: " << text;
+    } catch (const RibError& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+  };
+  expect_error("WorldBegin\nAttribute \"micropoly\" \"integer material\" 2\nWorldEnd\n", "material");
+  expect_error("WorldBegin\nPointsPolygons [3] [0 1 2] \"P\" [0 0 0 1 0 0 0 1 0] "
+               "\"uniform integer micropoly:material\" [1]\nWorldEnd\n",
+               "micropoly:material");
+  expect_error("WorldBegin\nPointsPolygons [3 3] [0 1 2 0 1 2] \"P\" [0 0 0 1 0 0 0 1 0] "
+               "\"uniform integer micropoly:material\" [0]\nWorldEnd\n",
+               "one material index per face");
+  expect_error("Option \"micropoly\" \"string boundsplit\" \"fast\"\n", "boundsplit");
+  expect_error("Option \"micropoly\" \"integer backfaceculling\" 2\n", "backfaceculling");
+  expect_error("WorldBegin\nLightSource \"micropoly_arealight\" 1 \"string shape\" \"disc\"\nWorldEnd\n", "shape");
+}
+
+TEST(RibWriterExtensions, AreaLightInCameraSpace) {
+  // Declared before WorldBegin: carried to world space like the standard lights.
+  const RibResult r = read_rib_string(
+      "LightSource \"micropoly_arealight\" 1 \"from\" [0 0 0] \"to\" [0 0 1] \"vector axis\" [0 1 0] "
+      "\"string shape\" \"ellipse\" \"float width\" 2 \"float height\" 3\n"
+      "Translate 0 0 5\nWorldBegin\nPolygon \"P\" [0 0 0 1 0 0 0 1 0]\nWorldEnd\n",
+      "area.rib");
+  ASSERT_EQ(r.scene.lights.size(), 1u);
+  const Light& l = r.scene.lights[0];
+  EXPECT_EQ(l.type, Light::Type::Area);
+  EXPECT_EQ(l.shape, Light::Shape::Ellipse);
+  EXPECT_EQ(l.position, glm::vec3(0, 0, -5));
+  EXPECT_EQ(l.direction, glm::vec3(0, 0, 1));
+  EXPECT_EQ(l.axis_u, glm::vec3(0, 1, 0));
+  EXPECT_EQ(l.size_u, 2.0f);
+  EXPECT_EQ(l.size_v, 3.0f);
+}
+
+// --- rendering: the round-tripped scene gives the same image ---------------------------
+
+class RibWriterRender : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    try {
+      renderer_ = std::make_unique<Renderer>();
+    } catch (const std::exception& e) {
+      setup_error_ = e.what();
+    }
+  }
+  static void TearDownTestSuite() { renderer_.reset(); }
+  void SetUp() override { ASSERT_TRUE(renderer_) << "no renderer: " << setup_error_; }
+
+  // Max abs difference over every channel of the two renders.
+  static float max_difference(const Scene& scene) {
+    const Scene back = round_trip(scene);
+    const RenderResult a = renderer_->render(scene);
+    const RenderResult b = renderer_->render(back);
+    EXPECT_EQ(a.width, b.width);
+    EXPECT_EQ(a.height, b.height);
+    EXPECT_EQ(a.rgba.size(), b.rgba.size());
+    float diff = 0.0f, sum = 0.0f;
+    for (size_t i = 0; i < std::min(a.rgba.size(), b.rgba.size()); ++i) {
+      diff = std::max(diff, std::fabs(a.rgba[i] - b.rgba[i]));
+      sum += a.rgba[i];
+    }
+    EXPECT_GT(sum, 0.0f) << "the test scene renders nothing";
+    return diff;
+  }
+
+  static std::unique_ptr<Renderer> renderer_;
+  static std::string setup_error_;
+};
+std::unique_ptr<Renderer> RibWriterRender::renderer_;
+std::string RibWriterRender::setup_error_;
+
+TEST_F(RibWriterRender, FullSceneRendersTheSame) {
+  Scene s = full_scene();
+  set_samples_per_pixel(s.settings, 4);
+  EXPECT_LE(max_difference(s), 1.0f / 255.0f);
+}
+
+TEST_F(RibWriterRender, FullSceneWithoutCropRendersTheSame) {
+  Scene s = full_scene();
+  s.settings.crop_x0 = s.settings.crop_y0 = 0.0f;
+  s.settings.crop_x1 = s.settings.crop_y1 = 1.0f;
+  s.settings.filter = PixelFilter::Gaussian;
+  s.settings.filter_width = 2.0f;
+  s.settings.bound_split = BoundSplitMethod::Bounded;
+  EXPECT_LE(max_difference(s), 1.0f / 255.0f);
+}
+
+TEST_F(RibWriterRender, OrthographicSceneRendersTheSame) {
+  EXPECT_LE(max_difference(ortho_scene()), 1.0f / 255.0f);
+}
+
+}  // namespace
+}  // namespace mp::test
+namespace mp::test { namespace {
+TEST_F(RibWriterRender, Scratch) {
+  Scene a = read_rib_file("/tmp/diag/full.rib").scene;
+  auto base = renderer_->render(a);
+  Scene t = a;
+  glm::vec3 orig(-0.3439188301563263f, 0.6295391917228699f, -0.6967067122459412f);
+  printf("read dir %.9g %.9g %.9g orig %.9g %.9g %.9g\n", a.lights[3].direction.x, a.lights[3].direction.y, a.lights[3].direction.z, orig.x, orig.y, orig.z);
+  t.lights[3].direction = orig;
+  auto c = renderer_->render(t);
+  float d = 0; size_t at = 0; for (size_t i = 0; i < c.rgba.size(); ++i) if (std::fabs(base.rgba[i]-c.rgba[i]) > d) { d = std::fabs(base.rgba[i]-c.rgba[i]); at = i; }
+  printf("orig dir: diff %g at pixel %zu (%g vs %g)\n", d, at / 4, base.rgba[at], c.rgba[at]);
+}
+}}
