@@ -49,6 +49,7 @@ inline float pow(float x, float y) { return std::pow(x, y); }
 inline float cos(float x) { return std::cos(x); }
 inline float sin(float x) { return std::sin(x); }
 inline float acos(float x) { return std::acos(x); }
+inline float atan2(float y, float x) { return std::atan2(y, x); }
 inline float exp(float x) { return std::exp(x); }
 }  // namespace mp_compat
 #include <cstring>

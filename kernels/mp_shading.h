@@ -43,7 +43,9 @@ MP_INLINE float mp_polygon_irradiance(float3 n, float3* v, int count) {
     float3 c = cross(ua, ub);
     float lc = length(c);
     if (!(lc > 1e-12f)) continue;
-    float angle = acos(clamp(dot(ua, ub), -1.0f, 1.0f));
+    /* atan2 keeps the small angles of distant or grazing lights accurate,
+     * where acos(dot) loses most of its digits. */
+    float angle = atan2(lc, dot(ua, ub));
     sum += angle * dot(n, c / lc);
   }
   return 0.5f * fabs(sum);
