@@ -610,16 +610,3 @@ TEST_F(RibWriterRender, OrthographicSceneRendersTheSame) {
 
 }  // namespace
 }  // namespace mp::test
-namespace mp::test { namespace {
-TEST_F(RibWriterRender, Scratch) {
-  Scene a = read_rib_file("/tmp/diag/full.rib").scene;
-  auto base = renderer_->render(a);
-  Scene t = a;
-  glm::vec3 orig(-0.3439188301563263f, 0.6295391917228699f, -0.6967067122459412f);
-  printf("read dir %.9g %.9g %.9g orig %.9g %.9g %.9g\n", a.lights[3].direction.x, a.lights[3].direction.y, a.lights[3].direction.z, orig.x, orig.y, orig.z);
-  t.lights[3].direction = orig;
-  auto c = renderer_->render(t);
-  float d = 0; size_t at = 0; for (size_t i = 0; i < c.rgba.size(); ++i) if (std::fabs(base.rgba[i]-c.rgba[i]) > d) { d = std::fabs(base.rgba[i]-c.rgba[i]); at = i; }
-  printf("orig dir: diff %g at pixel %zu (%g vs %g)\n", d, at / 4, base.rgba[at], c.rgba[at]);
-}
-}}
