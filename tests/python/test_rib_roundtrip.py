@@ -47,8 +47,12 @@ def build_scene():
     scene.add_light("point", intensity=6.0, position=[-2.0, 3.0, 2.0], color=[1.0, 0.9, 0.7])
     scene.add_light("spot", intensity=300.0, position=[0.5, 6.0, 20.0], direction=[-0.5, -6.0, -20.0],
                     cone_angle=0.25, cone_delta_angle=0.05, beam_distribution=1.5)
-    scene.add_light("area", shape="ellipse", intensity=3.0, position=[0.0, 3.0, 1.0],
-                    direction=[0.0, -1.0, -0.2], axis_u=[1.0, 0.0, 0.0], size_u=1.5, size_v=0.6)
+    # Small, distant and normalised in double precision, as the add-on exports
+    # them: the direction must come back bit for bit.
+    direction = np.array([-0.35, 0.62, -0.7])
+    scene.add_light("area", shape="ellipse", intensity=300.0, position=[2.0, -3.0, 3.0],
+                    direction=(direction / np.linalg.norm(direction)).tolist(), axis_u=[0.88, 0.48, 0.0],
+                    size_u=0.25, size_v=0.2)
     scene.add_light("area", shape="rectangle", intensity=2.0, position=[-1.5, 0.5, 3.0],
                     direction=[0.3, 0.0, -1.0], axis_u=[0.0, 1.0, 0.0], size_u=0.8, size_v=1.2)
     # Catmull-Clark cube with creases, a corner, a hole and per-face materials.
