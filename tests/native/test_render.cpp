@@ -9,29 +9,13 @@
 
 #include "micropoly/error.h"
 #include "micropoly/renderer.h"
+#include "renderer_fixture.h"
 #include "scene_fixtures.h"
 
 namespace mp::test {
 namespace {
 
-class RenderTest : public ::testing::Test {
- protected:
-  // One renderer (one kernel build) for the suite. A failure to create it must
-  // fail every test, not skip them.
-  static void SetUpTestSuite() {
-    try {
-      renderer_ = std::make_unique<Renderer>();
-    } catch (const std::exception& e) {
-      setup_error_ = e.what();
-    }
-  }
-  static void TearDownTestSuite() { renderer_.reset(); }
-  void SetUp() override { ASSERT_TRUE(renderer_) << "no renderer: " << setup_error_; }
-  static std::unique_ptr<Renderer> renderer_;
-  static std::string setup_error_;
-};
-std::unique_ptr<Renderer> RenderTest::renderer_;
-std::string RenderTest::setup_error_;
+class RenderTest : public SharedRendererTest {};
 
 double coverage(const RenderResult& r) {
   double sum = 0;

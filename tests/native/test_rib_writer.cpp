@@ -13,6 +13,7 @@
 
 #include "micropoly/error.h"
 #include "micropoly/renderer.h"
+#include "renderer_fixture.h"
 #include "rib/rib_reader.h"
 #include "rib/rib_writer.h"
 #include "scene_fixtures.h"
@@ -553,17 +554,8 @@ TEST(RibWriterExtensions, AreaLightInCameraSpace) {
 
 // --- rendering: the round-tripped scene gives the same image ---------------------------
 
-class RibWriterRender : public ::testing::Test {
+class RibWriterRender : public SharedRendererTest {
  protected:
-  static void SetUpTestSuite() {
-    try {
-      renderer_ = std::make_unique<Renderer>();
-    } catch (const std::exception& e) {
-      setup_error_ = e.what();
-    }
-  }
-  static void TearDownTestSuite() { renderer_.reset(); }
-  void SetUp() override { ASSERT_TRUE(renderer_) << "no renderer: " << setup_error_; }
 
   // Max abs difference over every channel of the two renders.
   static float max_difference(const Scene& scene) {
@@ -581,12 +573,7 @@ class RibWriterRender : public ::testing::Test {
     EXPECT_GT(sum, 0.0f) << "the test scene renders nothing";
     return diff;
   }
-
-  static std::unique_ptr<Renderer> renderer_;
-  static std::string setup_error_;
 };
-std::unique_ptr<Renderer> RibWriterRender::renderer_;
-std::string RibWriterRender::setup_error_;
 
 TEST_F(RibWriterRender, FullSceneRendersTheSame) {
   Scene s = full_scene();
