@@ -36,7 +36,7 @@ class MicropolyRenderEngine(bpy.types.RenderEngine):
         scene = depsgraph.scene
         view_layer = depsgraph.view_layer
         try:
-            exported = export.export_scene(depsgraph, final=True)
+            exported = export.export_scene(depsgraph)
         except export.ExportError as e:
             self.report({"ERROR"}, f"Micropoly: {e}")
             return

@@ -82,7 +82,7 @@ def export_camera(native_scene, scene, camera_object, width, height):
                             screen_window=window)
 
 
-def export_settings(native_scene, scene, width, height, final):
+def export_settings(native_scene, scene, width, height):
     settings = native_scene.settings
     mp = scene.micropoly
     r = scene.render
@@ -100,7 +100,7 @@ def export_settings(native_scene, scene, width, height, final):
     settings.bound_split_memory_mib = mp.bound_split_memory
 
 
-def export_scene(depsgraph, final=True):
+def export_scene(depsgraph):
     """Returns an ExportedScene; raises ExportError for scenes that cannot render."""
     scene = depsgraph.scene
     camera = scene.camera
@@ -109,7 +109,7 @@ def export_scene(depsgraph, final=True):
     width, height = render_size(scene)
     native_scene = _native.Scene()
     out = ExportedScene(scene=native_scene, width=width, height=height)
-    export_settings(native_scene, scene, width, height, final)
+    export_settings(native_scene, scene, width, height)
     export_camera(native_scene, scene, camera.evaluated_get(depsgraph), width, height)
     materials = export_materials.MaterialTable(native_scene)
     meshes = export_mesh.MeshCache()

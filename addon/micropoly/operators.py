@@ -11,7 +11,7 @@ def export_rib(depsgraph, path):
     Returns the list of export warnings."""
     from . import _native, export
 
-    exported = export.export_scene(depsgraph, final=True)
+    exported = export.export_scene(depsgraph)
     _native.write_rib(exported.scene, path)
     return exported.warnings
 

@@ -19,6 +19,17 @@ int64_t sum(const std::vector<int>& v) {
   return s;
 }
 
+// Face vertex counts (each >= 3) and the vertex list they index, checked to
+// agree in length (PointsPolygons, PointsGeneralPolygons, SubdivisionMesh).
+std::vector<int> face_counts(ArgReader& args, const Arg& nverts_arg, const Arg& verts_arg) {
+  std::vector<int> counts = args.int_array(nverts_arg, 3, kIntMax, "nvertices");
+  if (sum(counts) != static_cast<int64_t>(verts_arg.numbers.size()))
+    args.fail_at(verts_arg.line, "vertices has " + std::to_string(verts_arg.numbers.size()) +
+                                     " entries but nvertices adds up to " +
+                                     std::to_string(sum(counts)));
+  return counts;
+}
+
 // Checks that every index refers to one of `npoints` points.
 void check_indices(ArgReader& args, const Arg& where, const std::vector<int>& indices,
                    size_t npoints) {
@@ -131,11 +142,7 @@ void Parser::req_points_polygons(ArgReader& args) {
   const Arg& nverts_arg = args.number_array();
   const Arg& verts_arg = args.number_array();
   ParamList params(args, decls_);
-  std::vector<int> counts = args.int_array(nverts_arg, 3, kIntMax, "nvertices");
-  if (sum(counts) != static_cast<int64_t>(verts_arg.numbers.size()))
-    args.fail_at(verts_arg.line, "vertices has " + std::to_string(verts_arg.numbers.size()) +
-                                     " entries but nvertices adds up to " +
-                                     std::to_string(sum(counts)));
+  std::vector<int> counts = face_counts(args, nverts_arg, verts_arg);
   std::vector<int> indices = args.int_array(verts_arg, 0, kIntMax, "vertices");
   Primitive prim = make_primitive(Primitive::Kind::Mesh, args);
   if (!read_positions(args, params, false, &prim.mesh.points)) return;
@@ -154,11 +161,7 @@ void Parser::req_points_general_polygons(ArgReader& args) {
   if (sum(loops) != static_cast<int64_t>(nverts_arg.numbers.size()))
     args.fail_at(nverts_arg.line, "nvertices has " + std::to_string(nverts_arg.numbers.size()) +
                                       " entries but nloops adds up to " + std::to_string(sum(loops)));
-  const std::vector<int> counts = args.int_array(nverts_arg, 3, kIntMax, "nvertices");
-  if (sum(counts) != static_cast<int64_t>(verts_arg.numbers.size()))
-    args.fail_at(verts_arg.line, "vertices has " + std::to_string(verts_arg.numbers.size()) +
-                                     " entries but nvertices adds up to " +
-                                     std::to_string(sum(counts)));
+  const std::vector<int> counts = face_counts(args, nverts_arg, verts_arg);
   const std::vector<int> all = args.int_array(verts_arg, 0, kIntMax, "vertices");
   Primitive prim = make_primitive(Primitive::Kind::Mesh, args);
   if (!read_positions(args, params, false, &prim.mesh.points)) return;
@@ -219,11 +222,7 @@ void Parser::req_subdivision_mesh(ArgReader& args) {
               "SubdivisionMesh scheme \"" + scheme + "\" is not supported; the mesh is skipped");
     return;
   }
-  std::vector<int> counts = args.int_array(nverts_arg, 3, kIntMax, "nvertices");
-  if (sum(counts) != static_cast<int64_t>(verts_arg.numbers.size()))
-    args.fail_at(verts_arg.line, "vertices has " + std::to_string(verts_arg.numbers.size()) +
-                                     " entries but nvertices adds up to " +
-                                     std::to_string(sum(counts)));
+  std::vector<int> counts = face_counts(args, nverts_arg, verts_arg);
   std::vector<int> indices = args.int_array(verts_arg, 0, kIntMax, "vertices");
   if (!read_positions(args, params, false, &mesh.points)) return;
   const size_t npoints = mesh.points.size();
