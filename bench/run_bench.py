@@ -43,6 +43,8 @@ def summarise(runs):
         "device": runs[0]["device"],
         "micropolygons": runs[0]["micropolygons"],
         "subpatches_diced": runs[0]["subpatches_diced"],
+        # Dicing density: micropolygons per pixel of surface (per covered pixel per layer).
+        "micropolygons_per_pixel": runs[0]["micropolygons_sampled"] / max(runs[0]["sampled_area_px"], 1e-9),
         "patches": runs[0]["patches"],
         "bound_split_peak_mib": runs[0]["bound_split_peak_bytes"] / 2**20,
         "upload_ms": statistics.median(r["timings_ms"]["upload"] for r in runs),
@@ -90,11 +92,11 @@ def main():
                 runs = render(args.cli, paths[scene], args.out, f"{scene}_{tag}", args.repeat, args.device, extra, env)
                 sweep[f"{scene} / {label}"] = summarise(runs)
 
-    print("\n| scene | micropolygons | frame ms | device ms | " + " | ".join(s + " ms" for s in STAGES) +
+    print("\n| scene | micropolygons | micropolygons per pixel of surface | frame ms | device ms | " + " | ".join(s + " ms" for s in STAGES) +
           " | readback ms | upload ms | bound&split peak MiB |")
-    print("|---|---|---|---|" + "---|" * len(STAGES) + "---|---|---|")
+    print("|---|---|---|---|---|" + "---|" * len(STAGES) + "---|---|---|")
     for name, r in results.items():
-        print(f"| {name} | {r['micropolygons']} | {r['frame_ms']:.1f} | {r['device_ms']:.1f} | " +
+        print(f"| {name} | {r['micropolygons']} | {r['micropolygons_per_pixel']:.2f} | {r['frame_ms']:.1f} | {r['device_ms']:.1f} | " +
               " | ".join(f"{r[s + '_ms']:.2f}" for s in STAGES) +
               f" | {r['readback_ms']:.1f} | {r['upload_ms']:.1f} | {r['bound_split_peak_mib']:.2f} |")
     if sweep:

@@ -12,7 +12,7 @@ SCENES = os.path.join(HERE, "..", "scenes")
 CLI = os.environ.get("MICROPOLY_CLI", os.path.join(HERE, "..", "..", "build", "micropoly-render"))
 
 STATS_KEYS = {"device", "width", "height", "spp", "patches", "subpatches_diced", "micropolygons",
-              "bound_split_peak_bytes", "timings_ms"}
+              "micropolygons_sampled", "sampled_area_px", "bound_split_peak_bytes", "timings_ms"}
 TIMING_KEYS = {"upload", "bound_split", "dice", "shade", "sample", "resolve", "total"}
 
 

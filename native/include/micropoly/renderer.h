@@ -36,6 +36,11 @@ struct RenderStats {
   size_t patches = 0;
   size_t subpatches_diced = 0;
   size_t micropolygons = 0;
+  // Dicing density: micropolygons that reached the rasteriser and their total
+  // screen area; micropolygons_sampled / sampled_area_px is micropolygons per
+  // pixel of surface, i.e. per covered pixel per depth layer.
+  size_t micropolygons_sampled = 0;
+  double sampled_area_px = 0;
   size_t bound_split_peak_bytes = 0;
   size_t batches = 0;
   size_t bound_split_launches = 0;

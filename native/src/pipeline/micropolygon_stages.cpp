@@ -82,7 +82,17 @@ void ShadeStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffe
 }
 
 SampleStage::SampleStage(DeviceSession& session)
-    : session_(session), kernel_(session.program(), "sample_micropolygons"), clear_(session.program(), "clear_samples") {}
+    : session_(session), kernel_(session.program(), "sample_micropolygons"), clear_(session.program(), "clear_samples") {
+  totals_ = cl::Buffer(session.context(), CL_MEM_READ_WRITE, 2 * sizeof(cl_ulong));
+}
+
+void SampleStage::sampled_totals(size_t& micropolygons, double& area_px) {
+  cl_ulong t[2] = {0, 0};
+  session_.queue().enqueueReadBuffer(totals_, CL_TRUE, 0, sizeof t, t);
+  micropolygons = static_cast<size_t>(t[0]);
+  // The sampler sums twice the area in fixed-point units (mp_raster.h).
+  area_px = static_cast<double>(t[1]) / (2.0 * MP_SUBPIXEL_ONE * MP_SUBPIXEL_ONE);
+}
 
 void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer) {
   const int spp = f.spp_x * f.spp_y;
@@ -107,6 +117,8 @@ void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer) {
     spp_x_ = f.spp_x;
     spp_y_ = f.spp_y;
   }
+  cl_ulong zero = 0;
+  session_.queue().enqueueFillBuffer(totals_, zero, 0, 2 * sizeof zero);
   clear_.setArg(0, keys_);
   clear_.setArg(1, static_cast<cl_ulong>(samples));
   cl::Event e;
@@ -128,6 +140,7 @@ void SampleStage::run(const cl::Buffer& diceable, cl_uint first, cl_uint count, 
   kernel_.setArg(10, keys_);
   kernel_.setArg(11, colors_);
   kernel_.setArg(12, normals_);
+  kernel_.setArg(13, totals_);
   // Pass 0 finds each sample's nearest key; pass 1 lets its owner write.
   for (cl_uint pass = 0; pass < 2; ++pass) {
     kernel_.setArg(9, pass);

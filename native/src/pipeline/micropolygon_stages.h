@@ -57,12 +57,15 @@ class SampleStage {
   const cl::Buffer& colors() const { return colors_; }
   const cl::Buffer& normals() const { return normals_; }
   const cl::Buffer& offsets() const { return offsets_; }
+  // Micropolygons rasterised this frame and their total screen area in
+  // pixels (front faces only when back faces are culled; blocking read).
+  void sampled_totals(size_t& micropolygons, double& area_px);
 
  private:
   DeviceSession& session_;
   cl::Kernel kernel_;
   cl::Kernel clear_;
-  cl::Buffer keys_, colors_, normals_, offsets_;
+  cl::Buffer keys_, colors_, normals_, offsets_, totals_;
   size_t samples_ = 0;
   int spp_x_ = 0, spp_y_ = 0;
 };

@@ -40,6 +40,8 @@ std::string RenderStats::to_json() const {
   j += "  \"patches\": " + std::to_string(patches) + ",\n";
   j += "  \"subpatches_diced\": " + std::to_string(subpatches_diced) + ",\n";
   j += "  \"micropolygons\": " + std::to_string(micropolygons) + ",\n";
+  j += "  \"micropolygons_sampled\": " + std::to_string(micropolygons_sampled) + ",\n";
+  j += "  \"sampled_area_px\": " + num(sampled_area_px) + ",\n";
   j += "  \"bound_split_peak_bytes\": " + std::to_string(bound_split_peak_bytes) + ",\n";
   j += "  \"bound_split_launches\": " + std::to_string(bound_split_launches) + ",\n";
   j += "  \"batches\": " + std::to_string(batches) + ",\n";

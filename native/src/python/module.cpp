@@ -61,6 +61,8 @@ py::dict stats_dict(const RenderStats& s) {
   d["patches"] = s.patches;
   d["subpatches_diced"] = s.subpatches_diced;
   d["micropolygons"] = s.micropolygons;
+  d["micropolygons_sampled"] = s.micropolygons_sampled;
+  d["sampled_area_px"] = s.sampled_area_px;
   d["bound_split_peak_bytes"] = s.bound_split_peak_bytes;
   d["bound_split_launches"] = s.bound_split_launches;
   d["batches"] = s.batches;
