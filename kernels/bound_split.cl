@@ -11,7 +11,22 @@
 #include "mp_compat.h"
 #include "mp_patch.h"
 #include "mp_types.h"
+#include "mp_patch_eval.h"
+#include "mp_surface.h"
 #include "mp_bound.h"
+
+/* The whole domain of patch p, no edge rated yet. */
+inline SubPatch mp_root_subpatch(uint p) {
+  SubPatch sp;
+  sp.corner[0] = 0.0f; sp.corner[1] = 0.0f;
+  sp.corner[2] = 1.0f; sp.corner[3] = 0.0f;
+  sp.corner[4] = 1.0f; sp.corner[5] = 1.0f;
+  sp.corner[6] = 0.0f; sp.corner[7] = 1.0f;
+  sp.patch = p;
+  sp.info = 0u;
+  sp.rates = 0u;
+  return sp;
+}
 
 /* ---- breadth-first ------------------------------------------------------ */
 
@@ -19,15 +34,12 @@
 __kernel void bs_init_queue(__global SubPatch* queue, uint n) {
   uint i = get_global_id(0);
   if (i >= n) return;
-  SubPatch sp;
-  sp.u0 = 0.0f; sp.v0 = 0.0f; sp.u1 = 1.0f; sp.v1 = 1.0f;
-  sp.patch = i;
-  sp.info = 0u;
-  queue[i] = sp;
+  queue[i] = mp_root_subpatch(i);
 }
 
-__kernel void bs_breadth_classify(__global const SubPatch* queue, uint n,
+__kernel void bs_breadth_classify(__global SubPatch* queue, uint n,
                                   __global const float4* points, __global const uint* patch_info,
+                                  __global const uint* edges, __global const float4* curves,
                                   FrameParams f, __global uint* decision,
                                   __global uint* dice_flag, __global uint* split_flag) {
   uint i = get_global_id(0);
@@ -37,8 +49,10 @@ __kernel void bs_breadth_classify(__global const SubPatch* queue, uint n,
     split_flag[n] = 0u;
     return;
   }
-  uint d = mp_classify(points, patch_info, queue[i], f);
+  SubPatch sp = queue[i];
+  uint d = mp_classify(points, patch_info, edges, curves, &sp, f);
   uint action = MP_DECISION_ACTION(d);
+  queue[i] = sp; /* with the edge rates measured here */
   decision[i] = d;
   dice_flag[i] = action == MP_DICE ? 1u : 0u;
   split_flag[i] = action >= MP_SPLIT_U ? 1u : 0u;
@@ -58,7 +72,7 @@ __kernel void bs_breadth_scatter(__global const SubPatch* queue, uint n, __globa
     diceable[dice_offset[i]] = sp;
   } else if (action >= MP_SPLIT_U) {
     SubPatch a, b;
-    mp_split(sp, action, &a, &b);
+    mp_split(&sp, action, &a, &b);
     next_queue[2 * split_offset[i]] = a;
     next_queue[2 * split_offset[i] + 1] = b;
   }
@@ -77,6 +91,7 @@ __kernel void bs_breadth_scatter(__global const SubPatch* queue, uint n, __globa
 #define BS_COUNTERS 8
 
 __kernel void bs_bounded_step(__global const float4* points, __global const uint* patch_info,
+                              __global const uint* edges, __global const float4* curves,
                               uint patch_count, FrameParams f,
                               __global SubPatch* stacks, __global uint* stack_sizes, uint stack_depth,
                               __global SubPatch* ring, uint ring_capacity,
@@ -98,15 +113,11 @@ __kernel void bs_bounded_step(__global const float4* points, __global const uint
       } else {
         uint p = atomic_inc(&counters[BS_NEXT_PATCH]);
         if (p >= patch_count) break;
-        SubPatch sp;
-        sp.u0 = 0.0f; sp.v0 = 0.0f; sp.u1 = 1.0f; sp.v1 = 1.0f;
-        sp.patch = p;
-        sp.info = 0u;
-        stack[size++] = sp;
+        stack[size++] = mp_root_subpatch(p);
       }
     }
     SubPatch sp = stack[--size];
-    uint d = mp_classify(points, patch_info, sp, f);
+    uint d = mp_classify(points, patch_info, edges, curves, &sp, f);
     uint action = MP_DECISION_ACTION(d);
     if (action == MP_DICE) {
       uint slot = atomic_inc(&counters[BS_DICE_COUNT]);
@@ -118,7 +129,7 @@ __kernel void bs_bounded_step(__global const float4* points, __global const uint
       diceable[slot] = sp;
     } else if (action >= MP_SPLIT_U) {
       SubPatch a, b;
-      mp_split(sp, action, &a, &b);
+      mp_split(&sp, action, &a, &b);
       int donated = 0;
       if (donate_limit > 0u) {
         /* Ring entries written now become visible to takers in the next launch

@@ -1,10 +1,12 @@
 /* Dice: evaluate each diceable sub-patch on a (nu+1) x (nv+1) grid of
- * vertices, with smooth normals from the surface derivatives. Grids live in
+ * vertices (mp_grid_uv: edge vertices shared with the neighbours, bilinear
+ * inside), with smooth normals from the surface derivatives. Grids live in
  * fixed-size slots of (max_grid+1)^2 vertices. */
 #include "mp_compat.h"
 #include "mp_patch.h"
 #include "mp_types.h"
 #include "mp_patch_eval.h"
+#include "mp_surface.h"
 
 /* Unit normal of the patch at (u, v). Where the derivatives are parallel or
  * vanish (collapsed corners, poles) the normal is taken a little way towards
@@ -25,6 +27,7 @@ inline float3 mp_patch_normal(__global const float4* cp, uint type, float u, flo
 
 __kernel void dice_grids(__global const SubPatch* diceable, uint count,
                          __global const float4* points, __global const uint* patch_info,
+                         __global const uint* edges, __global const float4* curves,
                          FrameParams f, __global float4* grid_p, __global float4* grid_n,
                          volatile __global uint* micropolygon_count) {
   uint gid = get_global_id(0), i, j;
@@ -32,14 +35,13 @@ __kernel void dice_grids(__global const SubPatch* diceable, uint count,
   if (!mp_grid_vertex(gid, count, f.max_grid, diceable, &sp, &i, &j)) return;
   uint nu = MP_INFO_NU(sp.info), nv = MP_INFO_NV(sp.info);
   if (i == 0u && j == 0u) atomic_add(micropolygon_count, nu * nv);
-  float u = i == nu ? sp.u1 : sp.u0 + (sp.u1 - sp.u0) * ((float)i / (float)nu);
-  float v = j == nv ? sp.v1 : sp.v0 + (sp.v1 - sp.v0) * ((float)j / (float)nv);
+  float2 uv = mp_grid_uv(&sp, nu, nv, i, j);
+  float3 p, dpdu, dpdv;
+  mp_surface_point(points, patch_info, edges, curves, sp.patch, uv.x, uv.y, &p, &dpdu, &dpdv);
   __global const float4* cp = points + (ulong)sp.patch * MP_PATCH_POINTS;
   uint type = patch_info[4 * (ulong)sp.patch];
   uint flags = patch_info[4 * (ulong)sp.patch + 2];
-  float3 p, dpdu, dpdv;
-  mp_eval_patch(cp, type, u, v, &p, &dpdu, &dpdv);
-  float3 n = mp_patch_normal(cp, type, u, v, dpdu, dpdv);
+  float3 n = mp_patch_normal(cp, type, uv.x, uv.y, dpdu, dpdv);
   if (flags & MP_PATCH_FLIP_ORIENTATION) n = -n;
   grid_p[gid] = (float4)(p, 1.0f);
   grid_n[gid] = (float4)(n, 0.0f);

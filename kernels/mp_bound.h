@@ -15,6 +15,8 @@
 #include "mp_compat.h"
 #include "mp_patch.h"
 #include "mp_types.h"
+#include "mp_patch_eval.h"
+#include "mp_surface.h"
 
 #define MP_CULL 0u
 #define MP_DICE 1u
@@ -68,10 +70,11 @@ MP_INLINE int mp_interior_slot(int idx) {
 }
 
 /* Boxes [lo[k], hi[k]] containing the sub-patch's Bezier net (camera space). */
-MP_INLINE void mp_subpatch_net_boxes(const MP_GLOBAL float4* cp, uint type, SubPatch sp, float3* lo, float3* hi) {
+MP_INLINE void mp_subpatch_net_boxes(const MP_GLOBAL float4* cp, uint type, float u0, float v0, float u1, float v1,
+                                      float3* lo, float3* hi) {
   float Wu[16], Wv[16];
-  mp_subsegment_weights(sp.u0, sp.u1, Wu);
-  mp_subsegment_weights(sp.v0, sp.v1, Wv);
+  mp_subsegment_weights(u0, u1, Wu);
+  mp_subsegment_weights(v0, v1, Wv);
   float3 a[16];
   for (int k = 0; k < 16; ++k) a[k] = MP_XYZ(cp[k]);
   if (type == MP_PATCH_GREGORY) {
@@ -142,27 +145,8 @@ MP_INLINE MpBound mp_bound_boxes(const float3* lo, const float3* hi, FrameParams
   return b;
 }
 
-/* Screen lengths of the net along u (max over rows) and v (max over columns). */
-MP_INLINE void mp_net_screen_lengths(const float3* lo, const float3* hi, FrameParams f, float* lu, float* lv) {
-  float2 q[16];
-  for (int k = 0; k < 16; ++k) q[k] = mp_project(0.5f * (lo[k] + hi[k]), f);
-  float mu = 0.0f, mv = 0.0f;
-  for (int j = 0; j < 4; ++j) {
-    float su = 0.0f, sv = 0.0f;
-    for (int i = 0; i < 3; ++i) {
-      float2 du = q[4 * j + i + 1] - q[4 * j + i];
-      float2 dv = q[4 * (i + 1) + j] - q[4 * i + j];
-      su += sqrt(du.x * du.x + du.y * du.y);
-      sv += sqrt(dv.x * dv.x + dv.y * dv.y);
-    }
-    mu = fmax(mu, su);
-    mv = fmax(mv, sv);
-  }
-  *lu = mu;
-  *lv = mv;
-}
-
-/* Camera-space lengths of the net, for splitting patches that straddle the eye plane. */
+/* Camera-space lengths of the net along u and v: the split direction for a
+ * sub-patch that straddles the eye plane, where screen lengths do not exist. */
 MP_INLINE void mp_net_space_lengths(const float3* lo, const float3* hi, float* lu, float* lv) {
   float mu = 0.0f, mv = 0.0f;
   for (int j = 0; j < 4; ++j) {
@@ -178,55 +162,226 @@ MP_INLINE void mp_net_space_lengths(const float3* lo, const float3* hi, float* l
   *lv = mv;
 }
 
-MP_INLINE uint mp_grid_rate(float screen_length, FrameParams f) {
-  float n = ceil(screen_length / f.micropoly_edge);
-  return (uint)clamp(n, 1.0f, (float)f.max_grid);
+/* ---- Dicing rates per edge (DiagSplit, Fisher et al. 2009) ----------------
+ *
+ * Every edge of a sub-patch gets its own rate from its own screen length, and
+ * that rate is a function of the edge alone: the two sub-patches (or
+ * patches) sharing an edge measure it from the same points in the same order
+ * and reach the same rate, whatever their other edges or split depths. An
+ * edge too long to dice is split at its midpoint, and a sub-patch is diced
+ * only once all four of its edges have rates, so both sides of an edge cut it
+ * at the same points and place the same vertices along it (mp_surface.h).
+ *
+ * Rates are powers of two, the nearest to the edge's length over the target
+ * micropolygon edge (sqrt of the shading rate), so micropolygon edges run
+ * between 0.71 and 1.41 times the target. Powers of two keep every split
+ * point and every edge vertex a binary fraction that float holds exactly,
+ * which is what makes shared vertices bit-identical from both sides; it also
+ * makes a rated edge divisible: splitting a sub-patch across an edge of rate
+ * n >= 2 cuts it at its middle vertex into two edges of rate n/2. An edge of
+ * rate 1 has no middle vertex: the cut runs through its first corner instead
+ * and one child becomes a triangle (a quad with one zero-length edge). Only
+ * that case makes the cut line diagonal in (u, v). */
+
+/* Sub-patch edges are measured with this many straight segments. */
+#define MP_EDGE_SEGMENTS 4
+/* A length that cannot be measured: the edge crosses the eye plane, or spans
+ * both halves of a transition edge (mp_patch.h) and must be cut at its middle. */
+#define MP_UNMEASURABLE -1.0f
+
+MP_INLINE int mp_camera_point_usable(float3 p, FrameParams f) { return f.ortho || -p.z > f.eye_epsilon; }
+
+MP_INLINE float mp_polyline_screen_length(const float3* p, int count, FrameParams f) {
+  float len = 0.0f;
+  for (int k = 0; k < count; ++k)
+    if (!mp_camera_point_usable(p[k], f)) return MP_UNMEASURABLE;
+  for (int k = 0; k + 1 < count; ++k) {
+    float2 d = mp_project(p[k + 1], f) - mp_project(p[k], f);
+    len += sqrt(d.x * d.x + d.y * d.y);
+  }
+  return len;
+}
+
+/* Screen length of the sub-patch edge a -> b of patch `patch`, measured from
+ * a canonical direction: along the shared curve's own parameter for an edge
+ * on the patch boundary, else from the lexicographically smaller end. */
+MP_INLINE float mp_edge_screen_length(const MP_GLOBAL float4* points, const MP_GLOBAL uint* patch_info,
+                                      const MP_GLOBAL uint* edges, const MP_GLOBAL float4* curves, uint patch,
+                                      float2 a, float2 b, FrameParams f) {
+  float3 p[MP_EDGE_SEGMENTS + 1];
+  int e = a.y == 0.0f && b.y == 0.0f ? 0 : a.x == 1.0f && b.x == 1.0f ? 1 : a.y == 1.0f && b.y == 1.0f ? 2
+        : a.x == 0.0f && b.x == 0.0f ? 3 : -1;
+  if (e >= 0) {
+    float ta = (e & 1) ? a.y : a.x, tb = (e & 1) ? b.y : b.x;
+    const MP_GLOBAL uint* refs = edges + (ulong)patch * MP_EDGE_REFS + 2u * (uint)e;
+    uint ref = refs[0];
+    if (refs[1] != MP_NO_CURVE) {
+      if (fmax(ta, tb) <= 0.5f) {
+        ta *= 2.0f, tb *= 2.0f;
+      } else if (fmin(ta, tb) >= 0.5f) {
+        ta = 2.0f * ta - 1.0f, tb = 2.0f * tb - 1.0f, ref = refs[1];
+      } else {
+        return MP_UNMEASURABLE;
+      }
+    }
+    if (ref & 1u) ta = 1.0f - ta, tb = 1.0f - tb;
+    float lo = fmin(ta, tb), hi = fmax(ta, tb);
+    for (int k = 0; k <= MP_EDGE_SEGMENTS; ++k)
+      p[k] = mp_curve_point(curves, ref & ~1u, lo + (hi - lo) * ((float)k / (float)MP_EDGE_SEGMENTS));
+  } else {
+    int swap = b.x < a.x || (b.x == a.x && b.y < a.y);
+    float2 lo = swap ? b : a, hi = swap ? a : b;
+    const MP_GLOBAL float4* cp = points + (ulong)patch * MP_PATCH_POINTS;
+    uint type = patch_info[4 * (ulong)patch];
+    for (int k = 0; k <= MP_EDGE_SEGMENTS; ++k) {
+      float2 uv = lo + (hi - lo) * ((float)k / (float)MP_EDGE_SEGMENTS);
+      float3 du, dv;
+      mp_eval_patch(cp, type, uv.x, uv.y, &p[k], &du, &dv);
+    }
+  }
+  return mp_polyline_screen_length(p, MP_EDGE_SEGMENTS + 1, f);
+}
+
+/* Rate code (1 + log2 rate) for an edge of `len` pixels; 0 when the edge is
+ * longer than the largest grid allows (or unmeasurable) and must be split. */
+MP_INLINE uint mp_edge_rate_code(float len, FrameParams f) {
+  if (!(len >= 0.0f)) return 0u;
+  float x = len / f.micropoly_edge;
+  uint code = 1u, n = 1u;
+  while (x > 1.41421356f * (float)n) {
+    n *= 2u;
+    ++code;
+    if (n > (uint)f.max_grid) return 0u;
+  }
+  return code;
+}
+
+/* Screen length through the middle of the sub-patch, from the middle of edge
+ * 3 to the middle of edge 1 (dir 0) or of edge 0 to edge 2 (dir 1): the
+ * interior's own size, which may exceed its edges' (a bulge, or a patch with
+ * collapsed edges). Only this sub-patch uses it, so it needs no canonical order. */
+MP_INLINE float mp_mid_screen_length(const MP_GLOBAL float4* cp, uint type, const SubPatch* sp, int dir, FrameParams f) {
+  float2 c0 = mp_corner(sp, 0), c1 = mp_corner(sp, 1), c2 = mp_corner(sp, 2), c3 = mp_corner(sp, 3);
+  float2 a = dir == 0 ? 0.5f * (c3 + c0) : 0.5f * (c0 + c1);
+  float2 b = dir == 0 ? 0.5f * (c1 + c2) : 0.5f * (c2 + c3);
+  float3 p[MP_EDGE_SEGMENTS + 1];
+  for (int k = 0; k <= MP_EDGE_SEGMENTS; ++k) {
+    float2 uv = a + (b - a) * ((float)k / (float)MP_EDGE_SEGMENTS);
+    float3 du, dv;
+    mp_eval_patch(cp, type, uv.x, uv.y, &p[k], &du, &dv);
+  }
+  return mp_polyline_screen_length(p, MP_EDGE_SEGMENTS + 1, f);
+}
+
+/* Grid size along one direction: covers both edge rates (so both snap onto
+ * the grid) and the interior length, within the largest grid. */
+MP_INLINE uint mp_grid_size(uint code_a, uint code_b, float mid_len, FrameParams f) {
+  uint n = code_a ? MP_CODE_RATE(code_a) : (uint)f.max_grid;
+  n = max(n, code_b ? MP_CODE_RATE(code_b) : (uint)f.max_grid);
+  float interior = mid_len >= 0.0f ? ceil(mid_len / f.micropoly_edge) : 1.0f;
+  n = max(n, (uint)clamp(interior, 1.0f, (float)f.max_grid));
+  return min(n, (uint)f.max_grid);
 }
 
 /* The bound & split decision for one sub-patch: cull, dice (with grid size)
- * or split along the longer parametric direction. A pure function of its
- * inputs, so every bound & split strategy reaches the same diced set. */
-MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint* patch_info, SubPatch sp, FrameParams f) {
-  const MP_GLOBAL float4* cp = points + (ulong)sp.patch * MP_PATCH_POINTS;
+ * or split across edges 0 and 2 (MP_SPLIT_U) or 1 and 3 (MP_SPLIT_V). Rates of
+ * edges measured here are stored into *sp for its children or its dicing. A
+ * pure function of its inputs, so every bound & split strategy reaches the
+ * same diced set. */
+MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint* patch_info,
+                           const MP_GLOBAL uint* edges, const MP_GLOBAL float4* curves, SubPatch* sp,
+                           FrameParams f) {
+  const MP_GLOBAL float4* cp = points + (ulong)sp->patch * MP_PATCH_POINTS;
+  uint type = patch_info[4 * (ulong)sp->patch];
+  float u0 = fmin(fmin(sp->corner[0], sp->corner[2]), fmin(sp->corner[4], sp->corner[6]));
+  float u1 = fmax(fmax(sp->corner[0], sp->corner[2]), fmax(sp->corner[4], sp->corner[6]));
+  float v0 = fmin(fmin(sp->corner[1], sp->corner[3]), fmin(sp->corner[5], sp->corner[7]));
+  float v1 = fmax(fmax(sp->corner[1], sp->corner[3]), fmax(sp->corner[5], sp->corner[7]));
   float3 lo[16], hi[16];
-  mp_subpatch_net_boxes(cp, patch_info[4 * (ulong)sp.patch], sp, lo, hi);
+  mp_subpatch_net_boxes(cp, type, u0, v0, u1, v1, lo, hi);
   MpBound b = mp_bound_boxes(lo, hi, f);
-  uint depth = MP_INFO_DEPTH(sp.info);
+  uint depth = MP_INFO_DEPTH(sp->info);
   int can_split = (int)depth < f.max_depth;
 
   if (b.dmax < f.clip_near || b.dmin > f.clip_far) return MP_CULL;
-  if (!f.ortho && b.dmin <= f.eye_epsilon) {
-    /* Straddles the eye plane: no screen bound exists. Split, or give up. */
-    if (!can_split) return MP_CULL;
-    float lu, lv;
-    mp_net_space_lengths(lo, hi, &lu, &lv);
-    return lu >= lv ? MP_SPLIT_U : MP_SPLIT_V;
-  }
-  if (b.xmax < -f.ribbon || b.ymax < -f.ribbon || b.xmin > (float)f.width + f.ribbon ||
-      b.ymin > (float)f.height + f.ribbon)
+  int straddles = !f.ortho && b.dmin <= f.eye_epsilon;
+  if (straddles && !can_split) return MP_CULL;
+  if (!straddles && (b.xmax < -f.ribbon || b.ymax < -f.ribbon || b.xmin > (float)f.width + f.ribbon ||
+                     b.ymin > (float)f.height + f.ribbon))
     return MP_CULL;
 
-  float lu, lv;
-  mp_net_screen_lengths(lo, hi, f, &lu, &lv);
-  float limit = (float)f.max_grid * f.micropoly_edge;
-  if ((lu > limit || lv > limit) && can_split) return lu >= lv ? MP_SPLIT_U : MP_SPLIT_V;
-  return MP_DICE | (mp_grid_rate(lu, f) << 8) | (mp_grid_rate(lv, f) << 16);
+  /* Rate every edge that has none yet; score = length in target edges. */
+  uint codes[4];
+  float score[4];
+  int any_long = 0;
+  for (int e = 0; e < 4; ++e) {
+    uint code = MP_EDGE_CODE(sp->rates, e);
+    float len = 0.0f;
+    if (code == 0u) {
+      len = mp_edge_screen_length(points, patch_info, edges, curves, sp->patch, mp_corner(sp, e), mp_corner(sp, e + 1), f);
+      code = mp_edge_rate_code(len, f);
+      sp->rates |= code << (8u * (uint)e);
+    }
+    codes[e] = code;
+    score[e] = code ? (float)MP_CODE_RATE(code) : len >= 0.0f ? len / f.micropoly_edge : 3.0e38f;
+    any_long |= code == 0u;
+  }
+  float mid_u = straddles ? MP_UNMEASURABLE : mp_mid_screen_length(cp, type, sp, 0, f);
+  float mid_v = straddles ? MP_UNMEASURABLE : mp_mid_screen_length(cp, type, sp, 1, f);
+  float limit = 1.41421356f * (float)f.max_grid * f.micropoly_edge;
+  int long_u = mid_u > limit, long_v = mid_v > limit;
+
+  if ((any_long || straddles || long_u || long_v) && can_split) {
+    float su = fmax(fmax(score[0], score[2]), long_u ? mid_u / f.micropoly_edge : 0.0f);
+    float sv = fmax(fmax(score[1], score[3]), long_v ? mid_v / f.micropoly_edge : 0.0f);
+    if (straddles) {
+      /* Cut the longer side in camera space, which separates what lies
+       * behind the eye from what lies in front. For a sub-patch whose corners
+       * are not axis-aligned this is the bound's rectangle, a fair guide. */
+      float lu, lv;
+      mp_net_space_lengths(lo, hi, &lu, &lv);
+      int rot = fabs(sp->corner[2] - sp->corner[0]) + fabs(sp->corner[4] - sp->corner[6]) <
+                fabs(sp->corner[3] - sp->corner[1]) + fabs(sp->corner[5] - sp->corner[7]);
+      su = rot ? lv : lu;
+      sv = rot ? lu : lv;
+    }
+    /* A pair of rate-1 edges cannot be cut (the cut would run along an edge). */
+    int ok_u = !(codes[0] == 1u && codes[2] == 1u), ok_v = !(codes[1] == 1u && codes[3] == 1u);
+    if (ok_u && (su >= sv || !ok_v)) return MP_SPLIT_U;
+    if (ok_v) return MP_SPLIT_V;
+  }
+  uint nu = mp_grid_size(codes[0], codes[2], mid_u, f);
+  uint nv = mp_grid_size(codes[1], codes[3], mid_v, f);
+  return MP_DICE | (nu << 8) | (nv << 16);
 }
 
-MP_INLINE void mp_split(SubPatch sp, uint action, SubPatch* a, SubPatch* b) {
-  uint info = MP_MAKE_INFO(MP_INFO_DEPTH(sp.info) + 1u, 0u, 0u);
-  *a = sp;
-  *b = sp;
-  a->info = info;
-  b->info = info;
-  if (action == MP_SPLIT_U) {
-    float m = 0.5f * (sp.u0 + sp.u1);
-    a->u1 = m;
-    b->u0 = m;
-  } else {
-    float m = 0.5f * (sp.v0 + sp.v1);
-    a->v1 = m;
-    b->v0 = m;
+/* Splits across edges 0 and 2 (MP_SPLIT_U) or 1 and 3 (MP_SPLIT_V; done as
+ * the same cut on the corners rotated by one, which keeps the orientation). */
+MP_INLINE void mp_split(const SubPatch* sp, uint action, SubPatch* a, SubPatch* b) {
+  int rot = action == MP_SPLIT_V ? 1 : 0;
+  float2 c[4];
+  uint r[4];
+  for (int k = 0; k < 4; ++k) {
+    c[k] = mp_corner(sp, k + rot);
+    r[k] = MP_EDGE_CODE(sp->rates, (k + rot) & 3);
+  }
+  /* Cut point on edge 0 (c0 -> c1) and on edge 2 (c2 -> c3), and the rate
+   * codes of the two parts: a middle vertex, or the first corner of a rate-1 edge. */
+  float2 x = r[0] == 1u ? c[0] : 0.5f * (c[0] + c[1]);
+  float2 y = r[2] == 1u ? c[3] : 0.5f * (c[2] + c[3]);
+  uint x_first = r[0] > 1u ? r[0] - 1u : r[0], x_second = r[0] > 1u ? r[0] - 1u : r[0];
+  uint y_first = r[2] > 1u ? r[2] - 1u : r[2], y_second = r[2] > 1u ? r[2] - 1u : r[2];
+  float2 ca[4] = {c[0], x, y, c[3]}, cb[4] = {x, c[1], c[2], y};
+  uint ra[4] = {x_first, 0u, y_second, r[3]}, rb[4] = {x_second, r[1], y_first, 0u};
+  uint info = MP_MAKE_INFO(MP_INFO_DEPTH(sp->info) + 1u, 0u, 0u);
+  a->patch = b->patch = sp->patch;
+  a->info = b->info = info;
+  a->rates = b->rates = 0u;
+  for (int k = 0; k < 4; ++k) {
+    a->corner[2 * k] = ca[k].x, a->corner[2 * k + 1] = ca[k].y;
+    b->corner[2 * k] = cb[k].x, b->corner[2 * k + 1] = cb[k].y;
+    a->rates |= ra[k] << (8u * (uint)k);
+    b->rates |= rb[k] << (8u * (uint)k);
   }
 }
 

@@ -41,6 +41,8 @@ inline float fmin(float a, float b) { return std::fmin(a, b); }
 inline float fmax(float a, float b) { return std::fmax(a, b); }
 inline float clamp(float x, float a, float b) { return std::min(std::max(x, a), b); }
 inline int clamp(int x, int a, int b) { return std::min(std::max(x, a), b); }
+inline uint max(uint a, uint b) { return std::max(a, b); }
+inline uint min(uint a, uint b) { return std::min(a, b); }
 inline float mix(float a, float b, float t) { return a + (b - a) * t; }
 inline glm::vec3 mix(glm::vec3 a, glm::vec3 b, float t) { return a + (b - a) * t; }
 inline uint as_uint(float f) { uint u; std::memcpy(&u, &f, 4); return u; }

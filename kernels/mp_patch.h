@@ -28,6 +28,18 @@
 #define MP_PATCH_DOUBLE_SIDED 1u
 #define MP_PATCH_FLIP_ORIENTATION 2u
 
+/* Patch edges. Edge e of a patch is the boundary curve v = 0 (e = 0), u = 1
+ * (e = 1), v = 1 (e = 2) or u = 0 (e = 3), parametrised by u (e = 0, 2) or v
+ * (e = 1, 3). Neighbouring patches evaluate a shared edge from one stored
+ * cubic Bezier curve (4 float4 per curve), so both produce bit-identical
+ * points (mp_surface.h). PatchEdges holds 8 uints per patch, two per edge:
+ * a curve reference (curve index << 1 | 1 if the curve runs against the
+ * edge's parameter) and MP_NO_CURVE, or, for an edge whose neighbour side is
+ * two patches of the next finer level (a transition edge), the references of
+ * the halves t in [0, 1/2] and [1/2, 1]. */
+#define MP_NO_CURVE 0xffffffffu
+#define MP_EDGE_REFS 8
+
 /* Interior point indices in the 4x4 net and the index of their partners. */
 #define MP_INTERIOR_0 5
 #define MP_INTERIOR_1 6

@@ -5,14 +5,22 @@
 
 #include "mp_compat.h"
 
-/* A piece of a patch: the parametric rectangle [u0,u1] x [v0,v1] of patch
- * `patch`. `info` packs the split depth (bits 0-7) and, once the sub-patch is
- * diceable, its grid size in micropolygons (nu: bits 8-15, nv: bits 16-23). */
+/* A piece of a patch: the parametric quadrilateral with corners
+ * (corner[2k], corner[2k+1]), k = 0..3, counter-clockwise in (u, v), of patch
+ * `patch`. Edge k runs from corner k to corner k+1. `info` packs the split
+ * depth (bits 0-7) and, once the sub-patch is diceable, its grid size in
+ * micropolygons (nu: bits 8-15, nv: bits 16-23). `rates` holds one byte per
+ * edge: 0 while the edge is still to be measured (or too long to dice), else
+ * 1 + log2 of the number of micropolygon edges along it (see mp_bound.h). */
 typedef struct {
-  float u0, v0, u1, v1;
+  float corner[8];
   uint patch;
   uint info;
+  uint rates;
 } SubPatch;
+
+#define MP_EDGE_CODE(rates, e) (((rates) >> (8u * (uint)(e))) & 0xffu)
+#define MP_CODE_RATE(code) (1u << ((code) - 1u))
 
 #define MP_INFO_DEPTH(info) ((info) & 0xffu)
 #define MP_INFO_NU(info) (((info) >> 8) & 0xffu)

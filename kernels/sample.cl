@@ -180,8 +180,7 @@ void sample_micropolygons(__global const SubPatch* diceable, uint first, uint co
   mp_count_sampled(get_local_id(0), area2, pass, totals, area_sum, count_sum);
   if (!live) return;
   uint grid_id = mp_hash32(sp.patch);
-  grid_id = mp_hash_combine(mp_hash_combine(grid_id, as_uint(sp.u0)), as_uint(sp.v0));
-  grid_id = mp_hash_combine(mp_hash_combine(grid_id, as_uint(sp.u1)), as_uint(sp.v1));
+  for (int k = 0; k < 8; ++k) grid_id = mp_hash_combine(grid_id, as_uint(sp.corner[k]));
   uint mp_id = mp_hash_combine(grid_id, local_index);
   float opacity = grid_c[(ulong)slot * (mg + 1u) * (mg + 1u) + j * (mg + 1u) + i].w;
   mp_raster_quad(v[0], v[1], v[2], v[3], mp_id, opacity, f, offsets, pass, keys, colors, normals);

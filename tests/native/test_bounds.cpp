@@ -9,8 +9,9 @@
 
 #include "mp_compat.h"
 #include "mp_patch.h"
-#include "mp_patch_eval.h"
 #include "mp_types.h"
+#include "mp_patch_eval.h"
+#include "mp_surface.h"
 #include "mp_bound.h"
 #include "pipeline/frame_params.h"
 #include "scene_fixtures.h"
@@ -31,23 +32,25 @@ Checked check_scene(const Scene& scene) {
   PatchBuffer patches;
   for (const Mesh& m : scene.meshes) {
     glm::mat4 to_camera = scene.camera.world_to_camera * m.object_to_world;
+    const size_t first = patches.size();
     if (m.scheme == SubdivScheme::CatmullClark)
       append_subdiv_patches(m, to_camera, patches);
     else
       append_polygon_patches(m, to_camera, patches);
+    share_patch_edges(patches, first);
   }
   const uint* info = reinterpret_cast<const uint*>(patches.info.data());
   std::vector<SubPatch> stack;
-  for (uint p = 0; p < patches.size(); ++p) stack.push_back(SubPatch{0, 0, 1, 1, p, 0});
+  for (uint p = 0; p < patches.size(); ++p) stack.push_back(SubPatch{{0, 0, 1, 0, 1, 1, 0, 1}, p, 0, 0});
   Checked c;
   while (!stack.empty()) {
     SubPatch sp = stack.back();
     stack.pop_back();
-    uint d = mp_classify(patches.points.data(), info, sp, f);
+    uint d = mp_classify(patches.points.data(), info, patches.edges.data(), patches.curves.data(), &sp, f);
     uint action = MP_DECISION_ACTION(d);
     if (action >= MP_SPLIT_U) {
       SubPatch a, b;
-      mp_split(sp, action, &a, &b);
+      mp_split(&sp, action, &a, &b);
       stack.push_back(a);
       stack.push_back(b);
       continue;
@@ -57,16 +60,22 @@ Checked check_scene(const Scene& scene) {
     uint type = info[4 * sp.patch];
     c.gregory += type == MP_PATCH_GREGORY;
     float3 lo[16], hi[16];
-    mp_subpatch_net_boxes(cp, type, sp, lo, hi);
+    float u0 = std::min({sp.corner[0], sp.corner[2], sp.corner[4], sp.corner[6]});
+    float u1 = std::max({sp.corner[0], sp.corner[2], sp.corner[4], sp.corner[6]});
+    float v0 = std::min({sp.corner[1], sp.corner[3], sp.corner[5], sp.corner[7]});
+    float v1 = std::max({sp.corner[1], sp.corner[3], sp.corner[5], sp.corner[7]});
+    mp_subpatch_net_boxes(cp, type, u0, v0, u1, v1, lo, hi);
     MpBound bound = mp_bound_boxes(lo, hi, f);
     glm::vec3 box_lo(3e38f), box_hi(-3e38f);
     for (int k = 0; k < 16; ++k) box_lo = glm::min(box_lo, lo[k]), box_hi = glm::max(box_hi, hi[k]);
     uint nu = MP_INFO_NU(d), nv = MP_INFO_NV(d);
     for (uint j = 0; j <= nv; ++j)
       for (uint i = 0; i <= nu; ++i) {
-        float u = sp.u0 + (sp.u1 - sp.u0) * float(i) / float(nu), v = sp.v0 + (sp.v1 - sp.v0) * float(j) / float(nv);
+        glm::vec2 uv = mp_grid_uv(&sp, nu, nv, i, j);
+        float u = uv.x, v = uv.y;
         float3 P, du, dv;
-        mp_eval_patch(cp, type, u, v, &P, &du, &dv);
+        mp_surface_point(patches.points.data(), info, patches.edges.data(), patches.curves.data(), sp.patch, u, v, &P,
+                         &du, &dv);
         float tol = 1e-4f * (1.0f + glm::length(P));
         glm::vec2 r = mp_project(P, f);
         float rtol = 1e-3f * (1.0f + std::abs(r.x) + std::abs(r.y));

@@ -66,17 +66,19 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
     cl::Kernel step(s.program(), "bs_bounded_step");
     step.setArg(0, ctx.scene.points);
     step.setArg(1, ctx.scene.patch_info);
-    step.setArg(2, ctx.scene.patch_count);
-    step.setArg(3, ctx.frame);
-    step.setArg(4, ws.stacks);
-    step.setArg(5, ws.sizes);
-    step.setArg(6, stack_depth);
-    step.setArg(7, ws.ring);
-    step.setArg(8, ring_capacity);
-    step.setArg(12, ws.diceable);
-    step.setArg(13, dice_capacity);
-    step.setArg(14, ws.counters);
-    step.setArg(15, kStepsPerLaunch);
+    step.setArg(2, ctx.scene.patch_edges);
+    step.setArg(3, ctx.scene.edge_curves);
+    step.setArg(4, ctx.scene.patch_count);
+    step.setArg(5, ctx.frame);
+    step.setArg(6, ws.stacks);
+    step.setArg(7, ws.sizes);
+    step.setArg(8, stack_depth);
+    step.setArg(9, ws.ring);
+    step.setArg(10, ring_capacity);
+    step.setArg(14, ws.diceable);
+    step.setArg(15, dice_capacity);
+    step.setArg(16, ws.counters);
+    step.setArg(17, kStepsPerLaunch);
 
     auto whole_groups = [&](size_t n) { return std::min(workers, std::max<size_t>(64, (n + 63) / 64 * 64)); };
     // More workers than a few dice batches' worth would mostly hold work they
@@ -88,10 +90,10 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
     for (;;) {
       cl_uint c[kCounters] = {head, tail, next_patch, dice_count, 0, 0, 0, 0};
       queue.enqueueWriteBuffer(ws.counters, CL_FALSE, 0, sizeof c, c);
-      step.setArg(9, head);
-      step.setArg(10, tail);
+      step.setArg(11, head);
+      step.setArg(12, tail);
       // Hand out at most as many children as there will be idle workers.
-      step.setArg(11, hungry);
+      step.setArg(13, hungry);
       cl::Event e;
       queue.enqueueNDRangeKernel(step, cl::NullRange, cl::NDRange(launch), cl::NDRange(64), nullptr, &e);
       ctx.timer.add(Stage::BoundSplit, e);

@@ -40,10 +40,12 @@ BoundSplitResult bound_split_breadth(BoundSplitContext& ctx, cl_uint dice_capaci
       classify.setArg(1, n);
       classify.setArg(2, ctx.scene.points);
       classify.setArg(3, ctx.scene.patch_info);
-      classify.setArg(4, ctx.frame);
-      classify.setArg(5, decision.get());
-      classify.setArg(6, dice_flag.get());
-      classify.setArg(7, split_flag.get());
+      classify.setArg(4, ctx.scene.patch_edges);
+      classify.setArg(5, ctx.scene.edge_curves);
+      classify.setArg(6, ctx.frame);
+      classify.setArg(7, decision.get());
+      classify.setArg(8, dice_flag.get());
+      classify.setArg(9, split_flag.get());
       cl::Event e1;
       queue.enqueueNDRangeKernel(classify, cl::NullRange, round_up_range(n + 1), cl::NDRange(64), nullptr, &e1);
       ctx.timer.add(Stage::BoundSplit, e1);

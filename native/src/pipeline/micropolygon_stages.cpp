@@ -45,10 +45,12 @@ void DiceStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffer
   kernel_.setArg(1, count);
   kernel_.setArg(2, scene.points);
   kernel_.setArg(3, scene.patch_info);
-  kernel_.setArg(4, f);
-  kernel_.setArg(5, grids.p);
-  kernel_.setArg(6, grids.n);
-  kernel_.setArg(7, counter_);
+  kernel_.setArg(4, scene.patch_edges);
+  kernel_.setArg(5, scene.edge_curves);
+  kernel_.setArg(6, f);
+  kernel_.setArg(7, grids.p);
+  kernel_.setArg(8, grids.n);
+  kernel_.setArg(9, counter_);
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(count * grids.vertices_per_slot),
                                         cl::NDRange(64), nullptr, &e);

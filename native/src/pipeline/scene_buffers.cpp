@@ -70,15 +70,22 @@ cl::Buffer upload(cl::Context& context, cl::CommandQueue& queue, const std::vect
 HostSceneData prepare_scene_data(const Scene& scene) {
   HostSceneData out;
   const glm::mat4& w2c = scene.camera.world_to_camera;
+  // Each surface's patches share their edges' curves (patch_edges.h), so
+  // neighbouring patches dice watertight; separate surfaces do not.
   for (const Mesh& mesh : scene.meshes) {
     glm::mat4 to_camera = w2c * mesh.object_to_world;
+    const size_t first = out.patches.size();
     if (mesh.scheme == SubdivScheme::CatmullClark)
       append_subdiv_patches(mesh, to_camera, out.patches);
     else
       append_polygon_patches(mesh, to_camera, out.patches);
+    share_patch_edges(out.patches, first);
   }
-  for (const BezierPatches& set : scene.bezier_patches)
+  for (const BezierPatches& set : scene.bezier_patches) {
+    const size_t first = out.patches.size();
     append_bezier_patches(set, w2c * set.object_to_world, out.patches);
+    share_patch_edges(out.patches, first);
+  }
   if (scene.materials.empty()) out.materials.push_back(to_device(Material{}));
   for (const Material& m : scene.materials) out.materials.push_back(to_device(m));
   for (const Light& l : scene.lights) out.lights.push_back(to_device(l, w2c));
@@ -89,6 +96,8 @@ SceneBuffers upload_scene_data(cl::Context& context, cl::CommandQueue& queue, co
   SceneBuffers b;
   b.points = upload(context, queue, data.patches.points);
   b.patch_info = upload(context, queue, data.patches.info);
+  b.patch_edges = upload(context, queue, data.patches.edges);
+  b.edge_curves = upload(context, queue, data.patches.curves);
   b.materials = upload(context, queue, data.materials);
   b.lights = upload(context, queue, data.lights);
   b.patch_count = static_cast<cl_uint>(data.patches.size());

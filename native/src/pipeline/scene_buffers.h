@@ -22,6 +22,8 @@ HostSceneData prepare_scene_data(const Scene& scene);
 struct SceneBuffers {
   cl::Buffer points;      // float4 x MP_PATCH_POINTS per patch
   cl::Buffer patch_info;  // uint4 per patch
+  cl::Buffer patch_edges;  // MP_EDGE_REFS uints per patch (kernels/mp_patch.h)
+  cl::Buffer edge_curves;  // 4 float4 per shared edge curve
   cl::Buffer materials;
   cl::Buffer lights;
   cl_uint patch_count = 0;

@@ -2,6 +2,7 @@
 // (layout in kernels/mp_patch.h) by one of the append_* builders below.
 #pragma once
 
+#include <cstdint>
 #include <glm/glm.hpp>
 #include <vector>
 
@@ -12,6 +13,8 @@ namespace mp {
 struct PatchBuffer {
   std::vector<glm::vec4> points;  // MP_PATCH_POINTS per patch, already transformed
   std::vector<glm::uvec4> info;   // PatchInfo per patch (type, material, flags, prim id)
+  std::vector<uint32_t> edges;    // MP_EDGE_REFS curve references per patch (kernels/mp_patch.h)
+  std::vector<glm::vec4> curves;  // 4 control points per shared edge curve
   size_t size() const { return info.size(); }
 };
 
@@ -23,5 +26,12 @@ void append_subdiv_patches(const Mesh& mesh, const glm::mat4& to_space, PatchBuf
 void append_polygon_patches(const Mesh& mesh, const glm::mat4& to_space, PatchBuffer& out);
 // Bezier patch sets (RIB Patch/PatchMesh after basis conversion).
 void append_bezier_patches(const BezierPatches& set, const glm::mat4& to_space, PatchBuffer& out);
+
+// Fills `edges` (and `curves`) for patches [first, size()): edges that two
+// patches share, within a tolerance, get one curve and bit-identical corner
+// points; an edge whose other side is two half-length edges (a transition
+// between refinement levels, or a quad next to a split n-gon) refers to their
+// two curves. Every other edge gets a curve of its own.
+void share_patch_edges(PatchBuffer& buffer, size_t first);
 
 }  // namespace mp

@@ -1,0 +1,101 @@
+/* Surface points for dicing and edge measurement, watertight across patches.
+ *
+ * Inside a patch a point is the patch evaluated at (u, v) (mp_patch_eval.h).
+ * A point on the patch boundary is instead evaluated from the edge's shared
+ * curve (mp_patch.h), with the parameter mapped into the curve's own
+ * direction, so the two patches that share an edge compute it with the same
+ * operations on the same numbers. This relies on every (u, v) on a boundary
+ * being a binary fraction with few bits (see mp_bound.h), which makes
+ * t -> 1 - t and t -> 2t - 1 exact in float.
+ *
+ * Compiles as OpenCL C and C++ (include mp_compat.h, mp_patch.h,
+ * mp_patch_eval.h and mp_types.h first). */
+#ifndef MP_SURFACE_H
+#define MP_SURFACE_H
+
+/* Bernstein evaluation of curve `ref` at t along the referring edge. */
+MP_INLINE float3 mp_curve_point(const MP_GLOBAL float4* curves, uint ref, float t) {
+  const MP_GLOBAL float4* c = curves + (ulong)(ref >> 1) * 4u;
+  float s = (ref & 1u) ? 1.0f - t : t;
+  float r = 1.0f - s;
+  return (r * r * r) * MP_XYZ(c[0]) + (3.0f * s * r * r) * MP_XYZ(c[1]) + (3.0f * s * s * r) * MP_XYZ(c[2]) +
+         (s * s * s) * MP_XYZ(c[3]);
+}
+
+/* The curve and curve-relative parameter of edge e at t. On a transition
+ * edge the halves meet at t = 1/2, the shared end point of both half curves. */
+MP_INLINE uint mp_edge_curve(const MP_GLOBAL uint* edges, uint patch, uint e, float* t) {
+  const MP_GLOBAL uint* refs = edges + (ulong)patch * MP_EDGE_REFS + 2u * e;
+  if (refs[1] == MP_NO_CURVE) return refs[0];
+  if (*t <= 0.5f) {
+    *t = 2.0f * *t;
+    return refs[0];
+  }
+  *t = 2.0f * *t - 1.0f;
+  return refs[1];
+}
+
+/* Which patch edge (u, v) lies on, and its parameter there; -1 inside. */
+MP_INLINE int mp_boundary_edge(float u, float v, float* t) {
+  if (v == 0.0f) { *t = u; return 0; }
+  if (u == 1.0f) { *t = v; return 1; }
+  if (v == 1.0f) { *t = u; return 2; }
+  if (u == 0.0f) { *t = v; return 3; }
+  return -1;
+}
+
+/* Position and derivatives at (u, v) of patch `patch`; on the boundary the
+ * position comes from the shared edge curve. */
+MP_INLINE void mp_surface_point(const MP_GLOBAL float4* points, const MP_GLOBAL uint* patch_info,
+                                const MP_GLOBAL uint* edges, const MP_GLOBAL float4* curves, uint patch, float u,
+                                float v, float3* P, float3* dPdu, float3* dPdv) {
+  const MP_GLOBAL float4* cp = points + (ulong)patch * MP_PATCH_POINTS;
+  mp_eval_patch(cp, patch_info[4 * (ulong)patch], u, v, P, dPdu, dPdv);
+  float t;
+  int e = mp_boundary_edge(u, v, &t);
+  if (e >= 0) {
+    uint ref = mp_edge_curve(edges, patch, (uint)e, &t);
+    *P = mp_curve_point(curves, ref, t);
+  }
+}
+
+MP_INLINE float2 mp_corner(const SubPatch* sp, int k) {
+  k &= 3;
+#ifdef __OPENCL_VERSION__
+  return (float2)(sp->corner[2 * k], sp->corner[2 * k + 1]);
+#else
+  return float2(sp->corner[2 * k], sp->corner[2 * k + 1]);
+#endif
+}
+
+/* Vertex k of n along the segment a -> b. With a, b binary fractions and n a
+ * power of two this is exact, so it does not matter from which end or in
+ * which sub-patch a shared edge vertex is computed. */
+MP_INLINE float2 mp_edge_vertex(float2 a, float2 b, uint k, uint n) {
+  return a + (b - a) * ((float)k / (float)n);
+}
+
+/* (u, v) of grid vertex (i, j) of a diceable sub-patch with an nu x nv grid.
+ * The grid's outer rows and columns snap to the vertices of their edge (edge
+ * rates divide into nu, nv: mp_bound.h), so a sub-patch places exactly the
+ * vertices its neighbour places along their shared edge; micropolygons along
+ * an edge rated below the grid size collapse into triangles. Inside, the grid
+ * is bilinear in the corners. */
+MP_INLINE float2 mp_grid_uv(const SubPatch* sp, uint nu, uint nv, uint i, uint j) {
+  float2 c0 = mp_corner(sp, 0), c1 = mp_corner(sp, 1), c2 = mp_corner(sp, 2), c3 = mp_corner(sp, 3);
+  if (j == 0u || j == nv || i == 0u || i == nu) {
+    /* Edge, its start, its end, grid index along it and grid size along it. */
+    uint e = j == 0u ? 0u : j == nv ? 2u : i == 0u ? 3u : 1u;
+    uint g = (e == 0u || e == 2u) ? i : j, gn = (e == 0u || e == 2u) ? nu : nv;
+    float2 a = e == 0u ? c0 : e == 2u ? c3 : e == 3u ? c0 : c1;
+    float2 b = e == 0u ? c1 : e == 2u ? c2 : e == 3u ? c3 : c2;
+    uint code = MP_EDGE_CODE(sp->rates, e);
+    uint n = code ? MP_CODE_RATE(code) : gn;
+    uint k = (2u * g * n + gn) / (2u * gn);
+    return mp_edge_vertex(a, b, k, n);
+  }
+  float s = (float)i / (float)nu, t = (float)j / (float)nv;
+  return (1.0f - t) * ((1.0f - s) * c0 + s * c1) + t * ((1.0f - s) * c3 + s * c2);
+}
+
+#endif

@@ -1,0 +1,64 @@
+// Bound & split and dicing run on the host through the same headers the
+// kernels compile (mp_bound.h, mp_surface.h): the reference for tests that
+// inspect every diced grid.
+#pragma once
+
+#include <algorithm>
+#include <functional>
+#include <vector>
+
+#include "mp_compat.h"
+#include "mp_patch.h"
+#include "mp_types.h"
+#include "mp_patch_eval.h"
+#include "mp_surface.h"
+#include "mp_bound.h"
+#include "pipeline/frame_params.h"
+#include "pipeline/scene_buffers.h"
+
+namespace mp::test {
+
+struct DicedGrid {
+  SubPatch sp;
+  uint nu = 0, nv = 0;
+  std::vector<glm::vec3> p;  // (nu+1) x (nv+1), i fastest
+  glm::vec3 at(uint i, uint j) const { return p[size_t(j) * (nu + 1) + i]; }
+};
+
+// Calls `visit` for every grid the pipeline would dice for `scene`.
+inline void host_dice(const Scene& scene, const std::function<void(const DicedGrid&, const FrameParams&)>& visit) {
+  const FrameParams f = make_frame_setup(scene).params;
+  HostSceneData data = prepare_scene_data(scene);
+  const PatchBuffer& pb = data.patches;
+  const uint* info = reinterpret_cast<const uint*>(pb.info.data());
+  std::vector<SubPatch> stack;
+  for (uint p = 0; p < pb.size(); ++p) stack.push_back(SubPatch{{0, 0, 1, 0, 1, 1, 0, 1}, p, 0, 0});
+  DicedGrid g;
+  while (!stack.empty()) {
+    SubPatch sp = stack.back();
+    stack.pop_back();
+    const uint d = mp_classify(pb.points.data(), info, pb.edges.data(), pb.curves.data(), &sp, f);
+    const uint action = MP_DECISION_ACTION(d);
+    if (action >= MP_SPLIT_U) {
+      SubPatch a, b;
+      mp_split(&sp, action, &a, &b);
+      stack.push_back(b);
+      stack.push_back(a);
+      continue;
+    }
+    if (action != MP_DICE) continue;
+    g.sp = sp;
+    g.nu = MP_INFO_NU(d), g.nv = MP_INFO_NV(d);
+    g.p.clear();
+    for (uint j = 0; j <= g.nv; ++j)
+      for (uint i = 0; i <= g.nu; ++i) {
+        glm::vec2 uv = mp_grid_uv(&sp, g.nu, g.nv, i, j);
+        float3 P, du, dv;
+        mp_surface_point(pb.points.data(), info, pb.edges.data(), pb.curves.data(), sp.patch, uv.x, uv.y, &P, &du, &dv);
+        g.p.push_back(P);
+      }
+    visit(g, f);
+  }
+}
+
+}  // namespace mp::test
