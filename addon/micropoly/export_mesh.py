@@ -111,11 +111,15 @@ def export_object(native_scene, materials, cache, obj, matrix, warnings):
     boundary = "edge_and_corner"
     if subsurf is not None and subsurf.boundary_smooth == "ALL":
         boundary = "edge_only"
+    # Material > Settings > Backface Culling on every material makes the
+    # object single-sided, as in EEVEE and the viewport.
+    used = [slot.material for slot in obj.material_slots if slot.material is not None]
+    double_sided = not used or not all(getattr(m, "use_backface_culling", False) for m in used)
     empty_i, empty_f = np.zeros(0, dtype=np.int32), np.zeros(0, dtype=np.float32)
     native_scene.add_mesh(
         obj.name, arrays["points"], arrays["counts"], arrays["indices"], subdivision=subsurf is not None,
         object_to_world=matrix, face_materials=face_materials,
         crease_vertices=arrays.get("crease_vertices", empty_i), crease_sharpness=arrays.get("crease_sharpness", empty_f),
         corner_vertices=arrays.get("corner_vertices", empty_i), corner_sharpness=arrays.get("corner_sharpness", empty_f),
-        boundary=boundary, double_sided=True)
+        boundary=boundary, double_sided=double_sided)
     return True

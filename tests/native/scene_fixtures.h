@@ -1,6 +1,8 @@
 // Small scenes built in code for the native tests.
 #pragma once
 
+#include <cmath>
+
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "micropoly/scene.h"
@@ -75,6 +77,66 @@ inline Mesh cube_mesh(SubdivScheme scheme) {
   m.face_vertex_counts = {4, 4, 4, 4, 4, 4};
   m.face_vertex_indices = {0, 3, 2, 1, 4, 5, 6, 7, 0, 1, 5, 4, 2, 3, 7, 6, 1, 2, 6, 5, 0, 4, 7, 3};
   return m;
+}
+
+// A torus (ring radius 1, tube radius r) of n x m quads in which every third
+// face of one ring is cut into two triangles: the cut's end points become
+// extraordinary vertices of valence 5 and the triangles' centres of valence 3.
+inline Mesh torus_mesh(int n, int m, float r, SubdivScheme scheme) {
+  Mesh t;
+  t.name = "torus";
+  t.scheme = scheme;
+  const float pi = 3.14159265f;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < m; ++j) {
+      float a = 2 * pi * i / n, b = 2 * pi * j / m;
+      t.points.push_back({(1 + r * std::cos(b)) * std::cos(a), (1 + r * std::cos(b)) * std::sin(a), r * std::sin(b)});
+    }
+  auto id = [&](int i, int j) { return ((i + n) % n) * m + (j + m) % m; };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < m; ++j) {
+      int a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1), d = id(i, j + 1);
+      if (j == 0 && i % 3 == 0) {
+        t.face_vertex_counts.insert(t.face_vertex_counts.end(), {3, 3});
+        t.face_vertex_indices.insert(t.face_vertex_indices.end(), {a, b, c, a, c, d});
+      } else {
+        t.face_vertex_counts.push_back(4);
+        t.face_vertex_indices.insert(t.face_vertex_indices.end(), {a, b, c, d});
+      }
+    }
+  return t;
+}
+
+// A UV sphere of radius 1 as flat polygons: quads, with triangle fans at the
+// poles (the triangles' patches meet the quads' edges at their midpoints).
+inline Mesh uv_sphere_mesh(int rings, int segments) {
+  Mesh s;
+  s.name = "sphere";
+  s.scheme = SubdivScheme::None;
+  const float pi = 3.14159265f;
+  s.points.push_back({0, 0, -1});
+  for (int r = 1; r < rings; ++r)
+    for (int k = 0; k < segments; ++k) {
+      float th = pi * r / rings, ph = 2 * pi * k / segments;
+      s.points.push_back({std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), -std::cos(th)});
+    }
+  s.points.push_back({0, 0, 1});
+  const int top = int(s.points.size()) - 1;
+  auto id = [&](int r, int k) { return 1 + (r - 1) * segments + (k + segments) % segments; };
+  for (int k = 0; k < segments; ++k) {
+    s.face_vertex_counts.push_back(3);
+    s.face_vertex_indices.insert(s.face_vertex_indices.end(), {0, id(1, k + 1), id(1, k)});
+  }
+  for (int r = 1; r + 1 < rings; ++r)
+    for (int k = 0; k < segments; ++k) {
+      s.face_vertex_counts.push_back(4);
+      s.face_vertex_indices.insert(s.face_vertex_indices.end(), {id(r, k), id(r, k + 1), id(r + 1, k + 1), id(r + 1, k)});
+    }
+  for (int k = 0; k < segments; ++k) {
+    s.face_vertex_counts.push_back(3);
+    s.face_vertex_indices.insert(s.face_vertex_indices.end(), {top, id(rings - 1, k), id(rings - 1, k + 1)});
+  }
+  return s;
 }
 
 }  // namespace mp::test
