@@ -34,8 +34,9 @@ def _array(values, per_line=12):
     return "[" + "\n ".join(lines) + "]"
 
 
-def dense_subdiv(w=1920, h=1080, spp=4, rate=1.0, n=48):
-    """A wavy Catmull-Clark sheet of n x n faces filling about half the frame."""
+def dense_subdiv(w=1920, h=1080, spp=4, rate=1.0, n=48, tilt=25, distance=3.2):
+    """A wavy Catmull-Clark sheet of n x n faces filling about half the frame
+    (tilted 25 degrees; at 78 degrees it is seen at a grazing angle)."""
     pts, nverts, verts = [], [], []
     for j in range(n + 1):
         for i in range(n + 1):
@@ -48,7 +49,7 @@ def dense_subdiv(w=1920, h=1080, spp=4, rate=1.0, n=48):
             nverts.append(4)
             verts += [v, v + 1, v + n + 2, v + n + 1]
     return (_header(w, h, spp, rate, 40) +
-            "Translate 0 0 3.2\nRotate -25 1 0 0\nWorldBegin\n" + LIGHTS +
+            f"Translate 0 0 {distance}\nRotate -{tilt} 1 0 0\nWorldBegin\n" + LIGHTS +
             'AttributeBegin\nColor [0.7 0.55 0.4]\nSurface "plastic" "Ks" [0.4] "roughness" [0.15]\n'
             f'SubdivisionMesh "catmull-clark" {_array(nverts)} {_array(verts)} '
             '["interpolateboundary"] [0 0] [] [] '
@@ -113,6 +114,7 @@ def write_all(folder, teapot_source):
         # For the bound & split memory sweep: a 262k-face mesh at 4K, whose
         # widest split level is wide enough to show breadth-first's memory.
         "wide_subdiv_4k": dense_subdiv(w=3840, h=2160, spp=1, n=512),
+        "grazing_sheet": dense_subdiv(tilt=78, distance=2.2),
         "teapot": teapot(),
         "eye_split_plane": eye_split_plane(),
         "depth_stack_16": depth_stack(),
