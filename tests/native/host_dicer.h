@@ -21,12 +21,15 @@ namespace mp::test {
 struct DicedGrid {
   SubPatch sp;
   uint nu = 0, nv = 0;
-  std::vector<glm::vec3> p;  // (nu+1) x (nv+1), i fastest
+  std::vector<glm::vec3> p;   // (nu+1) x (nv+1), i fastest
+  std::vector<glm::vec2> uv;  // the patch parameters of p
   glm::vec3 at(uint i, uint j) const { return p[size_t(j) * (nu + 1) + i]; }
 };
 
-// Calls `visit` for every grid the pipeline would dice for `scene`.
-inline void host_dice(const Scene& scene, const std::function<void(const DicedGrid&, const FrameParams&)>& visit) {
+// Calls `visit` for every grid the pipeline would dice for `scene`, with the
+// frame and the scene's device patches.
+inline void host_dice(const Scene& scene,
+                      const std::function<void(const DicedGrid&, const FrameParams&, const PatchBuffer&)>& visit) {
   const FrameParams f = make_frame_setup(scene).params;
   HostSceneData data = prepare_scene_data(scene);
   const PatchBuffer& pb = data.patches;
@@ -50,14 +53,16 @@ inline void host_dice(const Scene& scene, const std::function<void(const DicedGr
     g.sp = sp;
     g.nu = MP_INFO_NU(d), g.nv = MP_INFO_NV(d);
     g.p.clear();
+    g.uv.clear();
     for (uint j = 0; j <= g.nv; ++j)
       for (uint i = 0; i <= g.nu; ++i) {
         glm::vec2 uv = mp_grid_uv(&sp, g.nu, g.nv, i, j);
         float3 P, du, dv;
         mp_surface_point(pb.points.data(), info, pb.edges.data(), pb.curves.data(), sp.patch, uv.x, uv.y, &P, &du, &dv);
         g.p.push_back(P);
+        g.uv.push_back(uv);
       }
-    visit(g, f);
+    visit(g, f, pb);
   }
 }
 

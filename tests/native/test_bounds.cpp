@@ -3,19 +3,12 @@
 // header code the kernels run (mp_bound.h, mp_patch_eval.h) on the host.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <glm/gtc/matrix_transform.hpp>
 #include <string>
-#include <vector>
 
-#include "mp_compat.h"
-#include "mp_patch.h"
-#include "mp_types.h"
-#include "mp_patch_eval.h"
-#include "mp_surface.h"
-#include "mp_bound.h"
-#include "pipeline/frame_params.h"
+#include "host_dicer.h"
 #include "scene_fixtures.h"
-#include "subdiv/patch_buffer.h"
 
 namespace mp::test {
 namespace {
@@ -27,37 +20,11 @@ struct Checked {
 
 // Runs bound & split on the host and checks every diced grid vertex.
 Checked check_scene(const Scene& scene) {
-  FrameSetup frame = make_frame_setup(scene);
-  FrameParams f = frame.params;
-  PatchBuffer patches;
-  for (const Mesh& m : scene.meshes) {
-    glm::mat4 to_camera = scene.camera.world_to_camera * m.object_to_world;
-    const size_t first = patches.size();
-    if (m.scheme == SubdivScheme::CatmullClark)
-      append_subdiv_patches(m, to_camera, patches);
-    else
-      append_polygon_patches(m, to_camera, patches);
-    share_patch_edges(patches, first);
-  }
-  const uint* info = reinterpret_cast<const uint*>(patches.info.data());
-  std::vector<SubPatch> stack;
-  for (uint p = 0; p < patches.size(); ++p) stack.push_back(SubPatch{{0, 0, 1, 0, 1, 1, 0, 1}, p, 0, 0});
   Checked c;
-  while (!stack.empty()) {
-    SubPatch sp = stack.back();
-    stack.pop_back();
-    uint d = mp_classify(patches.points.data(), info, patches.edges.data(), patches.curves.data(), &sp, f);
-    uint action = MP_DECISION_ACTION(d);
-    if (action >= MP_SPLIT_U) {
-      SubPatch a, b;
-      mp_split(&sp, action, &a, &b);
-      stack.push_back(a);
-      stack.push_back(b);
-      continue;
-    }
-    if (action != MP_DICE) continue;
+  host_dice(scene, [&](const DicedGrid& g, const FrameParams& f, const PatchBuffer& patches) {
+    const SubPatch& sp = g.sp;
     const glm::vec4* cp = patches.points.data() + size_t(sp.patch) * MP_PATCH_POINTS;
-    uint type = info[4 * sp.patch];
+    const uint type = patches.info[sp.patch].x;
     c.gregory += type == MP_PATCH_GREGORY;
     float3 lo[16], hi[16];
     float u0 = std::min({sp.corner[0], sp.corner[2], sp.corner[4], sp.corner[6]});
@@ -68,28 +35,22 @@ Checked check_scene(const Scene& scene) {
     MpBound bound = mp_bound_boxes(lo, hi, f);
     glm::vec3 box_lo(3e38f), box_hi(-3e38f);
     for (int k = 0; k < 16; ++k) box_lo = glm::min(box_lo, lo[k]), box_hi = glm::max(box_hi, hi[k]);
-    uint nu = MP_INFO_NU(d), nv = MP_INFO_NV(d);
-    for (uint j = 0; j <= nv; ++j)
-      for (uint i = 0; i <= nu; ++i) {
-        glm::vec2 uv = mp_grid_uv(&sp, nu, nv, i, j);
-        float u = uv.x, v = uv.y;
-        float3 P, du, dv;
-        mp_surface_point(patches.points.data(), info, patches.edges.data(), patches.curves.data(), sp.patch, u, v, &P,
-                         &du, &dv);
-        float tol = 1e-4f * (1.0f + glm::length(P));
-        glm::vec2 r = mp_project(P, f);
-        float rtol = 1e-3f * (1.0f + std::abs(r.x) + std::abs(r.y));
-        float depth = -P.z;
-        bool inside = depth >= bound.dmin - tol && depth <= bound.dmax + tol && r.x >= bound.xmin - rtol &&
-                      r.x <= bound.xmax + rtol && r.y >= bound.ymin - rtol && r.y <= bound.ymax + rtol;
-        for (int k = 0; k < 3; ++k) inside = inside && P[k] >= box_lo[k] - tol && P[k] <= box_hi[k] + tol;
-        if (!inside && c.violations++ == 0)
-          c.first_violation = "patch " + std::to_string(sp.patch) + " type " + std::to_string(type) + " at (" +
-                              std::to_string(u) + ", " + std::to_string(v) + ")";
-        ++c.vertices;
-      }
+    for (size_t k = 0; k < g.p.size(); ++k) {
+      const glm::vec3 P = g.p[k];
+      float tol = 1e-4f * (1.0f + glm::length(P));
+      glm::vec2 r = mp_project(P, f);
+      float rtol = 1e-3f * (1.0f + std::abs(r.x) + std::abs(r.y));
+      float depth = -P.z;
+      bool inside = depth >= bound.dmin - tol && depth <= bound.dmax + tol && r.x >= bound.xmin - rtol &&
+                    r.x <= bound.xmax + rtol && r.y >= bound.ymin - rtol && r.y <= bound.ymax + rtol;
+      for (int a = 0; a < 3; ++a) inside = inside && P[a] >= box_lo[a] - tol && P[a] <= box_hi[a] + tol;
+      if (!inside && c.violations++ == 0)
+        c.first_violation = "patch " + std::to_string(sp.patch) + " type " + std::to_string(type) + " at (" +
+                            std::to_string(g.uv[k].x) + ", " + std::to_string(g.uv[k].y) + ")";
+      ++c.vertices;
+    }
     ++c.diced;
-  }
+  });
   return c;
 }
 

@@ -80,7 +80,7 @@ Key bits(const glm::vec3& p) {
 // many grids produced each (undirected, bit-exact end points).
 size_t count_unmatched_segments(const Scene& scene, size_t* checked) {
   std::map<std::pair<Key, Key>, int> segments;
-  host_dice(scene, [&](const DicedGrid& g, const FrameParams& f) {
+  host_dice(scene, [&](const DicedGrid& g, const FrameParams& f, const PatchBuffer&) {
     auto inside = [&](const glm::vec3& p) {
       if (-p.z <= scene.camera.clip_near) return false;
       glm::vec2 r = mp_project(p, f);
