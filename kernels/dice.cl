@@ -8,23 +8,6 @@
 #include "mp_patch_eval.h"
 #include "mp_surface.h"
 
-/* Unit normal of the patch at (u, v). Where the derivatives are parallel or
- * vanish (collapsed corners, poles) the normal is taken a little way towards
- * the patch centre, which is its limit along that direction. */
-inline float3 mp_patch_normal(__global const float4* cp, uint type, float u, float v, float3 dpdu, float3 dpdv) {
-  float3 n = cross(dpdu, dpdv);
-  float scale = length(dpdu) * length(dpdv);
-  for (int k = 0; k < 3 && !(length(n) > 1e-7f * scale && length(n) > 0.0f); ++k) {
-    float t = k == 0 ? 1e-4f : k == 1 ? 1e-3f : 1e-2f;
-    float3 p;
-    mp_eval_patch(cp, type, u + (0.5f - u) * t, v + (0.5f - v) * t, &p, &dpdu, &dpdv);
-    n = cross(dpdu, dpdv);
-    scale = length(dpdu) * length(dpdv);
-  }
-  float len = length(n);
-  return len > 0.0f ? n / len : (float3)(0.0f, 0.0f, 1.0f);
-}
-
 __kernel void dice_grids(__global const SubPatch* diceable, uint count,
                          __global const float4* points, __global const uint* patch_info,
                          __global const uint* edges, __global const float4* curves,
@@ -38,11 +21,35 @@ __kernel void dice_grids(__global const SubPatch* diceable, uint count,
   float2 uv = mp_grid_uv(&sp, nu, nv, i, j);
   float3 p, dpdu, dpdv;
   mp_surface_point(points, patch_info, edges, curves, sp.patch, uv.x, uv.y, &p, &dpdu, &dpdv);
-  __global const float4* cp = points + (ulong)sp.patch * MP_PATCH_POINTS;
-  uint type = patch_info[4 * (ulong)sp.patch];
   uint flags = patch_info[4 * (ulong)sp.patch + 2];
-  float3 n = mp_patch_normal(cp, type, uv.x, uv.y, dpdu, dpdv);
+  float3 n = mp_surface_normal(points, patch_info, edges, curves, sp.patch, uv.x, uv.y, dpdu, dpdv);
   if (flags & MP_PATCH_FLIP_ORIENTATION) n = -n;
   grid_p[gid] = (float4)(p, 1.0f);
   grid_n[gid] = (float4)(n, 0.0f);
+}
+
+/* Normals of displaced grids, from the displaced vertices (central
+ * differences inside the grid, one-sided on its border), oriented like the
+ * surface normal they replace. Where the differences vanish (a collapsed
+ * grid edge) the undisplaced normal stays. Runs after every material's
+ * displacement (material_program.cl). */
+__kernel void displaced_normals(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
+                                __global const DeviceMaterial* materials, FrameParams f,
+                                __global const float4* grid_p, __global float4* grid_n) {
+  uint gid = get_global_id(0), i, j;
+  SubPatch sp;
+  if (!mp_grid_vertex(gid, count, f.max_grid, diceable, &sp, &i, &j)) return;
+  if (!(materials[patch_info[4 * (ulong)sp.patch + 1]].program[1] > 0.0f)) return;
+  uint nu = MP_INFO_NU(sp.info), nv = MP_INFO_NV(sp.info), stride = (uint)f.max_grid + 1u;
+  ulong row = gid - i - (ulong)j * stride; /* vertex (0, 0) of this grid */
+  uint i0 = i > 0u ? i - 1u : 0u, i1 = i < nu ? i + 1u : nu;
+  uint j0 = j > 0u ? j - 1u : 0u, j1 = j < nv ? j + 1u : nv;
+  float3 du = grid_p[row + j * stride + i1].xyz - grid_p[row + j * stride + i0].xyz;
+  float3 dv = grid_p[row + j1 * stride + i].xyz - grid_p[row + j0 * stride + i].xyz;
+  float3 n = cross(du, dv);
+  float len = length(n);
+  float3 old = grid_n[gid].xyz;
+  if (!(len > 1e-12f * dot(du, du) + 1e-30f)) return;
+  n /= len;
+  grid_n[gid] = (float4)(dot(n, old) < 0.0f ? -n : n, 0.0f);
 }

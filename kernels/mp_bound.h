@@ -299,6 +299,14 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
   float v1 = fmax(fmax(sp->corner[1], sp->corner[3]), fmax(sp->corner[5], sp->corner[7]));
   float3 lo[16], hi[16];
   mp_subpatch_net_boxes(cp, type, u0, v0, u1, v1, lo, hi);
+  /* Displacement moves the surface at most this far (mp_patch.h): widen the
+   * hull so culling and splitting never clip displaced geometry. */
+  float reach = MP_PATCH_DISPLACEMENT_BOUND(cp);
+  if (reach > 0.0f)
+    for (int k = 0; k < 16; ++k) {
+      lo[k] -= MP_F3(reach, reach, reach);
+      hi[k] += MP_F3(reach, reach, reach);
+    }
   MpBound b = mp_bound_boxes(lo, hi, f);
   uint depth = MP_INFO_DEPTH(sp->info);
   int can_split = (int)depth < f.max_depth;

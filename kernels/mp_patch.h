@@ -24,21 +24,31 @@
 #define MP_PATCH_GREGORY 1u
 
 /* PatchInfo (uint4): x = type, y = material index, z = flags, w = primitive id
- * (the face or patch index in its object, used to make sample ids stable). */
+ * (the face or patch index in its object, used to make sample ids stable).
+ * Flags bits 8-31 hold the patch's object index (DeviceObject, mp_types.h). */
 #define MP_PATCH_DOUBLE_SIDED 1u
 #define MP_PATCH_FLIP_ORIENTATION 2u
+#define MP_PATCH_OBJECT(flags) ((flags) >> 8)
+
+/* The w of the first control point is the patch's displacement bound: how
+ * far (camera space) its material's displacement can move the surface. */
+#define MP_PATCH_DISPLACEMENT_BOUND(cp) ((cp)[0].w)
 
 /* Patch edges. Edge e of a patch is the boundary curve v = 0 (e = 0), u = 1
  * (e = 1), v = 1 (e = 2) or u = 0 (e = 3), parametrised by u (e = 0, 2) or v
  * (e = 1, 3). Neighbouring patches evaluate a shared edge from one stored
- * cubic Bezier curve (4 float4 per curve), so both produce bit-identical
- * points (mp_surface.h). PatchEdges holds 8 uints per patch, two per edge:
+ * cubic Bezier curve, so both produce bit-identical points (mp_surface.h).
+ * A curve is MP_CURVE_FLOAT4S float4: its 4 control points, then 4 control
+ * points of a cubic that interpolates the surface normal along the edge
+ * (sampled from one of the patches), so displacement along the normal moves
+ * shared edge vertices identically from both sides. PatchEdges holds 8 uints per patch, two per edge:
  * a curve reference (curve index << 1 | 1 if the curve runs against the
  * edge's parameter) and MP_NO_CURVE, or, for an edge whose neighbour side is
  * two patches of the next finer level (a transition edge), the references of
  * the halves t in [0, 1/2] and [1/2, 1]. */
 #define MP_NO_CURVE 0xffffffffu
 #define MP_EDGE_REFS 8
+#define MP_CURVE_FLOAT4S 8
 
 /* Interior point indices in the 4x4 net and the index of their partners. */
 #define MP_INTERIOR_0 5

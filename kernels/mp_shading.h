@@ -90,7 +90,7 @@ MP_INLINE float mp_ggx_specular(float3 n, float3 l, float3 v, float alpha) {
 }
 
 /* Radiance leaving point p with normal n towards the eye. */
-MP_INLINE float3 mp_shade(float3 p, float3 n, int ortho, MP_GLOBAL const DeviceMaterial* m,
+MP_INLINE float3 mp_shade(float3 p, float3 n, int ortho, const DeviceMaterial* m,
                           MP_GLOBAL const DeviceLight* lights, uint light_count) {
   float3 cs = MP_F3(m->color[0], m->color[1], m->color[2]);
   float3 emission = MP_F3(m->emission[0], m->emission[1], m->emission[2]);

@@ -77,7 +77,19 @@ typedef struct {
   float specular[4];        /* specular color (plastic) */
   float emission[4];
   float principled[4];      /* metallic, specular, 0, 0 */
+  float program[4];         /* compiled node program index or -1, displaces (1/0), surface program (1/0), 0 */
 } DeviceMaterial;
+
+/* Per object, for material programs: camera -> object space (rows of a 3x4
+ * matrix), object -> camera (rows of a 3x4; displacement vectors use its
+ * linear part) and the texture space that maps object space onto Generated
+ * coordinates: generated = (P - location) / (2 size) + 1/2. */
+typedef struct {
+  float to_object[12];
+  float to_camera[12];
+  float texspace_location[4];
+  float texspace_size[4];
+} DeviceObject;
 
 #define MP_LIGHT_AMBIENT 0
 #define MP_LIGHT_DISTANT 1

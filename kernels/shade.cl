@@ -12,7 +12,8 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   if (!mp_grid_vertex(gid, count, f.max_grid, diceable, &sp, &i, &j)) return;
-  __global const DeviceMaterial* m = materials + patch_info[4 * (ulong)sp.patch + 1];
-  float3 c = mp_shade(grid_p[gid].xyz, grid_n[gid].xyz, f.ortho, m, lights, light_count);
-  grid_c[gid] = (float4)(c, m->opacity[3]);
+  DeviceMaterial m = materials[patch_info[4 * (ulong)sp.patch + 1]];
+  if (m.program[2] > 0.0f) return; /* shaded by its node program (material_program.cl) */
+  float3 c = mp_shade(grid_p[gid].xyz, grid_n[gid].xyz, f.ortho, &m, lights, light_count);
+  grid_c[gid] = (float4)(c, m.opacity[3]);
 }

@@ -111,7 +111,7 @@ def export_scene(depsgraph):
     out = ExportedScene(scene=native_scene, width=width, height=height)
     export_settings(native_scene, scene, width, height)
     export_camera(native_scene, scene, camera.evaluated_get(depsgraph), width, height)
-    materials = export_materials.MaterialTable(native_scene)
+    materials = export_materials.MaterialTable(native_scene, out.warnings)
     meshes = export_mesh.MeshCache()
     out.background = export_lights.export_world(native_scene, scene.world)
     for inst in depsgraph.object_instances:

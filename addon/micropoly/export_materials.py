@@ -6,6 +6,8 @@ Principled BSDF and Diffuse BSDF give their constant inputs, an Emission
 shader gives emission; anything else falls back to the material's viewport
 color, metallic and roughness."""
 
+from . import node_compiler
+
 
 def _input(node, *names, default=None):
     for name in names:
@@ -56,11 +58,15 @@ def material_parameters(material):
 
 
 class MaterialTable:
-    """One native material per Blender material; index 0 is Blender's default grey."""
+    """One native material per Blender material; index 0 is Blender's default grey.
+    Node trees that need per-point evaluation (textures, displacement) become
+    material programs; identical trees share one."""
 
-    def __init__(self, native_scene):
+    def __init__(self, native_scene, warnings=None):
         self.native = native_scene
         self.index = {}
+        self.programs = {}  # generated source -> program index
+        self.warnings = warnings if warnings is not None else []
         native_scene.add_material(name="default", **material_parameters(None))
 
     def get(self, material):
@@ -68,6 +74,15 @@ class MaterialTable:
             return 0
         key = material.name_full if hasattr(material, "name_full") else material.name
         if key not in self.index:
-            self.native.add_material(name=key, **material_parameters(material))
+            params = material_parameters(material)
+            compiled = node_compiler.compile_material(material, self.warnings)
+            if compiled is not None:
+                program = self.programs.get(compiled.source)
+                if program is None:
+                    program = self.native.add_material_program(key, compiled.source)
+                    self.programs[compiled.source] = program
+                params.update(program=program, program_displaces=compiled.displaces,
+                              program_shades=compiled.shades, displacement_bound=compiled.displacement_bound)
+            self.native.add_material(name=key, **params)
             self.index[key] = self.native.material_count - 1
         return self.index[key]

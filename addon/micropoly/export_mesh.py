@@ -121,5 +121,14 @@ def export_object(native_scene, materials, cache, obj, matrix, warnings):
         object_to_world=matrix, face_materials=face_materials,
         crease_vertices=arrays.get("crease_vertices", empty_i), crease_sharpness=arrays.get("crease_sharpness", empty_f),
         corner_vertices=arrays.get("corner_vertices", empty_i), corner_sharpness=arrays.get("corner_sharpness", empty_f),
-        boundary=boundary, double_sided=double_sided)
+        boundary=boundary, double_sided=double_sided, **_texture_space(obj.original.data))
     return True
+
+
+def _texture_space(mesh):
+    """Generated coordinates' texture space, as Blender keeps it on the mesh
+    (the attribute names differ between Blender versions)."""
+    for loc, size in (("texspace_location", "texspace_size"), ("texture_space_location", "texture_space_size")):
+        if hasattr(mesh, loc):
+            return dict(texspace_location=list(getattr(mesh, loc)), texspace_size=list(getattr(mesh, size)))
+    return {}

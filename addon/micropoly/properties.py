@@ -33,11 +33,22 @@ class MicropolySceneSettings(bpy.types.PropertyGroup):
                                 default=1.5, min=0.5, max=8.0, subtype="PIXEL")
 
 
+class MicropolyMaterialSettings(bpy.types.PropertyGroup):
+    displacement_bound: FloatProperty(
+        name="Displacement Bound", description="How far, in object units, displacement can move the surface "
+        "(as RenderMan's displacementbound); 0 derives it from the node tree", default=0.0, min=0.0,
+        soft_max=10.0, subtype="DISTANCE")
+
+
 def register():
     bpy.utils.register_class(MicropolySceneSettings)
+    bpy.utils.register_class(MicropolyMaterialSettings)
     bpy.types.Scene.micropoly = PointerProperty(type=MicropolySceneSettings)
+    bpy.types.Material.micropoly = PointerProperty(type=MicropolyMaterialSettings)
 
 
 def unregister():
+    del bpy.types.Material.micropoly
     del bpy.types.Scene.micropoly
+    bpy.utils.unregister_class(MicropolyMaterialSettings)
     bpy.utils.unregister_class(MicropolySceneSettings)

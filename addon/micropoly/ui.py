@@ -79,7 +79,28 @@ class MICROPOLY_PT_film(MicropolyPanel, bpy.types.Panel):
         layout.prop(context.scene.render, "film_transparent")
 
 
-CLASSES = (MICROPOLY_PT_sampling, MICROPOLY_PT_dicing, MICROPOLY_PT_bound_split, MICROPOLY_PT_film)
+class MICROPOLY_PT_material_displacement(MicropolyPanel, bpy.types.Panel):
+    """Material > Micropoly: the displacement bound; the method is Cycles' own setting."""
+    bl_label = "Micropoly Displacement"
+    bl_context = "material"
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES and context.material is not None
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        mat = context.material
+        if hasattr(mat, "displacement_method"):
+            layout.prop(mat, "displacement_method", text="Displacement")
+        elif hasattr(mat, "cycles"):
+            layout.prop(mat.cycles, "displacement_method", text="Displacement")
+        layout.prop(mat.micropoly, "displacement_bound")
+
+
+CLASSES = (MICROPOLY_PT_sampling, MICROPOLY_PT_dicing, MICROPOLY_PT_bound_split, MICROPOLY_PT_film,
+           MICROPOLY_PT_material_displacement)
 
 
 def _standard_panels():

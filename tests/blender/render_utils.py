@@ -5,6 +5,7 @@ same in Blender 3.4 and 4.x)."""
 import math
 import os
 import tempfile
+from collections import deque
 
 import bpy
 import numpy as np
@@ -172,3 +173,38 @@ def psnr(a, b, peak=None):
     mse = float(np.mean((a - b) ** 2))
     peak = float(max(a.max(), b.max())) if peak is None else peak
     return math.inf if mse == 0 else 10.0 * math.log10(peak * peak / mse)
+
+
+def pinholes(rgba, depth):
+    """Pixels of crack regions: connected not-fully-covered regions that stay
+    2 pixels off the frame's edge, hold fewer than 12 uncovered pixels and are
+    not seen past a silhouette (covered pixels around them within 10% in
+    depth). Same rule as tests/native/test_watertight.cpp."""
+    alpha = rgba[..., 3]
+    h, w = alpha.shape
+    full = alpha >= 1.0 - 1e-3
+    seen = np.zeros_like(full)
+    count = 0
+    for y0, x0 in zip(*np.nonzero(~full)):
+        if seen[y0, x0]:
+            continue
+        seen[y0, x0] = True
+        q = deque([(y0, x0)])
+        size = uncovered = 0
+        edge = False
+        dmin, dmax = math.inf, 0.0
+        while q:
+            y, x = q.popleft()
+            size += 1
+            edge |= x < 2 or y < 2 or x >= w - 2 or y >= h - 2
+            uncovered += alpha[y, x] < 1e-3
+            for yy in range(max(y - 1, 0), min(y + 2, h)):
+                for xx in range(max(x - 1, 0), min(x + 2, w)):
+                    if full[yy, xx]:
+                        dmin, dmax = min(dmin, depth[yy, xx]), max(dmax, depth[yy, xx])
+                    elif not seen[yy, xx]:
+                        seen[yy, xx] = True
+                        q.append((yy, xx))
+        if not (edge or uncovered >= 12 or dmax > 1.1 * dmin):
+            count += size
+    return count, int(full.sum())

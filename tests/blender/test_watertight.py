@@ -7,7 +7,6 @@ import math
 import os
 import random
 import sys
-from collections import deque
 
 import bpy
 import numpy as np
@@ -81,41 +80,6 @@ def view(rng, radius):
     return d * distance, target, lens
 
 
-def pinholes(rgba, depth):
-    """Pixels of crack regions: connected not-fully-covered regions that stay
-    2 pixels off the frame's edge, hold fewer than 12 uncovered pixels and are
-    not seen past a silhouette (covered pixels around them within 10% in
-    depth). Same rule as tests/native/test_watertight.cpp."""
-    alpha = rgba[..., 3]
-    h, w = alpha.shape
-    full = alpha >= 1.0 - 1e-3
-    seen = np.zeros_like(full)
-    count = 0
-    for y0, x0 in zip(*np.nonzero(~full)):
-        if seen[y0, x0]:
-            continue
-        seen[y0, x0] = True
-        q = deque([(y0, x0)])
-        size = uncovered = 0
-        edge = False
-        dmin, dmax = math.inf, 0.0
-        while q:
-            y, x = q.popleft()
-            size += 1
-            edge |= x < 2 or y < 2 or x >= w - 2 or y >= h - 2
-            uncovered += alpha[y, x] < 1e-3
-            for yy in range(max(y - 1, 0), min(y + 2, h)):
-                for xx in range(max(x - 1, 0), min(x + 2, w)):
-                    if full[yy, xx]:
-                        dmin, dmax = min(dmin, depth[yy, xx]), max(dmax, depth[yy, xx])
-                    elif not seen[yy, xx]:
-                        seen[yy, xx] = True
-                        q.append((yy, xx))
-        if not (edge or uncovered >= 12 or dmax > 1.1 * dmin):
-            count += size
-    return count, int(full.sum())
-
-
 def main():
     scene = ru.reset_scene()
     rng = random.Random(SEED)
@@ -130,7 +94,7 @@ def main():
             cam = ru.add_camera(scene, location, target, lens=lens)
             cam.data.clip_start = 0.001
             out = ru.render_passes(scene, "MICROPOLY", 120, 90, samples=16)
-            holes, covered = pinholes(out["rgba"], out["depth"])
+            holes, covered = ru.pinholes(out["rgba"], out["depth"])
             interior_views += covered > 200
             if holes:
                 failures.append(f"{name}, view {k} of seed {SEED}: {holes} pixels inside the silhouette below alpha 1")

@@ -31,6 +31,10 @@ struct Mesh {
   std::vector<int> face_materials;
   glm::mat4 object_to_world{1.0f};
   bool double_sided = true;
+  // Texture space for Generated coordinates: (P - location) / (2 size) + 1/2.
+  // A zero size means the bounding box of `points`.
+  glm::vec3 texspace_location{0.0f};
+  glm::vec3 texspace_size{0.0f};
 };
 
 // Bicubic patches already converted to Bezier form: 16 control points per
@@ -60,6 +64,23 @@ struct Material {
   float metallic = 0.0f;   // Principled only
   float specular = 0.5f;   // Principled only
   glm::vec3 emission{0.0f};
+  // A node tree compiled to a material program (Scene::material_programs),
+  // or -1. The program may displace the surface (displacement_bound is then
+  // how far, in object-space units, it can move it) and/or compute the
+  // Principled inputs above per shading point.
+  int program = -1;
+  bool program_displaces = false;
+  bool program_shades = false;
+  float displacement_bound = 0.0f;
+};
+
+// A material node tree translated to OpenCL C: `source` defines
+// mp_node_displacement and mp_node_surface (the contract is in
+// kernels/materials/material_program.cl and mp_node_lib.h). Materials with
+// identical trees share one program, built once.
+struct MaterialProgram {
+  std::string name;    // for messages: the material it came from
+  std::string source;
 };
 
 // Light sources in world space. For point and spot lights color * intensity
@@ -127,6 +148,7 @@ struct Scene {
   Camera camera;
   RenderSettings settings;
   std::vector<Material> materials;             // index 0 is the default
+  std::vector<MaterialProgram> material_programs;
   std::vector<Light> lights;
   std::vector<Mesh> meshes;
   std::vector<BezierPatches> bezier_patches;

@@ -63,17 +63,33 @@ std::string build_log(const cl::Program& program, const cl::Device& device) {
 
 }  // namespace
 
-std::string assemble_program_source() {
+std::map<std::string, std::string> embedded_files() {
   std::map<std::string, std::string> files;
   for (int i = 0; i < kEmbeddedKernelFileCount; ++i) files[kEmbeddedKernelFiles[i].name] = kEmbeddedKernelFiles[i].source;
+  return files;
+}
+
+std::string assemble_program_source() {
+  const std::map<std::string, std::string> files = embedded_files();
   std::string source;
   for (const auto& [name, text] : files) {
-    if (name.size() > 3 && name.compare(name.size() - 3, 3, ".cl") == 0) {
+    // Top-level kernels only: folders hold headers and material programs.
+    if (name.find('/') == std::string::npos && name.size() > 3 && name.compare(name.size() - 3, 3, ".cl") == 0) {
       source += "/* ---- " + name + " ---- */\n";
       source += expand_includes(text, files, 0);
     }
   }
   return source;
+}
+
+std::string assemble_material_program_source(const std::string& generated) {
+  std::map<std::string, std::string> files = embedded_files();
+  const std::string marker = "/* @MATERIAL_PROGRAM_SOURCE@ */";
+  std::string text = files.at("materials/material_program.cl");
+  const size_t at = text.find(marker);
+  if (at == std::string::npos) throw Error("kernel sources: material program marker missing");
+  text.replace(at, marker.size(), generated);
+  return expand_includes(text, files, 0);
 }
 
 BuiltProgram build_program_cached(const cl::Context& context, const cl::Device& device, const std::string& source,

@@ -14,6 +14,10 @@ namespace mp {
 // lines replaced by the embedded headers.
 std::string assemble_program_source();
 
+// One material program (kernels/materials/material_program.cl) with the
+// add-on's generated node functions in place of its marker.
+std::string assemble_material_program_source(const std::string& generated);
+
 struct BuiltProgram {
   cl::Program program;
   bool from_cache = false;

@@ -9,6 +9,7 @@
 #include "micropoly/error.h"
 #include "pipeline/bound_split.h"
 #include "pipeline/frame_params.h"
+#include "pipeline/material_programs.h"
 #include "pipeline/micropolygon_stages.h"
 #include "pipeline/scene_buffers.h"
 
@@ -30,12 +31,13 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 // and the buffers whose size does not depend on the scene.
 struct Renderer::Impl {
   explicit Impl(const std::string& selector)
-      : session(selector), dice(session), shade(session), sample(session), resolve(session) {}
+      : session(selector), dice(session), shade(session), sample(session), resolve(session), programs(session) {}
   DeviceSession session;
   DiceStage dice;
   ShadeStage shade;
   SampleStage sample;
   ResolveStage resolve;
+  MaterialPrograms programs;
   std::unique_ptr<GridBuffers> grids;
   BoundedWorkspace bounded;
   bool first_render = true;
@@ -72,6 +74,7 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
   try {
     StageTimer timer;
     auto t_upload = std::chrono::steady_clock::now();
+    impl_->programs.prepare(scene, st);
     HostSceneData host = prepare_scene_data(scene);
     SceneBuffers buffers = upload_scene_data(s.context(), s.queue(), host);
     st.timings_ms.upload = ms_since(t_upload);
@@ -109,7 +112,9 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     DiceSink sink = [&](const cl::Buffer& diceable, cl_uint count) {
       if (cancelled) return;
       dice.run(diceable, count, buffers, f, grids, timer);
+      impl_->programs.displace(diceable, count, buffers, f, grids, timer);
       shade.run(diceable, count, buffers, f, grids, timer);
+      impl_->programs.shade(diceable, count, buffers, f, grids, timer);
       const cl_uint chunk = progress ? kSampleChunk : count;
       for (cl_uint first = 0; first < count && !cancelled; first += chunk) {
         sample.run(diceable, first, std::min(chunk, count - first), buffers, f, grids, timer);

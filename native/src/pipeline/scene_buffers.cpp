@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mp_patch.h"
+
 namespace mp {
 namespace {
 
@@ -24,7 +26,49 @@ DeviceMaterial to_device(const Material& m) {
   put(d.emission, m.emission, 0.0f);
   d.principled[0] = std::clamp(m.metallic, 0.0f, 1.0f);
   d.principled[1] = std::max(m.specular, 0.0f);
+  d.program[0] = static_cast<float>(m.program);
+  d.program[1] = m.program >= 0 && m.program_displaces ? 1.0f : 0.0f;
+  d.program[2] = m.program >= 0 && m.program_shades ? 1.0f : 0.0f;
   return d;
+}
+
+// Camera <-> object transforms and texture space of one surface.
+DeviceObject to_device_object(const glm::mat4& to_camera, glm::vec3 texspace_location, glm::vec3 texspace_size,
+                              const std::vector<glm::vec3>& points) {
+  if (texspace_size == glm::vec3(0.0f) && !points.empty()) {
+    glm::vec3 lo(3e38f), hi(-3e38f);
+    for (const glm::vec3& p : points) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    texspace_location = 0.5f * (lo + hi);
+    texspace_size = 0.5f * (hi - lo);
+  }
+  DeviceObject o{};
+  const glm::mat4 to_object = glm::inverse(to_camera);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) {
+      o.to_object[4 * r + c] = to_object[c][r];  // glm is column-major
+      o.to_camera[4 * r + c] = to_camera[c][r];
+    }
+  put(o.texspace_location, texspace_location, 0.0f);
+  put(o.texspace_size, texspace_size, 0.0f);
+  return o;
+}
+
+// Longest a unit object-space vector can become in camera space.
+float max_scale(const glm::mat4& m) {
+  return std::max({glm::length(glm::vec3(m[0])), glm::length(glm::vec3(m[1])), glm::length(glm::vec3(m[2]))});
+}
+
+// Tags patches [first, size) with their object and, for displaced
+// materials, the displacement bound in camera space (mp_patch.h).
+void finish_object_patches(PatchBuffer& patches, size_t first, uint32_t object, const Scene& scene, float scale) {
+  for (size_t p = first; p < patches.size(); ++p) {
+    patches.info[p].z |= object << 8;
+    const unsigned mi = patches.info[p].y;
+    if (mi < scene.materials.size()) {
+      const Material& m = scene.materials[mi];
+      if (m.program >= 0 && m.program_displaces) patches.points[p * MP_PATCH_POINTS].w = m.displacement_bound * scale;
+    }
+  }
 }
 
 DeviceLight to_device(const Light& l, const glm::mat4& world_to_camera) {
@@ -80,11 +124,16 @@ HostSceneData prepare_scene_data(const Scene& scene) {
     else
       append_polygon_patches(mesh, to_camera, out.patches);
     share_patch_edges(out.patches, first);
+    finish_object_patches(out.patches, first, uint32_t(out.objects.size()), scene, max_scale(to_camera));
+    out.objects.push_back(to_device_object(to_camera, mesh.texspace_location, mesh.texspace_size, mesh.points));
   }
   for (const BezierPatches& set : scene.bezier_patches) {
     const size_t first = out.patches.size();
-    append_bezier_patches(set, w2c * set.object_to_world, out.patches);
+    glm::mat4 to_camera = w2c * set.object_to_world;
+    append_bezier_patches(set, to_camera, out.patches);
     share_patch_edges(out.patches, first);
+    finish_object_patches(out.patches, first, uint32_t(out.objects.size()), scene, max_scale(to_camera));
+    out.objects.push_back(to_device_object(to_camera, glm::vec3(0.0f), glm::vec3(0.0f), set.control_points));
   }
   if (scene.materials.empty()) out.materials.push_back(to_device(Material{}));
   for (const Material& m : scene.materials) out.materials.push_back(to_device(m));
@@ -99,6 +148,7 @@ SceneBuffers upload_scene_data(cl::Context& context, cl::CommandQueue& queue, co
   b.patch_edges = upload(context, queue, data.patches.edges);
   b.edge_curves = upload(context, queue, data.patches.curves);
   b.materials = upload(context, queue, data.materials);
+  b.objects = upload(context, queue, data.objects);
   b.lights = upload(context, queue, data.lights);
   b.patch_count = static_cast<cl_uint>(data.patches.size());
   b.light_count = static_cast<cl_uint>(data.lights.size());

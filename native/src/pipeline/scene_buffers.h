@@ -16,6 +16,7 @@ struct HostSceneData {
   PatchBuffer patches;
   std::vector<DeviceMaterial> materials;
   std::vector<DeviceLight> lights;
+  std::vector<DeviceObject> objects;  // one per surface, in patch order (MP_PATCH_OBJECT)
 };
 HostSceneData prepare_scene_data(const Scene& scene);
 
@@ -23,8 +24,9 @@ struct SceneBuffers {
   cl::Buffer points;      // float4 x MP_PATCH_POINTS per patch
   cl::Buffer patch_info;  // uint4 per patch
   cl::Buffer patch_edges;  // MP_EDGE_REFS uints per patch (kernels/mp_patch.h)
-  cl::Buffer edge_curves;  // 4 float4 per shared edge curve
+  cl::Buffer edge_curves;  // MP_CURVE_FLOAT4S float4 per shared edge curve
   cl::Buffer materials;
+  cl::Buffer objects;
   cl::Buffer lights;
   cl_uint patch_count = 0;
   cl_uint light_count = 0;

@@ -156,8 +156,13 @@ PYBIND11_MODULE(_native, m) {
           "add_material",
           [](Scene& s, const std::string& name, const std::string& model, std::vector<float> color,
              std::vector<float> opacity, float ka, float kd, float ks, float roughness, std::vector<float> specular_color,
-             std::vector<float> emission, float metallic, float specular) {
+             std::vector<float> emission, float metallic, float specular, int program, bool program_displaces,
+             bool program_shades, float displacement_bound) {
             Material mat;
+            mat.program = program;
+            mat.program_displaces = program_displaces;
+            mat.program_shades = program_shades;
+            mat.displacement_bound = displacement_bound;
             mat.name = name;
             if (model == "constant") mat.model = Material::Model::Constant;
             else if (model == "matte") mat.model = Material::Model::Matte;
@@ -178,7 +183,17 @@ PYBIND11_MODULE(_native, m) {
           py::arg("opacity") = std::vector<float>{1, 1, 1}, py::arg("ka") = 1.0f, py::arg("kd") = 0.5f,
           py::arg("ks") = 0.5f, py::arg("roughness") = 0.1f, py::arg("specular_color") = std::vector<float>{1, 1, 1},
           py::arg("emission") = std::vector<float>{0, 0, 0}, py::arg("metallic") = 0.0f, py::arg("specular") = 0.5f,
+          py::arg("program") = -1, py::arg("program_displaces") = false, py::arg("program_shades") = false,
+          py::arg("displacement_bound") = 0.0f,
           "Adds a material (constant, matte, plastic or principled; see scene.h); returns its index.")
+      .def(
+          "add_material_program",
+          [](Scene& s, const std::string& name, const std::string& source) {
+            s.material_programs.push_back(MaterialProgram{name, source});
+            return s.material_programs.size() - 1;
+          },
+          py::arg("name"), py::arg("source"),
+          "Adds a node tree translated to OpenCL C (kernels/materials/material_program.cl); returns its index.")
       .def(
           "add_light",
           [](Scene& s, const std::string& type, std::vector<float> color, float intensity, std::vector<float> position,
@@ -214,8 +229,11 @@ PYBIND11_MODULE(_native, m) {
              const Array<int>& face_vertex_indices, bool subdivision, const Array<float>& object_to_world, int material,
              const Array<int>& face_materials, const Array<int>& crease_vertices, const Array<float>& crease_sharpness,
              const Array<int>& corner_vertices, const Array<float>& corner_sharpness, const Array<int>& hole_faces,
-             const std::string& boundary, bool double_sided) {
+             const std::string& boundary, bool double_sided, std::vector<float> texspace_location,
+             std::vector<float> texspace_size) {
             Mesh mesh;
+            mesh.texspace_location = to_vec3(texspace_location, "texspace_location");
+            mesh.texspace_size = to_vec3(texspace_size, "texspace_size");
             mesh.name = name;
             mesh.scheme = subdivision ? SubdivScheme::CatmullClark : SubdivScheme::None;
             mesh.points = to_points(points, "points");
@@ -241,7 +259,9 @@ PYBIND11_MODULE(_native, m) {
           py::arg("material") = 0, py::arg("face_materials") = Array<int>(), py::arg("crease_vertices") = Array<int>(),
           py::arg("crease_sharpness") = Array<float>(), py::arg("corner_vertices") = Array<int>(),
           py::arg("corner_sharpness") = Array<float>(), py::arg("hole_faces") = Array<int>(),
-          py::arg("boundary") = "edge_and_corner", py::arg("double_sided") = true)
+          py::arg("boundary") = "edge_and_corner", py::arg("double_sided") = true,
+          py::arg("texspace_location") = std::vector<float>{0, 0, 0},
+          py::arg("texspace_size") = std::vector<float>{0, 0, 0})
       .def("validate", [](const Scene& s) { validate_scene(s); })
       .def_property_readonly("mesh_count", [](const Scene& s) { return s.meshes.size(); })
       .def_property_readonly("patch_set_count", [](const Scene& s) { return s.bezier_patches.size(); })

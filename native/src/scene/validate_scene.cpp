@@ -102,6 +102,12 @@ void validate_scene(const Scene& scene) {
     if (!finite(m.color) || !finite(m.opacity) || !finite(m.specular_color) || !finite(m.emission) ||
         !std::isfinite(m.ka + m.kd + m.ks + m.roughness + m.metallic + m.specular))
       fail("material", m.name.empty() ? std::to_string(i) : m.name, "has NaN or infinite values");
+    if (m.program < -1 || m.program >= static_cast<int>(scene.material_programs.size()))
+      fail("material", m.name.empty() ? std::to_string(i) : m.name,
+           "refers to material program " + std::to_string(m.program) + " of " +
+               std::to_string(scene.material_programs.size()));
+    if (!std::isfinite(m.displacement_bound) || m.displacement_bound < 0)
+      fail("material", m.name.empty() ? std::to_string(i) : m.name, "needs a finite, non-negative displacement bound");
   }
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     const Light& l = scene.lights[i];

@@ -9,14 +9,20 @@
 // edges with the same end points and nearly the same inner points get one
 // curve, and an edge whose other side is two half-length edges (adaptive
 // refinement's transitions between levels; a quad next to a split n-gon)
-// refers to the two half curves.
+// refers to the two half curves. Each curve also carries a cubic through the
+// surface normal along it (sampled from the patch that first had the edge),
+// so displacement moves shared edge vertices identically from both sides.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
 
+#include "mp_compat.h"
 #include "mp_patch.h"
+#include "mp_types.h"
+#include "mp_patch_eval.h"
+#include "mp_surface.h"
 #include "subdiv/patch_buffer.h"
 
 namespace mp {
@@ -77,6 +83,8 @@ struct Curve {
   glm::vec3 p[4];       // in its own direction; p[0], p[3] are welded corners
   uint32_t start, end;  // corner representatives
   int users = 0;
+  size_t owner = 0;     // the patch whose edge `owner_edge` created it, in its direction
+  int owner_edge = 0;
 };
 
 uint64_t pair_key(uint32_t a, uint32_t b) { return (uint64_t(std::min(a, b)) << 32) | std::max(a, b); }
@@ -148,7 +156,8 @@ void share_patch_edges(PatchBuffer& buffer, size_t first) {
   std::unordered_map<uint64_t, std::vector<uint32_t>> by_corners;
   std::vector<uint32_t> refs(count * 4);
   auto inner_tol = [&](const glm::vec3* q) { return std::max(tol, 1e-3f * glm::length(q[3] - q[0])); };
-  auto find_or_add = [&](uint32_t s, uint32_t e, const glm::vec3* q, bool add) -> uint32_t {
+  auto find_or_add = [&](uint32_t s, uint32_t e, const glm::vec3* q, bool add, size_t owner = 0,
+                         int owner_edge = 0) -> uint32_t {
     const float t = inner_tol(q);
     auto& list = by_corners[pair_key(s, e)];
     for (uint32_t id : list) {
@@ -159,6 +168,7 @@ void share_patch_edges(PatchBuffer& buffer, size_t first) {
     Curve c;
     for (int k = 0; k < 4; ++k) c.p[k] = q[k];
     c.start = s, c.end = e;
+    c.owner = owner, c.owner_edge = owner_edge;
     curves.push_back(c);
     list.push_back(uint32_t(curves.size() - 1));
     return uint32_t(curves.size() - 1) << 1;
@@ -167,7 +177,7 @@ void share_patch_edges(PatchBuffer& buffer, size_t first) {
     for (int e = 0; e < 4; ++e) {
       glm::vec3 q[4];
       for (int k = 0; k < 4; ++k) q[k] = glm::vec3(point(p, kEdgePoints[e][k]));
-      uint32_t ref = find_or_add(rep_of(p, kEdgePoints[e][0]), rep_of(p, kEdgePoints[e][3]), q, true);
+      uint32_t ref = find_or_add(rep_of(p, kEdgePoints[e][0]), rep_of(p, kEdgePoints[e][3]), q, true, p, e);
       ++curves[ref >> 1].users;
       refs[(p - first) * 4 + size_t(e)] = ref;
     }
@@ -204,10 +214,34 @@ void share_patch_edges(PatchBuffer& buffer, size_t first) {
       buffer.edges[p * MP_EDGE_REFS + 2 * size_t(e) + 1] = half_refs[1];
     }
 
-  buffer.curves.reserve(buffer.curves.size() + curves.size() * 4);
-  const uint32_t base = uint32_t(buffer.curves.size() / 4);
-  for (const Curve& c : curves)
-    for (int k = 0; k < 4; ++k) buffer.curves.emplace_back(c.p[k], 1.0f);
+  // 4. Normal cubics: end points from one normal per welded corner (the
+  // first patch's), inner control points so the cubic passes through the
+  // owner's normal at t = 1/3 and 2/3.
+  const glm::vec4* pts = buffer.points.data();
+  const uint* info = reinterpret_cast<const uint*>(buffer.info.data());
+  auto normal_at = [&](size_t p, int e, float t) {
+    const float u = e == 0 || e == 2 ? t : e == 1 ? 1.0f : 0.0f;
+    const float v = e == 1 || e == 3 ? t : e == 2 ? 1.0f : 0.0f;
+    const glm::vec4* cp = pts + p * MP_PATCH_POINTS;
+    float3 P, du, dv;
+    mp_eval_patch(cp, info[4 * p], u, v, &P, &du, &dv);
+    return glm::vec3(mp_patch_normal(cp, info[4 * p], u, v, du, dv));
+  };
+  std::unordered_map<uint32_t, glm::vec3> corner_normal;
+  for (size_t p = first; p < buffer.size(); ++p)
+    for (int e = 0; e < 4; ++e) corner_normal.emplace(rep_of(p, kEdgePoints[e][0]), normal_at(p, e, 0.0f));
+  buffer.curves.reserve(buffer.curves.size() + curves.size() * MP_CURVE_FLOAT4S);
+  const uint32_t base = uint32_t(buffer.curves.size() / MP_CURVE_FLOAT4S);
+  for (const Curve& c : curves) {
+    for (int k = 0; k < 4; ++k) buffer.curves.emplace_back(c.p[k], 0.0f);
+    glm::vec3 b0 = corner_normal[c.start], b3 = corner_normal[c.end];
+    if (glm::dot(b0, normal_at(c.owner, c.owner_edge, 0.0f)) < 0.0f) b0 = -b0;
+    if (glm::dot(b3, normal_at(c.owner, c.owner_edge, 1.0f)) < 0.0f) b3 = -b3;
+    const glm::vec3 r1 = 27.0f * normal_at(c.owner, c.owner_edge, 1.0f / 3.0f) - 8.0f * b0 - b3;
+    const glm::vec3 r2 = 27.0f * normal_at(c.owner, c.owner_edge, 2.0f / 3.0f) - b0 - 8.0f * b3;
+    const glm::vec3 n[4] = {b0, (2.0f * r1 - r2) / 18.0f, (2.0f * r2 - r1) / 18.0f, b3};
+    for (int k = 0; k < 4; ++k) buffer.curves.emplace_back(n[k], 0.0f);
+  }
   for (size_t p = first; p < buffer.size(); ++p)
     for (int r = 0; r < MP_EDGE_REFS; ++r) {
       uint32_t& ref = buffer.edges[p * MP_EDGE_REFS + size_t(r)];

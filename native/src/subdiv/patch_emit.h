@@ -39,7 +39,7 @@ inline void append_device_patch(const DevicePatch& patch, unsigned type, int mat
                                 const PatchInfoCommon& common, PatchBuffer& out) {
   for (const glm::dvec3& p : patch) {
     glm::dvec4 q = common.to_space * glm::dvec4(p, 1.0);
-    out.points.emplace_back(float(q.x), float(q.y), float(q.z), 1.0f);
+    out.points.emplace_back(float(q.x), float(q.y), float(q.z), 0.0f);  // w: displacement bound (mp_patch.h)
   }
   out.info.emplace_back(type, unsigned(material), common.flags, unsigned(prim_id));
 }

@@ -1,0 +1,500 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Material node trees -> OpenCL C material programs.
+
+A material's Surface shader inputs (Principled BSDF, Diffuse BSDF, Emission)
+and its Displacement output are translated into two device functions,
+mp_node_surface and mp_node_displacement (the contract is in
+kernels/materials/material_program.cl; the node functions they call are in
+kernels/materials/mp_node_lib.h and kernels/textures/). Every output socket
+that is used becomes one local variable, computed once. An unsupported node
+gives one warning naming the material and the node, and its outputs take
+their default values, so a render never fails on a node it cannot run."""
+
+import math
+
+import bpy
+
+FLOAT, VEC = "float", "float3"
+
+MATH_OPS = ["ADD", "SUBTRACT", "MULTIPLY", "DIVIDE", "MULTIPLY_ADD", "POWER", "LOGARITHM", "SQRT", "INVERSE_SQRT",
+            "ABSOLUTE", "EXPONENT", "MINIMUM", "MAXIMUM", "LESS_THAN", "GREATER_THAN", "SIGN", "COMPARE",
+            "SMOOTH_MIN", "SMOOTH_MAX", "ROUND", "FLOOR", "CEIL", "TRUNC", "FRACT", "MODULO", "FLOORED_MODULO",
+            "WRAP", "SNAP", "PINGPONG", "SINE", "COSINE", "TANGENT", "ARCSINE", "ARCCOSINE", "ARCTANGENT",
+            "ARCTAN2", "SINH", "COSH", "TANH", "RADIANS", "DEGREES"]
+VMATH_OPS = ["ADD", "SUBTRACT", "MULTIPLY", "DIVIDE", "MULTIPLY_ADD", "CROSS_PRODUCT", "PROJECT", "REFLECT",
+             "DOT_PRODUCT", "DISTANCE", "LENGTH", "SCALE", "NORMALIZE", "ABSOLUTE", "MINIMUM", "MAXIMUM", "FLOOR",
+             "CEIL", "FRACTION", "MODULO", "WRAP", "SNAP", "SINE", "COSINE", "TANGENT", "FACEFORWARD"]
+VMATH_VALUE_OPS = {"DOT_PRODUCT", "DISTANCE", "LENGTH"}
+BLEND_MODES = ["MIX", "ADD", "MULTIPLY", "SUBTRACT", "SCREEN", "DIVIDE", "DIFFERENCE", "DARKEN", "LIGHTEN",
+               "OVERLAY", "DODGE", "BURN", "SOFT_LIGHT", "LINEAR_LIGHT", "EXCLUSION"]
+RANGE_MODES = ["LINEAR", "STEPPED", "SMOOTHSTEP", "SMOOTHERSTEP"]
+MAPPING_TYPES = ["POINT", "TEXTURE", "VECTOR", "NORMAL"]
+FRACTAL_TYPES = ["FBM", "MULTIFRACTAL", "RIDGED_MULTIFRACTAL", "HYBRID_MULTIFRACTAL", "HETERO_TERRAIN"]
+VORONOI_FEATURES = ["F1", "F2", "SMOOTH_F1", "DISTANCE_TO_EDGE", "N_SPHERE_RADIUS"]
+VORONOI_METRICS = ["EUCLIDEAN", "MANHATTAN", "CHEBYCHEV", "MINKOWSKI"]
+TEXTURE_HEADERS = {"TEX_NOISE": "mp_tex_noise.h", "TEX_MUSGRAVE": "mp_tex_noise.h",
+                   "TEX_VORONOI": "mp_tex_voronoi.h", "TEX_WAVE": "mp_tex_wave.h"}
+# A texture's Fac stays close to [0, 1]; displacement bounds derived from it
+# take this margin on both sides.
+FAC_RANGE = (-0.25, 1.25)
+
+
+def blender_version():
+    major, minor = bpy.app.version[:2]
+    return major * 100 + minor
+
+
+def _lit(x):
+    x = float(x)
+    if x != x or x in (float("inf"), float("-inf")):
+        x = 0.0
+    return repr(x) + "f"
+
+
+def _vec_lit(v):
+    v = list(v)[:3] + [0.0] * max(0, 3 - len(v))
+    return f"(float3)({_lit(v[0])}, {_lit(v[1])}, {_lit(v[2])})"
+
+
+def _socket_kind(socket):
+    return FLOAT if socket.type in ("VALUE", "INT", "BOOLEAN") else VEC
+
+
+def _dims(s):
+    return int(s[0]) if s and s[0] in "1234" else 3
+
+
+class CompiledMaterial:
+    def __init__(self, source, displaces, shades, displacement_bound):
+        self.source = source
+        self.displaces = displaces
+        self.shades = shades
+        self.displacement_bound = displacement_bound
+
+
+class _Function:
+    """One generated function body: statements and memoised socket values."""
+
+    def __init__(self):
+        self.lines = []
+        self.values = {}  # (node name, output identifier) -> (expr, kind, range or None)
+        self.counter = 0
+
+    def temp(self, kind, expr, value_range=None):
+        name = f"v{self.counter}"
+        self.counter += 1
+        self.lines.append(f"  {kind} {name} = {expr};")
+        return name, kind, value_range
+
+
+class NodeCompiler:
+    def __init__(self, material, warnings, user_bound=0.0):
+        self.material = material
+        self.warnings = warnings
+        self.user_bound = user_bound
+        self.version = blender_version()
+        self.headers = set()
+        self.warned = set()
+        self.fn = None
+
+    # ---- helpers ----------------------------------------------------------
+    def warn(self, node, what):
+        key = (node.name, what)
+        if key not in self.warned:
+            self.warned.add(key)
+            self.warnings.append(f"material '{self.material.name}': node '{node.name}' ({node.bl_label}): {what}")
+
+    @staticmethod
+    def convert(value, kind):
+        expr, have, rng = value
+        if have == kind:
+            return value
+        if kind == VEC:
+            return f"(float3)({expr})", VEC, None
+        # Blender turns colors into floats by luminance; vectors average, but
+        # both reach here as float3 and color is the common case in materials.
+        return f"mp_rgb_to_bw({expr})", FLOAT, None
+
+    def input(self, node, key, kind=None):
+        socket = node.inputs[key] if isinstance(key, int) else (node.inputs.get(key) if hasattr(node.inputs, "get")
+                                                                 else None)
+        if socket is None:
+            raise KeyError(key)
+        kind = kind or _socket_kind(socket)
+        link = next((l for l in socket.links if getattr(l, "is_valid", True) and not getattr(l, "is_muted", False)),
+                    None)
+        if link is not None:
+            from_node, from_socket = link.from_node, link.from_socket
+            while from_node.type == "REROUTE":
+                inner = from_node.inputs[0].links
+                if not inner:
+                    from_node = None
+                    break
+                from_node, from_socket = inner[0].from_node, inner[0].from_socket
+            if from_node is not None:
+                return self.convert(self.output(from_node, from_socket), kind)
+        if not hasattr(socket, "default_value"):
+            return ("0.0f", FLOAT, (0.0, 0.0)) if kind == FLOAT else ("(float3)(0.0f)", VEC, None)
+        v = socket.default_value
+        try:
+            seq = list(v)
+        except TypeError:
+            seq = None
+        if kind == FLOAT:
+            x = float(seq[0]) if seq is not None else float(v)
+            return _lit(x), FLOAT, (x, x)
+        return _vec_lit(seq if seq is not None else [float(v)] * 3), VEC, None
+
+    def output(self, node, socket):
+        key = (node.name, socket.identifier)
+        if key not in self.fn.values:
+            if getattr(node, "mute", False):
+                self.warn(node, "is muted; its outputs take their default values")
+                outs = {}
+            else:
+                outs = self.emit(node)
+            for out in node.outputs:
+                k = (node.name, out.identifier)
+                if out.identifier in outs:
+                    self.fn.values[k] = outs[out.identifier]
+                else:
+                    dv = getattr(out, "default_value", 0.0)
+                    try:
+                        seq = list(dv)
+                        self.fn.values[k] = (_vec_lit(seq), VEC, None)
+                    except TypeError:
+                        self.fn.values[k] = (_lit(dv), FLOAT, (float(dv), float(dv)))
+        return self.fn.values.get(key, ("0.0f", FLOAT, (0.0, 0.0)))
+
+    def vector_or_generated(self, node, key="Vector"):
+        socket = node.inputs.get(key)
+        if socket is not None and socket.is_linked:
+            return self.input(node, key, VEC)[0]
+        return "g->generated"  # textures default to Generated coordinates
+
+    def by_id(self, node, identifier, kind):
+        for i, s in enumerate(node.inputs):
+            if s.identifier == identifier:
+                return self.input(node, i, kind)
+        raise KeyError(identifier)
+
+    # ---- nodes ----------------------------------------------------------------
+    def emit(self, node):
+        t = node.type
+        fn = self.fn
+        if t == "TEX_COORD":
+            if getattr(node, "object", None) is not None:
+                self.warn(node, "Object coordinates of another object are not supported; using this object's")
+            for name in ("UV", "Camera", "Window", "Reflection"):
+                if node.outputs[name].is_linked:
+                    self.warn(node, f"the {name} output is not supported yet; it gives zero")
+            return {"Generated": ("g->generated", VEC, None), "Object": ("g->P", VEC, None),
+                    "Normal": ("g->N", VEC, None)}
+        if t == "NEW_GEOMETRY":
+            self.warn(node, "only Normal is supported here, in object space")
+            return {"Normal": ("g->N", VEC, None)}
+        if t == "VALUE":
+            x = float(node.outputs[0].default_value)
+            return {node.outputs[0].identifier: (_lit(x), FLOAT, (x, x))}
+        if t == "RGB":
+            return {node.outputs[0].identifier: (_vec_lit(node.outputs[0].default_value), VEC, None)}
+        if t == "MATH":
+            return self.emit_math(node)
+        if t == "VECT_MATH":
+            op = node.operation
+            if op not in VMATH_OPS:
+                self.warn(node, f"operation {op} is not supported")
+                return {}
+            a, b, c = (self.input(node, i, VEC)[0] for i in range(3))
+            scale = self.input(node, 3, FLOAT)[0] if len(node.inputs) > 3 else "1.0f"
+            val = fn.temp(FLOAT, "0.0f")
+            vec = fn.temp(VEC, f"mp_vector_math({VMATH_OPS.index(op)}, {a}, {b}, {c}, {scale}, &{val[0]})")
+            return {"Vector": vec, "Value": val}
+        if t == "MIX_RGB":
+            return self.emit_mix(node, node.blend_type, node.use_clamp, False, self.input(node, "Fac", FLOAT),
+                                 self.input(node, "Color1", VEC), self.input(node, "Color2", VEC), "Color")
+        if t == "MIX":
+            return self.emit_mix_node(node)
+        if t == "MAP_RANGE":
+            if getattr(node, "data_type", "FLOAT") != "FLOAT":
+                self.warn(node, "vector Map Range is not supported")
+                return {}
+            mode = node.interpolation_type
+            args = [self.input(node, i, FLOAT) for i in range(6)]
+            expr = (f"mp_map_range({RANGE_MODES.index(mode)}, " + ", ".join(a[0] for a in args) +
+                    f", {1 if node.clamp else 0})")
+            lo, hi = args[3][2], args[4][2]
+            rng = None
+            if node.clamp and lo and hi and mode in ("LINEAR", "STEPPED"):
+                rng = (min(lo[0], hi[0]), max(lo[1], hi[1]))
+            return {"Result": fn.temp(FLOAT, expr, rng)}
+        if t == "CLAMP":
+            v, lo, hi = (self.input(node, i, FLOAT) for i in range(3))
+            rng = (min(lo[2][0], hi[2][0]), max(lo[2][1], hi[2][1])) if lo[2] and hi[2] else None
+            return {"Result": fn.temp(FLOAT, f"mp_clamp_node({1 if node.clamp_type == 'RANGE' else 0}, "
+                                             f"{v[0]}, {lo[0]}, {hi[0]})", rng)}
+        if t == "MAPPING":
+            v = self.input(node, "Vector", VEC)[0]
+            loc = self.input(node, "Location", VEC)[0] if "Location" in node.inputs else "(float3)(0.0f)"
+            rot = self.input(node, "Rotation", VEC)[0] if "Rotation" in node.inputs else "(float3)(0.0f)"
+            scl = self.input(node, "Scale", VEC)[0] if "Scale" in node.inputs else "(float3)(1.0f)"
+            return {"Vector": fn.temp(VEC, f"mp_mapping({MAPPING_TYPES.index(node.vector_type)}, {v}, {loc}, "
+                                           f"{rot}, {scl})")}
+        if t == "VALTORGB":
+            return self.emit_ramp(node)
+        if t in ("SEPXYZ", "SEPRGB", "SEPARATE_COLOR"):
+            if t == "SEPARATE_COLOR" and node.mode != "RGB":
+                self.warn(node, f"{node.mode} mode is not supported; RGB is used")
+            v = fn.temp(VEC, self.input(node, 0, VEC)[0])
+            outs = [o.identifier for o in node.outputs]
+            return {outs[0]: (f"{v[0]}.x", FLOAT, None), outs[1]: (f"{v[0]}.y", FLOAT, None),
+                    outs[2]: (f"{v[0]}.z", FLOAT, None)}
+        if t in ("COMBXYZ", "COMBRGB", "COMBINE_COLOR"):
+            if t == "COMBINE_COLOR" and node.mode != "RGB":
+                self.warn(node, f"{node.mode} mode is not supported; RGB is used")
+            x, y, z = (self.input(node, i, FLOAT)[0] for i in range(3))
+            return {node.outputs[0].identifier: fn.temp(VEC, f"(float3)({x}, {y}, {z})")}
+        if t == "RGBTOBW":
+            return {"Val": fn.temp(FLOAT, f"mp_rgb_to_bw({self.input(node, 0, VEC)[0]})")}
+        if t == "INVERT":
+            fac, col = self.input(node, "Fac", FLOAT)[0], self.input(node, "Color", VEC)[0]
+            return {"Color": fn.temp(VEC, f"mix({col}, (float3)(1.0f) - {col}, {fac})")}
+        if t == "DISPLACEMENT":
+            return self.emit_displacement(node)
+        if t in TEXTURE_HEADERS:
+            return self.emit_texture(node)
+        self.warn(node, "is not supported; its outputs take their default values")
+        return {}
+
+    def emit_math(self, node):
+        op = node.operation
+        if op not in MATH_OPS:
+            self.warn(node, f"operation {op} is not supported")
+            return {}
+        a, b, c = (self.input(node, i, FLOAT) for i in range(3))
+        expr = f"mp_math({MATH_OPS.index(op)}, {a[0]}, {b[0]}, {c[0]})"
+        rng = None
+        ra, rb, rc = a[2], b[2], c[2]
+        if ra and rb:
+            if op == "ADD":
+                rng = (ra[0] + rb[0], ra[1] + rb[1])
+            elif op == "SUBTRACT":
+                rng = (ra[0] - rb[1], ra[1] - rb[0])
+            elif op in ("MULTIPLY", "MULTIPLY_ADD"):
+                prods = [x * y for x in ra for y in rb]
+                rng = (min(prods), max(prods))
+                if op == "MULTIPLY_ADD":
+                    rng = (rng[0] + rc[0], rng[1] + rc[1]) if rc else None
+            elif op in ("MINIMUM", "MAXIMUM"):
+                f = min if op == "MINIMUM" else max
+                rng = (f(ra[0], rb[0]), f(ra[1], rb[1]))
+        if op in ("SINE", "COSINE"):
+            rng = (-1.0, 1.0)
+        if node.use_clamp:
+            expr = f"mp_nl_clamp01({expr})"
+            rng = (max(0.0, rng[0]), min(1.0, rng[1])) if rng else (0.0, 1.0)
+        return {node.outputs[0].identifier: self.fn.temp(FLOAT, expr, rng)}
+
+    def emit_mix(self, node, mode, clamp_result, clamp_factor, fac, a, b, out_id):
+        if mode not in BLEND_MODES:
+            self.warn(node, f"blend mode {mode} is not supported; Mix is used")
+            mode = "MIX"
+        t = f"mp_nl_clamp01({fac[0]})" if clamp_factor else fac[0]
+        expr = f"mp_blend({BLEND_MODES.index(mode)}, {t}, {a[0]}, {b[0]})"
+        if clamp_result:
+            expr = f"mp_nl_clamp01_3({expr})"
+        return {out_id: self.fn.temp(VEC, expr)}
+
+    def emit_mix_node(self, node):
+        dt = node.data_type
+        if dt == "FLOAT":
+            fac = self.by_id(node, "Factor_Float", FLOAT)
+            a, b = self.by_id(node, "A_Float", FLOAT), self.by_id(node, "B_Float", FLOAT)
+            t = f"mp_nl_clamp01({fac[0]})" if node.clamp_factor else fac[0]
+            return {"Result_Float": self.fn.temp(FLOAT, f"mix({a[0]}, {b[0]}, {t})")}
+        if dt == "VECTOR":
+            uniform = getattr(node, "factor_mode", "UNIFORM") == "UNIFORM"
+            fac = self.by_id(node, "Factor_Float" if uniform else "Factor_Vector", FLOAT if uniform else VEC)
+            a, b = self.by_id(node, "A_Vector", VEC), self.by_id(node, "B_Vector", VEC)
+            t = fac[0]
+            if node.clamp_factor:
+                t = f"mp_nl_clamp01({t})" if uniform else f"mp_nl_clamp01_3({t})"
+            return {"Result_Vector": self.fn.temp(VEC, f"{a[0]} + ({b[0]} - {a[0]}) * {t}")}
+        fac = self.by_id(node, "Factor_Float", FLOAT)
+        a, b = self.by_id(node, "A_Color", VEC), self.by_id(node, "B_Color", VEC)
+        return self.emit_mix(node, node.blend_type, node.clamp_result, node.clamp_factor, fac, a, b, "Result_Color")
+
+    def emit_ramp(self, node):
+        ramp = node.color_ramp
+        if ramp.color_mode != "RGB":
+            self.warn(node, f"{ramp.color_mode} color mode is not supported; RGB is used")
+        interp = {"LINEAR": 0, "CONSTANT": 1, "EASE": 2}.get(ramp.interpolation)
+        if interp is None:
+            self.warn(node, f"{ramp.interpolation} interpolation is not supported; Linear is used")
+            interp = 0
+        elems = sorted(ramp.elements, key=lambda e: e.position)
+        n = len(elems)
+        fac = self.input(node, "Fac", FLOAT)[0]
+        k = self.fn.counter
+        self.fn.counter += 1
+        pos = ", ".join(_lit(e.position) for e in elems)
+        cols = ", ".join("(float4)(" + ", ".join(_lit(c) for c in e.color) + ")" for e in elems)
+        self.fn.lines.append(f"  const float ramp_pos{k}[{n}] = {{{pos}}};")
+        self.fn.lines.append(f"  const float4 ramp_col{k}[{n}] = {{{cols}}};")
+        c = self.fn.temp("float4", f"mp_color_ramp({interp}, {n}, ramp_pos{k}, ramp_col{k}, {fac})")
+        return {"Color": (f"{c[0]}.xyz", VEC, None), "Alpha": (f"{c[0]}.w", FLOAT, (0.0, 1.0))}
+
+    def emit_displacement(self, node):
+        if node.inputs["Normal"].is_linked:
+            self.warn(node, "a linked Normal input is not supported; the surface normal is used")
+        if getattr(node, "space", "OBJECT") != "OBJECT":
+            self.warn(node, "World space is not supported; Object space is used")
+        h, mid, scale = (self.input(node, k, FLOAT) for k in ("Height", "Midlevel", "Scale"))
+        self.height_info = (h, mid, scale)
+        return {"Displacement": self.fn.temp(VEC, f"(({h[0]}) - ({mid[0]})) * ({scale[0]}) * g->N")}
+
+    def emit_texture(self, node):
+        t, fn, ver = node.type, self.fn, self.version
+        self.headers.add(TEXTURE_HEADERS[t])
+        inp = lambda name, default="0.0f": self.input(node, name, FLOAT)[0] if name in node.inputs else default
+        vec = self.vector_or_generated(node)
+        if t == "TEX_NOISE":
+            dims = _dims(node.noise_dimensions)
+            ntype = FRACTAL_TYPES.index(getattr(node, "noise_type", "FBM"))
+            normalize = 1 if getattr(node, "normalize", True) else 0
+            fac, col = fn.temp(FLOAT, "0.0f", FAC_RANGE), fn.temp(VEC, "(float3)(0.0f)")
+            fn.lines.append(f"  mp_tex_noise({vec}, {inp('W')}, {dims}, {ntype}, {normalize}, {inp('Scale')}, "
+                            f"{inp('Detail')}, {inp('Roughness')}, {inp('Lacunarity', '2.0f')}, "
+                            f"{inp('Offset')}, {inp('Gain', '1.0f')}, {inp('Distortion')}, {ver}, "
+                            f"&{fac[0]}, &{col[0]});")
+            return {"Fac": fac, "Color": col}
+        if t == "TEX_MUSGRAVE":
+            dims = _dims(node.musgrave_dimensions)
+            mtype = FRACTAL_TYPES.index(node.musgrave_type)
+            expr = (f"mp_tex_musgrave({vec}, {inp('W')}, {dims}, {mtype}, {inp('Scale')}, {inp('Detail')}, "
+                    f"{inp('Dimension')}, {inp('Lacunarity')}, {inp('Offset')}, {inp('Gain')}, {ver})")
+            return {"Fac": fn.temp(FLOAT, expr)}
+        if t == "TEX_WAVE":
+            wtype = 0 if node.wave_type == "BANDS" else 1
+            direction = (["X", "Y", "Z", "DIAGONAL"].index(node.bands_direction) if wtype == 0 else
+                         ["X", "Y", "Z", "SPHERICAL"].index(node.rings_direction))
+            profile = ["SIN", "SAW", "TRI"].index(node.wave_profile)
+            fac, col = fn.temp(FLOAT, "0.0f", FAC_RANGE), fn.temp(VEC, "(float3)(0.0f)")
+            fn.lines.append(f"  mp_tex_wave({vec}, {wtype}, {direction}, {profile}, {inp('Scale')}, "
+                            f"{inp('Distortion')}, {inp('Detail')}, {inp('Detail Scale')}, "
+                            f"{inp('Detail Roughness')}, {inp('Phase Offset')}, {ver}, &{fac[0]}, &{col[0]});")
+            return {"Fac": fac, "Color": col}
+        # Voronoi
+        dims = _dims(node.voronoi_dimensions)
+        feature = VORONOI_FEATURES.index(node.feature)
+        metric = VORONOI_METRICS.index(node.distance)
+        normalize = 1 if getattr(node, "normalize", False) else 0
+        # F1 lies within the point's own cell: at most the cell diagonal away.
+        near = node.feature in ("F1", "SMOOTH_F1") and node.distance == "EUCLIDEAN"
+        dist = fn.temp(FLOAT, "0.0f", (0.0, math.sqrt(dims)) if near else None)
+        col = fn.temp(VEC, "(float3)(0.0f)")
+        pos, w, rad = fn.temp(VEC, "(float3)(0.0f)"), fn.temp(FLOAT, "0.0f"), fn.temp(FLOAT, "0.0f")
+        fn.lines.append(f"  mp_tex_voronoi({vec}, {inp('W')}, {dims}, {feature}, {metric}, {inp('Scale')}, "
+                        f"{inp('Detail')}, {inp('Roughness', '0.5f')}, {inp('Lacunarity', '2.0f')}, "
+                        f"{inp('Smoothness', '1.0f')}, {inp('Exponent', '0.5f')}, {inp('Randomness', '1.0f')}, "
+                        f"{normalize}, {ver}, &{dist[0]}, &{col[0]}, &{pos[0]}, &{w[0]}, &{rad[0]});")
+        return {"Distance": dist, "Color": col, "Position": pos, "W": w, "Radius": rad}
+
+    # ---- the material -----------------------------------------------------------
+    def _function(self, header, body_fn):
+        self.fn = _Function()
+        result = body_fn()
+        text = header + " {\n" + "\n".join(self.fn.lines) + ("\n" if self.fn.lines else "") + result + "}\n"
+        return text
+
+    def compile(self):
+        tree = self.material.node_tree if self.material.use_nodes else None
+        if tree is None:
+            return None
+        outputs = [n for n in tree.nodes if n.type == "OUTPUT_MATERIAL" and n.target in ("ALL", "CYCLES")]
+        active = [n for n in outputs if n.is_active_output] or outputs
+        if not active:
+            return None
+        out = active[0]
+        method = getattr(self.material, "displacement_method", None)
+        if method is None:
+            method = getattr(getattr(self.material, "cycles", None), "displacement_method", "BUMP")
+        disp_socket = out.inputs["Displacement"]
+        displaces = disp_socket.is_linked and method in ("DISPLACEMENT", "BOTH")
+        if disp_socket.is_linked and method == "BUMP":
+            self.warnings.append(f"material '{self.material.name}': bump-only displacement is not supported yet; "
+                                 "set Settings > Displacement to Displacement Only or Displacement and Bump")
+        surface_links = out.inputs["Surface"].links
+        shader = surface_links[0].from_node if surface_links else None
+        while shader is not None and shader.type == "REROUTE":
+            links = shader.inputs[0].links
+            shader = links[0].from_node if links else None
+        assigns = []
+        if shader is not None and shader.type in ("BSDF_PRINCIPLED", "BSDF_DIFFUSE", "EMISSION"):
+            assigns = self._surface_assignments(shader)
+        shades = bool(assigns)
+        if not displaces and not shades:
+            return None
+
+        self.height_info = None
+        disp_src = self._function("float3 mp_node_displacement(const MpNodeGlobals* g)",
+                                  lambda: "  return " + self.input(out, "Displacement", VEC)[0] + ";\n"
+                                  if displaces else "  return (float3)(0.0f);\n")
+        bound = self._displacement_bound(displaces)
+        surf_src = self._function("void mp_node_surface(const MpNodeGlobals* g, MpSurfaceInputs* s)",
+                                  lambda: "".join(self._assignment(shader, *a) for a in assigns))
+        includes = "".join(f'#include "textures/{h}"\n' for h in sorted(self.headers))
+        source = includes + disp_src + surf_src
+        return CompiledMaterial(source, displaces, shades, bound)
+
+    def _assignment(self, shader, field, socket, kind, strength):
+        expr = self.input(shader, socket, kind)[0]
+        if strength is not None:
+            expr = f"{expr} * {self.input(shader, strength, FLOAT)[0] if strength in shader.inputs else '1.0f'}"
+        return f"  s->{field} = {expr};\n"
+
+    def _surface_assignments(self, shader):
+        """(field, socket, kind, strength socket) for every linked Principled input."""
+        linked = lambda name: name in shader.inputs and shader.inputs[name].is_linked
+        out = []
+        if shader.type == "EMISSION":
+            if linked("Color") or linked("Strength"):
+                out.append(("emission", "Color", VEC, "Strength"))
+            return out
+        color = "Base Color" if shader.type == "BSDF_PRINCIPLED" else "Color"
+        if linked(color):
+            out.append(("base_color", color, VEC, None))
+        if shader.type == "BSDF_PRINCIPLED":
+            for field, name in (("metallic", "Metallic"), ("roughness", "Roughness"), ("alpha", "Alpha")):
+                if linked(name):
+                    out.append((field, name, FLOAT, None))
+            emission = "Emission Color" if "Emission Color" in shader.inputs else "Emission"
+            if linked(emission) or linked("Emission Strength"):
+                out.append(("emission", emission, VEC, "Emission Strength"))
+        for sock in ("Normal",):
+            if linked(sock):
+                self.warnings.append(f"material '{self.material.name}': a linked {sock} input (bump or normal "
+                                     "map) is not supported yet")
+        return out
+
+    def _displacement_bound(self, displaces):
+        if not displaces:
+            return 0.0
+        if self.user_bound > 0.0:
+            return self.user_bound
+        info = self.height_info
+        if info is not None:
+            (_, _, hr), (_, _, mr), (_, _, sr) = info
+            if hr and mr and sr and mr[0] == mr[1] and sr[0] == sr[1]:
+                return abs(sr[0]) * max(abs(hr[1] - mr[0]), abs(hr[0] - mr[0]))
+        self.warnings.append(f"material '{self.material.name}': its displacement bound could not be derived from "
+                             "the node tree; 1 unit is assumed. Set Material > Micropoly > Displacement Bound if "
+                             "displaced geometry is clipped")
+        return 1.0
+
+
+def compile_material(material, warnings):
+    """CompiledMaterial for a Blender material, or None if it needs no program."""
+    settings = getattr(material, "micropoly", None)
+    user_bound = float(getattr(settings, "displacement_bound", 0.0)) if settings is not None else 0.0
+    return NodeCompiler(material, warnings, user_bound).compile()

@@ -1,0 +1,101 @@
+/* A material program: one material node tree, translated to OpenCL C by the
+ * add-on (mp_node_displacement and mp_node_surface, inserted below by the
+ * host), built into its own program so that identical trees share one build
+ * and a changed tree rebuilds only itself. Its kernels run over a whole
+ * batch of diced grids and touch only the vertices of the materials that use
+ * this program (DeviceMaterial.program[0]). */
+#include "mp_compat.h"
+#include "mp_patch.h"
+#include "mp_types.h"
+#include "mp_shading.h"
+#include "materials/mp_node_lib.h"
+
+/* @MATERIAL_PROGRAM_SOURCE@ */
+
+inline float mp_row3(__global const float* m, int r, float3 v, float w) {
+  return m[4 * r] * v.x + m[4 * r + 1] * v.y + m[4 * r + 2] * v.z + m[4 * r + 3] * w;
+}
+
+/* Object -> camera for a direction; camera -> object for a normal uses the
+ * transpose of the same linear part (the inverse transpose of its inverse). */
+inline float3 mp_object_dir_to_camera(__global const DeviceObject* o, float3 d) {
+  return (float3)(mp_row3(o->to_camera, 0, d, 0.0f), mp_row3(o->to_camera, 1, d, 0.0f), mp_row3(o->to_camera, 2, d, 0.0f));
+}
+inline float3 mp_camera_normal_to_object(__global const DeviceObject* o, float3 n) {
+  __global const float* m = o->to_camera;
+  float3 r = (float3)(m[0] * n.x + m[4] * n.y + m[8] * n.z, m[1] * n.x + m[5] * n.y + m[9] * n.z,
+                      m[2] * n.x + m[6] * n.y + m[10] * n.z);
+  float l = length(r);
+  return l > 0.0f ? r / l : (float3)(0.0f, 0.0f, 1.0f);
+}
+
+inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, float3 n, int ortho) {
+  MpNodeGlobals g;
+  g.P = (float3)(mp_row3(o->to_object, 0, p, 1.0f), mp_row3(o->to_object, 1, p, 1.0f), mp_row3(o->to_object, 2, p, 1.0f));
+  g.N = mp_camera_normal_to_object(o, n);
+  float3 loc = (float3)(o->texspace_location[0], o->texspace_location[1], o->texspace_location[2]);
+  float3 size = (float3)(o->texspace_size[0], o->texspace_size[1], o->texspace_size[2]);
+  float3 rel = g.P - loc;
+  g.generated = (float3)(size.x != 0.0f ? rel.x / (2.0f * size.x) : 0.0f, size.y != 0.0f ? rel.y / (2.0f * size.y) : 0.0f,
+                         size.z != 0.0f ? rel.z / (2.0f * size.z) : 0.0f) + (float3)(0.5f, 0.5f, 0.5f);
+  float3 eye = ortho ? (float3)(0.0f, 0.0f, 1.0f) : -p;
+  g.incoming = mp_camera_normal_to_object(o, eye); /* a direction: rigid cameras keep it exact enough */
+  return g;
+}
+
+/* The vertex this work-item handles, if its material uses this program. */
+inline int mp_program_vertex(uint gid, uint count, FrameParams f, __global const SubPatch* diceable,
+                             __global const uint* patch_info, __global const DeviceMaterial* materials, int program,
+                             SubPatch* sp, uint* material, uint* object) {
+  uint i, j;
+  if (!mp_grid_vertex(gid, count, f.max_grid, diceable, sp, &i, &j)) return 0;
+  *material = patch_info[4 * (ulong)sp->patch + 1];
+  *object = MP_PATCH_OBJECT(patch_info[4 * (ulong)sp->patch + 2]);
+  return (int)materials[*material].program[0] == program;
+}
+
+/* Moves each vertex by the program's displacement vector (object space). */
+__kernel void displace_grids(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
+                             __global const DeviceMaterial* materials, __global const DeviceObject* objects,
+                             FrameParams f, int program, __global float4* grid_p, __global const float4* grid_n) {
+  uint gid = get_global_id(0), material, object;
+  SubPatch sp;
+  if (!mp_program_vertex(gid, count, f, diceable, patch_info, materials, program, &sp, &material, &object)) return;
+  if (!(materials[material].program[1] > 0.0f)) return;
+  __global const DeviceObject* o = objects + object;
+  float3 p = grid_p[gid].xyz;
+  MpNodeGlobals g = mp_node_globals(o, p, grid_n[gid].xyz, f.ortho);
+  float3 d = mp_node_displacement(&g);
+  if (!(isfinite(d.x) && isfinite(d.y) && isfinite(d.z))) return;
+  grid_p[gid] = (float4)(p + mp_object_dir_to_camera(o, d), 1.0f);
+}
+
+/* Shades each vertex with the Principled inputs the program computes. */
+__kernel void shade_program_grids(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
+                                  __global const DeviceMaterial* materials, __global const DeviceObject* objects,
+                                  FrameParams f, int program, __global const float4* grid_p,
+                                  __global const float4* grid_n, __global const DeviceLight* lights, uint light_count,
+                                  __global float4* grid_c) {
+  uint gid = get_global_id(0), material, object;
+  SubPatch sp;
+  if (!mp_program_vertex(gid, count, f, diceable, patch_info, materials, program, &sp, &material, &object)) return;
+  DeviceMaterial m = materials[material];
+  if (!(m.program[2] > 0.0f)) return;
+  float3 p = grid_p[gid].xyz, n = grid_n[gid].xyz;
+  MpNodeGlobals g = mp_node_globals(objects + object, p, n, f.ortho);
+  MpSurfaceInputs s;
+  s.base_color = (float3)(m.color[0], m.color[1], m.color[2]);
+  s.metallic = m.principled[0];
+  s.specular = m.principled[1];
+  s.roughness = m.coeffs[3];
+  s.alpha = m.opacity[3];
+  s.emission = (float3)(m.emission[0], m.emission[1], m.emission[2]);
+  mp_node_surface(&g, &s);
+  m.color[0] = s.base_color.x, m.color[1] = s.base_color.y, m.color[2] = s.base_color.z;
+  m.principled[0] = clamp(s.metallic, 0.0f, 1.0f);
+  m.principled[1] = fmax(s.specular, 0.0f);
+  m.coeffs[3] = clamp(s.roughness, 0.0f, 1.0f);
+  m.emission[0] = s.emission.x, m.emission[1] = s.emission.y, m.emission[2] = s.emission.z;
+  float3 c = mp_shade(p, n, f.ortho, &m, lights, light_count);
+  grid_c[gid] = (float4)(c, clamp(s.alpha, 0.0f, 1.0f));
+}

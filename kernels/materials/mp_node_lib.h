@@ -1,0 +1,380 @@
+/* Blender shader nodes as device functions: what material programs (node
+ * trees translated to OpenCL C by the add-on, see material_program.cl) call.
+ * Each function reproduces the node's documented behaviour in Blender,
+ * including its guards (division by zero gives 0, and so on), so a node tree
+ * computes the same values here as in Cycles. Operation codes are the
+ * MP_MATH_*, MP_VMATH_*, MP_BLEND_* and MP_RANGE_* constants below; the
+ * add-on's node compiler maps Blender's enum names onto them. */
+#ifndef MP_NODE_LIB_H
+#define MP_NODE_LIB_H
+
+#include "mp_compat.h"
+
+/* What the nodes can read at a shading point. Object-space position and
+ * normal (Texture Coordinate > Object and Normal), Generated coordinates. */
+typedef struct {
+  float3 P;
+  float3 N;
+  float3 generated;
+  float3 incoming; /* unit vector towards the eye, object space */
+} MpNodeGlobals;
+
+/* Principled BSDF inputs a surface program may set. */
+typedef struct {
+  float3 base_color;
+  float metallic, roughness, specular, alpha;
+  float3 emission; /* color times strength */
+} MpSurfaceInputs;
+
+MP_INLINE float mp_nl_safe_div(float a, float b) { return b != 0.0f ? a / b : 0.0f; }
+MP_INLINE float mp_nl_fract(float a) { return a - floor(a); }
+MP_INLINE float mp_nl_clamp01(float a) { return fmin(fmax(a, 0.0f), 1.0f); }
+MP_INLINE float mp_nl_wrap(float a, float hi, float lo) {
+  float range = hi - lo;
+  return range != 0.0f ? a - range * floor((a - lo) / range) : lo;
+}
+MP_INLINE float mp_nl_pingpong(float a, float scale) {
+  return scale != 0.0f ? fabs(mp_nl_fract((a - scale) / (scale * 2.0f)) * scale * 2.0f - scale) : 0.0f;
+}
+MP_INLINE float mp_nl_smoothmin(float a, float b, float k) {
+  if (!(k != 0.0f)) return fmin(a, b);
+  float h = fmax(k - fabs(a - b), 0.0f) / k;
+  return fmin(a, b) - h * h * h * k * (1.0f / 6.0f);
+}
+MP_INLINE float mp_nl_safe_fmod(float a, float b) { return b != 0.0f ? a - b * trunc(a / b) : 0.0f; }
+
+/* ---- Math node ---------------------------------------------------------- */
+#define MP_MATH_ADD 0
+#define MP_MATH_SUBTRACT 1
+#define MP_MATH_MULTIPLY 2
+#define MP_MATH_DIVIDE 3
+#define MP_MATH_MULTIPLY_ADD 4
+#define MP_MATH_POWER 5
+#define MP_MATH_LOGARITHM 6
+#define MP_MATH_SQRT 7
+#define MP_MATH_INVERSE_SQRT 8
+#define MP_MATH_ABSOLUTE 9
+#define MP_MATH_EXPONENT 10
+#define MP_MATH_MINIMUM 11
+#define MP_MATH_MAXIMUM 12
+#define MP_MATH_LESS_THAN 13
+#define MP_MATH_GREATER_THAN 14
+#define MP_MATH_SIGN 15
+#define MP_MATH_COMPARE 16
+#define MP_MATH_SMOOTH_MIN 17
+#define MP_MATH_SMOOTH_MAX 18
+#define MP_MATH_ROUND 19
+#define MP_MATH_FLOOR 20
+#define MP_MATH_CEIL 21
+#define MP_MATH_TRUNC 22
+#define MP_MATH_FRACT 23
+#define MP_MATH_MODULO 24
+#define MP_MATH_FLOORED_MODULO 25
+#define MP_MATH_WRAP 26
+#define MP_MATH_SNAP 27
+#define MP_MATH_PINGPONG 28
+#define MP_MATH_SINE 29
+#define MP_MATH_COSINE 30
+#define MP_MATH_TANGENT 31
+#define MP_MATH_ARCSINE 32
+#define MP_MATH_ARCCOSINE 33
+#define MP_MATH_ARCTANGENT 34
+#define MP_MATH_ARCTAN2 35
+#define MP_MATH_SINH 36
+#define MP_MATH_COSH 37
+#define MP_MATH_TANH 38
+#define MP_MATH_RADIANS 39
+#define MP_MATH_DEGREES 40
+
+MP_INLINE float mp_math(int op, float a, float b, float c) {
+  switch (op) {
+    case MP_MATH_ADD: return a + b;
+    case MP_MATH_SUBTRACT: return a - b;
+    case MP_MATH_MULTIPLY: return a * b;
+    case MP_MATH_DIVIDE: return mp_nl_safe_div(a, b);
+    case MP_MATH_MULTIPLY_ADD: return a * b + c;
+    case MP_MATH_POWER:
+      if (a >= 0.0f) return pow(a, b);
+      /* A negative base only for integer exponents, as Blender's safe power. */
+      return b == floor(b) ? (fmod(fabs(b), 2.0f) == 1.0f ? -pow(-a, b) : pow(-a, b)) : 0.0f;
+    case MP_MATH_LOGARITHM: return (a > 0.0f && b > 0.0f) ? log(a) / log(b) : 0.0f;
+    case MP_MATH_SQRT: return a > 0.0f ? sqrt(a) : 0.0f;
+    case MP_MATH_INVERSE_SQRT: return a > 0.0f ? 1.0f / sqrt(a) : 0.0f;
+    case MP_MATH_ABSOLUTE: return fabs(a);
+    case MP_MATH_EXPONENT: return exp(a);
+    case MP_MATH_MINIMUM: return fmin(a, b);
+    case MP_MATH_MAXIMUM: return fmax(a, b);
+    case MP_MATH_LESS_THAN: return a < b ? 1.0f : 0.0f;
+    case MP_MATH_GREATER_THAN: return a > b ? 1.0f : 0.0f;
+    case MP_MATH_SIGN: return a > 0.0f ? 1.0f : a < 0.0f ? -1.0f : 0.0f;
+    case MP_MATH_COMPARE: return fabs(a - b) <= fmax(c, 1e-5f) ? 1.0f : 0.0f;
+    case MP_MATH_SMOOTH_MIN: return mp_nl_smoothmin(a, b, c);
+    case MP_MATH_SMOOTH_MAX: return -mp_nl_smoothmin(-a, -b, c);
+    case MP_MATH_ROUND: return floor(a + 0.5f);
+    case MP_MATH_FLOOR: return floor(a);
+    case MP_MATH_CEIL: return ceil(a);
+    case MP_MATH_TRUNC: return trunc(a);
+    case MP_MATH_FRACT: return mp_nl_fract(a);
+    case MP_MATH_MODULO: return mp_nl_safe_fmod(a, b);
+    case MP_MATH_FLOORED_MODULO: return b != 0.0f ? a - floor(a / b) * b : 0.0f;
+    case MP_MATH_WRAP: return mp_nl_wrap(a, b, c);
+    case MP_MATH_SNAP: return b != 0.0f ? floor(a / b) * b : 0.0f;
+    case MP_MATH_PINGPONG: return mp_nl_pingpong(a, b);
+    case MP_MATH_SINE: return sin(a);
+    case MP_MATH_COSINE: return cos(a);
+    case MP_MATH_TANGENT: return tan(a);
+    case MP_MATH_ARCSINE: return asin(fmin(fmax(a, -1.0f), 1.0f));
+    case MP_MATH_ARCCOSINE: return acos(fmin(fmax(a, -1.0f), 1.0f));
+    case MP_MATH_ARCTANGENT: return atan(a);
+    case MP_MATH_ARCTAN2: return atan2(a, b);
+    case MP_MATH_SINH: return sinh(a);
+    case MP_MATH_COSH: return cosh(a);
+    case MP_MATH_TANH: return tanh(a);
+    case MP_MATH_RADIANS: return a * (3.14159265358979f / 180.0f);
+    case MP_MATH_DEGREES: return a * (180.0f / 3.14159265358979f);
+  }
+  return 0.0f;
+}
+
+/* ---- Vector Math node --------------------------------------------------- */
+#define MP_VMATH_ADD 0
+#define MP_VMATH_SUBTRACT 1
+#define MP_VMATH_MULTIPLY 2
+#define MP_VMATH_DIVIDE 3
+#define MP_VMATH_MULTIPLY_ADD 4
+#define MP_VMATH_CROSS_PRODUCT 5
+#define MP_VMATH_PROJECT 6
+#define MP_VMATH_REFLECT 7
+#define MP_VMATH_DOT_PRODUCT 8
+#define MP_VMATH_DISTANCE 9
+#define MP_VMATH_LENGTH 10
+#define MP_VMATH_SCALE 11
+#define MP_VMATH_NORMALIZE 12
+#define MP_VMATH_ABSOLUTE 13
+#define MP_VMATH_MINIMUM 14
+#define MP_VMATH_MAXIMUM 15
+#define MP_VMATH_FLOOR 16
+#define MP_VMATH_CEIL 17
+#define MP_VMATH_FRACTION 18
+#define MP_VMATH_MODULO 19
+#define MP_VMATH_WRAP 20
+#define MP_VMATH_SNAP 21
+#define MP_VMATH_SINE 22
+#define MP_VMATH_COSINE 23
+#define MP_VMATH_TANGENT 24
+#define MP_VMATH_FACEFORWARD 25
+
+MP_INLINE float3 mp_nl_f3(float x, float y, float z) { return MP_F3(x, y, z); }
+MP_INLINE float3 mp_nl_safe_normalize(float3 a) {
+  float l = length(a);
+  return l > 0.0f ? a / l : MP_F3(0.0f, 0.0f, 0.0f);
+}
+
+/* Returns the vector output; *value gets the float output. */
+MP_INLINE float3 mp_vector_math(int op, float3 a, float3 b, float3 c, float scale, float* value) {
+  *value = 0.0f;
+  switch (op) {
+    case MP_VMATH_ADD: return a + b;
+    case MP_VMATH_SUBTRACT: return a - b;
+    case MP_VMATH_MULTIPLY: return a * b;
+    case MP_VMATH_DIVIDE: return mp_nl_f3(mp_nl_safe_div(a.x, b.x), mp_nl_safe_div(a.y, b.y), mp_nl_safe_div(a.z, b.z));
+    case MP_VMATH_MULTIPLY_ADD: return a * b + c;
+    case MP_VMATH_CROSS_PRODUCT: return cross(a, b);
+    case MP_VMATH_PROJECT: {
+      float bb = dot(b, b);
+      return bb != 0.0f ? b * (dot(a, b) / bb) : MP_F3(0.0f, 0.0f, 0.0f);
+    }
+    case MP_VMATH_REFLECT: {
+      float3 n = mp_nl_safe_normalize(b);
+      return a - 2.0f * dot(n, a) * n;
+    }
+    case MP_VMATH_FACEFORWARD: return dot(c, b) < 0.0f ? a : -a;
+    case MP_VMATH_DOT_PRODUCT: *value = dot(a, b); return MP_F3(0.0f, 0.0f, 0.0f);
+    case MP_VMATH_DISTANCE: *value = length(a - b); return MP_F3(0.0f, 0.0f, 0.0f);
+    case MP_VMATH_LENGTH: *value = length(a); return MP_F3(0.0f, 0.0f, 0.0f);
+    case MP_VMATH_SCALE: return a * scale;
+    case MP_VMATH_NORMALIZE: return mp_nl_safe_normalize(a);
+    case MP_VMATH_ABSOLUTE: return mp_nl_f3(fabs(a.x), fabs(a.y), fabs(a.z));
+    case MP_VMATH_MINIMUM: return fmin(a, b);
+    case MP_VMATH_MAXIMUM: return fmax(a, b);
+    case MP_VMATH_FLOOR: return mp_nl_f3(floor(a.x), floor(a.y), floor(a.z));
+    case MP_VMATH_CEIL: return mp_nl_f3(ceil(a.x), ceil(a.y), ceil(a.z));
+    case MP_VMATH_FRACTION: return mp_nl_f3(mp_nl_fract(a.x), mp_nl_fract(a.y), mp_nl_fract(a.z));
+    case MP_VMATH_MODULO:
+      return mp_nl_f3(mp_nl_safe_fmod(a.x, b.x), mp_nl_safe_fmod(a.y, b.y), mp_nl_safe_fmod(a.z, b.z));
+    case MP_VMATH_WRAP:
+      return mp_nl_f3(mp_nl_wrap(a.x, b.x, c.x), mp_nl_wrap(a.y, b.y, c.y), mp_nl_wrap(a.z, b.z, c.z));
+    case MP_VMATH_SNAP:
+      return mp_nl_f3(b.x != 0.0f ? floor(a.x / b.x) * b.x : 0.0f, b.y != 0.0f ? floor(a.y / b.y) * b.y : 0.0f,
+                      b.z != 0.0f ? floor(a.z / b.z) * b.z : 0.0f);
+    case MP_VMATH_SINE: return mp_nl_f3(sin(a.x), sin(a.y), sin(a.z));
+    case MP_VMATH_COSINE: return mp_nl_f3(cos(a.x), cos(a.y), cos(a.z));
+    case MP_VMATH_TANGENT: return mp_nl_f3(tan(a.x), tan(a.y), tan(a.z));
+  }
+  return MP_F3(0.0f, 0.0f, 0.0f);
+}
+
+/* ---- Mix (color blend modes) ---------------------------------------------- */
+#define MP_BLEND_MIX 0
+#define MP_BLEND_ADD 1
+#define MP_BLEND_MULTIPLY 2
+#define MP_BLEND_SUBTRACT 3
+#define MP_BLEND_SCREEN 4
+#define MP_BLEND_DIVIDE 5
+#define MP_BLEND_DIFFERENCE 6
+#define MP_BLEND_DARKEN 7
+#define MP_BLEND_LIGHTEN 8
+#define MP_BLEND_OVERLAY 9
+#define MP_BLEND_DODGE 10
+#define MP_BLEND_BURN 11
+#define MP_BLEND_SOFT_LIGHT 12
+#define MP_BLEND_LINEAR_LIGHT 13
+#define MP_BLEND_EXCLUSION 14
+
+MP_INLINE float mp_nl_overlay(float t, float a, float b) {
+  float tm = 1.0f - t;
+  return a < 0.5f ? a * (tm + 2.0f * t * b) : 1.0f - (tm + 2.0f * t * (1.0f - b)) * (1.0f - a);
+}
+MP_INLINE float mp_nl_dodge(float t, float a, float b) {
+  if (a == 0.0f) return a;
+  float tmp = 1.0f - t * b;
+  if (tmp <= 0.0f) return 1.0f;
+  tmp = a / tmp;
+  return tmp > 1.0f ? 1.0f : tmp;
+}
+MP_INLINE float mp_nl_burn(float t, float a, float b) {
+  float tmp = (1.0f - t) + t * b;
+  if (tmp <= 0.0f) return 0.0f;
+  tmp = 1.0f - (1.0f - a) / tmp;
+  return tmp < 0.0f ? 0.0f : tmp > 1.0f ? 1.0f : tmp;
+}
+MP_INLINE float mp_nl_soft_light(float t, float a, float b) {
+  float scr = 1.0f - (1.0f - b) * (1.0f - a);
+  return (1.0f - t) * a + t * ((1.0f - a) * b * a + a * scr);
+}
+
+MP_INLINE float3 mp_blend(int mode, float t, float3 a, float3 b) {
+  float tm = 1.0f - t;
+  switch (mode) {
+    case MP_BLEND_MIX: return tm * a + t * b;
+    case MP_BLEND_ADD: return a + t * b;
+    case MP_BLEND_MULTIPLY: return a * (tm + t * b);
+    case MP_BLEND_SUBTRACT: return a - t * b;
+    case MP_BLEND_SCREEN:
+      return MP_F3(1.0f, 1.0f, 1.0f) - (MP_F3(tm, tm, tm) + t * (MP_F3(1.0f, 1.0f, 1.0f) - b)) *
+                                           (MP_F3(1.0f, 1.0f, 1.0f) - a);
+    case MP_BLEND_DIVIDE:
+      return mp_nl_f3(b.x != 0.0f ? tm * a.x + t * a.x / b.x : a.x, b.y != 0.0f ? tm * a.y + t * a.y / b.y : a.y,
+                      b.z != 0.0f ? tm * a.z + t * a.z / b.z : a.z);
+    case MP_BLEND_DIFFERENCE: {
+      float3 d = a - b;
+      return tm * a + t * mp_nl_f3(fabs(d.x), fabs(d.y), fabs(d.z));
+    }
+    case MP_BLEND_EXCLUSION: {
+      float3 e = a + b - 2.0f * a * b;
+      return tm * a + t * fmax(e, MP_F3(0.0f, 0.0f, 0.0f));
+    }
+    case MP_BLEND_DARKEN: return tm * a + t * fmin(a, b);
+    case MP_BLEND_LIGHTEN: return tm * a + t * fmax(a, b);
+    case MP_BLEND_OVERLAY: return mp_nl_f3(mp_nl_overlay(t, a.x, b.x), mp_nl_overlay(t, a.y, b.y), mp_nl_overlay(t, a.z, b.z));
+    case MP_BLEND_DODGE: return mp_nl_f3(mp_nl_dodge(t, a.x, b.x), mp_nl_dodge(t, a.y, b.y), mp_nl_dodge(t, a.z, b.z));
+    case MP_BLEND_BURN: return mp_nl_f3(mp_nl_burn(t, a.x, b.x), mp_nl_burn(t, a.y, b.y), mp_nl_burn(t, a.z, b.z));
+    case MP_BLEND_SOFT_LIGHT:
+      return mp_nl_f3(mp_nl_soft_light(t, a.x, b.x), mp_nl_soft_light(t, a.y, b.y), mp_nl_soft_light(t, a.z, b.z));
+    case MP_BLEND_LINEAR_LIGHT: return a + t * (2.0f * b - MP_F3(1.0f, 1.0f, 1.0f));
+  }
+  return a;
+}
+
+MP_INLINE float3 mp_nl_clamp01_3(float3 c) {
+  return mp_nl_f3(mp_nl_clamp01(c.x), mp_nl_clamp01(c.y), mp_nl_clamp01(c.z));
+}
+
+/* ---- Map Range ------------------------------------------------------------ */
+#define MP_RANGE_LINEAR 0
+#define MP_RANGE_STEPPED 1
+#define MP_RANGE_SMOOTHSTEP 2
+#define MP_RANGE_SMOOTHERSTEP 3
+
+MP_INLINE float mp_map_range(int mode, float value, float from_min, float from_max, float to_min, float to_max,
+                             float steps, int clamp_result) {
+  float factor = 0.0f;
+  if (from_max != from_min) {
+    float f = (value - from_min) / (from_max - from_min);
+    if (mode == MP_RANGE_LINEAR) {
+      factor = f;
+    } else if (mode == MP_RANGE_STEPPED) {
+      factor = steps > 0.0f ? floor(f * (steps + 1.0f)) / steps : 0.0f;
+    } else {
+      float t = mp_nl_clamp01(f);
+      factor = mode == MP_RANGE_SMOOTHSTEP ? t * t * (3.0f - 2.0f * t) : t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f);
+    }
+  }
+  float r = to_min + factor * (to_max - to_min);
+  if (clamp_result && mode <= MP_RANGE_STEPPED)
+    r = to_max > to_min ? fmin(fmax(r, to_min), to_max) : fmin(fmax(r, to_max), to_min);
+  return r;
+}
+
+/* ---- Clamp ---------------------------------------------------------------- */
+MP_INLINE float mp_clamp_node(int range_mode, float value, float lo, float hi) {
+  if (range_mode && lo > hi) return fmin(fmax(value, hi), lo);
+  return fmin(fmax(value, lo), hi);
+}
+
+/* ---- Mapping: location, Euler XYZ rotation, scale -------------------------- */
+#define MP_MAPPING_POINT 0
+#define MP_MAPPING_TEXTURE 1
+#define MP_MAPPING_VECTOR 2
+#define MP_MAPPING_NORMAL 3
+
+/* Rotation by Euler angles, X first, then Y, then Z (Blender's XYZ order). */
+MP_INLINE float3 mp_nl_euler_rotate(float3 v, float3 r, int inverse) {
+  float cx = cos(r.x), sx = sin(r.x), cy = cos(r.y), sy = sin(r.y), cz = cos(r.z), sz = sin(r.z);
+  /* Rows of R = Rz * Ry * Rx. */
+  float3 r0 = mp_nl_f3(cy * cz, sy * sx * cz - cx * sz, sy * cx * cz + sx * sz);
+  float3 r1 = mp_nl_f3(cy * sz, sy * sx * sz + cx * cz, sy * cx * sz - sx * cz);
+  float3 r2 = mp_nl_f3(-sy, cy * sx, cy * cx);
+  if (!inverse) return mp_nl_f3(dot(r0, v), dot(r1, v), dot(r2, v));
+  return v.x * r0 + v.y * r1 + v.z * r2; /* the transpose */
+}
+
+MP_INLINE float3 mp_mapping(int type, float3 v, float3 location, float3 rotation, float3 scale) {
+  switch (type) {
+    case MP_MAPPING_POINT: return mp_nl_euler_rotate(v * scale, rotation, 0) + location;
+    case MP_MAPPING_TEXTURE:
+      return mp_nl_f3(mp_nl_safe_div(1.0f, scale.x), mp_nl_safe_div(1.0f, scale.y), mp_nl_safe_div(1.0f, scale.z)) *
+             mp_nl_euler_rotate(v - location, rotation, 1);
+    case MP_MAPPING_VECTOR: return mp_nl_euler_rotate(v * scale, rotation, 0);
+    case MP_MAPPING_NORMAL:
+      return mp_nl_safe_normalize(mp_nl_euler_rotate(
+          v * mp_nl_f3(mp_nl_safe_div(1.0f, scale.x), mp_nl_safe_div(1.0f, scale.y), mp_nl_safe_div(1.0f, scale.z)),
+          rotation, 0));
+  }
+  return v;
+}
+
+/* ---- Color Ramp: stops sorted by position, RGB mode ------------------------ */
+#define MP_RAMP_LINEAR 0
+#define MP_RAMP_CONSTANT 1
+#define MP_RAMP_EASE 2
+
+MP_INLINE float4 mp_color_ramp(int interpolation, int count, const float* positions, const float4* colors, float t) {
+  if (count <= 0) return MP_F4(0.0f, 0.0f, 0.0f, 1.0f);
+  if (t <= positions[0]) return colors[0];
+  for (int k = 1; k < count; ++k) {
+    if (t < positions[k]) {
+      if (interpolation == MP_RAMP_CONSTANT) return colors[k - 1];
+      float span = positions[k] - positions[k - 1];
+      float f = span > 0.0f ? (t - positions[k - 1]) / span : 0.0f;
+      if (interpolation == MP_RAMP_EASE) f = f * f * (3.0f - 2.0f * f);
+      return colors[k - 1] + (colors[k] - colors[k - 1]) * f;
+    }
+  }
+  return colors[count - 1];
+}
+
+/* Luminance of a scene-linear Rec.709 color (RGB to BW). */
+MP_INLINE float mp_rgb_to_bw(float3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+#endif

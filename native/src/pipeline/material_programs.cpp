@@ -1,0 +1,99 @@
+#include "pipeline/material_programs.h"
+
+#include "cl/program_cache.h"
+#include "micropoly/error.h"
+
+namespace mp {
+
+void MaterialPrograms::prepare(const Scene& scene, RenderStats& stats) {
+  active_.clear();
+  displaces_ = false;
+  std::vector<bool> displaces(scene.material_programs.size(), false), shades(displaces);
+  for (const Material& m : scene.materials) {
+    if (m.program < 0) continue;
+    displaces[m.program] = displaces[m.program] || m.program_displaces;
+    shades[m.program] = shades[m.program] || m.program_shades;
+  }
+  for (size_t i = 0; i < scene.material_programs.size(); ++i) {
+    if (!displaces[i] && !shades[i]) continue;
+    const MaterialProgram& mp = scene.material_programs[i];
+    auto it = built_.find(mp.source);
+    if (it == built_.end()) {
+      BuiltProgram b;
+      try {
+        b = build_program_cached(session_.context(), session_.device(), assemble_material_program_source(mp.source),
+                                 "-cl-std=CL1.2");
+      } catch (const Error& e) {
+        throw Error("material '" + mp.name + "': its node tree did not compile: " + e.what());
+      }
+      stats.program_build_ms += b.build_ms;
+      auto built = std::make_unique<Built>();
+      built->program = b.program;
+      built->displace = cl::Kernel(built->program, "displace_grids");
+      built->shade = cl::Kernel(built->program, "shade_program_grids");
+      it = built_.emplace(mp.source, std::move(built)).first;
+    }
+    active_.push_back({it->second.get(), static_cast<cl_int>(i), static_cast<bool>(displaces[i]),
+                       static_cast<bool>(shades[i])});
+    displaces_ = displaces_ || displaces[i];
+  }
+  if (displaces_ && !normals_) normals_ = std::make_unique<cl::Kernel>(session_.program(), "displaced_normals");
+}
+
+void MaterialPrograms::launch(cl::Kernel& kernel, cl_uint count, GridBuffers& grids, Stage stage, StageTimer& timer) {
+  cl::Event e;
+  session_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, round_up_range(count * grids.vertices_per_slot),
+                                        cl::NDRange(64), nullptr, &e);
+  timer.add(stage, e);
+}
+
+void MaterialPrograms::displace(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
+                                const FrameParams& f, GridBuffers& grids, StageTimer& timer) {
+  if (!displaces_) return;
+  for (Active& a : active_) {
+    if (!a.displaces) continue;
+    cl::Kernel& k = a.built->displace;
+    k.setArg(0, diceable);
+    k.setArg(1, count);
+    k.setArg(2, scene.patch_info);
+    k.setArg(3, scene.materials);
+    k.setArg(4, scene.objects);
+    k.setArg(5, f);
+    k.setArg(6, a.index);
+    k.setArg(7, grids.p);
+    k.setArg(8, grids.n);
+    launch(k, count, grids, Stage::Dice, timer);
+  }
+  cl::Kernel& k = *normals_;
+  k.setArg(0, diceable);
+  k.setArg(1, count);
+  k.setArg(2, scene.patch_info);
+  k.setArg(3, scene.materials);
+  k.setArg(4, f);
+  k.setArg(5, grids.p);
+  k.setArg(6, grids.n);
+  launch(k, count, grids, Stage::Dice, timer);
+}
+
+void MaterialPrograms::shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
+                             const FrameParams& f, GridBuffers& grids, StageTimer& timer) {
+  for (Active& a : active_) {
+    if (!a.shades) continue;
+    cl::Kernel& k = a.built->shade;
+    k.setArg(0, diceable);
+    k.setArg(1, count);
+    k.setArg(2, scene.patch_info);
+    k.setArg(3, scene.materials);
+    k.setArg(4, scene.objects);
+    k.setArg(5, f);
+    k.setArg(6, a.index);
+    k.setArg(7, grids.p);
+    k.setArg(8, grids.n);
+    k.setArg(9, scene.lights);
+    k.setArg(10, scene.light_count);
+    k.setArg(11, grids.c);
+    launch(k, count, grids, Stage::Shade, timer);
+  }
+}
+
+}  // namespace mp

@@ -1,0 +1,55 @@
+// Material programs: each distinct node tree's OpenCL C, built into its own
+// program (kernels/materials/material_program.cl) and kept across frames,
+// so an unchanged tree is never rebuilt and a changed one rebuilds alone
+// (from the on-disk binary cache when it was built before).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "cl/device_session.h"
+#include "micropoly/renderer.h"
+#include "micropoly/scene.h"
+#include "pipeline/frame_params.h"
+#include "pipeline/micropolygon_stages.h"
+#include "pipeline/scene_buffers.h"
+#include "pipeline/stage_timer.h"
+
+namespace mp {
+
+class MaterialPrograms {
+ public:
+  explicit MaterialPrograms(DeviceSession& session) : session_(session) {}
+  // Builds what the scene's materials use; adds the build time to `stats`.
+  void prepare(const Scene& scene, RenderStats& stats);
+  bool displaces() const { return displaces_; }
+  // Displacement of every program that displaces, then the normals of the
+  // displaced grids from their new vertices.
+  void displace(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+                GridBuffers& grids, StageTimer& timer);
+  // Shades the vertices whose materials compute their Principled inputs.
+  void shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+             GridBuffers& grids, StageTimer& timer);
+
+ private:
+  struct Built {
+    cl::Program program;
+    cl::Kernel displace, shade;
+  };
+  struct Active {
+    Built* built;
+    cl_int index;  // the scene's program index, as DeviceMaterial.program[0]
+    bool displaces, shades;
+  };
+  void launch(cl::Kernel& kernel, cl_uint count, GridBuffers& grids, Stage stage, StageTimer& timer);
+
+  DeviceSession& session_;
+  std::unordered_map<std::string, std::unique_ptr<Built>> built_;  // by source
+  std::vector<Active> active_;
+  bool displaces_ = false;
+  std::unique_ptr<cl::Kernel> normals_;
+};
+
+}  // namespace mp
