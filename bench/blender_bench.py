@@ -1,7 +1,7 @@
 """Micropoly, Cycles and EEVEE rendering one scene side by side, plus the
 export time of a 1M-face mesh. Run with Blender (or a Python with bpy):
 
-  MICROPOLY_ADDON_DIR=build/addons blender -b --factory-startup --python bench/blender_bench.py -- [--repeat 3] [--quick]
+  MICROPOLY_ADDON_DIR=build/addons blender -b --factory-startup --python bench/blender_bench.py -- [--repeat 3] [--quick] [--displaced]
 
 Scene: six subdivided Suzannes (Subdivision Surface, rendered by Micropoly as
 limit surfaces and by Cycles with adaptive subdivision at 1 px) on a floor,
@@ -25,6 +25,9 @@ import render_utils as ru  # noqa: E402
 args = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 REPEAT = int(args[args.index("--repeat") + 1]) if "--repeat" in args else 3
 QUICK = "--quick" in args
+# --displaced: every Suzanne's material is displaced by a Noise texture
+# (Displacement Only), the issue-5 benchmark scene.
+DISPLACED = "--displaced" in args
 W, H = (480, 270) if QUICK else (1920, 1080)
 SAMPLES = 16
 
@@ -38,7 +41,21 @@ def build_scene():
         obj = bpy.context.object
         obj.modifiers.new("Subdivision", "SUBSURF").render_levels = 2
         bpy.ops.object.shade_smooth()
-        obj.data.materials.append(ru.diffuse_material(f"m{i}", (0.2 + 0.12 * i, 0.5, 0.8 - 0.1 * i)))
+        mat = ru.diffuse_material(f"m{i}", (0.2 + 0.12 * i, 0.5, 0.8 - 0.1 * i))
+        if DISPLACED:
+            nt = mat.node_tree
+            noise = nt.nodes.new("ShaderNodeTexNoise")
+            noise.inputs["Scale"].default_value = 4.0
+            disp = nt.nodes.new("ShaderNodeDisplacement")
+            disp.inputs["Scale"].default_value = 0.15
+            nt.links.new(noise.outputs["Fac"], disp.inputs["Height"])
+            out = next(n for n in nt.nodes if n.type == "OUTPUT_MATERIAL")
+            nt.links.new(disp.outputs["Displacement"], out.inputs["Displacement"])
+            if hasattr(mat, "displacement_method"):
+                mat.displacement_method = "DISPLACEMENT"
+            else:
+                mat.cycles.displacement_method = "DISPLACEMENT"
+        obj.data.materials.append(mat)
     bpy.ops.mesh.primitive_plane_add(size=30.0, location=(0, 0, -1.0))
     for kind, energy, loc in (("SUN", 3.0, (3, -3, 6)), ("POINT", 1000.0, (-4, -4, 4)), ("AREA", 500.0, (0, -6, 5))):
         data = bpy.data.lights.new(kind, kind)

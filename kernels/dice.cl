@@ -11,7 +11,8 @@
 __kernel void dice_grids(__global const SubPatch* diceable, uint count,
                          __global const float4* points, __global const uint* patch_info,
                          __global const uint* edges, __global const float4* curves,
-                         FrameParams f, __global float4* grid_p, __global float4* grid_n,
+                         __global const DeviceMaterial* materials, FrameParams f, __global float4* grid_p,
+                         __global float4* grid_n,
                          volatile __global uint* micropolygon_count) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
@@ -22,7 +23,13 @@ __kernel void dice_grids(__global const SubPatch* diceable, uint count,
   float3 p, dpdu, dpdv;
   mp_surface_point(points, patch_info, edges, curves, sp.patch, uv.x, uv.y, &p, &dpdu, &dpdv);
   uint flags = patch_info[4 * (ulong)sp.patch + 2];
-  float3 n = mp_surface_normal(points, patch_info, edges, curves, sp.patch, uv.x, uv.y, dpdu, dpdv);
+  /* Displaced materials move shared edge vertices along the edge's own normal
+   * (watertight); others shade with the patch's normal, which keeps polygon
+   * faces flat. */
+  float3 n = materials[patch_info[4 * (ulong)sp.patch + 1]].program[1] > 0.0f
+                 ? mp_surface_normal(points, patch_info, edges, curves, sp.patch, uv.x, uv.y, dpdu, dpdv)
+                 : mp_patch_normal(points + (ulong)sp.patch * MP_PATCH_POINTS, patch_info[4 * (ulong)sp.patch], uv.x,
+                                   uv.y, dpdu, dpdv);
   if (flags & MP_PATCH_FLIP_ORIENTATION) n = -n;
   grid_p[gid] = (float4)(p, 1.0f);
   grid_n[gid] = (float4)(n, 0.0f);

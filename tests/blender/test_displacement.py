@@ -166,6 +166,9 @@ def case_pinholes(views=12):
             cam = ru.add_camera(scene, d * distance, (0.0, 0.0, 0.0), lens=25.0 + 35.0 * rng.random())
             cam.data.clip_start = 0.001
             out = ru.render_passes(scene, "MICROPOLY", 120, 90, samples=16)
+            if out["depth"] is None:  # Blender 5.0: no depth read-back (render_utils); 3.4 and 4.5 cover this
+                print("pinhole views skipped: no depth pass read-back in this Blender")
+                return failures
             holes, covered = ru.pinholes(out["rgba"], out["depth"])
             if covered < 200:
                 failures.append(f"displaced {shape}, view {k} of seed {SEED}: the object is not in view")

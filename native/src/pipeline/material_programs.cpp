@@ -40,6 +40,24 @@ void MaterialPrograms::prepare(const Scene& scene, RenderStats& stats) {
   if (displaces_ && !normals_) normals_ = std::make_unique<cl::Kernel>(session_.program(), "displaced_normals");
 }
 
+namespace {
+
+// The arguments displace_grids and shade_program_grids share (material_program.cl).
+void set_grid_args(cl::Kernel& k, const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
+                   const FrameParams& f, cl_int program, GridBuffers& grids) {
+  k.setArg(0, diceable);
+  k.setArg(1, count);
+  k.setArg(2, scene.patch_info);
+  k.setArg(3, scene.materials);
+  k.setArg(4, scene.objects);
+  k.setArg(5, f);
+  k.setArg(6, program);
+  k.setArg(7, grids.p);
+  k.setArg(8, grids.n);
+}
+
+}  // namespace
+
 void MaterialPrograms::launch(cl::Kernel& kernel, cl_uint count, GridBuffers& grids, Stage stage, StageTimer& timer) {
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, round_up_range(count * grids.vertices_per_slot),
@@ -53,15 +71,7 @@ void MaterialPrograms::displace(const cl::Buffer& diceable, cl_uint count, const
   for (Active& a : active_) {
     if (!a.displaces) continue;
     cl::Kernel& k = a.built->displace;
-    k.setArg(0, diceable);
-    k.setArg(1, count);
-    k.setArg(2, scene.patch_info);
-    k.setArg(3, scene.materials);
-    k.setArg(4, scene.objects);
-    k.setArg(5, f);
-    k.setArg(6, a.index);
-    k.setArg(7, grids.p);
-    k.setArg(8, grids.n);
+    set_grid_args(k, diceable, count, scene, f, a.index, grids);
     launch(k, count, grids, Stage::Dice, timer);
   }
   cl::Kernel& k = *normals_;
@@ -80,15 +90,7 @@ void MaterialPrograms::shade(const cl::Buffer& diceable, cl_uint count, const Sc
   for (Active& a : active_) {
     if (!a.shades) continue;
     cl::Kernel& k = a.built->shade;
-    k.setArg(0, diceable);
-    k.setArg(1, count);
-    k.setArg(2, scene.patch_info);
-    k.setArg(3, scene.materials);
-    k.setArg(4, scene.objects);
-    k.setArg(5, f);
-    k.setArg(6, a.index);
-    k.setArg(7, grids.p);
-    k.setArg(8, grids.n);
+    set_grid_args(k, diceable, count, scene, f, a.index, grids);
     k.setArg(9, scene.lights);
     k.setArg(10, scene.light_count);
     k.setArg(11, grids.c);

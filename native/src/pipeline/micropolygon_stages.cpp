@@ -47,10 +47,11 @@ void DiceStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffer
   kernel_.setArg(3, scene.patch_info);
   kernel_.setArg(4, scene.patch_edges);
   kernel_.setArg(5, scene.edge_curves);
-  kernel_.setArg(6, f);
-  kernel_.setArg(7, grids.p);
-  kernel_.setArg(8, grids.n);
-  kernel_.setArg(9, counter_);
+  kernel_.setArg(6, scene.materials);
+  kernel_.setArg(7, f);
+  kernel_.setArg(8, grids.p);
+  kernel_.setArg(9, grids.n);
+  kernel_.setArg(10, counter_);
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(count * grids.vertices_per_slot),
                                         cl::NDRange(64), nullptr, &e);
