@@ -18,13 +18,8 @@ def _input(node, *names, default=None):
 
 
 def _surface_node(material):
-    if not material.use_nodes or material.node_tree is None:
-        return None
-    outputs = [n for n in material.node_tree.nodes if n.type == "OUTPUT_MATERIAL"]
-    active = [n for n in outputs if n.is_active_output] or outputs
-    if not active:
-        return None
-    links = active[0].inputs["Surface"].links
+    out = node_compiler.active_output(material)
+    links = out.inputs["Surface"].links if out is not None else ()
     return links[0].from_node if links else None
 
 

@@ -105,15 +105,17 @@ class NodeCompiler:
             self.warnings.append(f"material '{self.material.name}': node '{node.name}' ({node.bl_label}): {what}")
 
     @staticmethod
-    def convert(value, kind):
+    def convert(value, kind, from_type):
         expr, have, rng = value
         if have == kind:
             return value
         if kind == VEC:
             return f"(float3)({expr})", VEC, None
-        # Blender turns colors into floats by luminance; vectors average, but
-        # both reach here as float3 and color is the common case in materials.
-        return f"mp_rgb_to_bw({expr})", FLOAT, None
+        # Blender turns a color into a float by its luminance and a vector
+        # into the average of its components.
+        if from_type == "RGBA":
+            return f"mp_rgb_to_bw({expr})", FLOAT, None
+        return f"dot({expr}, (float3)(1.0f / 3.0f))", FLOAT, None
 
     def input(self, node, key, kind=None):
         socket = node.inputs[key] if isinstance(key, int) else (node.inputs.get(key) if hasattr(node.inputs, "get")
@@ -132,7 +134,7 @@ class NodeCompiler:
                     break
                 from_node, from_socket = inner[0].from_node, inner[0].from_socket
             if from_node is not None:
-                return self.convert(self.output(from_node, from_socket), kind)
+                return self.convert(self.output(from_node, from_socket), kind, from_socket.type)
         if not hasattr(socket, "default_value"):
             return ("0.0f", FLOAT, (0.0, 0.0)) if kind == FLOAT else ("(float3)(0.0f)", VEC, None)
         v = socket.default_value
@@ -408,14 +410,9 @@ class NodeCompiler:
         return text
 
     def compile(self):
-        tree = self.material.node_tree if self.material.use_nodes else None
-        if tree is None:
+        out = active_output(self.material)
+        if out is None:
             return None
-        outputs = [n for n in tree.nodes if n.type == "OUTPUT_MATERIAL" and n.target in ("ALL", "CYCLES")]
-        active = [n for n in outputs if n.is_active_output] or outputs
-        if not active:
-            return None
-        out = active[0]
         method = getattr(self.material, "displacement_method", None)
         if method is None:
             method = getattr(getattr(self.material, "cycles", None), "displacement_method", "BUMP")
@@ -491,6 +488,16 @@ class NodeCompiler:
                              "the node tree; 1 unit is assumed. Set Material > Micropoly > Displacement Bound if "
                              "displaced geometry is clipped")
         return 1.0
+
+
+def active_output(material):
+    """The Material Output node a render uses (for all engines or Cycles), or None."""
+    if not material.use_nodes or material.node_tree is None:
+        return None
+    outputs = [n for n in material.node_tree.nodes
+               if n.type == "OUTPUT_MATERIAL" and getattr(n, "target", "ALL") in ("ALL", "CYCLES")]
+    active = [n for n in outputs if n.is_active_output] or outputs
+    return active[0] if active else None
 
 
 def compile_material(material, warnings):

@@ -29,7 +29,7 @@ inline float3 mp_camera_normal_to_object(__global const DeviceObject* o, float3 
   return l > 0.0f ? r / l : (float3)(0.0f, 0.0f, 1.0f);
 }
 
-inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, float3 n, int ortho) {
+inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, float3 n) {
   MpNodeGlobals g;
   g.P = (float3)(mp_row3(o->to_object, 0, p, 1.0f), mp_row3(o->to_object, 1, p, 1.0f), mp_row3(o->to_object, 2, p, 1.0f));
   g.N = mp_camera_normal_to_object(o, n);
@@ -38,8 +38,6 @@ inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, f
   float3 rel = g.P - loc;
   g.generated = (float3)(size.x != 0.0f ? rel.x / (2.0f * size.x) : 0.0f, size.y != 0.0f ? rel.y / (2.0f * size.y) : 0.0f,
                          size.z != 0.0f ? rel.z / (2.0f * size.z) : 0.0f) + (float3)(0.5f, 0.5f, 0.5f);
-  float3 eye = ortho ? (float3)(0.0f, 0.0f, 1.0f) : -p;
-  g.incoming = mp_camera_normal_to_object(o, eye); /* a direction: rigid cameras keep it exact enough */
   return g;
 }
 
@@ -64,7 +62,7 @@ __kernel void displace_grids(__global const SubPatch* diceable, uint count, __gl
   if (!(materials[material].program[1] > 0.0f)) return;
   __global const DeviceObject* o = objects + object;
   float3 p = grid_p[gid].xyz;
-  MpNodeGlobals g = mp_node_globals(o, p, grid_n[gid].xyz, f.ortho);
+  MpNodeGlobals g = mp_node_globals(o, p, grid_n[gid].xyz);
   float3 d = mp_node_displacement(&g);
   if (!(isfinite(d.x) && isfinite(d.y) && isfinite(d.z))) return;
   grid_p[gid] = (float4)(p + mp_object_dir_to_camera(o, d), 1.0f);
@@ -82,7 +80,7 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   DeviceMaterial m = materials[material];
   if (!(m.program[2] > 0.0f)) return;
   float3 p = grid_p[gid].xyz, n = grid_n[gid].xyz;
-  MpNodeGlobals g = mp_node_globals(objects + object, p, n, f.ortho);
+  MpNodeGlobals g = mp_node_globals(objects + object, p, n);
   MpSurfaceInputs s;
   s.base_color = (float3)(m.color[0], m.color[1], m.color[2]);
   s.metallic = m.principled[0];

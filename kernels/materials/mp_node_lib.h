@@ -16,7 +16,6 @@ typedef struct {
   float3 P;
   float3 N;
   float3 generated;
-  float3 incoming; /* unit vector towards the eye, object space */
 } MpNodeGlobals;
 
 /* Principled BSDF inputs a surface program may set. */
@@ -164,7 +163,6 @@ MP_INLINE float mp_math(int op, float a, float b, float c) {
 #define MP_VMATH_TANGENT 24
 #define MP_VMATH_FACEFORWARD 25
 
-MP_INLINE float3 mp_nl_f3(float x, float y, float z) { return MP_F3(x, y, z); }
 MP_INLINE float3 mp_nl_safe_normalize(float3 a) {
   float l = length(a);
   return l > 0.0f ? a / l : MP_F3(0.0f, 0.0f, 0.0f);
@@ -177,7 +175,7 @@ MP_INLINE float3 mp_vector_math(int op, float3 a, float3 b, float3 c, float scal
     case MP_VMATH_ADD: return a + b;
     case MP_VMATH_SUBTRACT: return a - b;
     case MP_VMATH_MULTIPLY: return a * b;
-    case MP_VMATH_DIVIDE: return mp_nl_f3(mp_nl_safe_div(a.x, b.x), mp_nl_safe_div(a.y, b.y), mp_nl_safe_div(a.z, b.z));
+    case MP_VMATH_DIVIDE: return MP_F3(mp_nl_safe_div(a.x, b.x), mp_nl_safe_div(a.y, b.y), mp_nl_safe_div(a.z, b.z));
     case MP_VMATH_MULTIPLY_ADD: return a * b + c;
     case MP_VMATH_CROSS_PRODUCT: return cross(a, b);
     case MP_VMATH_PROJECT: {
@@ -194,22 +192,22 @@ MP_INLINE float3 mp_vector_math(int op, float3 a, float3 b, float3 c, float scal
     case MP_VMATH_LENGTH: *value = length(a); return MP_F3(0.0f, 0.0f, 0.0f);
     case MP_VMATH_SCALE: return a * scale;
     case MP_VMATH_NORMALIZE: return mp_nl_safe_normalize(a);
-    case MP_VMATH_ABSOLUTE: return mp_nl_f3(fabs(a.x), fabs(a.y), fabs(a.z));
+    case MP_VMATH_ABSOLUTE: return MP_F3(fabs(a.x), fabs(a.y), fabs(a.z));
     case MP_VMATH_MINIMUM: return fmin(a, b);
     case MP_VMATH_MAXIMUM: return fmax(a, b);
-    case MP_VMATH_FLOOR: return mp_nl_f3(floor(a.x), floor(a.y), floor(a.z));
-    case MP_VMATH_CEIL: return mp_nl_f3(ceil(a.x), ceil(a.y), ceil(a.z));
-    case MP_VMATH_FRACTION: return mp_nl_f3(mp_nl_fract(a.x), mp_nl_fract(a.y), mp_nl_fract(a.z));
+    case MP_VMATH_FLOOR: return MP_F3(floor(a.x), floor(a.y), floor(a.z));
+    case MP_VMATH_CEIL: return MP_F3(ceil(a.x), ceil(a.y), ceil(a.z));
+    case MP_VMATH_FRACTION: return MP_F3(mp_nl_fract(a.x), mp_nl_fract(a.y), mp_nl_fract(a.z));
     case MP_VMATH_MODULO:
-      return mp_nl_f3(mp_nl_safe_fmod(a.x, b.x), mp_nl_safe_fmod(a.y, b.y), mp_nl_safe_fmod(a.z, b.z));
+      return MP_F3(mp_nl_safe_fmod(a.x, b.x), mp_nl_safe_fmod(a.y, b.y), mp_nl_safe_fmod(a.z, b.z));
     case MP_VMATH_WRAP:
-      return mp_nl_f3(mp_nl_wrap(a.x, b.x, c.x), mp_nl_wrap(a.y, b.y, c.y), mp_nl_wrap(a.z, b.z, c.z));
+      return MP_F3(mp_nl_wrap(a.x, b.x, c.x), mp_nl_wrap(a.y, b.y, c.y), mp_nl_wrap(a.z, b.z, c.z));
     case MP_VMATH_SNAP:
-      return mp_nl_f3(b.x != 0.0f ? floor(a.x / b.x) * b.x : 0.0f, b.y != 0.0f ? floor(a.y / b.y) * b.y : 0.0f,
+      return MP_F3(b.x != 0.0f ? floor(a.x / b.x) * b.x : 0.0f, b.y != 0.0f ? floor(a.y / b.y) * b.y : 0.0f,
                       b.z != 0.0f ? floor(a.z / b.z) * b.z : 0.0f);
-    case MP_VMATH_SINE: return mp_nl_f3(sin(a.x), sin(a.y), sin(a.z));
-    case MP_VMATH_COSINE: return mp_nl_f3(cos(a.x), cos(a.y), cos(a.z));
-    case MP_VMATH_TANGENT: return mp_nl_f3(tan(a.x), tan(a.y), tan(a.z));
+    case MP_VMATH_SINE: return MP_F3(sin(a.x), sin(a.y), sin(a.z));
+    case MP_VMATH_COSINE: return MP_F3(cos(a.x), cos(a.y), cos(a.z));
+    case MP_VMATH_TANGENT: return MP_F3(tan(a.x), tan(a.y), tan(a.z));
   }
   return MP_F3(0.0f, 0.0f, 0.0f);
 }
@@ -264,11 +262,11 @@ MP_INLINE float3 mp_blend(int mode, float t, float3 a, float3 b) {
       return MP_F3(1.0f, 1.0f, 1.0f) - (MP_F3(tm, tm, tm) + t * (MP_F3(1.0f, 1.0f, 1.0f) - b)) *
                                            (MP_F3(1.0f, 1.0f, 1.0f) - a);
     case MP_BLEND_DIVIDE:
-      return mp_nl_f3(b.x != 0.0f ? tm * a.x + t * a.x / b.x : a.x, b.y != 0.0f ? tm * a.y + t * a.y / b.y : a.y,
+      return MP_F3(b.x != 0.0f ? tm * a.x + t * a.x / b.x : a.x, b.y != 0.0f ? tm * a.y + t * a.y / b.y : a.y,
                       b.z != 0.0f ? tm * a.z + t * a.z / b.z : a.z);
     case MP_BLEND_DIFFERENCE: {
       float3 d = a - b;
-      return tm * a + t * mp_nl_f3(fabs(d.x), fabs(d.y), fabs(d.z));
+      return tm * a + t * MP_F3(fabs(d.x), fabs(d.y), fabs(d.z));
     }
     case MP_BLEND_EXCLUSION: {
       float3 e = a + b - 2.0f * a * b;
@@ -276,18 +274,18 @@ MP_INLINE float3 mp_blend(int mode, float t, float3 a, float3 b) {
     }
     case MP_BLEND_DARKEN: return tm * a + t * fmin(a, b);
     case MP_BLEND_LIGHTEN: return tm * a + t * fmax(a, b);
-    case MP_BLEND_OVERLAY: return mp_nl_f3(mp_nl_overlay(t, a.x, b.x), mp_nl_overlay(t, a.y, b.y), mp_nl_overlay(t, a.z, b.z));
-    case MP_BLEND_DODGE: return mp_nl_f3(mp_nl_dodge(t, a.x, b.x), mp_nl_dodge(t, a.y, b.y), mp_nl_dodge(t, a.z, b.z));
-    case MP_BLEND_BURN: return mp_nl_f3(mp_nl_burn(t, a.x, b.x), mp_nl_burn(t, a.y, b.y), mp_nl_burn(t, a.z, b.z));
+    case MP_BLEND_OVERLAY: return MP_F3(mp_nl_overlay(t, a.x, b.x), mp_nl_overlay(t, a.y, b.y), mp_nl_overlay(t, a.z, b.z));
+    case MP_BLEND_DODGE: return MP_F3(mp_nl_dodge(t, a.x, b.x), mp_nl_dodge(t, a.y, b.y), mp_nl_dodge(t, a.z, b.z));
+    case MP_BLEND_BURN: return MP_F3(mp_nl_burn(t, a.x, b.x), mp_nl_burn(t, a.y, b.y), mp_nl_burn(t, a.z, b.z));
     case MP_BLEND_SOFT_LIGHT:
-      return mp_nl_f3(mp_nl_soft_light(t, a.x, b.x), mp_nl_soft_light(t, a.y, b.y), mp_nl_soft_light(t, a.z, b.z));
+      return MP_F3(mp_nl_soft_light(t, a.x, b.x), mp_nl_soft_light(t, a.y, b.y), mp_nl_soft_light(t, a.z, b.z));
     case MP_BLEND_LINEAR_LIGHT: return a + t * (2.0f * b - MP_F3(1.0f, 1.0f, 1.0f));
   }
   return a;
 }
 
 MP_INLINE float3 mp_nl_clamp01_3(float3 c) {
-  return mp_nl_f3(mp_nl_clamp01(c.x), mp_nl_clamp01(c.y), mp_nl_clamp01(c.z));
+  return MP_F3(mp_nl_clamp01(c.x), mp_nl_clamp01(c.y), mp_nl_clamp01(c.z));
 }
 
 /* ---- Map Range ------------------------------------------------------------ */
@@ -332,10 +330,10 @@ MP_INLINE float mp_clamp_node(int range_mode, float value, float lo, float hi) {
 MP_INLINE float3 mp_nl_euler_rotate(float3 v, float3 r, int inverse) {
   float cx = cos(r.x), sx = sin(r.x), cy = cos(r.y), sy = sin(r.y), cz = cos(r.z), sz = sin(r.z);
   /* Rows of R = Rz * Ry * Rx. */
-  float3 r0 = mp_nl_f3(cy * cz, sy * sx * cz - cx * sz, sy * cx * cz + sx * sz);
-  float3 r1 = mp_nl_f3(cy * sz, sy * sx * sz + cx * cz, sy * cx * sz - sx * cz);
-  float3 r2 = mp_nl_f3(-sy, cy * sx, cy * cx);
-  if (!inverse) return mp_nl_f3(dot(r0, v), dot(r1, v), dot(r2, v));
+  float3 r0 = MP_F3(cy * cz, sy * sx * cz - cx * sz, sy * cx * cz + sx * sz);
+  float3 r1 = MP_F3(cy * sz, sy * sx * sz + cx * cz, sy * cx * sz - sx * cz);
+  float3 r2 = MP_F3(-sy, cy * sx, cy * cx);
+  if (!inverse) return MP_F3(dot(r0, v), dot(r1, v), dot(r2, v));
   return v.x * r0 + v.y * r1 + v.z * r2; /* the transpose */
 }
 
@@ -343,12 +341,12 @@ MP_INLINE float3 mp_mapping(int type, float3 v, float3 location, float3 rotation
   switch (type) {
     case MP_MAPPING_POINT: return mp_nl_euler_rotate(v * scale, rotation, 0) + location;
     case MP_MAPPING_TEXTURE:
-      return mp_nl_f3(mp_nl_safe_div(1.0f, scale.x), mp_nl_safe_div(1.0f, scale.y), mp_nl_safe_div(1.0f, scale.z)) *
+      return MP_F3(mp_nl_safe_div(1.0f, scale.x), mp_nl_safe_div(1.0f, scale.y), mp_nl_safe_div(1.0f, scale.z)) *
              mp_nl_euler_rotate(v - location, rotation, 1);
     case MP_MAPPING_VECTOR: return mp_nl_euler_rotate(v * scale, rotation, 0);
     case MP_MAPPING_NORMAL:
       return mp_nl_safe_normalize(mp_nl_euler_rotate(
-          v * mp_nl_f3(mp_nl_safe_div(1.0f, scale.x), mp_nl_safe_div(1.0f, scale.y), mp_nl_safe_div(1.0f, scale.z)),
+          v * MP_F3(mp_nl_safe_div(1.0f, scale.x), mp_nl_safe_div(1.0f, scale.y), mp_nl_safe_div(1.0f, scale.z)),
           rotation, 0));
   }
   return v;

@@ -37,7 +37,6 @@ void MaterialPrograms::prepare(const Scene& scene, RenderStats& stats) {
                        static_cast<bool>(shades[i])});
     displaces_ = displaces_ || displaces[i];
   }
-  if (displaces_ && !normals_) normals_ = std::make_unique<cl::Kernel>(session_.program(), "displaced_normals");
 }
 
 namespace {
@@ -74,7 +73,7 @@ void MaterialPrograms::displace(const cl::Buffer& diceable, cl_uint count, const
     set_grid_args(k, diceable, count, scene, f, a.index, grids);
     launch(k, count, grids, Stage::Dice, timer);
   }
-  cl::Kernel& k = *normals_;
+  cl::Kernel& k = normals_;
   k.setArg(0, diceable);
   k.setArg(1, count);
   k.setArg(2, scene.patch_info);

@@ -21,10 +21,10 @@ namespace mp {
 
 class MaterialPrograms {
  public:
-  explicit MaterialPrograms(DeviceSession& session) : session_(session) {}
+  explicit MaterialPrograms(DeviceSession& session)
+      : session_(session), normals_(session.program(), "displaced_normals") {}
   // Builds what the scene's materials use; adds the build time to `stats`.
   void prepare(const Scene& scene, RenderStats& stats);
-  bool displaces() const { return displaces_; }
   // Displacement of every program that displaces, then the normals of the
   // displaced grids from their new vertices.
   void displace(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
@@ -49,7 +49,7 @@ class MaterialPrograms {
   std::unordered_map<std::string, std::unique_ptr<Built>> built_;  // by source
   std::vector<Active> active_;
   bool displaces_ = false;
-  std::unique_ptr<cl::Kernel> normals_;
+  cl::Kernel normals_;  // displaced_normals, from the main program
 };
 
 }  // namespace mp
