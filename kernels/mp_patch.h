@@ -50,6 +50,13 @@
 #define MP_EDGE_REFS 8
 #define MP_CURVE_FLOAT4S 8
 
+/* UV maps. Each patch has, per UV layer, its corner UVs in two float4:
+ * (uv(0,0), uv(1,0)) and (uv(1,1), uv(0,1)), at patch_uvs[2 * (patch *
+ * layers + layer)]. Inside the patch UVs are bilinear in the corners (exact
+ * for flat faces and for OpenSubdiv's linearly interpolated face-varying
+ * data); mp_patch_uv in mp_surface.h evaluates them watertight. */
+#define MP_MAX_UV_LAYERS 4
+
 /* Interior point indices in the 4x4 net and the index of their partners. */
 #define MP_INTERIOR_0 5
 #define MP_INTERIOR_1 6

@@ -100,6 +100,63 @@ MP_INLINE float3 mp_surface_normal(const MP_GLOBAL float4* points, const MP_GLOB
   return n;
 }
 
+/* Corner c (counter-clockwise from (0,0)) of a patch's UVs (mp_patch.h). */
+MP_INLINE float2 mp_uv_corner(const MP_GLOBAL float4* uvs, ulong base, uint c) {
+  float4 q = uvs[base + (c >> 1)];
+#ifdef __OPENCL_VERSION__
+  return (c & 1u) ? q.zw : q.xy;
+#else
+  return (c & 1u) ? float2(q.z, q.w) : float2(q.x, q.y);
+#endif
+}
+
+/* a + (b - a) s, returning the end points themselves at s = 0 and 1. */
+MP_INLINE float2 mp_uv_lerp(float2 a, float2 b, float s) {
+  return s == 0.0f ? a : s == 1.0f ? b : a + (b - a) * s;
+}
+
+/* UV of `layer` at (u, v) of patch `patch`. Inside, bilinear in the corner
+ * UVs. On the boundary, interpolated along the edge in its shared curve's
+ * direction between end points the host made bit-identical on both sides
+ * (patch_edges.cpp), so a shared vertex gets the same UV, and thus the same
+ * UV-driven displacement, from both patches. The coarse side of a
+ * transition edge interpolates each half from the edge's midpoint, which is
+ * the value the host gave the fine side's corner. */
+MP_INLINE float2 mp_patch_uv(const MP_GLOBAL float4* uvs, uint layers, const MP_GLOBAL uint* edges, uint patch,
+                             uint layer, float u, float v) {
+  ulong base = 2u * ((ulong)patch * layers + layer);
+  float t;
+  int e = mp_boundary_edge(u, v, &t);
+  if (e < 0) {
+    float2 c0 = mp_uv_corner(uvs, base, 0u), c1 = mp_uv_corner(uvs, base, 1u);
+    float2 c2 = mp_uv_corner(uvs, base, 2u), c3 = mp_uv_corner(uvs, base, 3u);
+    return (1.0f - v) * ((1.0f - u) * c0 + u * c1) + v * ((1.0f - u) * c3 + u * c2);
+  }
+  uint ea = e == 0 ? 0u : e == 1 ? 1u : e == 2 ? 3u : 0u;
+  uint eb = e == 0 ? 1u : e == 1 ? 2u : e == 2 ? 2u : 3u;
+  float2 a = mp_uv_corner(uvs, base, ea), b = mp_uv_corner(uvs, base, eb);
+  const MP_GLOBAL uint* refs = edges + (ulong)patch * MP_EDGE_REFS + 2u * (uint)e;
+  uint ref = refs[0];
+  if (refs[1] != MP_NO_CURVE) {
+    float2 m = a + (b - a) * 0.5f;
+    if (t <= 0.5f) {
+      b = m;
+      t = 2.0f * t;
+    } else {
+      a = m;
+      t = 2.0f * t - 1.0f;
+      ref = refs[1];
+    }
+  }
+  if (ref & 1u) {
+    float2 swap = a;
+    a = b;
+    b = swap;
+    t = 1.0f - t;
+  }
+  return mp_uv_lerp(a, b, t);
+}
+
 MP_INLINE float2 mp_corner(const SubPatch* sp, int k) {
   k &= 3;
 #ifdef __OPENCL_VERSION__

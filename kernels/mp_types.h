@@ -91,6 +91,16 @@ typedef struct {
   float texspace_size[4];
 } DeviceObject;
 
+/* A texture image (scene.h Image): its texels are width * height float4
+ * (RGBA, rows bottom to top) from `offset` in the texel buffer; srgb = 1
+ * when they hold sRGB-encoded colour to decode after filtering. */
+typedef struct {
+  uint offset;
+  uint width;
+  uint height;
+  uint srgb;
+} DeviceImage;
+
 #define MP_LIGHT_AMBIENT 0
 #define MP_LIGHT_DISTANT 1
 #define MP_LIGHT_POINT 2

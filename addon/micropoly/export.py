@@ -114,6 +114,11 @@ def export_scene(depsgraph):
     materials = export_materials.MaterialTable(native_scene, out.warnings)
     meshes = export_mesh.MeshCache()
     out.background = export_lights.export_world(native_scene, scene.world)
+    # Materials first: their node programs decide which UV maps meshes export.
+    for inst in depsgraph.object_instances:
+        if inst.object.type == "MESH":
+            for slot in inst.object.material_slots:
+                materials.get(slot.material)
     for inst in depsgraph.object_instances:
         obj = inst.object
         if obj.type == "MESH":

@@ -6,7 +6,10 @@ Principled BSDF and Diffuse BSDF give their constant inputs, an Emission
 shader gives emission; anything else falls back to the material's viewport
 color, metallic and roughness."""
 
-from . import node_compiler
+from . import export_images, node_compiler
+
+# Material programs see at most this many UV maps (MP_MAX_UV_LAYERS).
+MAX_UV_LAYERS = 4
 
 
 def _input(node, *names, default=None):
@@ -62,7 +65,23 @@ class MaterialTable:
         self.index = {}
         self.programs = {}  # generated source -> program index
         self.warnings = warnings if warnings is not None else []
+        # UV maps the programs read, by name ("" = each mesh's active render
+        # UV map); meshes export these layers in this order.
+        self.uv_names = []
+        self.images = export_images.ImageTable(native_scene)
         native_scene.add_material(name="default", **material_parameters(None))
+
+    # ---- what node programs ask for (node_compiler.NoResources) ----
+    def uv_layer(self, name):
+        if name not in self.uv_names:
+            if len(self.uv_names) == MAX_UV_LAYERS:
+                self.warnings.append(f"more than {MAX_UV_LAYERS} UV maps are used; '{name}' reads the first")
+                return 0
+            self.uv_names.append(name)
+        return self.uv_names.index(name)
+
+    def image(self, image, warn):
+        return self.images.get(image, warn)
 
     def get(self, material):
         if material is None:
@@ -70,7 +89,7 @@ class MaterialTable:
         key = material.name_full if hasattr(material, "name_full") else material.name
         if key not in self.index:
             params = material_parameters(material)
-            compiled = node_compiler.compile_material(material, self.warnings)
+            compiled = node_compiler.compile_material(material, self.warnings, self)
             if compiled is not None:
                 program = self.programs.get(compiled.source)
                 if program is None:

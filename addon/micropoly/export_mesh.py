@@ -57,7 +57,28 @@ class MeshCache:
         self.arrays = {}
 
 
-def _mesh_arrays(mesh, with_creases):
+def _uv_layers(mesh, names, n_loops):
+    """(len(names), n_loops, 2) UVs per face corner; "" names the active render
+    UV map; a map the mesh lacks reads zero, as in Cycles."""
+    out = np.zeros((len(names), n_loops, 2), dtype=np.float32)
+    layers = mesh.uv_layers
+    for k, name in enumerate(names):
+        if name:
+            layer = layers.get(name)
+        else:
+            layer = next((l for l in layers if l.active_render), None) or layers.active
+        if layer is None:
+            continue
+        flat = np.empty(n_loops * 2, dtype=np.float32)
+        if hasattr(layer, "uv"):  # Blender 3.5 and later
+            layer.uv.foreach_get("vector", flat)
+        else:
+            layer.data.foreach_get("uv", flat)
+        out[k] = flat.reshape(-1, 2)
+    return out
+
+
+def _mesh_arrays(mesh, with_creases, uv_names=()):
     n_verts, n_polys, n_loops, n_edges = len(mesh.vertices), len(mesh.polygons), len(mesh.loops), len(mesh.edges)
     points = np.empty(n_verts * 3, dtype=np.float32)
     mesh.vertices.foreach_get("co", points)
@@ -68,6 +89,8 @@ def _mesh_arrays(mesh, with_creases):
     material_index = np.empty(n_polys, dtype=np.int32)
     mesh.polygons.foreach_get("material_index", material_index)
     arrays = dict(points=points.reshape(-1, 3), counts=counts, indices=indices, material_index=material_index)
+    if uv_names:
+        arrays["uv_layers"] = _uv_layers(mesh, uv_names, n_loops)
     if with_creases:
         edge_crease = _float_attribute(mesh, "crease_edge", lambda m: m.edges, "crease", n_edges)
         creased = np.nonzero(edge_crease > 0.0)[0]
@@ -97,7 +120,8 @@ def export_object(native_scene, materials, cache, obj, matrix, warnings):
     if arrays is None:
         mesh = cage if cage is not None else obj.to_mesh()
         try:
-            arrays = _mesh_arrays(mesh, with_creases=subsurf is not None and subsurf.use_creases)
+            arrays = _mesh_arrays(mesh, with_creases=subsurf is not None and subsurf.use_creases,
+                                  uv_names=materials.uv_names)
         finally:
             if cage is None:
                 obj.to_mesh_clear()
@@ -121,7 +145,8 @@ def export_object(native_scene, materials, cache, obj, matrix, warnings):
         object_to_world=matrix, face_materials=face_materials,
         crease_vertices=arrays.get("crease_vertices", empty_i), crease_sharpness=arrays.get("crease_sharpness", empty_f),
         corner_vertices=arrays.get("corner_vertices", empty_i), corner_sharpness=arrays.get("corner_sharpness", empty_f),
-        boundary=boundary, double_sided=double_sided, **_texture_space(obj.original.data))
+        boundary=boundary, double_sided=double_sided, uv_layers=arrays.get("uv_layers", empty_f),
+        **_texture_space(obj.original.data))
     return True
 
 

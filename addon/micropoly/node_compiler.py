@@ -34,6 +34,8 @@ VORONOI_FEATURES = ["F1", "F2", "SMOOTH_F1", "DISTANCE_TO_EDGE", "N_SPHERE_RADIU
 VORONOI_METRICS = ["EUCLIDEAN", "MANHATTAN", "CHEBYCHEV", "MINKOWSKI"]
 TEXTURE_HEADERS = {"TEX_NOISE": "mp_tex_noise.h", "TEX_MUSGRAVE": "mp_tex_noise.h",
                    "TEX_VORONOI": "mp_tex_voronoi.h", "TEX_WAVE": "mp_tex_wave.h"}
+IMAGE_INTERPOLATION = {"Linear": 0, "Closest": 1, "Cubic": 2, "Smart": 2}  # Cycles renders Smart as Cubic
+IMAGE_EXTENSION = {"REPEAT": 0, "EXTEND": 1, "CLIP": 2, "MIRROR": 3}
 # A texture's Fac stays close to [0, 1]; displacement bounds derived from it
 # take this margin on both sides.
 FAC_RANGE = (-0.25, 1.25)
@@ -87,11 +89,24 @@ class _Function:
         return name, kind, value_range
 
 
+class NoResources:
+    """What a node tree may ask of the exporter: UV layer and image indices.
+    Without an exporter (tests of the compiler alone) UVs read layer 0 and
+    images are missing."""
+
+    def uv_layer(self, name):
+        return 0
+
+    def image(self, image, warn):
+        return -1, False
+
+
 class NodeCompiler:
-    def __init__(self, material, warnings, user_bound=0.0):
+    def __init__(self, material, warnings, user_bound=0.0, resources=None):
         self.material = material
         self.warnings = warnings
         self.user_bound = user_bound
+        self.resources = resources or NoResources()
         self.version = blender_version()
         self.headers = set()
         self.warned = set()
@@ -113,9 +128,10 @@ class NodeCompiler:
             return f"(float3)({expr})", VEC, None
         # Blender turns a color into a float by its luminance and a vector
         # into the average of its components.
+        # Both are weighted averages, so a range of the components carries over.
         if from_type == "RGBA":
-            return f"mp_rgb_to_bw({expr})", FLOAT, None
-        return f"dot({expr}, (float3)(1.0f / 3.0f))", FLOAT, None
+            return f"mp_rgb_to_bw({expr})", FLOAT, rng
+        return f"dot({expr}, (float3)(1.0f / 3.0f))", FLOAT, rng
 
     def input(self, node, key, kind=None):
         socket = node.inputs[key] if isinstance(key, int) else (node.inputs.get(key) if hasattr(node.inputs, "get")
@@ -174,6 +190,10 @@ class NodeCompiler:
             return self.input(node, key, VEC)[0]
         return "g->generated"  # textures default to Generated coordinates
 
+    def uv(self, name=""):
+        """The UV layer of that name ("": the mesh's active render UV map)."""
+        return f"g->uv[{self.resources.uv_layer(name)}]"
+
     def by_id(self, node, identifier, kind):
         for i, s in enumerate(node.inputs):
             if s.identifier == identifier:
@@ -187,11 +207,20 @@ class NodeCompiler:
         if t == "TEX_COORD":
             if getattr(node, "object", None) is not None:
                 self.warn(node, "Object coordinates of another object are not supported; using this object's")
-            for name in ("UV", "Camera", "Window", "Reflection"):
+            for name in ("Camera", "Window", "Reflection"):
                 if node.outputs[name].is_linked:
                     self.warn(node, f"the {name} output is not supported yet; it gives zero")
-            return {"Generated": ("g->generated", VEC, None), "Object": ("g->P", VEC, None),
+            outs = {"Generated": ("g->generated", VEC, None), "Object": ("g->P", VEC, None),
                     "Normal": ("g->N", VEC, None)}
+            if node.outputs["UV"].is_linked:
+                outs["UV"] = (self.uv(), VEC, None)
+            return outs
+        if t == "UVMAP":
+            if getattr(node, "from_instancer", False):
+                self.warn(node, "From Instancer is not supported; the object's own UV map is used")
+            return {"UV": (self.uv(node.uv_map), VEC, None)}
+        if t == "TEX_IMAGE":
+            return self.emit_image(node)
         if t == "NEW_GEOMETRY":
             self.warn(node, "only Normal is supported here, in object space")
             return {"Normal": ("g->N", VEC, None)}
@@ -402,6 +431,25 @@ class NodeCompiler:
                         f"{normalize}, {ver}, &{dist[0]}, &{col[0]}, &{pos[0]}, &{w[0]}, &{rad[0]});")
         return {"Distance": dist, "Color": col, "Position": pos, "W": w, "Radius": rad}
 
+    def emit_image(self, node):
+        self.headers.add("mp_tex_image.h")
+        if node.projection != "FLAT":
+            self.warn(node, f"{node.projection} projection is not supported; Flat is used")
+        index, byte_image = self.resources.image(node.image, lambda what: self.warn(node, what))
+        vec = self.input(node, "Vector", VEC)[0] if node.inputs["Vector"].is_linked else self.uv()
+        interp = IMAGE_INTERPOLATION.get(node.interpolation, 0)
+        ext = IMAGE_EXTENSION.get(node.extension, 0)
+        rgba = self.fn.temp("float4", f"mp_tex_image(g->images, g->image_count, g->texels, {index}, ({vec}).x, "
+                                      f"({vec}).y, {interp}, {ext})")[0]
+        # Cycles hands out colour premultiplied by alpha unless the Alpha
+        # output is used (or alpha is channel-packed, ignored, or data).
+        image = node.image
+        straight = node.outputs["Alpha"].is_linked or image is None or image.alpha_mode in ("CHANNEL_PACKED", "NONE") \
+            or image.colorspace_settings.is_data
+        color = f"{rgba}.xyz" if straight else f"({rgba}.xyz * {rgba}.w)"
+        rng = (0.0, 1.0) if byte_image else None  # 8-bit images hold [0, 1]
+        return {"Color": (color, VEC, rng), "Alpha": (f"{rgba}.w", FLOAT, (0.0, 1.0))}
+
     # ---- the material -----------------------------------------------------------
     def _function(self, header, body_fn):
         self.fn = _Function()
@@ -500,8 +548,9 @@ def active_output(material):
     return active[0] if active else None
 
 
-def compile_material(material, warnings):
-    """CompiledMaterial for a Blender material, or None if it needs no program."""
+def compile_material(material, warnings, resources=None):
+    """CompiledMaterial for a Blender material, or None if it needs no program.
+    `resources` gives UV layer and image indices (NoResources for the interface)."""
     settings = getattr(material, "micropoly", None)
     user_bound = float(getattr(settings, "displacement_bound", 0.0)) if settings is not None else 0.0
-    return NodeCompiler(material, warnings, user_bound).compile()
+    return NodeCompiler(material, warnings, user_bound, resources).compile()

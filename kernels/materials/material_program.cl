@@ -8,7 +8,10 @@
 #include "mp_patch.h"
 #include "mp_types.h"
 #include "mp_shading.h"
+#include "mp_patch_eval.h"
+#include "mp_surface.h"
 #include "materials/mp_node_lib.h"
+#include "textures/mp_tex_image.h"
 
 /* @MATERIAL_PROGRAM_SOURCE@ */
 
@@ -29,7 +32,19 @@ inline float3 mp_camera_normal_to_object(__global const DeviceObject* o, float3 
   return l > 0.0f ? r / l : (float3)(0.0f, 0.0f, 1.0f);
 }
 
-inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, float3 n) {
+/* What every material program kernel reads besides the grid: the patches'
+ * edges and UVs, and the texture images. */
+typedef struct {
+  __global const uint* edges;
+  __global const float4* uvs;
+  uint uv_layers;
+  __global const DeviceImage* images;
+  uint image_count;
+  __global const float4* texels;
+} MpProgramInputs;
+
+inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, float3 n, const MpProgramInputs* in,
+                                     uint patch, float2 uv) {
   MpNodeGlobals g;
   g.P = (float3)(mp_row3(o->to_object, 0, p, 1.0f), mp_row3(o->to_object, 1, p, 1.0f), mp_row3(o->to_object, 2, p, 1.0f));
   g.N = mp_camera_normal_to_object(o, n);
@@ -38,31 +53,49 @@ inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, f
   float3 rel = g.P - loc;
   g.generated = (float3)(size.x != 0.0f ? rel.x / (2.0f * size.x) : 0.0f, size.y != 0.0f ? rel.y / (2.0f * size.y) : 0.0f,
                          size.z != 0.0f ? rel.z / (2.0f * size.z) : 0.0f) + (float3)(0.5f, 0.5f, 0.5f);
+  for (uint k = 0; k < MP_MAX_UV_LAYERS; ++k) {
+    float2 t = k < in->uv_layers ? mp_patch_uv(in->uvs, in->uv_layers, in->edges, patch, k, uv.x, uv.y) : (float2)(0.0f);
+    g.uv[k] = (float3)(t.x, t.y, 0.0f);
+  }
+  g.images = in->images;
+  g.image_count = in->image_count;
+  g.texels = in->texels;
   return g;
 }
 
-/* The vertex this work-item handles, if its material uses this program. */
+/* The vertex this work-item handles, if its material uses this program,
+ * with its (u, v) on the patch. */
 inline int mp_program_vertex(uint gid, uint count, FrameParams f, __global const SubPatch* diceable,
                              __global const uint* patch_info, __global const DeviceMaterial* materials, int program,
-                             SubPatch* sp, uint* material, uint* object) {
+                             SubPatch* sp, uint* material, uint* object, float2* uv) {
   uint i, j;
   if (!mp_grid_vertex(gid, count, f.max_grid, diceable, sp, &i, &j)) return 0;
   *material = patch_info[4 * (ulong)sp->patch + 1];
   *object = MP_PATCH_OBJECT(patch_info[4 * (ulong)sp->patch + 2]);
+  *uv = mp_grid_uv(sp, MP_INFO_NU(sp->info), MP_INFO_NV(sp->info), i, j);
   return (int)materials[*material].program[0] == program;
 }
+
+#define MP_PROGRAM_INPUT_ARGS                                                                             \
+  __global const uint *patch_edges, __global const float4 *patch_uvs, uint uv_layers,                     \
+      __global const DeviceImage *images, uint image_count, __global const float4 *texels
+#define MP_PROGRAM_INPUTS {patch_edges, patch_uvs, uv_layers, images, image_count, texels}
 
 /* Moves each vertex by the program's displacement vector (object space). */
 __kernel void displace_grids(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
                              __global const DeviceMaterial* materials, __global const DeviceObject* objects,
-                             FrameParams f, int program, __global float4* grid_p, __global const float4* grid_n) {
+                             FrameParams f, int program, __global float4* grid_p, __global const float4* grid_n,
+                             MP_PROGRAM_INPUT_ARGS) {
   uint gid = get_global_id(0), material, object;
   SubPatch sp;
-  if (!mp_program_vertex(gid, count, f, diceable, patch_info, materials, program, &sp, &material, &object)) return;
+  float2 uv;
+  if (!mp_program_vertex(gid, count, f, diceable, patch_info, materials, program, &sp, &material, &object, &uv))
+    return;
   if (!(materials[material].program[1] > 0.0f)) return;
   __global const DeviceObject* o = objects + object;
   float3 p = grid_p[gid].xyz;
-  MpNodeGlobals g = mp_node_globals(o, p, grid_n[gid].xyz);
+  MpProgramInputs in = MP_PROGRAM_INPUTS;
+  MpNodeGlobals g = mp_node_globals(o, p, grid_n[gid].xyz, &in, sp.patch, uv);
   float3 d = mp_node_displacement(&g);
   if (!(isfinite(d.x) && isfinite(d.y) && isfinite(d.z))) return;
   grid_p[gid] = (float4)(p + mp_object_dir_to_camera(o, d), 1.0f);
@@ -72,15 +105,18 @@ __kernel void displace_grids(__global const SubPatch* diceable, uint count, __gl
 __kernel void shade_program_grids(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
                                   __global const DeviceMaterial* materials, __global const DeviceObject* objects,
                                   FrameParams f, int program, __global const float4* grid_p,
-                                  __global const float4* grid_n, __global const DeviceLight* lights, uint light_count,
-                                  __global float4* grid_c) {
+                                  __global const float4* grid_n, MP_PROGRAM_INPUT_ARGS,
+                                  __global const DeviceLight* lights, uint light_count, __global float4* grid_c) {
   uint gid = get_global_id(0), material, object;
   SubPatch sp;
-  if (!mp_program_vertex(gid, count, f, diceable, patch_info, materials, program, &sp, &material, &object)) return;
+  float2 uv;
+  if (!mp_program_vertex(gid, count, f, diceable, patch_info, materials, program, &sp, &material, &object, &uv))
+    return;
   DeviceMaterial m = materials[material];
   if (!(m.program[2] > 0.0f)) return;
   float3 p = grid_p[gid].xyz, n = grid_n[gid].xyz;
-  MpNodeGlobals g = mp_node_globals(objects + object, p, n);
+  MpProgramInputs in = MP_PROGRAM_INPUTS;
+  MpNodeGlobals g = mp_node_globals(objects + object, p, n, &in, sp.patch, uv);
   MpSurfaceInputs s;
   s.base_color = (float3)(m.color[0], m.color[1], m.color[2]);
   s.metallic = m.principled[0];

@@ -9,13 +9,21 @@
 #define MP_NODE_LIB_H
 
 #include "mp_compat.h"
+#include "mp_patch.h"
+#include "mp_types.h"
 
 /* What the nodes can read at a shading point. Object-space position and
- * normal (Texture Coordinate > Object and Normal), Generated coordinates. */
+ * normal (Texture Coordinate > Object and Normal), Generated coordinates,
+ * the scene's UV layers (z = 0, as Blender's UV output) and the texture
+ * images (Image Texture, textures/mp_tex_image.h). */
 typedef struct {
   float3 P;
   float3 N;
   float3 generated;
+  float3 uv[MP_MAX_UV_LAYERS];
+  MP_GLOBAL const DeviceImage* images;
+  MP_GLOBAL const float4* texels;
+  uint image_count;
 } MpNodeGlobals;
 
 /* Principled BSDF inputs a surface program may set. */

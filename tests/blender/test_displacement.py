@@ -2,11 +2,15 @@
 Cycles rendering the same scene (adaptive subdivision at a dicing rate of
 1 px, the same material, no bounces, light shadows off):
 
-  - a plane and a sphere displaced by Noise and by Voronoi: silhouettes agree
-    (alpha IoU >= 0.97) and so does depth on the pixels both cover (median
-    relative difference <= 1%);
+  - a plane and a sphere displaced by Noise, by Voronoi and by an image
+    texture read through the UV map: silhouettes agree (alpha IoU >= 0.97)
+    and so does depth on the pixels both cover (median relative difference
+    <= 1%);
   - a diffuse object whose base color comes from procedural textures through
-    a Color Ramp and Mix: Combined >= 30 dB PSNR against Cycles' direct light;
+    a Color Ramp and Mix and from an image through its UV map: Combined
+    >= 30 dB PSNR against Cycles' direct light;
+  - an emitting plane showing an image under every interpolation and
+    extension mode, with UVs reaching outside [0, 1]: >= 30 dB PSNR;
   - closed displaced surfaces (single-sided, Film > Transparent, 16 spp) show
     no pinholes from seeded views.
 Run: blender -b --factory-startup --python tests/blender/test_displacement.py"""
@@ -14,6 +18,7 @@ import math
 import os
 import random
 import sys
+import tempfile
 
 import bpy
 import numpy as np
@@ -33,11 +38,53 @@ def set_displacement_method(mat, method):
         mat.cycles.displacement_method = method
 
 
+IMAGE_DIR = tempfile.mkdtemp(prefix="micropoly_images_")
+
+
+def png_image(name, rgba, colorspace):
+    """Writes rgba ((h, w, 4) in [0, 1], rows bottom to top) as an 8-bit PNG
+    and loads it back, as an artist's image file would be."""
+    h, w = rgba.shape[:2]
+    img = bpy.data.images.new(name + "_src", w, h, alpha=True)
+    img.pixels.foreach_set(np.ascontiguousarray(rgba, dtype=np.float32).reshape(-1))
+    path = os.path.join(IMAGE_DIR, name + ".png")
+    img.filepath_raw = path
+    img.file_format = "PNG"
+    img.save()
+    bpy.data.images.remove(img)
+    loaded = bpy.data.images.load(path)
+    loaded.colorspace_settings.name = colorspace
+    return loaded
+
+
+def height_image():
+    """A smooth height field, periodic in u and v (no step at UV seams)."""
+    v, u = np.meshgrid((np.arange(64) + 0.5) / 64, (np.arange(128) + 0.5) / 128, indexing="ij")
+    h = 0.5 + 0.25 * np.sin(2 * math.pi * 3 * u) * np.cos(2 * math.pi * 2 * v) + 0.2 * np.cos(2 * math.pi * 5 * u)
+    rgba = np.ones((64, 128, 4))
+    rgba[..., :3] = h[..., None]
+    return png_image("height", rgba, "Non-Color")
+
+
+def color_image(w=96, h=48):
+    """Coloured stripes and blocks: sharp edges show any UV misplacement."""
+    v, u = np.meshgrid((np.arange(h) + 0.5) / h, (np.arange(w) + 0.5) / w, indexing="ij")
+    rgba = np.ones((h, w, 4))
+    rgba[..., 0] = 0.15 + 0.8 * (np.floor(u * 3) % 2)
+    rgba[..., 1] = 0.2 + 0.7 * v
+    rgba[..., 2] = 0.1 + 0.8 * (np.floor(v * 4) % 2) * (1 - u)
+    return png_image(f"color_{w}x{h}", rgba, "sRGB")
+
+
 def displaced_material(texture, scale):
     mat = ru.diffuse_material("displaced_" + texture, (0.8, 0.8, 0.8))
     nt = mat.node_tree
     out = next(n for n in nt.nodes if n.type == "OUTPUT_MATERIAL")
-    if texture == "noise":
+    if texture == "image":
+        tex = nt.nodes.new("ShaderNodeTexImage")  # default vector: the UV map
+        tex.image = height_image()
+        height = tex.outputs["Color"]
+    elif texture == "noise":
         tex = nt.nodes.new("ShaderNodeTexNoise")
         tex.inputs["Scale"].default_value = 2.5
         tex.inputs["Detail"].default_value = 3.0
@@ -72,17 +119,17 @@ def sun(scene):
     scene.collection.objects.link(obj)
 
 
-def render_both(scene):
-    mp = ru.render_passes(scene, "MICROPOLY", W, H, samples=16)
-    ru.setup_cycles(scene, samples=16)
-    cy = ru.render_passes(scene, "CYCLES", W, H, samples=16)
+def render_both(scene, w=W, h=H, samples=16, cycles_samples=16):
+    mp = ru.render_passes(scene, "MICROPOLY", w, h, samples=samples)
+    ru.setup_cycles(scene, samples=cycles_samples)
+    cy = ru.render_passes(scene, "CYCLES", w, h, samples=cycles_samples)
     return mp, cy
 
 
 def case_displaced(shape, texture):
     scene = ru.reset_scene()
     obj = add_surface(shape)
-    obj.data.materials.append(displaced_material(texture, 0.4 if texture == "noise" else 0.3))
+    obj.data.materials.append(displaced_material(texture, 0.4 if texture in ("noise", "image") else 0.3))
     if shape == "sphere":
         ru.add_camera(scene, (0.0, -4.0, 0.6), (0.0, 0.0, 0.0), lens=40)
     else:  # low enough that the bumps stand out against the background
@@ -131,7 +178,16 @@ def case_textured():
     links.new(noise.outputs["Fac"], ramp.inputs["Fac"])
     links.new(ramp.outputs["Color"], mix.inputs["Color1"])
     links.new(wave.outputs["Color"], mix.inputs["Color2"])
-    links.new(mix.outputs["Color"], bsdf.inputs["Color"])
+    image = nt.nodes.new("ShaderNodeTexImage")
+    image.image = color_image()
+    uv_map = nt.nodes.new("ShaderNodeUVMap")
+    uv_map.uv_map = obj.data.uv_layers[0].name
+    mix_image = nt.nodes.new("ShaderNodeMixRGB")
+    mix_image.inputs["Fac"].default_value = 0.5
+    links.new(uv_map.outputs["UV"], image.inputs["Vector"])
+    links.new(mix.outputs["Color"], mix_image.inputs["Color1"])
+    links.new(image.outputs["Color"], mix_image.inputs["Color2"])
+    links.new(mix_image.outputs["Color"], bsdf.inputs["Color"])
     obj.data.materials.append(mat)
     ru.add_camera(scene, (0.0, -4.0, 1.0), (0.0, 0.0, 0.0), lens=45)
     sun(scene)
@@ -142,11 +198,58 @@ def case_textured():
     return [] if value >= 30.0 else [f"textured diffuse sphere: PSNR {value:.2f} dB < 30"]
 
 
+def case_image_modes():
+    """Every interpolation and extension mode on an emitting plane whose UVs
+    run from -0.6 to 1.6, so the borders and the outside show. Shading at
+    grid vertices turns a texel edge into a ramp across one micropolygon,
+    placed where the grid falls; Closest's hard edges therefore need
+    micropolygons well below a pixel (shading rate 1/16) to follow
+    Cycles' per-sample lookups; both take more samples (64, and 256 for
+    Cycles' random ones) so that sampling noise along those edges does not
+    dominate the comparison."""
+    scene = ru.reset_scene()
+    scene.micropoly.shading_rate = 0.0625
+    bpy.ops.mesh.primitive_plane_add(size=2)
+    obj = bpy.context.active_object
+    mat = bpy.data.materials.new("image_modes")
+    mat.use_nodes = True
+    nt = mat.node_tree
+    for n in list(nt.nodes):
+        if n.type != "OUTPUT_MATERIAL":
+            nt.nodes.remove(n)
+    out = next(n for n in nt.nodes if n.type == "OUTPUT_MATERIAL")
+    emit = nt.nodes.new("ShaderNodeEmission")
+    coords = nt.nodes.new("ShaderNodeTexCoord")
+    mapping = nt.nodes.new("ShaderNodeMapping")
+    mapping.inputs["Location"].default_value = (-0.6, -0.6, 0.0)
+    mapping.inputs["Scale"].default_value = (2.2, 2.2, 1.0)
+    image = nt.nodes.new("ShaderNodeTexImage")
+    image.image = color_image(12, 6)  # few texels: interpolation differences show
+    nt.links.new(coords.outputs["UV"], mapping.inputs["Vector"])
+    nt.links.new(mapping.outputs["Vector"], image.inputs["Vector"])
+    nt.links.new(image.outputs["Color"], emit.inputs["Color"])
+    nt.links.new(emit.outputs["Emission"], out.inputs["Surface"])
+    obj.data.materials.append(mat)
+    ru.add_camera(scene, (0.0, 0.0, 3.0), (0.0, 0.0, 0.0), lens=50)
+    extensions = ["REPEAT", "EXTEND", "CLIP"] + (["MIRROR"] if bpy.app.version >= (3, 5, 0) else [])
+    failures = []
+    for interpolation in ("Closest", "Linear", "Cubic"):
+        for extension in extensions:
+            image.interpolation, image.extension = interpolation, extension
+            mp, cy = render_both(scene, 96, 96, samples=64, cycles_samples=256)
+            both = (mp["rgba"][..., 3] > 0.99) & (cy["rgba"][..., 3] > 0.99)
+            value = ru.psnr(mp["rgba"][..., :3][both], cy["rgba"][..., :3][both])
+            print(f"image {interpolation} / {extension}: PSNR {value:.2f} dB over {both.sum()} pixels")
+            if value < 30.0:
+                failures.append(f"image texture {interpolation} / {extension}: PSNR {value:.2f} dB < 30")
+    return failures
+
+
 def case_pinholes(views=12):
     """Closed displaced surfaces from seeded views, near and far."""
     rng = random.Random(SEED)
     failures = []
-    for shape in ("sphere", "torus"):
+    for shape, texture in (("sphere", "noise"), ("torus", "noise"), ("torus", "image")):
         scene = ru.reset_scene()
         if shape == "sphere":
             obj = add_surface("sphere")
@@ -154,7 +257,7 @@ def case_pinholes(views=12):
             bpy.ops.mesh.primitive_torus_add(major_segments=16, minor_segments=8, minor_radius=0.4)
             obj = bpy.context.active_object
             obj.modifiers.new("Subdivision", "SUBSURF")
-        mat = displaced_material("noise", 0.3)
+        mat = displaced_material(texture, 0.3)
         mat.use_backface_culling = True
         obj.data.materials.append(mat)
         sun(scene)
@@ -171,19 +274,20 @@ def case_pinholes(views=12):
                 return failures
             holes, covered = ru.pinholes(out["rgba"], out["depth"])
             if covered < 200:
-                failures.append(f"displaced {shape}, view {k} of seed {SEED}: the object is not in view")
+                failures.append(f"{shape} displaced by {texture}, view {k} of seed {SEED}: the object is not in view")
             if holes:
-                failures.append(f"displaced {shape}, view {k} of seed {SEED}: {holes} pinhole pixels")
-        print(f"displaced {shape}: {views} views checked for pinholes")
+                failures.append(f"{shape} displaced by {texture}, view {k} of seed {SEED}: {holes} pinhole pixels")
+        print(f"{shape} displaced by {texture}: {views} views checked for pinholes")
     return failures
 
 
 def main():
     failures = []
     for shape in ("plane", "sphere"):
-        for texture in ("noise", "voronoi"):
+        for texture in ("noise", "voronoi", "image"):
             failures += case_displaced(shape, texture)
     failures += case_textured()
+    failures += case_image_modes()
     failures += case_pinholes()
     print("\n".join(failures) if failures else "displacement: OK")
     return 1 if failures else 0

@@ -60,6 +60,56 @@ TEST_F(MaterialProgramTest, SurfaceProgramColorsByGeneratedCoordinates) {
   }
 }
 
+// UVs that are an affine function of position reach the program unchanged
+// wherever the surface is that same affine image of its faces: a flat n-gon
+// (split into quads around its centroid) and the interior of a uniform
+// Catmull-Clark grid, whose limit surface reproduces linear functions (UVs
+// pass through OpenSubdiv's face-varying patches there).
+glm::vec2 affine_uv(glm::vec3 p) { return {0.1f * p.x + 0.3f, 0.05f * p.y + 0.02f * p.x + 0.2f}; }
+
+void set_affine_uvs(Mesh& m) {
+  std::vector<glm::vec2> layer;
+  for (int v : m.face_vertex_indices) layer.push_back(affine_uv(m.points[size_t(v)]));
+  m.uv_layers = {std::vector<glm::vec2>(layer.size(), glm::vec2(7.0f)), layer};  // layer 1 is read
+}
+
+void expect_affine_uv_colours(const RenderResult& r, const char* what) {
+  const float half = 5.0f * std::tan(glm::radians(22.5f));
+  for (int row : {10, 32, 50})
+    for (int c : {8, 20, 32, 44, 56}) {
+      const glm::vec3 p(half * ((c + 0.5f) / 32.0f - 1.0f), -half * ((row + 0.5f) / 32.0f - 1.0f), 0.0f);
+      const glm::vec2 uv = affine_uv(p);
+      const size_t px = 4 * (size_t(row) * 64 + size_t(c));
+      EXPECT_NEAR(r.rgba[px], uv.x, 2e-3f) << what << " row " << row << " column " << c;
+      EXPECT_NEAR(r.rgba[px + 1], uv.y, 2e-3f) << what << " row " << row << " column " << c;
+    }
+}
+
+TEST_F(MaterialProgramTest, SurfaceProgramReadsUVLayers) {
+  const std::string program = std::string(kNoDisplacement) +
+                              "void mp_node_surface(const MpNodeGlobals* g, MpSurfaceInputs* s) {"
+                              " s->base_color = (float3)(g->uv[1].x, g->uv[1].y, 0.0f); }\n";
+  Scene s = facing_plane(static_cast<int>(Material::Model::Constant));
+  s.meshes[0] = polygon({{-4, -3, 0}, {3, -4, 0}, {5, 1, 0}, {0, 4, 0}, {-5, 2, 0}});
+  set_affine_uvs(s.meshes[0]);
+  s.material_programs.push_back({"uv", program});
+  s.materials[0].program_shades = true;
+  expect_affine_uv_colours(renderer_->render(s), "pentagon");
+
+  s.meshes[0] = grid_mesh(12, 6.0f, SubdivScheme::CatmullClark);
+  set_affine_uvs(s.meshes[0]);
+  expect_affine_uv_colours(renderer_->render(s), "subdivided grid");
+}
+
+TEST_F(MaterialProgramTest, UVMapsOfTheWrongSizeAreRejected) {
+  Scene s = facing_plane(static_cast<int>(Material::Model::Matte));
+  s.material_programs.push_back({"ok", std::string(kNoDisplacement) + kNoSurface});
+  s.meshes[0].uv_layers = {std::vector<glm::vec2>(3)};
+  EXPECT_THROW(validate_scene(s), Error);
+  s.meshes[0].uv_layers = {std::vector<glm::vec2>(4, glm::vec2(std::nanf(""), 0.0f))};
+  EXPECT_THROW(validate_scene(s), Error);
+}
+
 TEST_F(MaterialProgramTest, ProgramThatDoesNotCompileNamesTheMaterial) {
   Scene s = facing_plane(static_cast<int>(Material::Model::Matte));
   s.material_programs.push_back({"node material", "this is not OpenCL C"});

@@ -35,6 +35,12 @@ struct Mesh {
   // A zero size means the bounding box of `points`.
   glm::vec3 texspace_location{0.0f};
   glm::vec3 texspace_size{0.0f};
+  // UV maps, each one (u, v) per face corner (face_vertex_indices order).
+  // Layer k is what material programs read as UV layer k (MpNodeGlobals.uv);
+  // a mesh with fewer layers reads zeros from the missing ones. Inside each
+  // face (each ptex sub-face of a subdivided non-quad) UVs interpolate
+  // bilinearly, as OpenSubdiv's face-varying "linear all" rule does.
+  std::vector<std::vector<glm::vec2>> uv_layers;
 };
 
 // Bicubic patches already converted to Bezier form: 16 control points per
@@ -81,6 +87,18 @@ struct Material {
 struct MaterialProgram {
   std::string name;    // for messages: the material it came from
   std::string source;
+};
+
+// A texture image for material programs (Image Texture nodes): RGBA, rows
+// bottom to top as Blender stores them; texel (i, j) covers [i, i+1]/width x
+// [j, j+1]/height of UV space. Pixels are scene-linear, or, with `srgb`,
+// sRGB-encoded values that are decoded after filtering, as Cycles treats
+// 8-bit sRGB images (so filtered results match it).
+struct Image {
+  std::string name;
+  int width = 0, height = 0;
+  std::vector<glm::vec4> pixels;  // width * height
+  bool srgb = false;
 };
 
 // Light sources in world space. For point and spot lights color * intensity
@@ -149,6 +167,7 @@ struct Scene {
   RenderSettings settings;
   std::vector<Material> materials;             // index 0 is the default
   std::vector<MaterialProgram> material_programs;
+  std::vector<Image> images;
   std::vector<Light> lights;
   std::vector<Mesh> meshes;
   std::vector<BezierPatches> bezier_patches;

@@ -53,6 +53,12 @@ void set_grid_args(cl::Kernel& k, const cl::Buffer& diceable, cl_uint count, con
   k.setArg(6, program);
   k.setArg(7, grids.p);
   k.setArg(8, grids.n);
+  k.setArg(9, scene.patch_edges);
+  k.setArg(10, scene.patch_uvs);
+  k.setArg(11, scene.uv_layers);
+  k.setArg(12, scene.images);
+  k.setArg(13, scene.image_count);
+  k.setArg(14, scene.texels);
 }
 
 }  // namespace
@@ -90,9 +96,9 @@ void MaterialPrograms::shade(const cl::Buffer& diceable, cl_uint count, const Sc
     if (!a.shades) continue;
     cl::Kernel& k = a.built->shade;
     set_grid_args(k, diceable, count, scene, f, a.index, grids);
-    k.setArg(9, scene.lights);
-    k.setArg(10, scene.light_count);
-    k.setArg(11, grids.c);
+    k.setArg(15, scene.lights);
+    k.setArg(16, scene.light_count);
+    k.setArg(17, grids.c);
     launch(k, count, grids, Stage::Shade, timer);
   }
 }

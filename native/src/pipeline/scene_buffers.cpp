@@ -114,6 +114,8 @@ cl::Buffer upload(cl::Context& context, cl::CommandQueue& queue, const std::vect
 HostSceneData prepare_scene_data(const Scene& scene) {
   HostSceneData out;
   const glm::mat4& w2c = scene.camera.world_to_camera;
+  for (const Mesh& mesh : scene.meshes)
+    out.patches.uv_layers = std::max(out.patches.uv_layers, int(mesh.uv_layers.size()));
   // Each surface's patches share their edges' curves (patch_edges.h), so
   // neighbouring patches dice watertight; separate surfaces do not.
   for (const Mesh& mesh : scene.meshes) {
@@ -138,6 +140,11 @@ HostSceneData prepare_scene_data(const Scene& scene) {
   if (scene.materials.empty()) out.materials.push_back(to_device(Material{}));
   for (const Material& m : scene.materials) out.materials.push_back(to_device(m));
   for (const Light& l : scene.lights) out.lights.push_back(to_device(l, w2c));
+  for (const Image& image : scene.images) {
+    out.images.push_back(DeviceImage{uint32_t(out.texels.size()), uint32_t(image.width), uint32_t(image.height),
+                                     image.srgb ? 1u : 0u});
+    out.texels.insert(out.texels.end(), image.pixels.begin(), image.pixels.end());
+  }
   return out;
 }
 
@@ -150,6 +157,11 @@ SceneBuffers upload_scene_data(cl::Context& context, cl::CommandQueue& queue, co
   b.materials = upload(context, queue, data.materials);
   b.objects = upload(context, queue, data.objects);
   b.lights = upload(context, queue, data.lights);
+  b.patch_uvs = upload(context, queue, data.patches.uvs);
+  b.images = upload(context, queue, data.images);
+  b.texels = upload(context, queue, data.texels);
+  b.uv_layers = static_cast<cl_uint>(data.patches.uv_layers);
+  b.image_count = static_cast<cl_uint>(data.images.size());
   b.patch_count = static_cast<cl_uint>(data.patches.size());
   b.light_count = static_cast<cl_uint>(data.lights.size());
   queue.finish();

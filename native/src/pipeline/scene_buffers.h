@@ -17,6 +17,8 @@ struct HostSceneData {
   std::vector<DeviceMaterial> materials;
   std::vector<DeviceLight> lights;
   std::vector<DeviceObject> objects;  // one per surface, in patch order (MP_PATCH_OBJECT)
+  std::vector<DeviceImage> images;
+  std::vector<glm::vec4> texels;      // every image's pixels, one after the other
 };
 HostSceneData prepare_scene_data(const Scene& scene);
 
@@ -28,8 +30,13 @@ struct SceneBuffers {
   cl::Buffer materials;
   cl::Buffer objects;
   cl::Buffer lights;
+  cl::Buffer patch_uvs;   // 2 float4 per patch and UV layer (kernels/mp_patch.h)
+  cl::Buffer images;      // DeviceImage per image
+  cl::Buffer texels;      // float4
   cl_uint patch_count = 0;
   cl_uint light_count = 0;
+  cl_uint uv_layers = 0;
+  cl_uint image_count = 0;
 };
 SceneBuffers upload_scene_data(cl::Context& context, cl::CommandQueue& queue, const HostSceneData& data);
 

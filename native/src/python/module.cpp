@@ -230,8 +230,18 @@ PYBIND11_MODULE(_native, m) {
              const Array<int>& face_materials, const Array<int>& crease_vertices, const Array<float>& crease_sharpness,
              const Array<int>& corner_vertices, const Array<float>& corner_sharpness, const Array<int>& hole_faces,
              const std::string& boundary, bool double_sided, std::vector<float> texspace_location,
-             std::vector<float> texspace_size) {
+             std::vector<float> texspace_size, const Array<float>& uv_layers) {
             Mesh mesh;
+            if (uv_layers.size() > 0) {
+              if (uv_layers.ndim() != 3 || uv_layers.shape(2) != 2)
+                throw Error("mesh '" + name + "': uv_layers must be a (layers, face corners, 2) array");
+              const auto per_layer = static_cast<size_t>(uv_layers.shape(1));
+              for (py::ssize_t k = 0; k < uv_layers.shape(0); ++k) {
+                std::vector<glm::vec2> layer(per_layer);
+                std::memcpy(layer.data(), uv_layers.data(k, 0, 0), per_layer * sizeof(glm::vec2));
+                mesh.uv_layers.push_back(std::move(layer));
+              }
+            }
             mesh.texspace_location = to_vec3(texspace_location, "texspace_location");
             mesh.texspace_size = to_vec3(texspace_size, "texspace_size");
             mesh.name = name;
@@ -261,7 +271,27 @@ PYBIND11_MODULE(_native, m) {
           py::arg("corner_sharpness") = Array<float>(), py::arg("hole_faces") = Array<int>(),
           py::arg("boundary") = "edge_and_corner", py::arg("double_sided") = true,
           py::arg("texspace_location") = std::vector<float>{0, 0, 0},
-          py::arg("texspace_size") = std::vector<float>{0, 0, 0})
+          py::arg("texspace_size") = std::vector<float>{0, 0, 0}, py::arg("uv_layers") = Array<float>(),
+          "Adds a mesh; uv_layers is (layers, face corners, 2): UV layer k is what material programs read as "
+          "UV layer k.")
+      .def(
+          "add_image",
+          [](Scene& s, const std::string& name, const Array<float>& pixels, bool srgb) {
+            if (pixels.ndim() != 3 || pixels.shape(2) != 4)
+              throw Error("image '" + name + "': pixels must be a (height, width, 4) array");
+            Image im;
+            im.name = name;
+            im.srgb = srgb;
+            im.height = static_cast<int>(pixels.shape(0));
+            im.width = static_cast<int>(pixels.shape(1));
+            im.pixels.resize(static_cast<size_t>(pixels.size() / 4));
+            std::memcpy(im.pixels.data(), pixels.data(), im.pixels.size() * sizeof(glm::vec4));
+            s.images.push_back(std::move(im));
+            return s.images.size() - 1;
+          },
+          py::arg("name"), py::arg("pixels"), py::arg("srgb") = false,
+          "Adds a texture image: (height, width, 4) RGBA, rows bottom to top, scene-linear or (srgb) sRGB-encoded "
+          "colour decoded after filtering; returns its index.")
       .def("validate", [](const Scene& s) { validate_scene(s); })
       .def_property_readonly("mesh_count", [](const Scene& s) { return s.meshes.size(); })
       .def_property_readonly("patch_set_count", [](const Scene& s) { return s.bezier_patches.size(); })

@@ -5,11 +5,14 @@
 
 #include "micropoly/error.h"
 #include "micropoly/scene.h"
+#include "mp_patch.h"
 
 namespace mp {
 namespace {
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+bool finite(const glm::vec4& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) && std::isfinite(v.w); }
 
 bool finite(const glm::mat4& m) {
   for (int c = 0; c < 4; ++c)
@@ -62,6 +65,16 @@ void validate_mesh(const Mesh& m, size_t materials) {
     if (!std::isfinite(s) || s < 0) fail(what, m.name, "corner sharpness must be finite and >= 0");
   for (int h : m.hole_faces)
     if (h < 0 || static_cast<size_t>(h) >= m.face_vertex_counts.size()) fail(what, m.name, "hole face index out of range");
+  if (m.uv_layers.size() > MP_MAX_UV_LAYERS)
+    fail(what, m.name, "has " + std::to_string(m.uv_layers.size()) + " UV maps; at most " +
+                           std::to_string(MP_MAX_UV_LAYERS) + " are supported");
+  for (size_t k = 0; k < m.uv_layers.size(); ++k) {
+    if (m.uv_layers[k].size() != m.face_vertex_indices.size())
+      fail(what, m.name, "UV map " + std::to_string(k) + " has " + std::to_string(m.uv_layers[k].size()) +
+                             " values; it needs one per face corner (" + std::to_string(m.face_vertex_indices.size()) + ")");
+    for (const glm::vec2& uv : m.uv_layers[k])
+      if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) fail(what, m.name, "UV map " + std::to_string(k) + " has a NaN or infinite value");
+  }
   check_material_index(m.material, materials, what, m.name);
   if (!m.face_materials.empty()) {
     if (m.face_materials.size() != m.face_vertex_counts.size())
@@ -117,6 +130,12 @@ void validate_scene(const Scene& scene) {
       fail("light", std::to_string(i), "has NaN or infinite values");
   }
   for (const Mesh& m : scene.meshes) validate_mesh(m, scene.materials.size());
+  for (const Image& im : scene.images) {
+    if (im.width <= 0 || im.height <= 0 || im.pixels.size() != size_t(im.width) * size_t(im.height))
+      fail("image", im.name, "needs width * height pixels");
+    for (const glm::vec4& p : im.pixels)
+      if (!finite(p)) fail("image", im.name, "has NaN or infinite pixels");
+  }
   for (const BezierPatches& b : scene.bezier_patches) {
     if (b.control_points.size() % 16 != 0) fail("patch set", b.name, "needs 16 control points per bicubic patch");
     for (const glm::vec3& p : b.control_points)

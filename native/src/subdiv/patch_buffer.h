@@ -14,7 +14,11 @@ struct PatchBuffer {
   std::vector<glm::vec4> points;  // MP_PATCH_POINTS per patch, already transformed
   std::vector<glm::uvec4> info;   // PatchInfo per patch (type, material, flags, prim id)
   std::vector<uint32_t> edges;    // MP_EDGE_REFS curve references per patch (kernels/mp_patch.h)
-  std::vector<glm::vec4> curves;  // 4 control points per shared edge curve
+  std::vector<glm::vec4> curves;  // MP_CURVE_FLOAT4S float4 per shared edge curve
+  // UV maps: uv_layers x 2 float4 per patch, the corner UVs of each layer
+  // (MP_PATCH_UV_* in kernels/mp_patch.h). Set uv_layers before appending.
+  int uv_layers = 0;
+  std::vector<glm::vec4> uvs;
   size_t size() const { return info.size(); }
 };
 

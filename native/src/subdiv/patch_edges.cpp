@@ -114,6 +114,65 @@ void halve(const glm::vec3* p, glm::vec3* first, glm::vec3* second) {
   second[0] = glm::vec3(m), second[1] = glm::vec3(bcd), second[2] = glm::vec3(cd), second[3] = p[3];
 }
 
+// A coarse patch edge whose other side is two half edges meeting at corner `middle`.
+struct Transition {
+  size_t patch;
+  int edge;
+  uint32_t middle;
+};
+
+// Corner UVs made bit-identical where patches meet, so that the device's UV
+// on a shared edge (mp_patch_uv) is the same from both sides: UVs of one
+// welded corner that agree within rounding take one value (UV seams, where
+// they differ, stay apart), and the half edges of a transition take, at
+// their shared corner, exactly the midpoint the coarse side computes.
+void share_corner_uvs(PatchBuffer& buffer, size_t first, const std::vector<uint32_t>& corner_rep,
+                      const std::vector<Transition>& transitions) {
+  const int layers = buffer.uv_layers;
+  if (layers == 0) return;
+  // Counter-clockwise corner c of a patch: (0,0), (1,0), (1,1), (0,1); its
+  // index in corner_rep (which follows kCorners) and the edges' end corners.
+  constexpr int kRepIndex[4] = {0, 1, 3, 2};
+  constexpr int kEdgeEnds[4][2] = {{0, 1}, {1, 2}, {3, 2}, {0, 3}};
+  auto uv = [&](size_t p, int layer, int c) -> glm::vec4& { return buffer.uvs[(p * size_t(layers) + size_t(layer)) * 2 + size_t(c >> 1)]; };
+  auto get = [&](size_t p, int layer, int c) { glm::vec4& q = uv(p, layer, c); return (c & 1) ? glm::vec2(q.z, q.w) : glm::vec2(q.x, q.y); };
+  auto set = [&](size_t p, int layer, int c, glm::vec2 v) {
+    glm::vec4& q = uv(p, layer, c);
+    if (c & 1) q.z = v.x, q.w = v.y;
+    else q.x = v.x, q.y = v.y;
+  };
+  auto close = [](glm::vec2 a, glm::vec2 b) {
+    glm::vec2 d = glm::abs(a - b);
+    float scale = std::max(1.0f, std::max(std::max(std::abs(a.x), std::abs(a.y)), std::max(std::abs(b.x), std::abs(b.y))));
+    return std::max(d.x, d.y) <= 1e-5f * scale;
+  };
+  auto snap = [&](std::unordered_map<uint64_t, std::vector<glm::vec2>>& values, bool add) {
+    for (size_t p = first; p < buffer.size(); ++p)
+      for (int layer = 0; layer < layers; ++layer)
+        for (int c = 0; c < 4; ++c) {
+          const uint64_t key = (uint64_t(corner_rep[(p - first) * 4 + size_t(kRepIndex[c])]) << 8) | uint64_t(layer);
+          auto it = values.find(key);
+          const glm::vec2 v = get(p, layer, c);
+          if (it != values.end()) {
+            auto same = std::find_if(it->second.begin(), it->second.end(), [&](glm::vec2 w) { return close(v, w); });
+            if (same != it->second.end()) {
+              set(p, layer, c, *same);
+              continue;
+            }
+          }
+          if (add) values[key].push_back(v);
+        }
+  };
+  std::unordered_map<uint64_t, std::vector<glm::vec2>> welded, midpoints;
+  snap(welded, true);
+  for (const Transition& t : transitions)
+    for (int layer = 0; layer < layers; ++layer) {
+      const glm::vec2 a = get(t.patch, layer, kEdgeEnds[t.edge][0]), b = get(t.patch, layer, kEdgeEnds[t.edge][1]);
+      midpoints[(uint64_t(t.middle) << 8) | uint64_t(layer)].push_back(a + (b - a) * 0.5f);  // as mp_patch_uv
+    }
+  snap(midpoints, false);
+}
+
 }  // namespace
 
 void share_patch_edges(PatchBuffer& buffer, size_t first) {
@@ -189,6 +248,7 @@ void share_patch_edges(PatchBuffer& buffer, size_t first) {
     neighbours[c.start].push_back(c.end);
     neighbours[c.end].push_back(c.start);
   }
+  std::vector<Transition> transitions;
   for (size_t p = first; p < buffer.size(); ++p)
     for (int e = 0; e < 4; ++e) {
       uint32_t& ref = refs[(p - first) * 4 + size_t(e)];
@@ -206,6 +266,7 @@ void share_patch_edges(PatchBuffer& buffer, size_t first) {
           uint32_t ra = find_or_add(s, m, a, false), rb = find_or_add(m, t, b, false);
           if (ra != MP_NO_CURVE && rb != MP_NO_CURVE) {
             half_refs[0] = ra, half_refs[1] = rb;
+            transitions.push_back({p, e, m});
             break;
           }
         }
@@ -213,6 +274,8 @@ void share_patch_edges(PatchBuffer& buffer, size_t first) {
       buffer.edges[p * MP_EDGE_REFS + 2 * size_t(e)] = half_refs[0];
       buffer.edges[p * MP_EDGE_REFS + 2 * size_t(e) + 1] = half_refs[1];
     }
+
+  share_corner_uvs(buffer, first, corner_rep, transitions);
 
   // 4. Normal cubics: end points from one normal per welded corner (the
   // first patch's), inner control points so the cubic passes through the

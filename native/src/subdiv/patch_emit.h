@@ -35,13 +35,31 @@ inline PatchInfoCommon make_patch_info_common(const glm::mat4& to_space, bool do
   return c;
 }
 
+// Corner UVs of one patch for every UV layer: corner (0,0), (1,0), (1,1),
+// (0,1) of layer k at [4k .. 4k+3]; null for a patch without UVs (zeros).
 inline void append_device_patch(const DevicePatch& patch, unsigned type, int material, int prim_id,
-                                const PatchInfoCommon& common, PatchBuffer& out) {
+                                const PatchInfoCommon& common, PatchBuffer& out,
+                                const glm::vec2* corner_uvs = nullptr) {
   for (const glm::dvec3& p : patch) {
     glm::dvec4 q = common.to_space * glm::dvec4(p, 1.0);
     out.points.emplace_back(float(q.x), float(q.y), float(q.z), 0.0f);  // w: displacement bound (mp_patch.h)
   }
   out.info.emplace_back(type, unsigned(material), common.flags, unsigned(prim_id));
+  for (int k = 0; k < out.uv_layers; ++k) {
+    if (corner_uvs == nullptr) {
+      out.uvs.emplace_back(0.0f), out.uvs.emplace_back(0.0f);
+      continue;
+    }
+    const glm::vec2* c = corner_uvs + 4 * k;
+    out.uvs.emplace_back(c[0].x, c[0].y, c[1].x, c[1].y);
+    out.uvs.emplace_back(c[2].x, c[2].y, c[3].x, c[3].y);
+  }
+}
+
+// The mesh's UV of layer k at face corner `corner` (face_vertex_indices
+// order), zero where the mesh has fewer layers.
+inline glm::vec2 corner_uv(const Mesh& mesh, int k, size_t corner) {
+  return size_t(k) < mesh.uv_layers.size() ? mesh.uv_layers[size_t(k)][corner] : glm::vec2(0.0f);
 }
 
 // Bezier partners are the interior points themselves (mp_patch.h).
@@ -82,6 +100,11 @@ inline void check_face_topology(const Mesh& mesh) {
   for (const glm::vec3& p : mesh.points)
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
       throw_mesh_error(mesh, "a point is not finite");
+  for (const std::vector<glm::vec2>& layer : mesh.uv_layers) {
+    if (layer.size() != total) throw_mesh_error(mesh, "a UV map needs one (u, v) per face corner");
+    for (const glm::vec2& uv : layer)
+      if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) throw_mesh_error(mesh, "a UV is not finite");
+  }
 }
 
 }  // namespace mp::subdiv_detail

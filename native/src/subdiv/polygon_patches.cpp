@@ -44,30 +44,48 @@ void append_polygon_patches(const Mesh& mesh, const glm::mat4& to_space, PatchBu
   const subdiv_detail::PatchInfoCommon common =
       subdiv_detail::make_patch_info_common(to_space, mesh.double_sided);
 
+  const int layers = out.uv_layers;
   std::vector<glm::dvec3> corners;
+  std::vector<glm::dvec2> uvs;                       // [layer * n + corner]
+  std::vector<glm::vec2> patch_uvs(size_t(4 * layers));  // append_device_patch's layout
   size_t first = 0;
   for (size_t face = 0; face < mesh.face_vertex_counts.size(); ++face) {
     const int n = mesh.face_vertex_counts[face];
     corners.clear();
-    for (int k = 0; k < n; ++k) corners.emplace_back(mesh.points[mesh.face_vertex_indices[first + k]]);
+    uvs.assign(size_t(n * layers), glm::dvec2(0.0));
+    for (int k = 0; k < n; ++k) {
+      corners.emplace_back(mesh.points[mesh.face_vertex_indices[first + k]]);
+      for (int l = 0; l < layers; ++l) uvs[size_t(l * n + k)] = glm::dvec2(subdiv_detail::corner_uv(mesh, l, first + k));
+    }
     first += size_t(n);
     const int material = subdiv_detail::face_material(mesh, face);
 
     if (n == 4) {
+      for (size_t i = 0; i < uvs.size(); ++i) patch_uvs[i] = glm::vec2(uvs[i]);
       subdiv_detail::append_device_patch(bilinear_patch(corners[0], corners[1], corners[2], corners[3]),
-                                         MP_PATCH_BEZIER, material, int(face), common, out);
+                                         MP_PATCH_BEZIER, material, int(face), common, out, patch_uvs.data());
       continue;
     }
-    glm::dvec3 centroid(0.0);
-    for (const glm::dvec3& c : corners) centroid += c;
-    centroid /= double(n);
+    // The split quads carry the same bilinear blend of the face's UVs as of
+    // its points: centroid, edge midpoints, corner.
+    auto quad = [n](const auto* v, int k, auto* out4) {
+      auto centroid = v[0] * 0.0;
+      for (int i = 0; i < n; ++i) centroid += v[i];
+      centroid /= double(n);
+      const auto& prev = v[(k + n - 1) % n];
+      const auto& next = v[(k + 1) % n];
+      out4[0] = centroid, out4[1] = 0.5 * (prev + v[k]), out4[2] = v[k], out4[3] = 0.5 * (v[k] + next);
+    };
     for (int k = 0; k < n; ++k) {
-      const glm::dvec3& prev = corners[(k + n - 1) % n];
-      const glm::dvec3& next = corners[(k + 1) % n];
-      const glm::dvec3& here = corners[k];
-      subdiv_detail::append_device_patch(
-          bilinear_patch(centroid, 0.5 * (prev + here), here, 0.5 * (here + next)), MP_PATCH_BEZIER,
-          material, int(face), common, out);
+      glm::dvec3 q[4];
+      quad(corners.data(), k, q);
+      for (int l = 0; l < layers; ++l) {
+        glm::dvec2 t[4];
+        quad(uvs.data() + l * n, k, t);
+        for (int c = 0; c < 4; ++c) patch_uvs[size_t(4 * l + c)] = glm::vec2(t[c]);
+      }
+      subdiv_detail::append_device_patch(bilinear_patch(q[0], q[1], q[2], q[3]), MP_PATCH_BEZIER, material,
+                                         int(face), common, out, patch_uvs.data());
     }
   }
 }

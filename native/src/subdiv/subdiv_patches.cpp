@@ -35,6 +35,13 @@ struct PointSum {
   void AddWithWeight(const PointSum& src, double weight) { p += weight * src.p; }
 };
 
+// Face-varying (UV) values for Far's refinement.
+struct UVSum {
+  glm::dvec2 uv{0.0};
+  void Clear(void* = nullptr) { uv = glm::dvec2(0.0); }
+  void AddWithWeight(const UVSum& src, double weight) { uv += weight * src.uv; }
+};
+
 Sdc::Options::VtxBoundaryInterpolation to_sdc(BoundaryInterpolation b) {
   switch (b) {
     case BoundaryInterpolation::None: return Sdc::Options::VTX_BOUNDARY_NONE;
@@ -172,7 +179,25 @@ SubdivRefinement refine_subdiv_mesh(const Mesh& mesh) {
   desc.holeIndices = mesh.hole_faces.data();
   desc.isLeftHanded = false;  // counter-clockwise faces are front faces
 
+  // UV maps: one face-varying channel each, one value per face corner. Every
+  // face has values of its own, so each edge is a face-varying seam; with
+  // linear interpolation that changes nothing where neighbours agree, and
+  // keeps real seams.
+  const int layers = int(mesh.uv_layers.size());
+  std::vector<int> corner_ids(mesh.face_vertex_indices.size());
+  for (size_t k = 0; k < corner_ids.size(); ++k) corner_ids[k] = int(k);
+  std::vector<Far::TopologyDescriptor::FVarChannel> channels(static_cast<size_t>(layers));
+  for (Far::TopologyDescriptor::FVarChannel& c : channels) {
+    c.numValues = int(corner_ids.size());
+    c.valueIndices = corner_ids.data();
+  }
+  desc.numFVarChannels = layers;
+  desc.fvarChannels = channels.data();
+
   Sdc::Options sdc;
+  // Linear UVs inside each face, as Cycles interpolates face-corner
+  // attributes of adaptively subdivided meshes (docs/subdivision.md).
+  sdc.SetFVarLinearInterpolation(Sdc::Options::FVAR_LINEAR_ALL);
   sdc.SetVtxBoundaryInterpolation(to_sdc(mesh.boundary));
   sdc.SetCreasingMethod(Sdc::Options::CREASE_UNIFORM);
   sdc.SetTriangleSubdivision(Sdc::Options::TRI_SUB_CATMARK);
@@ -189,7 +214,7 @@ SubdivRefinement refine_subdiv_mesh(const Mesh& mesh) {
   options.generateLegacySharpCornerPatches = false;  // smooth corners stay smooth
   options.generateVaryingTables = false;
   options.generateVaryingLocalPoints = false;
-  options.generateFVarTables = false;
+  options.generateFVarTables = layers > 0;
   options.SetPatchPrecision<double>();
 
   Far::TopologyRefiner::AdaptiveOptions adaptive = options.GetRefineAdaptiveOptions();
@@ -217,6 +242,20 @@ SubdivRefinement refine_subdiv_mesh(const Mesh& mesh) {
   if (local > 0)
     r.patch_table->GetLocalPointStencilTable<double>()->UpdateValues(values.data(), values.data() + refined);
 
+  r.fvar.resize(size_t(layers));
+  for (int c = 0; c < layers; ++c) {
+    std::vector<UVSum> uv(size_t(r.refiner->GetNumFVarValuesTotal(c)));
+    for (size_t k = 0; k < corner_ids.size(); ++k) uv[k].uv = glm::dvec2(mesh.uv_layers[size_t(c)][k]);
+    UVSum* from = uv.data();
+    for (int level = 1; level <= r.refiner->GetMaxLevel(); ++level) {
+      UVSum* to = from + r.refiner->GetLevel(level - 1).GetNumFVarValues(c);
+      primvars.InterpolateFaceVarying(level, from, to, c);
+      from = to;
+    }
+    r.fvar[size_t(c)].resize(uv.size());
+    for (size_t k = 0; k < uv.size(); ++k) r.fvar[size_t(c)][k] = uv[k].uv;
+  }
+
   r.points.resize(values.size());
   for (size_t k = 0; k < values.size(); ++k) r.points[k] = values[k].p;
   r.ptex_to_face = map_ptex_faces_to_base_faces(*r.refiner, mesh);
@@ -239,6 +278,29 @@ unsigned convert_far_patch(const SubdivRefinement& r, int array, int patch, Devi
   }
 }
 
+void far_patch_corner_uvs(const SubdivRefinement& r, int array, int absolute_patch, glm::vec2* out) {
+  const Far::PatchTable& table = *r.patch_table;
+  Far::PatchTable::PatchHandle handle;
+  handle.arrayIndex = array;
+  handle.patchIndex = absolute_patch;
+  handle.vertIndex = 0;  // unused by the face-varying queries
+  const Far::PatchParam param = table.GetPatchParam(handle);
+  constexpr double kCorner[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  for (size_t c = 0; c < r.fvar.size(); ++c) {
+    const Far::ConstIndexArray values = table.GetPatchFVarValues(handle, int(c));
+    double w[20];
+    for (int k = 0; k < 4; ++k) {
+      // Face-varying patches are evaluated in the base face's parametrisation.
+      double s = kCorner[k][0], t = kCorner[k][1];
+      param.Unnormalize(s, t);
+      table.EvaluateBasisFaceVarying(handle, s, t, w, nullptr, nullptr, nullptr, nullptr, nullptr, int(c));
+      glm::dvec2 uv(0.0);
+      for (int i = 0; i < values.size(); ++i) uv += w[i] * r.fvar[c][size_t(values[i])];
+      out[4 * c + size_t(k)] = glm::vec2(uv);
+    }
+  }
+}
+
 }  // namespace subdiv_detail
 
 void append_subdiv_patches(const Mesh& mesh, const glm::mat4& to_space, PatchBuffer& out) {
@@ -251,15 +313,18 @@ void append_subdiv_patches(const Mesh& mesh, const glm::mat4& to_space, PatchBuf
   out.info.reserve(out.info.size() + size_t(table.GetNumPatchesTotal()));
 
   subdiv_detail::DevicePatch patch;
+  std::vector<glm::vec2> uvs(4 * size_t(out.uv_layers), glm::vec2(0.0f));
+  int absolute = 0;
   for (int array = 0; array < table.GetNumPatchArrays(); ++array) {
-    for (int k = 0; k < table.GetNumPatches(array); ++k) {
+    for (int k = 0; k < table.GetNumPatches(array); ++k, ++absolute) {
       const unsigned type = subdiv_detail::convert_far_patch(r, array, k, patch);
+      if (!r.fvar.empty()) subdiv_detail::far_patch_corner_uvs(r, array, absolute, uvs.data());
       const int ptex_face = table.GetPatchParam(array, k).GetFaceId();
       if (ptex_face < 0 || size_t(ptex_face) >= r.ptex_to_face.size() || r.ptex_to_face[size_t(ptex_face)] < 0)
         subdiv_detail::throw_mesh_error(mesh, "OpenSubdiv patch refers to an unknown face");
       const int face = r.ptex_to_face[size_t(ptex_face)];
       subdiv_detail::append_device_patch(patch, type, subdiv_detail::face_material(mesh, size_t(face)),
-                                         face, common, out);
+                                         face, common, out, uvs.data());
     }
   }
 }

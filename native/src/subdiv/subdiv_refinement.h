@@ -31,6 +31,9 @@ struct SubdivRefinement {
   std::vector<glm::dvec3> points;
   // Base face of each ptex face (PatchParam::GetFaceId() is a ptex index).
   std::vector<int> ptex_to_face;
+  // UV maps as OpenSubdiv face-varying channels (one per Mesh::uv_layers
+  // entry, "linear all" interpolation): base and refined values per channel.
+  std::vector<std::vector<glm::dvec2>> fvar;
   int isolation_level = 0;
 };
 
@@ -45,5 +48,11 @@ SubdivRefinement refine_subdiv_mesh(const Mesh& mesh);
 // The device form of one Far patch (object space) and its MP_PATCH_* type.
 unsigned convert_far_patch(const SubdivRefinement& refinement, int array, int patch,
                            DevicePatch& out);
+
+// The UV of every layer at the corners (0,0), (1,0), (1,1), (0,1) of patch
+// `absolute_patch` (array `array`), from OpenSubdiv's face-varying patches;
+// `out` holds 4 per layer.
+void far_patch_corner_uvs(const SubdivRefinement& refinement, int array, int absolute_patch,
+                          glm::vec2* out);
 
 }  // namespace mp::subdiv_detail
