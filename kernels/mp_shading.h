@@ -90,14 +90,66 @@ MP_INLINE float mp_ggx_specular(float3 n, float3 l, float3 v, float alpha) {
 }
 
 /* Radiance leaving point p with normal n towards the eye. */
-MP_INLINE float3 mp_shade(float3 p, float3 n, int ortho, const DeviceMaterial* m,
-                          MP_GLOBAL const DeviceLight* lights, uint light_count) {
+/* A shading normal n (unit, on the viewer's side of the geometric normal
+ * ng; v the unit direction to the viewer) turned towards ng just enough
+ * that the mirror direction of v about it stays above the surface by
+ * min(0.9 (ng . v), 0.01), the condition Cycles imposes on the normals
+ * linked into its BSDFs. With X the unit tangent part of n, a normal at
+ * angle a from ng reflects v to a height vx sin 2a + vz cos 2a, so the
+ * bound is reached at 2a = phi +- acos(t / rho); the admissible solution
+ * nearest n is taken. */
+MP_INLINE float3 mp_valid_reflection_normal(float3 ng, float3 v, float3 n) {
+  float vz = dot(ng, v);
+  float t = fmin(0.9f * vz, 0.01f);
+  float3 r = 2.0f * dot(n, v) * n - v;
+  if (dot(ng, r) >= t) return n;
+  float3 x = n - dot(n, ng) * ng;
+  float xl = length(x);
+  if (!(xl > 1e-7f)) return ng;
+  x = x / xl;
+  float vx = dot(v, x);
+  float rho = sqrt(vx * vx + vz * vz);
+  if (!(rho > 0.0f)) return ng;
+  float phi = atan2(vx, vz), spread = acos(fmin(fmax(t / rho, -1.0f), 1.0f));
+  float a0 = atan2(dot(n, x), dot(n, ng));
+  float best = 0.0f, best_gap = 1e30f;
+  for (int k = 0; k < 2; ++k) {
+    float a = 0.5f * (phi + (k == 0 ? spread : -spread));
+    if (a < 0.0f || a > 1.5707964f) continue;
+    float gap = fabs(a - a0);
+    if (gap < best_gap) best = a, best_gap = gap;
+  }
+  return sin(best) * x + cos(best) * ng;
+}
+
+/* Shadowing of a bumped diffuse surface by the unbumped one it stands for
+ * (Chiang, Li, Burley, "Taming the Shadow Terminator", SIGGRAPH 2019 talk),
+ * as Cycles applies it to diffuse closures whose normal differs from the
+ * surface's: with g = (ng . l) / ((n . l)(ng . n)), full light for g >= 1,
+ * none for g < 0, else the smooth step -g^3 + g^2 + g. */
+MP_INLINE float mp_bump_shadowing(float3 ng, float3 n, float3 l) {
+  float denom = dot(n, l) * dot(ng, n);
+  float g = denom != 0.0f ? dot(ng, l) / denom : 0.0f;
+  if (g >= 1.0f) return 1.0f;
+  if (g < 0.0f) return 0.0f;
+  return -g * g * g + g * g + g;
+}
+
+/* Shading with a shading normal `n` (e.g. bumped) on the side of the
+ * geometric normal `ng`: both flip together when the surface is seen from
+ * behind, so a bumped normal that tilts away from the viewer near a
+ * silhouette is not flipped on its own. bump_shadowing: n is a BSDF's own
+ * normal, different from the surface's, so its diffuse light is shadowed
+ * by mp_bump_shadowing. */
+MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bump_shadowing, int ortho, const DeviceMaterial* m,
+                                 MP_GLOBAL const DeviceLight* lights, uint light_count) {
   float3 cs = MP_F3(m->color[0], m->color[1], m->color[2]);
   float3 emission = MP_F3(m->emission[0], m->emission[1], m->emission[2]);
   int model = (int)m->color[3];
   if (model == MP_MODEL_CONSTANT) return cs + emission;
   float3 v = ortho ? MP_F3(0.0f, 0.0f, 1.0f) : normalize(-p);
-  float3 nf = dot(n, v) < 0.0f ? -n : n; /* faceforward */
+  float3 ngf = dot(ng, v) < 0.0f ? -ng : ng;
+  float3 nf = dot(ng, v) < 0.0f ? -n : n; /* faceforward */
   float ka = m->coeffs[0], kd = m->coeffs[1], ks = m->coeffs[2], roughness = m->coeffs[3];
   float inv_roughness = 1.0f / fmax(roughness, 1e-4f);
   float metallic = m->principled[0];
@@ -134,7 +186,7 @@ MP_INLINE float3 mp_shade(float3 p, float3 n, int ortho, const DeviceMaterial* m
       e = cl * fmax(dot(nf, l), 0.0f);
     }
     if (!(e.x > 0.0f || e.y > 0.0f || e.z > 0.0f)) continue;
-    diffuse += e;
+    diffuse += bump_shadowing ? e * mp_bump_shadowing(ngf, nf, l) : e;
     if (model == MP_MODEL_PRINCIPLED) {
       float vh = fmax(dot(v, normalize(l + v)), 0.0f);
       float3 fresnel = f0 + (MP_F3(1.0f, 1.0f, 1.0f) - f0) * pow(1.0f - vh, 5.0f);
@@ -151,6 +203,11 @@ MP_INLINE float3 mp_shade(float3 p, float3 n, int ortho, const DeviceMaterial* m
   float3 c = cs * (ka * ambient + kd * diffuse);
   if (model == MP_MODEL_PLASTIC) c += MP_F3(m->specular[0], m->specular[1], m->specular[2]) * (ks * specular);
   return c + emission;
+}
+
+MP_INLINE float3 mp_shade(float3 p, float3 n, int ortho, const DeviceMaterial* m,
+                          MP_GLOBAL const DeviceLight* lights, uint light_count) {
+  return mp_shade_bumped(p, n, n, 0, ortho, m, lights, light_count);
 }
 
 #endif

@@ -111,6 +111,8 @@ class NodeCompiler:
         self.headers = set()
         self.warned = set()
         self.fn = None
+        self.helpers = []          # extra functions (Bump heights), emitted before the main two
+        self.uses_neighbours = False
 
     # ---- helpers ----------------------------------------------------------
     def warn(self, node, what):
@@ -292,6 +294,8 @@ class NodeCompiler:
             return {"Color": fn.temp(VEC, f"mix({col}, (float3)(1.0f) - {col}, {fac})")}
         if t == "DISPLACEMENT":
             return self.emit_displacement(node)
+        if t == "BUMP":
+            return self.emit_bump(node)
         if t in TEXTURE_HEADERS:
             return self.emit_texture(node)
         self.warn(node, "is not supported; its outputs take their default values")
@@ -431,6 +435,31 @@ class NodeCompiler:
                         f"{normalize}, {ver}, &{dist[0]}, &{col[0]}, &{pos[0]}, &{w[0]}, &{rad[0]});")
         return {"Distance": dist, "Color": col, "Position": pos, "W": w, "Radius": rad}
 
+    def height_function(self, node, key):
+        """A helper function evaluating input `key` of `node` for any globals."""
+        outer = self.fn
+        name = f"mp_height_{len(self.helpers)}"
+        self.helpers.append(None)  # reserve the slot: nested heights get later ones
+        slot = len(self.helpers) - 1
+        text = self._function(f"float {name}(const MpNodeGlobals* g)",
+                              lambda: f"  return {self.input(node, key, FLOAT)[0]};\n")
+        self.helpers[slot] = text
+        self.fn = outer
+        return name
+
+    def emit_bump(self, node):
+        """Bump: heights at this vertex and its grid neighbours (mp_bump)."""
+        self.uses_neighbours = True
+        strength = self.input(node, "Strength", FLOAT)[0]
+        distance = self.input(node, "Distance", FLOAT)[0]
+        n_in = self.input(node, "Normal", VEC)[0] if node.inputs["Normal"].is_linked else "g->N"
+        if not node.inputs["Height"].is_linked:
+            return {"Normal": (n_in, VEC, None)}
+        h = self.height_function(node, "Height")
+        invert = 1 if node.invert else 0
+        return {"Normal": self.fn.temp(VEC, f"mp_bump(g, {h}(g), g->dx ? {h}(g->dx) : 0.0f, "
+                                            f"g->dy ? {h}(g->dy) : 0.0f, {strength}, {distance}, {invert}, {n_in})")}
+
     def emit_image(self, node):
         self.headers.add("mp_tex_image.h")
         if node.projection != "FLAT":
@@ -466,9 +495,10 @@ class NodeCompiler:
             method = getattr(getattr(self.material, "cycles", None), "displacement_method", "BUMP")
         disp_socket = out.inputs["Displacement"]
         displaces = disp_socket.is_linked and method in ("DISPLACEMENT", "BOTH")
-        if disp_socket.is_linked and method == "BUMP":
-            self.warnings.append(f"material '{self.material.name}': bump-only displacement is not supported yet; "
-                                 "set Settings > Displacement to Displacement Only or Displacement and Bump")
+        # Bump only: the displacement tilts shading normals (as a Bump node of
+        # distance 1 on the height along the normal, the way Cycles turns
+        # displacement into bump) and leaves the geometry where it is.
+        bump_only = disp_socket.is_linked and method == "BUMP"
         surface_links = out.inputs["Surface"].links
         shader = surface_links[0].from_node if surface_links else None
         while shader is not None and shader.type == "REROUTE":
@@ -477,23 +507,33 @@ class NodeCompiler:
         assigns = []
         if shader is not None and shader.type in ("BSDF_PRINCIPLED", "BSDF_DIFFUSE", "EMISSION"):
             assigns = self._surface_assignments(shader)
-        shades = bool(assigns)
+        bump_line = ""
+        if bump_only and not any(a[0] == "normal" for a in assigns):
+            self.uses_neighbours = True
+            h = "dot(mp_node_displacement({0}), g->N)"
+            bump_line = (f"  s->normal = mp_bump(g, {h.format('g')}, g->dx ? {h.format('g->dx')} : 0.0f, "
+                         f"g->dy ? {h.format('g->dy')} : 0.0f, 1.0f, 1.0f, 0, g->N);\n  s->has_normal = MP_NORMAL_SET;\n")
+        shades = bool(assigns) or bool(bump_line)
         if not displaces and not shades:
             return None
 
         self.height_info = None
         disp_src = self._function("float3 mp_node_displacement(const MpNodeGlobals* g)",
                                   lambda: "  return " + self.input(out, "Displacement", VEC)[0] + ";\n"
-                                  if displaces else "  return (float3)(0.0f);\n")
+                                  if displaces or bump_only else "  return (float3)(0.0f);\n")
         bound = self._displacement_bound(displaces)
         surf_src = self._function("void mp_node_surface(const MpNodeGlobals* g, MpSurfaceInputs* s)",
-                                  lambda: "".join(self._assignment(shader, *a) for a in assigns))
+                                  lambda: bump_line + "".join(self._assignment(shader, *a) for a in assigns))
         includes = "".join(f'#include "textures/{h}"\n' for h in sorted(self.headers))
-        source = includes + disp_src + surf_src
+        if self.uses_neighbours:
+            includes = "#define MP_NODE_USES_NEIGHBOURS 1\n" + includes
+        source = includes + "".join(self.helpers) + disp_src + surf_src
         return CompiledMaterial(source, displaces, shades, bound)
 
     def _assignment(self, shader, field, socket, kind, strength):
         expr = self.input(shader, socket, kind)[0]
+        if field == "normal":
+            return f"  s->normal = {expr};\n  s->has_normal = MP_NORMAL_INPUT;\n"
         if strength is not None:
             expr = f"{expr} * {self.input(shader, strength, FLOAT)[0] if strength in shader.inputs else '1.0f'}"
         return f"  s->{field} = {expr};\n"
@@ -516,10 +556,8 @@ class NodeCompiler:
             emission = "Emission Color" if "Emission Color" in shader.inputs else "Emission"
             if linked(emission) or linked("Emission Strength"):
                 out.append(("emission", emission, VEC, "Emission Strength"))
-        for sock in ("Normal",):
-            if linked(sock):
-                self.warnings.append(f"material '{self.material.name}': a linked {sock} input (bump or normal "
-                                     "map) is not supported yet")
+        if linked("Normal"):
+            out.append(("normal", "Normal", VEC, None))
         return out
 
     def _displacement_bound(self, displaces):

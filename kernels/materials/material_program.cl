@@ -60,7 +60,29 @@ inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, f
   g.images = in->images;
   g.image_count = in->image_count;
   g.texels = in->texels;
+  g.dx = 0;
+  g.dy = 0;
   return g;
+}
+
+/* Globals a fraction t of the way from g to those of a neighbouring vertex:
+ * positions and coordinates move, the normal stays, as when Cycles offsets
+ * a shading point by a fraction of its differential for bump evaluation. */
+inline MpNodeGlobals mp_node_globals_toward(const MpNodeGlobals* g, const MpNodeGlobals* to, float t) {
+  MpNodeGlobals r = *g;
+  r.P = g->P + t * (to->P - g->P);
+  r.generated = g->generated + t * (to->generated - g->generated);
+  for (uint k = 0; k < MP_MAX_UV_LAYERS; ++k) r.uv[k] = g->uv[k] + t * (to->uv[k] - g->uv[k]);
+  return r;
+}
+
+/* Object -> camera for a normal: the transpose of camera -> object's linear part. */
+inline float3 mp_object_normal_to_camera(__global const DeviceObject* o, float3 n) {
+  __global const float* m = o->to_object;
+  float3 r = (float3)(m[0] * n.x + m[4] * n.y + m[8] * n.z, m[1] * n.x + m[5] * n.y + m[9] * n.z,
+                      m[2] * n.x + m[6] * n.y + m[10] * n.z);
+  float l = length(r);
+  return l > 0.0f ? r / l : n;
 }
 
 /* The vertex this work-item handles, if its material uses this program,
@@ -116,7 +138,25 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   if (!(m.program[2] > 0.0f)) return;
   float3 p = grid_p[gid].xyz, n = grid_n[gid].xyz;
   MpProgramInputs in = MP_PROGRAM_INPUTS;
-  MpNodeGlobals g = mp_node_globals(objects + object, p, n, &in, sp.patch, uv);
+  __global const DeviceObject* o = objects + object;
+  MpNodeGlobals g = mp_node_globals(o, p, n, &in, sp.patch, uv);
+#ifdef MP_NODE_USES_NEIGHBOURS
+  /* Bump nodes difference their heights towards the next grid vertex along
+   * u and along v (the previous one on the last row), a tenth of the way:
+   * a small step keeps the difference first-order even where a
+   * micropolygon spans much of a texture's feature (grazing views). */
+  uint stride = (uint)f.max_grid + 1u, nu = MP_INFO_NU(sp.info), nv = MP_INFO_NV(sp.info);
+  uint i = (gid % (stride * stride)) % stride, j = (gid % (stride * stride)) / stride;
+  uint ni = i < nu ? i + 1u : i - 1u, nj = j < nv ? j + 1u : j - 1u;
+  uint gx = gid - i + ni, gy = gid + (nj - j) * stride;
+  MpNodeGlobals nx = mp_node_globals(o, grid_p[gx].xyz, grid_n[gx].xyz, &in, sp.patch, mp_grid_uv(&sp, nu, nv, ni, j));
+  MpNodeGlobals ny = mp_node_globals(o, grid_p[gy].xyz, grid_n[gy].xyz, &in, sp.patch, mp_grid_uv(&sp, nu, nv, i, nj));
+  MpNodeGlobals g_dx = mp_node_globals_toward(&g, &nx, 0.1f), g_dy = mp_node_globals_toward(&g, &ny, 0.1f);
+  if (nu > 0u && nv > 0u) {
+    g.dx = &g_dx;
+    g.dy = &g_dy;
+  }
+#endif
   MpSurfaceInputs s;
   s.base_color = (float3)(m.color[0], m.color[1], m.color[2]);
   s.metallic = m.principled[0];
@@ -124,12 +164,23 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   s.roughness = m.coeffs[3];
   s.alpha = m.opacity[3];
   s.emission = (float3)(m.emission[0], m.emission[1], m.emission[2]);
+  s.normal = g.N;
+  s.has_normal = 0;
   mp_node_surface(&g, &s);
   m.color[0] = s.base_color.x, m.color[1] = s.base_color.y, m.color[2] = s.base_color.z;
   m.principled[0] = clamp(s.metallic, 0.0f, 1.0f);
   m.principled[1] = fmax(s.specular, 0.0f);
   m.coeffs[3] = clamp(s.roughness, 0.0f, 1.0f);
   m.emission[0] = s.emission.x, m.emission[1] = s.emission.y, m.emission[2] = s.emission.z;
-  float3 c = mp_shade(p, n, f.ortho, &m, lights, light_count);
+  float3 ns = n;
+  if (s.has_normal && all(isfinite(s.normal)) && length(s.normal) > 1e-6f) {
+    ns = mp_object_normal_to_camera(o, s.normal);
+    if (s.has_normal == MP_NORMAL_INPUT) {
+      float3 v = f.ortho ? (float3)(0.0f, 0.0f, 1.0f) : normalize(-p);
+      float side = dot(n, v) < 0.0f ? -1.0f : 1.0f;  /* the viewer's side */
+      ns = side * mp_valid_reflection_normal(side * n, v, side * ns);
+    }
+  }
+  float3 c = mp_shade_bumped(p, n, ns, s.has_normal == MP_NORMAL_INPUT, f.ortho, &m, lights, light_count);
   grid_c[gid] = (float4)(c, clamp(s.alpha, 0.0f, 1.0f));
 }

@@ -16,7 +16,7 @@
  * normal (Texture Coordinate > Object and Normal), Generated coordinates,
  * the scene's UV layers (z = 0, as Blender's UV output) and the texture
  * images (Image Texture, textures/mp_tex_image.h). */
-typedef struct {
+typedef struct MpNodeGlobals {
   float3 P;
   float3 N;
   float3 generated;
@@ -24,6 +24,10 @@ typedef struct {
   MP_GLOBAL const DeviceImage* images;
   MP_GLOBAL const float4* texels;
   uint image_count;
+  /* The same a small step towards the next grid vertex along u and along v
+   * (the finite differences of Bump nodes), or null. */
+  const struct MpNodeGlobals* dx;
+  const struct MpNodeGlobals* dy;
 } MpNodeGlobals;
 
 /* Principled BSDF inputs a surface program may set. */
@@ -31,7 +35,38 @@ typedef struct {
   float3 base_color;
   float metallic, roughness, specular, alpha;
   float3 emission; /* color times strength */
+  float3 normal;   /* shading normal, object space (Bump, bump-only displacement) */
+  int has_normal;  /* 0, or MP_NORMAL_SET, or MP_NORMAL_INPUT (a BSDF's Normal input) */
 } MpSurfaceInputs;
+
+/* How a surface program set MpSurfaceInputs.normal: as the surface's shading
+ * normal (bump-only displacement) or through a BSDF's Normal input, which
+ * Cycles keeps from reflecting the view direction below the surface. */
+#define MP_NORMAL_SET 1
+#define MP_NORMAL_INPUT 2
+
+/* Bump node: the normal tilted by the height's gradient over the surface,
+ * from heights at the point and a small step along u and v (hc, hx, hy),
+ * with the surface-gradient formulation Cycles' Bump node uses: tangents
+ * Rx = dPdy x N and Ry = N x dPdx, and the normal |det| N - distance
+ * sign(det) ((hx - hc) Rx + (hy - hc) Ry), blended with N by strength. */
+MP_INLINE float3 mp_bump(const MpNodeGlobals* g, float hc, float hx, float hy, float strength, float distance,
+                         int invert, float3 n_in) {
+  if (g->dx == 0 || g->dy == 0) return n_in;
+  float3 dpdx = g->dx->P - g->P, dpdy = g->dy->P - g->P;
+  float3 rx = cross(dpdy, n_in), ry = cross(n_in, dpdx);
+  float det = dot(dpdx, rx);
+  float3 surfgrad = (hx - hc) * rx + (hy - hc) * ry;
+  if (invert) distance = -distance;
+  float3 n = fabs(det) * n_in - distance * (det < 0.0f ? -1.0f : 1.0f) * surfgrad;
+  float len = length(n);
+  if (!(len > 0.0f) || !isfinite(len)) return n_in;
+  n = n / len;
+  strength = fmax(strength, 0.0f);
+  n = strength * n + (1.0f - strength) * n_in;
+  len = length(n);
+  return len > 0.0f ? n / len : n_in;
+}
 
 MP_INLINE float mp_nl_safe_div(float a, float b) { return b != 0.0f ? a / b : 0.0f; }
 MP_INLINE float mp_nl_fract(float a) { return a - floor(a); }
