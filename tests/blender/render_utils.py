@@ -58,13 +58,20 @@ def add_camera(scene, location, target, lens=50.0, ortho_scale=None, shift=(0.0,
     return cam
 
 
-def diffuse_material(name, color):
+def empty_material(name):
+    """A node material holding only its Material Output; returns (material, output node)."""
     m = bpy.data.materials.new(name)
     m.use_nodes = True
     nodes = m.node_tree.nodes
     for n in list(nodes):
         if n.type != "OUTPUT_MATERIAL":
             nodes.remove(n)
+    return m, next(n for n in nodes if n.type == "OUTPUT_MATERIAL")
+
+
+def diffuse_material(name, color):
+    m, _ = empty_material(name)
+    nodes = m.node_tree.nodes
     bsdf = nodes.new("ShaderNodeBsdfDiffuse")
     bsdf.inputs["Color"].default_value = (*color, 1.0)
     out = next(n for n in nodes if n.type == "OUTPUT_MATERIAL")

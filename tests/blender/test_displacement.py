@@ -128,6 +128,18 @@ def render_both(scene, w=W, h=H, samples=16, cycles_samples=16):
     return mp, cy
 
 
+def lit_psnr(scene, label):
+    """Combined PSNR against Cycles on the pixels both cover, from a camera
+    above the front of the object, lit by the sun."""
+    ru.add_camera(scene, (0.0, -4.0, 1.0), (0.0, 0.0, 0.0), lens=45)
+    sun(scene)
+    mp, cy = render_both(scene)
+    both = (mp["rgba"][..., 3] > 0.99) & (cy["rgba"][..., 3] > 0.99)
+    value = ru.psnr(mp["rgba"][..., :3][both], cy["rgba"][..., :3][both])
+    print(f"{label}: PSNR {value:.2f} dB over {both.sum()} pixels")
+    return value
+
+
 def case_displaced(shape, texture):
     scene = ru.reset_scene()
     obj = add_surface(shape)
@@ -191,12 +203,7 @@ def case_textured():
     links.new(image.outputs["Color"], mix_image.inputs["Color2"])
     links.new(mix_image.outputs["Color"], bsdf.inputs["Color"])
     obj.data.materials.append(mat)
-    ru.add_camera(scene, (0.0, -4.0, 1.0), (0.0, 0.0, 0.0), lens=45)
-    sun(scene)
-    mp, cy = render_both(scene)
-    both = (mp["rgba"][..., 3] > 0.99) & (cy["rgba"][..., 3] > 0.99)
-    value = ru.psnr(mp["rgba"][..., :3][both], cy["rgba"][..., :3][both])
-    print(f"textured diffuse sphere: PSNR {value:.2f} dB over {both.sum()} pixels")
+    value = lit_psnr(scene, "textured diffuse sphere")
     return [] if value >= 30.0 else [f"textured diffuse sphere: PSNR {value:.2f} dB < 30"]
 
 
@@ -229,12 +236,7 @@ def case_bump(kind):
         nt.links.new(disp.outputs["Displacement"], out.inputs["Displacement"])
         set_displacement_method(mat, "BUMP")
     obj.data.materials.append(mat)
-    ru.add_camera(scene, (0.0, -4.0, 1.0), (0.0, 0.0, 0.0), lens=45)
-    sun(scene)
-    mp, cy = render_both(scene)
-    both = (mp["rgba"][..., 3] > 0.99) & (cy["rgba"][..., 3] > 0.99)
-    value = ru.psnr(mp["rgba"][..., :3][both], cy["rgba"][..., :3][both])
-    print(f"bump ({kind}): PSNR {value:.2f} dB over {both.sum()} pixels")
+    value = lit_psnr(scene, f"bump ({kind})")
     if kind == "node" and bpy.app.version >= (4, 0, 0):
         # Cycles 4.x shades bumped BSDF normals differently near grazing
         # angles (the far rim of the torus); Micropoly follows 3.x there.
@@ -257,13 +259,8 @@ def case_image_modes():
     scene.micropoly.shading_rate = 0.0625
     bpy.ops.mesh.primitive_plane_add(size=2)
     obj = bpy.context.active_object
-    mat = bpy.data.materials.new("image_modes")
-    mat.use_nodes = True
+    mat, out = ru.empty_material("image_modes")
     nt = mat.node_tree
-    for n in list(nt.nodes):
-        if n.type != "OUTPUT_MATERIAL":
-            nt.nodes.remove(n)
-    out = next(n for n in nt.nodes if n.type == "OUTPUT_MATERIAL")
     emit = nt.nodes.new("ShaderNodeEmission")
     coords = nt.nodes.new("ShaderNodeTexCoord")
     mapping = nt.nodes.new("ShaderNodeMapping")

@@ -263,13 +263,8 @@ def build_scene(cases):
     tile_world = 2.0  # world units per tile; quads are scaled to leave a gap
     for i, case in enumerate(cases):
         row, col = divmod(i, COLS)
-        mat = bpy.data.materials.new(f"case{i}")
-        mat.use_nodes = True
+        mat, out = ru.empty_material(f"case{i}")
         nt = mat.node_tree
-        for n in list(nt.nodes):
-            if n.type != "OUTPUT_MATERIAL":
-                nt.nodes.remove(n)
-        out = next(n for n in nt.nodes if n.type == "OUTPUT_MATERIAL")
         emission = nt.nodes.new("ShaderNodeEmission")
         emission.inputs["Strength"].default_value = 1.0
         nt.links.new(emission.outputs["Emission"], out.inputs["Surface"])

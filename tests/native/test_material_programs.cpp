@@ -6,8 +6,12 @@
 #include <cmath>
 #include <string>
 
+#include <sstream>
+
 #include "micropoly/error.h"
 #include "micropoly/renderer.h"
+#include "rib/rib_reader.h"
+#include "rib/rib_writer.h"
 #include "renderer_fixture.h"
 #include "scene_fixtures.h"
 
@@ -30,13 +34,19 @@ Scene facing_plane(int program_material_model) {
   return s;
 }
 
-TEST_F(MaterialProgramTest, ConstantDisplacementMovesThePlaneAlongItsNormal) {
+// The plane displaced by a constant 0.5 along its normal.
+Scene lifted_plane() {
   Scene s = facing_plane(static_cast<int>(Material::Model::Matte));
   s.material_programs.push_back(
       {"lift", std::string("float3 mp_node_displacement(const MpNodeGlobals* g) { return 0.5f * g->N; }\n") +
                    kNoSurface});
   s.materials[0].program_displaces = true;
   s.materials[0].displacement_bound = 0.5f;
+  return s;
+}
+
+TEST_F(MaterialProgramTest, ConstantDisplacementMovesThePlaneAlongItsNormal) {
+  Scene s = lifted_plane();
   RenderResult r = renderer_->render(s);
   const size_t centre = 32 * 64 + 32;
   EXPECT_NEAR(r.depth[centre], 4.5f, 1e-3f);  // 0.5 nearer than the undisplaced plane at 5
@@ -99,6 +109,23 @@ TEST_F(MaterialProgramTest, SurfaceProgramReadsUVLayers) {
   s.meshes[0] = grid_mesh(12, 6.0f, SubdivScheme::CatmullClark);
   set_affine_uvs(s.meshes[0]);
   expect_affine_uv_colours(renderer_->render(s), "subdivided grid");
+}
+
+// RIB carries material programs (Attribute "micropoly" "string program"):
+// the scene read back renders the same displaced plane.
+TEST_F(MaterialProgramTest, ProgramsSurviveARibRoundTrip) {
+  Scene s = lifted_plane();
+  std::ostringstream rib;
+  write_rib(s, rib);
+  Scene back = read_rib_string(rib.str(), "roundtrip").scene;
+  ASSERT_EQ(back.material_programs.size(), 1u);
+  EXPECT_EQ(back.material_programs[0].source, s.material_programs[0].source);
+  ASSERT_FALSE(back.materials.empty());
+  EXPECT_EQ(back.materials[0].program, 0);
+  EXPECT_TRUE(back.materials[0].program_displaces);
+  EXPECT_FLOAT_EQ(back.materials[0].displacement_bound, 0.5f);
+  RenderResult r = renderer_->render(back);
+  EXPECT_NEAR(r.depth[32 * 64 + 32], 4.5f, 1e-3f);
 }
 
 TEST_F(MaterialProgramTest, UVMapsOfTheWrongSizeAreRejected) {

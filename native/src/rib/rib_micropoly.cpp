@@ -70,7 +70,8 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
 
 void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
   const int line = args.request().line;
-  warn_unknown(params, {"material", "materialname"}, [&](const std::string& name) {
+  warn_unknown(params, {"material", "materialname", "program", "programdisplaces", "programshades",
+                        "displacementbound"}, [&](const std::string& name) {
     warn_once("attribute-micropoly:" + name, line,
               "Attribute \"micropoly\": parameter \"" + name + "\" is ignored");
   });
@@ -85,10 +86,27 @@ void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
   const long long count = static_cast<long long>(result_.scene.materials.size());
   int index = 0;
   get_int(args, params, "material", 0, std::min<long long>(count, INT_MAX), &index);
-  define_material(index, params.get_string("materialname", attrs_.surface.name));
+  // A material program (node tree as OpenCL C), shared by identical sources.
+  MaterialProgramUse use;
+  const std::string source = params.get_string("program", "");
+  if (!source.empty()) {
+    std::vector<MaterialProgram>& programs = result_.scene.material_programs;
+    auto it = std::find_if(programs.begin(), programs.end(), [&](const MaterialProgram& p) { return p.source == source; });
+    use.program = static_cast<int>(it - programs.begin());
+    if (it == programs.end()) programs.push_back({params.get_string("materialname", "material program"), source});
+    int flag = 0;
+    get_int(args, params, "programdisplaces", 0, 1, &flag);
+    use.displaces = flag != 0;
+    flag = 0;
+    get_int(args, params, "programshades", 0, 1, &flag);
+    use.shades = flag != 0;
+    use.displacement_bound = params.get_float("displacementbound", 0.0f);
+    if (!(use.displacement_bound >= 0.0f)) args.fail("\"displacementbound\" must be a non-negative number");
+  }
+  define_material(index, params.get_string("materialname", attrs_.surface.name), use);
 }
 
-void Parser::define_material(int index, const std::string& name) {
+void Parser::define_material(int index, const std::string& name, const MaterialProgramUse& use) {
   // The current shading state becomes material `index` and is selected for
   // the following primitives of the attribute block. Redefining a material
   // changes it for every primitive that uses it (the writer always repeats
@@ -97,6 +115,10 @@ void Parser::define_material(int index, const std::string& name) {
   m.color = attrs_.color;
   m.opacity = attrs_.opacity;
   m.name = name;
+  m.program = use.program;
+  m.program_displaces = use.displaces;
+  m.program_shades = use.shades;
+  m.displacement_bound = use.displacement_bound;
   std::vector<Material>& materials = result_.scene.materials;
   const size_t i = static_cast<size_t>(index);
   if (i == materials.size()) {

@@ -218,7 +218,13 @@ class Parser {
   // rib_micropoly.cpp
   void micropoly_option(ArgReader& args, const ParamList& params);
   void micropoly_attribute(ArgReader& args, const ParamList& params);
-  void define_material(int index, const std::string& name);
+  // The material program a micropoly material attribute names (Material::program).
+  struct MaterialProgramUse {
+    int program = -1;
+    bool displaces = false, shades = false;
+    float displacement_bound = 0.0f;
+  };
+  void define_material(int index, const std::string& name, const MaterialProgramUse& use);
   // Per-face Scene material indices ("uniform integer micropoly:material"),
   // left empty when the parameter is absent.
   void read_face_materials(ArgReader& args, const ParamList& params, size_t faces,

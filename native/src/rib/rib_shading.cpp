@@ -37,7 +37,8 @@ std::vector<float> Parser::material_key(const Material& m) {
           m.ka, m.kd, m.ks, m.roughness,
           m.specular_color.x, m.specular_color.y, m.specular_color.z,
           m.emission.x, m.emission.y, m.emission.z,
-          m.metallic, m.specular};
+          m.metallic, m.specular, static_cast<float>(m.program), m.displacement_bound,
+          static_cast<float>(m.program_displaces), static_cast<float>(m.program_shades)};
 }
 
 int Parser::material_index(const Attributes& attrs) {

@@ -293,7 +293,8 @@ void write_light(std::string& o, const Light& l, int handle) {
 
 // The standard shading requests for a material, then the micropoly
 // attribute that makes that state Scene material `index` (with its name).
-void write_material(std::string& o, const Material& m, int index, const char* indent) {
+void write_material(std::string& o, const Material& m, int index, const char* indent,
+                    const std::vector<MaterialProgram>& programs) {
   o += indent;
   o += "Color ";
   put_vec3(o, m.color);
@@ -334,23 +335,31 @@ void write_material(std::string& o, const Material& m, int index, const char* in
   o += "Attribute \"micropoly\"";
   param(o, "integer material", static_cast<long long>(index));
   param(o, "string materialname", m.name);
+  if (m.program >= 0 && static_cast<size_t>(m.program) < programs.size()) {
+    param(o, "string program", programs[static_cast<size_t>(m.program)].source);
+    param(o, "integer programdisplaces", static_cast<long long>(m.program_displaces ? 1 : 0));
+    param(o, "integer programshades", static_cast<long long>(m.program_shades ? 1 : 0));
+    param(o, "float displacementbound", m.displacement_bound);
+  }
   o += '\n';
 }
 
 // Name, placement, sides and material: what a mesh and a patch set share.
 void write_object_state(std::string& o, const std::string& name, const glm::mat4& object_to_world,
-                        bool double_sided, const std::vector<Material>& materials, int material) {
+                        bool double_sided, const std::vector<Material>& materials, int material,
+                        const std::vector<MaterialProgram>& programs) {
   o += "  Attribute \"identifier\"";
   param(o, "name", name);
   o += "\n  Transform ";
   put_matrix(o, object_to_world);
   o += double_sided ? "\n  Sides 2\n" : "\n  Sides 1\n";
-  write_material(o, materials[static_cast<size_t>(material)], material, "  ");
+  write_material(o, materials[static_cast<size_t>(material)], material, "  ", programs);
 }
 
-void write_mesh(std::string& o, const Mesh& m, const std::vector<Material>& materials) {
+void write_mesh(std::string& o, const Mesh& m, const std::vector<Material>& materials,
+                const std::vector<MaterialProgram>& programs) {
   o += "AttributeBegin\n";
-  write_object_state(o, m.name, m.object_to_world, m.double_sided, materials, m.material);
+  write_object_state(o, m.name, m.object_to_world, m.double_sided, materials, m.material, programs);
   if (m.scheme == SubdivScheme::CatmullClark) {
     o += "  SubdivisionMesh \"catmull-clark\" ";
     put_ints(o, m.face_vertex_counts);
@@ -411,11 +420,12 @@ void write_mesh(std::string& o, const Mesh& m, const std::vector<Material>& mate
   o += "\nAttributeEnd\n";
 }
 
-void write_patches(std::string& o, const BezierPatches& b, const std::vector<Material>& materials) {
+void write_patches(std::string& o, const BezierPatches& b, const std::vector<Material>& materials,
+                   const std::vector<MaterialProgram>& programs) {
   // One Patch request per 4x4 net in the default Bezier basis (step 3); the
   // reader joins consecutive patches of one attribute block into one set.
   o += "AttributeBegin\n";
-  write_object_state(o, b.name, b.object_to_world, b.double_sided, materials, b.material);
+  write_object_state(o, b.name, b.object_to_world, b.double_sided, materials, b.material, programs);
   o += "  Basis \"bezier\" 3 \"bezier\" 3\n";
   for (size_t p = 0; p + 16 <= b.control_points.size(); p += 16) {
     o += "  Patch \"bicubic\" \"P\" ";
@@ -456,16 +466,16 @@ void write_valid_scene(const Scene& scene, std::ostream& out, const std::string&
   // The material table, in index order (index 0 replaces the default surface).
   for (size_t i = 0; i < materials.size(); ++i) {
     o += "AttributeBegin\n";
-    write_material(o, materials[i], static_cast<int>(i), "  ");
+    write_material(o, materials[i], static_cast<int>(i), "  ", scene.material_programs);
     o += "AttributeEnd\n";
   }
   flush(out, o);
   for (const Mesh& m : scene.meshes) {
-    write_mesh(o, m, materials);
+    write_mesh(o, m, materials, scene.material_programs);
     flush(out, o);
   }
   for (const BezierPatches& b : scene.bezier_patches) {
-    write_patches(o, b, materials);
+    write_patches(o, b, materials, scene.material_programs);
     flush(out, o);
   }
   o += "WorldEnd\nFrameEnd\n";
