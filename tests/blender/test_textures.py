@@ -36,6 +36,9 @@ import traceback
 import bpy
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(__file__))
+import render_utils as ru  # noqa: E402
+
 VERSION = bpy.app.version[0] * 100 + bpy.app.version[1]
 TILE = 40  # pixels per case, square
 COLS = 12
