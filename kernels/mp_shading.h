@@ -89,7 +89,6 @@ MP_INLINE float mp_ggx_specular(float3 n, float3 l, float3 v, float alpha) {
   return D * gl * gv / (4.0f * nl * nv);
 }
 
-/* Radiance leaving point p with normal n towards the eye. */
 /* A shading normal n (unit, on the viewer's side of the geometric normal
  * ng; v the unit direction to the viewer) turned towards ng just enough
  * that the mirror direction of v about it stays above the surface by
@@ -135,13 +134,14 @@ MP_INLINE float mp_bump_shadowing(float3 ng, float3 n, float3 l) {
   return -g * g * g + g * g + g;
 }
 
-/* Shading with a shading normal `n` (e.g. bumped) on the side of the
- * geometric normal `ng`: both flip together when the surface is seen from
- * behind, so a bumped normal that tilts away from the viewer near a
- * silhouette is not flipped on its own. bump_shadowing: n is a BSDF's own
- * normal, different from the surface's, so its diffuse light is shadowed
- * by mp_bump_shadowing. */
-MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bump_shadowing, int ortho, const DeviceMaterial* m,
+/* Radiance leaving point p towards the eye, with a shading normal `n`
+ * (e.g. bumped) on the side of the geometric normal `ng`: both flip together
+ * when the surface is seen from behind, so a bumped normal that tilts away
+ * from the viewer near a silhouette is not flipped on its own. bsdf_normal:
+ * n is a BSDF's own normal, different from the surface's, which Cycles keeps
+ * from reflecting the view below the surface (mp_valid_reflection_normal)
+ * and whose diffuse light it shadows by the surface (mp_bump_shadowing). */
+MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal, int ortho, const DeviceMaterial* m,
                                  MP_GLOBAL const DeviceLight* lights, uint light_count) {
   float3 cs = MP_F3(m->color[0], m->color[1], m->color[2]);
   float3 emission = MP_F3(m->emission[0], m->emission[1], m->emission[2]);
@@ -150,6 +150,7 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bump_shadowi
   float3 v = ortho ? MP_F3(0.0f, 0.0f, 1.0f) : normalize(-p);
   float3 ngf = dot(ng, v) < 0.0f ? -ng : ng;
   float3 nf = dot(ng, v) < 0.0f ? -n : n; /* faceforward */
+  if (bsdf_normal) nf = mp_valid_reflection_normal(ngf, v, nf);
   float ka = m->coeffs[0], kd = m->coeffs[1], ks = m->coeffs[2], roughness = m->coeffs[3];
   float inv_roughness = 1.0f / fmax(roughness, 1e-4f);
   float metallic = m->principled[0];
@@ -186,7 +187,7 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bump_shadowi
       e = cl * fmax(dot(nf, l), 0.0f);
     }
     if (!(e.x > 0.0f || e.y > 0.0f || e.z > 0.0f)) continue;
-    diffuse += bump_shadowing ? e * mp_bump_shadowing(ngf, nf, l) : e;
+    diffuse += bsdf_normal ? e * mp_bump_shadowing(ngf, nf, l) : e;
     if (model == MP_MODEL_PRINCIPLED) {
       float vh = fmax(dot(v, normalize(l + v)), 0.0f);
       float3 fresnel = f0 + (MP_F3(1.0f, 1.0f, 1.0f) - f0) * pow(1.0f - vh, 5.0f);
@@ -205,6 +206,7 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bump_shadowi
   return c + emission;
 }
 
+/* Radiance leaving point p with normal n towards the eye. */
 MP_INLINE float3 mp_shade(float3 p, float3 n, int ortho, const DeviceMaterial* m,
                           MP_GLOBAL const DeviceLight* lights, uint light_count) {
   return mp_shade_bumped(p, n, n, 0, ortho, m, lights, light_count);

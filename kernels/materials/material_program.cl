@@ -146,13 +146,15 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
    * a small step keeps the difference first-order even where a
    * micropolygon spans much of a texture's feature (grazing views). */
   uint stride = (uint)f.max_grid + 1u, nu = MP_INFO_NU(sp.info), nv = MP_INFO_NV(sp.info);
-  uint i = (gid % (stride * stride)) % stride, j = (gid % (stride * stride)) / stride;
-  uint ni = i < nu ? i + 1u : i - 1u, nj = j < nv ? j + 1u : j - 1u;
-  uint gx = gid - i + ni, gy = gid + (nj - j) * stride;
-  MpNodeGlobals nx = mp_node_globals(o, grid_p[gx].xyz, grid_n[gx].xyz, &in, sp.patch, mp_grid_uv(&sp, nu, nv, ni, j));
-  MpNodeGlobals ny = mp_node_globals(o, grid_p[gy].xyz, grid_n[gy].xyz, &in, sp.patch, mp_grid_uv(&sp, nu, nv, i, nj));
-  MpNodeGlobals g_dx = mp_node_globals_toward(&g, &nx, 0.1f), g_dy = mp_node_globals_toward(&g, &ny, 0.1f);
+  MpNodeGlobals g_dx, g_dy;
   if (nu > 0u && nv > 0u) {
+    uint i = (gid % (stride * stride)) % stride, j = (gid % (stride * stride)) / stride;
+    uint ni = i < nu ? i + 1u : i - 1u, nj = j < nv ? j + 1u : j - 1u;
+    uint gx = gid - i + ni, gy = gid - j * stride + nj * stride;
+    MpNodeGlobals nx = mp_node_globals(o, grid_p[gx].xyz, grid_n[gx].xyz, &in, sp.patch, mp_grid_uv(&sp, nu, nv, ni, j));
+    MpNodeGlobals ny = mp_node_globals(o, grid_p[gy].xyz, grid_n[gy].xyz, &in, sp.patch, mp_grid_uv(&sp, nu, nv, i, nj));
+    g_dx = mp_node_globals_toward(&g, &nx, 0.1f);
+    g_dy = mp_node_globals_toward(&g, &ny, 0.1f);
     g.dx = &g_dx;
     g.dy = &g_dy;
   }
@@ -172,15 +174,8 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   m.principled[1] = fmax(s.specular, 0.0f);
   m.coeffs[3] = clamp(s.roughness, 0.0f, 1.0f);
   m.emission[0] = s.emission.x, m.emission[1] = s.emission.y, m.emission[2] = s.emission.z;
-  float3 ns = n;
-  if (s.has_normal && all(isfinite(s.normal)) && length(s.normal) > 1e-6f) {
-    ns = mp_object_normal_to_camera(o, s.normal);
-    if (s.has_normal == MP_NORMAL_INPUT) {
-      float3 v = f.ortho ? (float3)(0.0f, 0.0f, 1.0f) : normalize(-p);
-      float side = dot(n, v) < 0.0f ? -1.0f : 1.0f;  /* the viewer's side */
-      ns = side * mp_valid_reflection_normal(side * n, v, side * ns);
-    }
-  }
-  float3 c = mp_shade_bumped(p, n, ns, s.has_normal == MP_NORMAL_INPUT, f.ortho, &m, lights, light_count);
+  int has_normal = s.has_normal && all(isfinite(s.normal)) && length(s.normal) > 1e-6f;
+  float3 ns = has_normal ? mp_object_normal_to_camera(o, s.normal) : n;
+  float3 c = mp_shade_bumped(p, n, ns, has_normal && s.has_normal == MP_NORMAL_INPUT, f.ortho, &m, lights, light_count);
   grid_c[gid] = (float4)(c, clamp(s.alpha, 0.0f, 1.0f));
 }

@@ -52,20 +52,6 @@ MP_INLINE float mp_srgb_to_linear(float c) {
   return c <= 0.04045f ? c / 12.92f : pow((fmax(c, 0.0f) + 0.055f) / 1.055f, 2.4f);
 }
 
-MP_INLINE float4 mp_tex_image_filtered(const MP_GLOBAL float4* texels, DeviceImage im, float u, float v,
-                                       int interpolation, int extension);
-
-/* RGBA of image `index` at (u, v), scene-linear; magenta for an image index
- * the scene does not have (Blender's colour for a missing image). */
-MP_INLINE float4 mp_tex_image(const MP_GLOBAL DeviceImage* images, uint image_count, const MP_GLOBAL float4* texels,
-                              int index, float u, float v, int interpolation, int extension) {
-  if (index < 0 || (uint)index >= image_count) return MP_F4(1.0f, 0.0f, 1.0f, 1.0f);
-  DeviceImage im = images[index];
-  float4 c = mp_tex_image_filtered(texels, im, u, v, interpolation, extension);
-  if (im.srgb) c = MP_F4(mp_srgb_to_linear(c.x), mp_srgb_to_linear(c.y), mp_srgb_to_linear(c.z), c.w);
-  return c;
-}
-
 /* Filtered texel values of one image at (u, v). */
 MP_INLINE float4 mp_tex_image_filtered(const MP_GLOBAL float4* texels, DeviceImage im, float u, float v,
                                        int interpolation, int extension) {
@@ -99,6 +85,17 @@ MP_INLINE float4 mp_tex_image_filtered(const MP_GLOBAL float4* texels, DeviceIma
   float4 a = mp_image_texel(texels, im, ix, iy, extension), b = mp_image_texel(texels, im, ix + 1, iy, extension);
   float4 c = mp_image_texel(texels, im, ix, iy + 1, extension), d = mp_image_texel(texels, im, ix + 1, iy + 1, extension);
   return (1.0f - ty) * ((1.0f - tx) * a + tx * b) + ty * ((1.0f - tx) * c + tx * d);
+}
+
+/* RGBA of image `index` at (u, v), scene-linear; magenta for an image index
+ * the scene does not have (Blender's colour for a missing image). */
+MP_INLINE float4 mp_tex_image(const MP_GLOBAL DeviceImage* images, uint image_count, const MP_GLOBAL float4* texels,
+                              int index, float u, float v, int interpolation, int extension) {
+  if (index < 0 || (uint)index >= image_count) return MP_F4(1.0f, 0.0f, 1.0f, 1.0f);
+  DeviceImage im = images[index];
+  float4 c = mp_tex_image_filtered(texels, im, u, v, interpolation, extension);
+  if (im.srgb) c = MP_F4(mp_srgb_to_linear(c.x), mp_srgb_to_linear(c.y), mp_srgb_to_linear(c.z), c.w);
+  return c;
 }
 
 #endif

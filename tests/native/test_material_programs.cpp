@@ -3,6 +3,7 @@
 // and bad programs or references rejected with the material's name.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -126,6 +127,70 @@ TEST_F(MaterialProgramTest, ProgramsSurviveARibRoundTrip) {
   EXPECT_FLOAT_EQ(back.materials[0].displacement_bound, 0.5f);
   RenderResult r = renderer_->render(back);
   EXPECT_NEAR(r.depth[32 * 64 + 32], 4.5f, 1e-3f);
+}
+
+// Image Texture lookups from a program: a 2 x 1 image (black | white, sRGB
+// encoded) under Linear / Extend across the plane's U, and a missing image
+// index, which renders magenta.
+TEST_F(MaterialProgramTest, ImagesAreFilteredThenDecodedAndMissingOnesAreMagenta) {
+  const std::string lookup =
+      "void mp_node_surface(const MpNodeGlobals* g, MpSurfaceInputs* s) {"
+      " float4 c = mp_tex_image(g->images, g->image_count, g->texels, INDEX, g->uv[0].x, 0.5f, 0, 1);"
+      " s->base_color = c.xyz; }\n";
+  Scene s = facing_plane(static_cast<int>(Material::Model::Constant));
+  std::vector<glm::vec2> uvs;
+  for (int v : s.meshes[0].face_vertex_indices) uvs.push_back((glm::vec2(s.meshes[0].points[size_t(v)]) + 3.0f) / 6.0f);
+  s.meshes[0].uv_layers = {uvs};
+  s.images.push_back({"ramp", 2, 1, {glm::vec4(0.0f, 0.0f, 0.0f, 1.0f), glm::vec4(1.0f)}, true});
+  auto with_index = [&](const char* index) {
+    std::string src = lookup;
+    src.replace(src.find("INDEX"), 5, index);
+    return std::string("#include \"textures/mp_tex_image.h\"\n") + kNoDisplacement + src;
+  };
+  s.material_programs.push_back({"image", with_index("0")});
+  s.materials[0].program_shades = true;
+  RenderResult r = renderer_->render(s);
+  // u = (x + 3) / 6; texel centres at u = 1/4 and 3/4, Extend beyond them.
+  // The sRGB value blends linearly in u, then decodes.
+  const float half = 5.0f * std::tan(glm::radians(22.5f));
+  auto srgb_to_linear = [](float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); };
+  // The pixel may sit up to a quarter pixel off (sampling and filtering),
+  // so the value must lie in the ramp's range over that span.
+  auto expected = [&](float column) {
+    const float u = (half * (column / 32.0f - 1.0f) + 3.0f) / 6.0f;
+    return srgb_to_linear(std::clamp((u - 0.25f) * 2.0f, 0.0f, 1.0f));
+  };
+  for (int c : {16, 28, 32, 36, 48}) {
+    const float lo = expected(c + 0.25f) - 1e-3f, hi = expected(c + 0.75f) + 1e-3f;
+    const float got = r.rgba[4 * (32 * 64 + c)];
+    EXPECT_TRUE(got >= lo && got <= hi) << "column " << c << ": " << got << " not in [" << lo << ", " << hi << "]";
+  }
+  s.material_programs[0].source = with_index("5");
+  r = renderer_->render(s);
+  EXPECT_NEAR(r.rgba[4 * (32 * 64 + 32)], 1.0f, 1e-5f);
+  EXPECT_NEAR(r.rgba[4 * (32 * 64 + 32) + 1], 0.0f, 1e-5f);
+  EXPECT_NEAR(r.rgba[4 * (32 * 64 + 32) + 2], 1.0f, 1e-5f);
+}
+
+TEST_F(MaterialProgramTest, ImagesWithoutTheirPixelsOrWithNaNsAreRejected) {
+  Scene s = facing_plane(static_cast<int>(Material::Model::Matte));
+  s.material_programs.push_back({"ok", std::string(kNoDisplacement) + kNoSurface});
+  s.images.push_back({"short", 2, 2, std::vector<glm::vec4>(3, glm::vec4(0.5f)), false});
+  try {
+    validate_scene(s);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("short"), std::string::npos) << e.what();
+  }
+  s.images[0] = {"nan", 1, 1, {glm::vec4(std::nanf(""))}, false};
+  EXPECT_THROW(validate_scene(s), Error);
+}
+
+TEST_F(MaterialProgramTest, NegativeDisplacementBoundInRibIsAnError) {
+  const std::string rib =
+      "WorldBegin\nAttribute \"micropoly\" \"integer material\" [0] \"string program\" [\"x\"] "
+      "\"float displacementbound\" [-1]\nWorldEnd\n";
+  EXPECT_THROW(read_rib_string(rib, "bad bound"), Error);
 }
 
 TEST_F(MaterialProgramTest, UVMapsOfTheWrongSizeAreRejected) {

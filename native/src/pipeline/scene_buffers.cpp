@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+
+#include "micropoly/error.h"
 
 #include "mp_patch.h"
 
@@ -141,6 +144,9 @@ HostSceneData prepare_scene_data(const Scene& scene) {
   for (const Material& m : scene.materials) out.materials.push_back(to_device(m));
   for (const Light& l : scene.lights) out.lights.push_back(to_device(l, w2c));
   for (const Image& image : scene.images) {
+    // DeviceImage offsets are 32-bit texel indices (64 GiB of float texels).
+    if (out.texels.size() + image.pixels.size() > size_t(UINT32_MAX))
+      throw Error("image '" + image.name + "': the scene's images exceed 2^32 texels");
     out.images.push_back(DeviceImage{uint32_t(out.texels.size()), uint32_t(image.width), uint32_t(image.height),
                                      image.srgb ? 1u : 0u});
     out.texels.insert(out.texels.end(), image.pixels.begin(), image.pixels.end());

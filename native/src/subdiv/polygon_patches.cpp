@@ -13,6 +13,7 @@
 // planar convex face the quads tile it exactly. These are the quads the
 // first Catmull-Clark step makes of a non-quad face (there with the vertex at
 // (0,0)), so flat and subdivided versions of a mesh split faces alike.
+#include <type_traits>
 #include <vector>
 
 #include "subdiv/patch_buffer.h"
@@ -69,7 +70,7 @@ void append_polygon_patches(const Mesh& mesh, const glm::mat4& to_space, PatchBu
     // The split quads carry the same bilinear blend of the face's UVs as of
     // its points: centroid, edge midpoints, corner.
     auto quad = [n](const auto* v, int k, auto* out4) {
-      auto centroid = v[0] * 0.0;
+      std::decay_t<decltype(v[0])> centroid(0.0);
       for (int i = 0; i < n; ++i) centroid += v[i];
       centroid /= double(n);
       const auto& prev = v[(k + n - 1) % n];
