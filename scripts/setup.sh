@@ -16,7 +16,7 @@ packages=(
   libglm-dev pybind11-dev libosd-dev libgtest-dev libgmock-dev
   libpng-dev libopenexr-dev
   python3 python3-dev python3-numpy python3-pytest python3-venv
-  blender
+  blender xvfb xauth libgl1-mesa-dri
 )
 missing=()
 for p in "${packages[@]}"; do

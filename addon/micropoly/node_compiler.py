@@ -26,7 +26,8 @@ VMATH_OPS = ["ADD", "SUBTRACT", "MULTIPLY", "DIVIDE", "MULTIPLY_ADD", "CROSS_PRO
              "CEIL", "FRACTION", "MODULO", "WRAP", "SNAP", "SINE", "COSINE", "TANGENT", "FACEFORWARD"]
 VMATH_VALUE_OPS = {"DOT_PRODUCT", "DISTANCE", "LENGTH"}
 BLEND_MODES = ["MIX", "ADD", "MULTIPLY", "SUBTRACT", "SCREEN", "DIVIDE", "DIFFERENCE", "DARKEN", "LIGHTEN",
-               "OVERLAY", "DODGE", "BURN", "SOFT_LIGHT", "LINEAR_LIGHT", "EXCLUSION"]
+               "OVERLAY", "DODGE", "BURN", "SOFT_LIGHT", "LINEAR_LIGHT", "EXCLUSION", "HUE", "SATURATION", "VALUE",
+               "COLOR"]
 RANGE_MODES = ["LINEAR", "STEPPED", "SMOOTHSTEP", "SMOOTHERSTEP"]
 MAPPING_TYPES = ["POINT", "TEXTURE", "VECTOR", "NORMAL"]
 FRACTAL_TYPES = ["FBM", "MULTIFRACTAL", "RIDGED_MULTIFRACTAL", "HYBRID_MULTIFRACTAL", "HETERO_TERRAIN"]
@@ -113,13 +114,20 @@ class NodeCompiler:
         self.fn = None
         self.helpers = []          # extra functions (Bump heights), emitted before the main two
         self.uses_neighbours = False
+        self.groups = []           # the Group nodes whose trees are being compiled, outermost first
 
     # ---- helpers ----------------------------------------------------------
     def warn(self, node, what):
-        key = (node.name, what)
+        where = "".join(f"group '{g.name}' > " for g in self.groups)
+        key = (where, node.name, what)
         if key not in self.warned:
             self.warned.add(key)
-            self.warnings.append(f"material '{self.material.name}': node '{node.name}' ({node.bl_label}): {what}")
+            self.warnings.append(f"material '{self.material.name}': {where}node '{node.name}' ({node.bl_label}): "
+                                 f"{what}")
+
+    def key(self, node, identifier):
+        """Memo key of a node output: node names repeat across group trees."""
+        return tuple(g.name for g in self.groups) + (node.name, identifier)
 
     @staticmethod
     def convert(value, kind, from_type):
@@ -151,6 +159,8 @@ class NodeCompiler:
                     from_node = None
                     break
                 from_node, from_socket = inner[0].from_node, inner[0].from_socket
+            if from_node is not None and from_node.type == "GROUP_INPUT":
+                return self.group_input(from_socket, kind)
             if from_node is not None:
                 return self.convert(self.output(from_node, from_socket), kind, from_socket.type)
         if not hasattr(socket, "default_value"):
@@ -166,7 +176,7 @@ class NodeCompiler:
         return _vec_lit(seq if seq is not None else [float(v)] * 3), VEC, None
 
     def output(self, node, socket):
-        key = (node.name, socket.identifier)
+        key = self.key(node, socket.identifier)
         if key not in self.fn.values:
             if getattr(node, "mute", False):
                 self.warn(node, "is muted; its outputs take their default values")
@@ -174,7 +184,7 @@ class NodeCompiler:
             else:
                 outs = self.emit(node)
             for out in node.outputs:
-                k = (node.name, out.identifier)
+                k = self.key(node, out.identifier)
                 if out.identifier in outs:
                     self.fn.values[k] = outs[out.identifier]
                 else:
@@ -185,6 +195,43 @@ class NodeCompiler:
                     except TypeError:
                         self.fn.values[k] = (_lit(dv), FLOAT, (float(dv), float(dv)))
         return self.fn.values.get(key, ("0.0f", FLOAT, (0.0, 0.0)))
+
+    def group_input(self, socket, kind):
+        """A Group Input socket inside a group: the Group node's input of the
+        same identifier, evaluated in the tree around the Group node."""
+        if not self.groups:
+            return ("0.0f", FLOAT, (0.0, 0.0)) if kind == FLOAT else ("(float3)(0.0f)", VEC, None)
+        group = self.groups.pop()
+        try:
+            index = next((i for i, s in enumerate(group.inputs) if s.identifier == socket.identifier), None)
+            if index is None:
+                return ("0.0f", FLOAT, (0.0, 0.0)) if kind == FLOAT else ("(float3)(0.0f)", VEC, None)
+            return self.input(group, index, kind)
+        finally:
+            self.groups.append(group)
+
+    def emit_group(self, node):
+        """A node group: its Group Output's inputs, compiled inside the group's
+        tree (names there are scoped by the Group node)."""
+        tree = node.node_tree
+        outputs = [n for n in tree.nodes if n.type == "GROUP_OUTPUT"] if tree is not None else []
+        active = [n for n in outputs if getattr(n, "is_active_output", False)] or outputs
+        if not active:
+            self.warn(node, "has no node tree or no Group Output; its outputs take their default values")
+            return {}
+        out_node = active[0]
+        result = {}
+        self.groups.append(node)
+        try:
+            for out in node.outputs:
+                if out.type == "SHADER" or not out.is_linked:
+                    continue
+                index = next((i for i, s in enumerate(out_node.inputs) if s.identifier == out.identifier), None)
+                if index is not None:
+                    result[out.identifier] = self.input(out_node, index, _socket_kind(out))
+        finally:
+            self.groups.pop()
+        return result
 
     def vector_or_generated(self, node, key="Vector"):
         socket = node.inputs.get(key)
@@ -248,11 +295,20 @@ class NodeCompiler:
                                  self.input(node, "Color1", VEC), self.input(node, "Color2", VEC), "Color")
         if t == "MIX":
             return self.emit_mix_node(node)
+        if t == "GROUP":
+            return self.emit_group(node)
+        if t == "HUE_SAT":
+            h, sat, val, fac = (self.input(node, k, FLOAT)[0] for k in ("Hue", "Saturation", "Value", "Fac"))
+            col = self.input(node, "Color", VEC)[0]
+            return {"Color": fn.temp(VEC, f"mp_hue_saturation({h}, {sat}, {val}, {fac}, {col})")}
         if t == "MAP_RANGE":
-            if getattr(node, "data_type", "FLOAT") != "FLOAT":
-                self.warn(node, "vector Map Range is not supported")
-                return {}
             mode = node.interpolation_type
+            if getattr(node, "data_type", "FLOAT") == "FLOAT_VECTOR":
+                names = ("Vector", "From_Min_FLOAT3", "From_Max_FLOAT3", "To_Min_FLOAT3", "To_Max_FLOAT3",
+                         "Steps_FLOAT3")
+                args = [self.by_id(node, n, VEC)[0] for n in names]
+                return {"Vector": fn.temp(VEC, f"mp_map_range3({RANGE_MODES.index(mode)}, " + ", ".join(args) +
+                                               f", {1 if node.clamp else 0})")}
             args = [self.input(node, i, FLOAT) for i in range(6)]
             expr = (f"mp_map_range({RANGE_MODES.index(mode)}, " + ", ".join(a[0] for a in args) +
                     f", {1 if node.clamp else 0})")

@@ -271,6 +271,78 @@ MP_INLINE float3 mp_vector_math(int op, float3 a, float3 b, float3 c, float scal
 #define MP_BLEND_SOFT_LIGHT 12
 #define MP_BLEND_LINEAR_LIGHT 13
 #define MP_BLEND_EXCLUSION 14
+#define MP_BLEND_HUE 15
+#define MP_BLEND_SATURATION 16
+#define MP_BLEND_VALUE 17
+#define MP_BLEND_COLOR 18
+
+/* RGB <-> HSV with hue in [0, 1), the conversion Blender's colour nodes use:
+ * a grey (zero saturation) has hue 0, and hue 1 wraps to 0. */
+MP_INLINE float3 mp_rgb_to_hsv(float3 c) {
+  float cmax = fmax(c.x, fmax(c.y, c.z)), cmin = fmin(c.x, fmin(c.y, c.z));
+  float delta = cmax - cmin;
+  float s = cmax != 0.0f ? delta / cmax : 0.0f;
+  float h = 0.0f;
+  if (s != 0.0f) {
+    float3 k = (MP_F3(cmax, cmax, cmax) - c) / delta;
+    if (c.x == cmax) h = k.z - k.y;
+    else if (c.y == cmax) h = 2.0f + k.x - k.z;
+    else h = 4.0f + k.y - k.x;
+    h /= 6.0f;
+    if (h < 0.0f) h += 1.0f;
+  }
+  return MP_F3(h, s, cmax);
+}
+
+MP_INLINE float3 mp_hsv_to_rgb(float3 hsv) {
+  float h = hsv.x, s = hsv.y, v = hsv.z;
+  if (s == 0.0f) return MP_F3(v, v, v);
+  if (h == 1.0f) h = 0.0f;
+  h *= 6.0f;
+  float i = floor(h), f = h - i;
+  float p = v * (1.0f - s), q = v * (1.0f - s * f), t = v * (1.0f - s * (1.0f - f));
+  switch ((int)i) {
+    case 0: return MP_F3(v, t, p);
+    case 1: return MP_F3(q, v, p);
+    case 2: return MP_F3(p, v, t);
+    case 3: return MP_F3(p, q, v);
+    case 4: return MP_F3(t, p, v);
+  }
+  return MP_F3(v, p, q);
+}
+
+/* Hue, Saturation, Value and Color blend modes: take some HSV channels from b.
+ * Hue and Color leave a unchanged where b is grey (its hue is undefined);
+ * Saturation leaves a grey a unchanged. */
+MP_INLINE float3 mp_blend_hsv(int mode, float t, float3 a, float3 b) {
+  float3 hb = mp_rgb_to_hsv(b), ha = mp_rgb_to_hsv(a);
+  if (mode == MP_BLEND_VALUE) {
+    ha.z = (1.0f - t) * ha.z + t * hb.z;
+    return mp_hsv_to_rgb(ha);
+  }
+  if (mode == MP_BLEND_SATURATION) {
+    if (ha.y == 0.0f) return a;
+    ha.y = (1.0f - t) * ha.y + t * hb.y;
+    return mp_hsv_to_rgb(ha);
+  }
+  if (hb.y == 0.0f) return a;
+  ha.x = hb.x;
+  if (mode == MP_BLEND_COLOR) ha.y = hb.y;
+  return (1.0f - t) * a + t * mp_hsv_to_rgb(ha);
+}
+
+/* Hue/Saturation/Value node: hue shifted (0.5 is no shift), saturation
+ * scaled and clamped to [0, 1], value scaled, blended with the input by fac
+ * and kept non-negative. */
+MP_INLINE float3 mp_hue_saturation(float hue, float saturation, float value, float fac, float3 color) {
+  float3 hsv = mp_rgb_to_hsv(color);
+  float hx = hsv.x + hue + 0.5f;
+  hsv.x = hx - floor(hx);
+  hsv.y = fmin(fmax(hsv.y * saturation, 0.0f), 1.0f);
+  hsv.z *= value;
+  float3 out = fac * mp_hsv_to_rgb(hsv) + (1.0f - fac) * color;
+  return fmax(out, MP_F3(0.0f, 0.0f, 0.0f));
+}
 
 MP_INLINE float mp_nl_overlay(float t, float a, float b) {
   float tm = 1.0f - t;
@@ -323,6 +395,10 @@ MP_INLINE float3 mp_blend(int mode, float t, float3 a, float3 b) {
     case MP_BLEND_SOFT_LIGHT:
       return MP_F3(mp_nl_soft_light(t, a.x, b.x), mp_nl_soft_light(t, a.y, b.y), mp_nl_soft_light(t, a.z, b.z));
     case MP_BLEND_LINEAR_LIGHT: return a + t * (2.0f * b - MP_F3(1.0f, 1.0f, 1.0f));
+    case MP_BLEND_HUE:
+    case MP_BLEND_SATURATION:
+    case MP_BLEND_VALUE:
+    case MP_BLEND_COLOR: return mp_blend_hsv(mode, t, a, b);
   }
   return a;
 }
@@ -355,6 +431,14 @@ MP_INLINE float mp_map_range(int mode, float value, float from_min, float from_m
   if (clamp_result && mode <= MP_RANGE_STEPPED)
     r = to_max > to_min ? fmin(fmax(r, to_min), to_max) : fmin(fmax(r, to_max), to_min);
   return r;
+}
+
+/* Vector Map Range: each component mapped on its own (steps per component). */
+MP_INLINE float3 mp_map_range3(int mode, float3 v, float3 from_min, float3 from_max, float3 to_min, float3 to_max,
+                               float3 steps, int clamp_result) {
+  return MP_F3(mp_map_range(mode, v.x, from_min.x, from_max.x, to_min.x, to_max.x, steps.x, clamp_result),
+               mp_map_range(mode, v.y, from_min.y, from_max.y, to_min.y, to_max.y, steps.y, clamp_result),
+               mp_map_range(mode, v.z, from_min.z, from_max.z, to_min.z, to_max.z, steps.z, clamp_result));
 }
 
 /* ---- Clamp ---------------------------------------------------------------- */
