@@ -9,7 +9,7 @@ import time
 import bpy
 import numpy as np
 
-from . import export, preferences
+from . import export, export_mesh, preferences, viewport
 
 PASSES = (("Depth", 1, "Z", "VALUE"), ("Normal", 3, "XYZ", "VECTOR"))
 
@@ -19,7 +19,89 @@ class MicropolyRenderEngine(bpy.types.RenderEngine):
     bl_label = "Micropoly"
     bl_use_preview = False
     bl_use_postprocess = True
+    bl_use_eevee_viewport = True  # Material Preview shading stays EEVEE's, as with Cycles
 
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._viewport = None        # viewport.ViewportSession while the view is Rendered
+        self._viewport_meshes = None  # export_mesh.MeshCache kept between viewport updates
+        self._viewport_texture = None
+        self._viewport_signature = None
+
+    def __del__(self):
+        session = getattr(self, "_viewport", None)
+        if session is not None:
+            session.close()
+
+    # ---- viewport (Rendered shading) ---------------------------------------
+    def view_update(self, context, depsgraph):
+        """The scene changed (or the view opened): forget the meshes whose
+        geometry changed, export again and restart the refinement."""
+        from . import viewport_draw
+
+        first = self._viewport is None
+        if first:
+            try:
+                from . import _native  # noqa: F401
+            except ImportError as e:
+                self.update_stats("", f"Micropoly: the native module did not load: {e}")
+                return
+            self._viewport = viewport.ViewportSession(preferences.device_selector(context))
+            self._viewport_meshes = export_mesh.MeshCache()
+            self._viewport_texture = viewport_draw.ViewportTexture()
+        # Updates of the Scene alone also come from edits that change nothing
+        # rendered (a new image data-block, selection): those are told apart
+        # by the scene settings Micropoly reads.
+        signature = viewport.scene_signature(depsgraph.scene)
+        relevant = first or signature != self._viewport_signature
+        for update in depsgraph.updates:
+            if not isinstance(update.id, bpy.types.Scene):
+                relevant = True
+            if update.is_updated_geometry:
+                self._viewport_meshes.forget(update.id.original)
+        self._viewport_signature = signature
+        if relevant:
+            self._viewport_export(context, depsgraph)
+
+    def _viewport_export(self, context, depsgraph):
+        scene = depsgraph.scene
+        view = viewport.view_from_context(context)
+        try:
+            exported = export.export_scene(depsgraph, view=view, meshes=self._viewport_meshes)
+        except export.ExportError as e:
+            self._viewport_status = f"Micropoly: {e}"
+            self._viewport.cancel()
+            return
+        mp = scene.micropoly
+        self._viewport_status = "; ".join(exported.warnings)
+        self._viewport.request(exported, view, mp.viewport_samples, mp.viewport_shading_rate)
+
+    def view_draw(self, context, depsgraph):
+        """Draws the newest image; a changed view restarts the refinement."""
+        from . import viewport_draw
+
+        session = self._viewport
+        if session is None:
+            return
+        view = viewport.view_from_context(context)
+        if not viewport.same_view(view, session.view()):
+            session.restart_view(view)
+        image = session.image()
+        if image is not None:
+            viewport_draw.draw(self, depsgraph.scene, self._viewport_texture, image, view.width, view.height)
+        error = session.error()
+        if error:
+            self.update_stats("", f"Micropoly: {error}")
+        elif getattr(self, "_viewport_status", "").startswith("Micropoly:"):
+            self.update_stats("", self._viewport_status)
+        elif image is not None:
+            state = "Done" if image.final and not session.busy() else "Refining"
+            self.update_stats("", f"Micropoly | {session.device} | {state} | {image.samples} spp | "
+                                  f"{image.stats.get('micropolygons', 0):,} micropolygons | {image.seconds:.2f} s")
+        if session.busy():
+            self.tag_redraw()  # draw again soon: the next pass is on its way
+
+    # ---- final render ---------------------------------------------------------
     def update_render_passes(self, scene=None, renderlayer=None):
         self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
         if renderlayer.use_pass_z:

@@ -29,6 +29,7 @@ class ExportedScene:
     warnings: list = field(default_factory=list)
     background: np.ndarray = field(default_factory=lambda: np.zeros(3, dtype=np.float32))
     objects: int = 0
+    transparent: bool = False  # Film > Transparent: no world colour behind objects
 
     @property
     def summary(self):
@@ -82,6 +83,30 @@ def export_camera(native_scene, scene, camera_object, width, height):
                             screen_window=window)
 
 
+@dataclass
+class ViewCamera:
+    """A view to render instead of the scene camera (the 3D viewport's):
+    world_to_camera looks down -Z; screen_window is (left, right, bottom,
+    top) at unit distance (perspective) or in scene units (orthographic);
+    crop is (x0, x1, y0, y1) as fractions of the image, y0 at the top."""
+    width: int
+    height: int
+    world_to_camera: np.ndarray
+    orthographic: bool
+    screen_window: tuple
+    clip_near: float
+    clip_far: float
+    crop: tuple = None
+
+    def apply(self, native_scene):
+        native_scene.set_camera(self.world_to_camera, orthographic=self.orthographic, fov_degrees=90.0,
+                                clip_near=self.clip_near, clip_far=self.clip_far,
+                                screen_window=list(self.screen_window))
+        s = native_scene.settings
+        s.width, s.height, s.pixel_aspect = self.width, self.height, 1.0
+        s.crop_x0, s.crop_x1, s.crop_y0, s.crop_y1 = self.crop or (0.0, 1.0, 0.0, 1.0)
+
+
 def export_settings(native_scene, scene, width, height):
     settings = native_scene.settings
     mp = scene.micropoly
@@ -100,19 +125,25 @@ def export_settings(native_scene, scene, width, height):
     settings.bound_split_memory_mib = mp.bound_split_memory
 
 
-def export_scene(depsgraph):
-    """Returns an ExportedScene; raises ExportError for scenes that cannot render."""
+def export_scene(depsgraph, view=None, meshes=None):
+    """Returns an ExportedScene; raises ExportError for scenes that cannot render.
+    view: a ViewCamera to render instead of the scene camera (the viewport);
+    meshes: a MeshCache kept between exports (the viewport's), else a new one."""
     scene = depsgraph.scene
     camera = scene.camera
-    if camera is None:
+    if camera is None and view is None:
         raise ExportError("the scene has no active camera")
-    width, height = render_size(scene)
+    width, height = render_size(scene) if view is None else (view.width, view.height)
     native_scene = _native.Scene()
-    out = ExportedScene(scene=native_scene, width=width, height=height)
+    out = ExportedScene(scene=native_scene, width=width, height=height,
+                        transparent=scene.render.film_transparent)
     export_settings(native_scene, scene, width, height)
-    export_camera(native_scene, scene, camera.evaluated_get(depsgraph), width, height)
+    if view is None:
+        export_camera(native_scene, scene, camera.evaluated_get(depsgraph), width, height)
+    else:
+        view.apply(native_scene)
     materials = export_materials.MaterialTable(native_scene, out.warnings)
-    meshes = export_mesh.MeshCache()
+    meshes = meshes if meshes is not None else export_mesh.MeshCache()
     out.background = export_lights.export_world(native_scene, scene.world)
     # Materials first: their node programs decide which UV maps meshes export.
     for inst in depsgraph.object_instances:
@@ -124,7 +155,7 @@ def export_scene(depsgraph):
         if obj.type == "MESH":
             try:
                 if export_mesh.export_object(native_scene, materials, meshes, obj, _matrix(inst.matrix_world),
-                                             out.warnings):
+                                             out.warnings, is_instance=inst.is_instance):
                     out.objects += 1
             except RuntimeError as e:  # numpy/native rejections of the data
                 raise ExportError(f"object '{obj.name}': {e}") from e

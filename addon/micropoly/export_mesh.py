@@ -51,10 +51,29 @@ def subdivision_modifier(obj):
 
 
 class MeshCache:
-    """Arrays per mesh data-block, so instances of one mesh export it once."""
+    """Arrays per mesh, so instances of one mesh export it once, and the
+    viewport re-reads only meshes whose geometry changed. Keys: ("cage", mesh
+    name) for the mesh under a Subdivision Surface, ("eval", object name) for
+    an object's evaluated mesh. The arrays depend on the UV maps that node
+    programs read, so a change of those starts a new cache."""
 
     def __init__(self):
         self.arrays = {}
+        self.uv_names = None
+
+    def for_uv_names(self, uv_names):
+        if self.uv_names != list(uv_names):
+            self.arrays.clear()
+            self.uv_names = list(uv_names)
+
+    def forget(self, id_data):
+        """Drops what was read from an object or mesh whose geometry changed."""
+        names = {id_data.name_full}
+        data = getattr(id_data, "data", None)
+        if data is not None:
+            names.add(data.name_full)
+        for key in [k for k in self.arrays if k[1] in names]:
+            del self.arrays[key]
 
 
 def _uv_layers(mesh, names, n_loops):
@@ -107,7 +126,7 @@ def _mesh_arrays(mesh, with_creases, uv_names=()):
     return arrays
 
 
-def export_object(native_scene, materials, cache, obj, matrix, warnings):
+def export_object(native_scene, materials, cache, obj, matrix, warnings, is_instance=False):
     """Adds one mesh instance; returns False when it has no faces."""
     subsurf, only = subdivision_modifier(obj)
     if subsurf is not None and not only:
@@ -115,9 +134,14 @@ def export_object(native_scene, materials, cache, obj, matrix, warnings):
                         "limit surface only when the Subdivision Surface modifier is the only modifier")
         subsurf = None
     cage = obj.original.data if subsurf is not None else None
-    key = ("cage", cage.name_full) if cage is not None else None
+    cache.for_uv_names(materials.uv_names)
+    # Instances made by geometry nodes or particles may carry meshes of their
+    # own under the instanced object's name: only real objects are cached.
+    key = ("cage", cage.name_full) if cage is not None else (("eval", obj.name_full) if not is_instance else None)
     arrays = cache.arrays.get(key) if key else None
     if arrays is None:
+        if cage is not None and obj.original.mode == "EDIT":
+            obj.original.update_from_editmode()  # the cage as edited so far
         mesh = cage if cage is not None else obj.to_mesh()
         try:
             arrays = _mesh_arrays(mesh, with_creases=subsurf is not None and subsurf.use_creases,

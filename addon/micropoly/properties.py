@@ -22,6 +22,11 @@ class MicropolySceneSettings(bpy.types.PropertyGroup):
                          default=16, min=1, max=1024)
     shading_rate: FloatProperty(name="Shading Rate", description="Area of a micropolygon in pixels; "
                                 "smaller is finer and slower", default=1.0, min=0.05, max=64.0)
+    viewport_samples: IntProperty(name="Viewport Samples", description="Samples per pixel that Rendered "
+                                  "viewport shading refines to", default=16, min=1, max=1024)
+    viewport_shading_rate: FloatProperty(name="Viewport Shading Rate", description="Area of a micropolygon "
+                                         "in pixels in the Rendered viewport; coarser than final renders keeps "
+                                         "the view responsive", default=2.0, min=0.05, max=64.0)
     max_grid_size: IntProperty(name="Split Limit", description="Largest grid, in micropolygons per side, "
                                "that a sub-patch is diced into before it is split instead",
                                default=16, min=2, max=32)

@@ -40,7 +40,9 @@ class MICROPOLY_PT_sampling(MicropolyPanel, bpy.types.Panel):
         layout = self.layout
         layout.use_property_split = True
         settings = context.scene.micropoly
-        layout.prop(settings, "samples")
+        col = layout.column(align=True)
+        col.prop(settings, "samples", text="Render Samples")
+        col.prop(settings, "viewport_samples", text="Viewport")
         layout.prop(settings, "filter_type")
         layout.prop(settings, "filter_width")
 
@@ -52,7 +54,9 @@ class MICROPOLY_PT_dicing(MicropolyPanel, bpy.types.Panel):
         layout = self.layout
         layout.use_property_split = True
         settings = context.scene.micropoly
-        layout.prop(settings, "shading_rate")
+        col = layout.column(align=True)
+        col.prop(settings, "shading_rate", text="Render Shading Rate")
+        col.prop(settings, "viewport_shading_rate", text="Viewport")
         layout.prop(settings, "max_grid_size")
 
 

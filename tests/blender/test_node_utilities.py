@@ -239,15 +239,18 @@ def main():
         if not value >= MIN_PSNR:
             failures.append(f"{name}: {value:.1f} dB < {MIN_PSNR} dB")
     if failures:
-        raise SystemExit("FAIL: " + "; ".join(failures))
+        print("FAIL: " + "; ".join(failures))
+        return 1
     print(f"OK: {len(cases)} node cases within {MIN_PSNR} dB of Cycles")
+    return 0
 
 
 if __name__ == "__main__":
     try:
-        main()
-    except SystemExit:
-        raise
+        code = main()
     except Exception:
         traceback.print_exc()
-        sys.exit(1)
+        code = 1
+    sys.stdout.flush()
+    # The bpy module can hang in its exit handlers: leave without them.
+    os._exit(code) if bpy.app.background else sys.exit(code)

@@ -9,6 +9,7 @@
 
 #include "micropoly/error.h"
 #include "micropoly/renderer.h"
+#include "micropoly/settings_util.h"
 #include "renderer_fixture.h"
 #include "scene_fixtures.h"
 
@@ -69,6 +70,46 @@ TEST_F(RenderTest, SameSceneRendersBitIdenticallyTwice) {
   EXPECT_EQ(a.rgba, b.rgba);
   EXPECT_EQ(a.depth, b.depth);
   EXPECT_EQ(a.normal, b.normal);
+}
+
+// The renderer keeps the last scene's device buffers for a re-render of the
+// same content. Re-rendering at another sample count or size reuses them;
+// any change to geometry, transforms, camera placement, materials or lights
+// must not, and must show in the image.
+TEST_F(RenderTest, SceneBuffersAreReusedOnlyForTheSameContent) {
+  Scene s = base_scene(200, 150, 4);
+  s.camera = look_at({2.5f, 2.0f, 4.0f}, {0, 0, 0});
+  s.meshes.push_back(cube_mesh(SubdivScheme::CatmullClark));
+  s.lights.push_back(Light{});
+  s.lights.back().position = glm::vec3(3.0f, 4.0f, 5.0f);
+  s.lights.back().intensity = 20.0f;
+  RenderResult first = renderer_->render(s);
+  ASSERT_GT(coverage(first), 1000.0);
+  RenderResult again = renderer_->render(s);
+  EXPECT_TRUE(again.stats.scene_reused);
+  EXPECT_EQ(first.rgba, again.rgba);
+
+  Scene more = s;
+  set_samples_per_pixel(more.settings, 16);
+  more.settings.width = 100, more.settings.height = 75;
+  RenderResult small = renderer_->render(more);
+  EXPECT_TRUE(small.stats.scene_reused) << "samples and size do not change the scene's buffers";
+
+  auto changed = [&](const char* what, auto edit) {
+    Scene t = s;
+    edit(t);
+    RenderResult r = renderer_->render(t);
+    EXPECT_FALSE(r.stats.scene_reused) << what;
+    EXPECT_NE(r.rgba, first.rgba) << what;
+    renderer_->render(s);  // back to the original for the next case
+  };
+  changed("a moved vertex", [](Scene& t) { t.meshes[0].points[0] += glm::vec3(0.3f, 0.2f, 0.4f); });
+  changed("an object transform", [](Scene& t) {
+    t.meshes[0].object_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(0.2f, 0.0f, 0.0f));
+  });
+  changed("the camera placement", [](Scene& t) { t.camera = look_at({2.4f, 2.1f, 4.0f}, {0, 0, 0}); });
+  changed("a material colour", [](Scene& t) { t.materials[0].color = glm::vec3(0.2f, 0.9f, 0.3f); });
+  changed("a light", [](Scene& t) { t.lights[0].intensity = 5.0f; });
 }
 
 TEST_F(RenderTest, BoundedAndBreadthFirstProduceTheSameImage) {

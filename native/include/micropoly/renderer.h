@@ -47,6 +47,9 @@ struct RenderStats {
   double program_build_ms = 0;       // 0 when the binary cache was used... see program_cache_hit
   bool program_cache_hit = false;
   bool cancelled = false;
+  // The scene's device buffers were those of the previous render (same
+  // geometry, camera placement, materials, lights and images).
+  bool scene_reused = false;
   StageTimings timings_ms;
   std::string to_json() const;
 };

@@ -48,6 +48,7 @@ std::string RenderStats::to_json() const {
   j += "  \"program_build_ms\": " + num(program_build_ms) + ",\n";
   j += "  \"program_cache_hit\": " + std::string(program_cache_hit ? "true" : "false") + ",\n";
   j += "  \"cancelled\": " + std::string(cancelled ? "true" : "false") + ",\n";
+  j += "  \"scene_reused\": " + std::string(scene_reused ? "true" : "false") + ",\n";
   j += "  \"timings_ms\": {\"upload\": " + num(timings_ms.upload) + ", \"bound_split\": " + num(timings_ms.bound_split) +
        ", \"dice\": " + num(timings_ms.dice) + ", \"shade\": " + num(timings_ms.shade) + ", \"sample\": " +
        num(timings_ms.sample) + ", \"resolve\": " + num(timings_ms.resolve) + ", \"readback\": " + num(timings_ms.readback) + ", \"total\": " + num(timings_ms.total) + "}\n";

@@ -12,6 +12,7 @@
 #include "pipeline/material_programs.h"
 #include "pipeline/micropolygon_stages.h"
 #include "pipeline/scene_buffers.h"
+#include "pipeline/scene_fingerprint.h"
 
 namespace mp {
 namespace {
@@ -41,6 +42,11 @@ struct Renderer::Impl {
   std::unique_ptr<GridBuffers> grids;
   BoundedWorkspace bounded;
   bool first_render = true;
+  // The last scene uploaded, kept for the next render of the same content
+  // (scene_fingerprint.h): progressive passes and repeated frames skip
+  // building and uploading patches.
+  std::unique_ptr<SceneBuffers> scene_buffers;
+  uint64_t scene_key = 0;
 };
 
 Renderer::Renderer(const std::string& selector) : impl_(std::make_unique<Impl>(selector)) {}
@@ -75,8 +81,16 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     StageTimer timer;
     auto t_upload = std::chrono::steady_clock::now();
     impl_->programs.prepare(scene, st);
-    HostSceneData host = prepare_scene_data(scene);
-    SceneBuffers buffers = upload_scene_data(s.context(), s.queue(), host);
+    const uint64_t key = scene_fingerprint(scene);
+    if (!impl_->scene_buffers || impl_->scene_key != key) {
+      impl_->scene_buffers.reset();  // free the old scene's device memory first
+      HostSceneData host = prepare_scene_data(scene);
+      impl_->scene_buffers = std::make_unique<SceneBuffers>(upload_scene_data(s.context(), s.queue(), host));
+      impl_->scene_key = key;
+    } else {
+      st.scene_reused = true;
+    }
+    const SceneBuffers& buffers = *impl_->scene_buffers;
     st.timings_ms.upload = ms_since(t_upload);
     st.patches = buffers.patch_count;
 

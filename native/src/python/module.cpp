@@ -69,6 +69,7 @@ py::dict stats_dict(const RenderStats& s) {
   d["program_build_ms"] = s.program_build_ms;
   d["program_cache_hit"] = s.program_cache_hit;
   d["cancelled"] = s.cancelled;
+  d["scene_reused"] = s.scene_reused;
   t["upload"] = s.timings_ms.upload;
   t["bound_split"] = s.timings_ms.bound_split;
   t["dice"] = s.timings_ms.dice;

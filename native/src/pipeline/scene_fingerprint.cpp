@@ -1,0 +1,99 @@
+#include "pipeline/scene_fingerprint.h"
+
+#include <cstring>
+#include <type_traits>
+
+namespace mp {
+namespace {
+
+// FNV-1a over 64-bit words (the tail byte by byte): fast enough to run over
+// a million-face mesh in milliseconds. Values are hashed field by field, so
+// struct padding never enters.
+class Hasher {
+ public:
+  void bytes(const void* data, size_t n) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    size_t words = n / 8;
+    for (size_t i = 0; i < words; ++i) {
+      uint64_t w;
+      std::memcpy(&w, p + 8 * i, 8);
+      mix(w);
+    }
+    for (size_t i = words * 8; i < n; ++i) mix(p[i]);
+    mix(n);
+  }
+  template <typename T>
+  void value(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    bytes(&v, sizeof(T));
+  }
+  template <typename T>
+  void values(const std::vector<T>& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    bytes(v.data(), v.size() * sizeof(T));
+  }
+  void text(const std::string& s) { bytes(s.data(), s.size()); }
+  uint64_t result() const { return h_; }
+
+ private:
+  void mix(uint64_t w) { h_ = (h_ ^ w) * 0x100000001b3ull; }
+  uint64_t h_ = 0xcbf29ce484222325ull;
+};
+
+}  // namespace
+
+uint64_t scene_fingerprint(const Scene& scene) {
+  Hasher h;
+  h.value(scene.camera.world_to_camera);
+  h.value(scene.meshes.size());
+  for (const Mesh& m : scene.meshes) {
+    h.text(m.name);
+    h.value(m.scheme);
+    h.values(m.points);
+    h.values(m.face_vertex_counts);
+    h.values(m.face_vertex_indices);
+    h.values(m.crease_vertices);
+    h.values(m.crease_sharpness);
+    h.values(m.corner_vertices);
+    h.values(m.corner_sharpness);
+    h.values(m.hole_faces);
+    h.value(m.boundary);
+    h.value(m.material);
+    h.values(m.face_materials);
+    h.value(m.object_to_world);
+    h.value(m.double_sided);
+    h.value(m.texspace_location);
+    h.value(m.texspace_size);
+    h.value(m.uv_layers.size());
+    for (const auto& layer : m.uv_layers) h.values(layer);
+  }
+  h.value(scene.bezier_patches.size());
+  for (const BezierPatches& b : scene.bezier_patches) {
+    h.values(b.control_points);
+    h.value(b.material);
+    h.value(b.object_to_world);
+    h.value(b.double_sided);
+  }
+  h.value(scene.materials.size());
+  for (const Material& m : scene.materials) {
+    h.value(m.model);
+    h.value(m.color), h.value(m.opacity);
+    h.value(m.ka), h.value(m.kd), h.value(m.ks), h.value(m.roughness);
+    h.value(m.specular_color), h.value(m.metallic), h.value(m.specular), h.value(m.emission);
+    h.value(m.program), h.value(m.program_displaces), h.value(m.program_shades), h.value(m.displacement_bound);
+  }
+  h.value(scene.lights.size());
+  for (const Light& l : scene.lights) {
+    h.value(l.type), h.value(l.color), h.value(l.intensity), h.value(l.position), h.value(l.direction);
+    h.value(l.cone_angle), h.value(l.cone_delta_angle), h.value(l.beam_distribution);
+    h.value(l.shape), h.value(l.axis_u), h.value(l.size_u), h.value(l.size_v);
+  }
+  h.value(scene.images.size());
+  for (const Image& im : scene.images) {
+    h.value(im.width), h.value(im.height), h.value(im.srgb);
+    h.values(im.pixels);
+  }
+  return h.result();
+}
+
+}  // namespace mp
