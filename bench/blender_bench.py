@@ -146,6 +146,7 @@ def main():
                       "export_faces": faces, "export_s": export_times}))
 
 
-main()
-sys.stdout.flush()
-os._exit(0)
+if __name__ == "__main__":
+    main()
+    sys.stdout.flush()
+    os._exit(0)  # the bpy module can hang in its exit handlers

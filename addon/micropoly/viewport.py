@@ -9,8 +9,7 @@ on the session's thread, which owns one native Renderer for the session's
 lifetime, so kernels are built once. A newer request cancels the render in
 flight at its next progress check (between bound & split launches and sample
 chunks). Refinement follows `refinement_passes`: a quarter-resolution image
-with one sample first, then full resolution with one sample, then the
-viewport sample count."""
+with one sample first, then the full view at the viewport sample count."""
 
 import math
 import threading
@@ -24,13 +23,16 @@ from . import export
 
 
 def refinement_passes(samples, shading_rate):
-    """(resolution divisor, samples per pixel, shading rate) per pass. The
-    shading rate is in the pass's own pixels, so the coarse first pass also
-    dices four times coarser in the final image's pixels."""
-    passes = [(4, 1, shading_rate), (1, 1, shading_rate)]
-    if samples > 1:
-        passes.append((1, samples, shading_rate))
-    return passes
+    """(resolution divisor, samples per pixel, shading rate) per pass: a
+    quarter-resolution image at one sample, then the full view at the
+    viewport's samples. Shading rates are in the pass's own pixels; the first
+    pass's micropolygons are 4x larger still (8x8 final pixels at rate 1):
+    it is a preview, replaced within about a second. There is no
+    full-resolution 1-sample pass in between: dicing and shading cost the
+    same at any sample count (Reyes shades grid vertices, not samples), so it
+    would nearly double the time to the final image (bench/viewport_bench.py:
+    3.4 s instead of 2.0 s on PoCL at 1.5M micropolygons)."""
+    return [(4, 1, 4.0 * shading_rate), (1, samples, shading_rate)]
 
 
 # ---------------------------------------------------------------------------
@@ -178,6 +180,7 @@ class ViewportSession:
         self._job = None          # (generation, native scene, view, background, samples, rate, requested at)
         self._image = None
         self._error = None
+        self._fatal = None        # the renderer could not be made: every request gets this error
         self._busy = False
         self._stop = False
         self.device = ""
@@ -192,8 +195,8 @@ class ViewportSession:
         with self._cond:
             self._generation += 1
             self._job = (self._generation, exported, view, samples, shading_rate, time.perf_counter())
-            self._busy = True
-            self._error = None
+            self._busy = self._fatal is None
+            self._error = self._fatal
             self._cond.notify()
         return self._generation
 
@@ -261,7 +264,7 @@ class ViewportSession:
             self.device = renderer.device
         except Exception as e:  # no device, kernels that do not build
             with self._cond:
-                self._error = str(e)
+                self._fatal = self._error = str(e)
                 self._busy = False
                 self._cond.notify_all()
             return
@@ -295,6 +298,7 @@ class ViewportSession:
             pass_view.apply(native)
             native.settings.samples = spp
             native.settings.shading_rate = rate
+            native.settings.depth_and_normal_passes = False  # the viewport draws colour only
             result = renderer.render(native, lambda p: self._current(generation))
             if result["stats"]["cancelled"] or not self._current(generation):
                 return
