@@ -30,6 +30,24 @@ def enable_addon():
     _registered.append(micropoly)
 
 
+def run_test(main):
+    """Runs main() (returning an exit status) and exits with it. An exception
+    is a failure. In background mode the process leaves at once, without
+    exit handlers: the bpy module can hang in them after renders."""
+    import sys
+    import traceback
+
+    try:
+        code = main()
+    except Exception:
+        traceback.print_exc()
+        code = 1
+    sys.stdout.flush()
+    if bpy.app.background:
+        os._exit(code)
+    sys.exit(code)
+
+
 def reset_scene():
     """A fresh, empty scene with the add-on registered and a black world."""
     while _registered:

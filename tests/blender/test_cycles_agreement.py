@@ -174,6 +174,4 @@ def main():
 
 
 if __name__ == "__main__":
-    code = main()
-    sys.stdout.flush()
-    os._exit(code) if bpy.app.background else sys.exit(code)
+    ru.run_test(main)

@@ -338,7 +338,4 @@ def main():
 
 
 if __name__ == "__main__":
-    code = main()
-    sys.stdout.flush()
-    # The bpy module can hang while shutting down after renders; leave at once.
-    os._exit(code) if bpy.app.background else sys.exit(code)
+    ru.run_test(main)

@@ -22,7 +22,6 @@ Mix) drops its case to 18 dB."""
 
 import os
 import sys
-import traceback
 
 import bpy
 import numpy as np
@@ -246,11 +245,4 @@ def main():
 
 
 if __name__ == "__main__":
-    try:
-        code = main()
-    except Exception:
-        traceback.print_exc()
-        code = 1
-    sys.stdout.flush()
-    # The bpy module can hang in its exit handlers: leave without them.
-    os._exit(code) if bpy.app.background else sys.exit(code)
+    ru.run_test(main)

@@ -286,10 +286,4 @@ if __name__ == "__main__":
     if "--gui" in argv:
         window_main(argv[argv.index("--gui") + 1])
     else:
-        try:
-            code = background_main()
-        except Exception:
-            traceback.print_exc()
-            code = 1
-        sys.stdout.flush()
-        os._exit(code)
+        ru.run_test(background_main)
