@@ -27,6 +27,7 @@ class MicropolyRenderEngine(bpy.types.RenderEngine):
         self._viewport_meshes = None  # export_mesh.MeshCache kept between viewport updates
         self._viewport_texture = None
         self._viewport_signature = None
+        self._viewport_export_error = None  # why the scene could not be exported, shown in the view
 
     def __del__(self):
         session = getattr(self, "_viewport", None)
@@ -69,11 +70,11 @@ class MicropolyRenderEngine(bpy.types.RenderEngine):
         try:
             exported = export.export_scene(depsgraph, view=view, meshes=self._viewport_meshes)
         except export.ExportError as e:
-            self._viewport_status = f"Micropoly: {e}"
+            self._viewport_export_error = f"Micropoly: {e}"
             self._viewport.cancel()
             return
         mp = scene.micropoly
-        self._viewport_status = "; ".join(exported.warnings)
+        self._viewport_export_error = None
         self._viewport.request(exported, view, mp.viewport_samples, mp.viewport_shading_rate)
 
     def view_draw(self, context, depsgraph):
@@ -92,8 +93,8 @@ class MicropolyRenderEngine(bpy.types.RenderEngine):
         error = session.error()
         if error:
             self.update_stats("", f"Micropoly: {error}")
-        elif getattr(self, "_viewport_status", "").startswith("Micropoly:"):
-            self.update_stats("", self._viewport_status)
+        elif self._viewport_export_error:
+            self.update_stats("", self._viewport_export_error)
         elif image is not None:
             state = "Done" if image.final and not session.busy() else "Refining"
             self.update_stats("", f"Micropoly | {session.device} | {state} | {image.samples} spp | "

@@ -15,7 +15,7 @@ import math
 import threading
 import time
 import weakref
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -293,9 +293,7 @@ class ViewportSession:
             if not self._current(generation):
                 return
             w, h = max(1, math.ceil(view.width / divisor)), max(1, math.ceil(view.height / divisor))
-            pass_view = export.ViewCamera(w, h, view.world_to_camera, view.orthographic, view.screen_window,
-                                          view.clip_near, view.clip_far, view.crop)
-            pass_view.apply(native)
+            replace(view, width=w, height=h).apply(native)
             native.settings.samples = spp
             native.settings.shading_rate = rate
             native.settings.depth_and_normal_passes = False  # the viewport draws colour only

@@ -87,6 +87,16 @@ def empty_material(name):
     return m, next(n for n in nodes if n.type == "OUTPUT_MATERIAL")
 
 
+def emission_material(name):
+    """A node material whose surface is an Emission shader of strength 1;
+    returns (material, emission node) for the test to link its colour."""
+    m, out = empty_material(name)
+    emission = m.node_tree.nodes.new("ShaderNodeEmission")
+    emission.inputs["Strength"].default_value = 1.0
+    m.node_tree.links.new(emission.outputs["Emission"], out.inputs["Surface"])
+    return m, emission
+
+
 def diffuse_material(name, color):
     m, _ = empty_material(name)
     nodes = m.node_tree.nodes

@@ -259,9 +259,8 @@ def case_image_modes():
     scene.micropoly.shading_rate = 0.0625
     bpy.ops.mesh.primitive_plane_add(size=2)
     obj = bpy.context.active_object
-    mat, out = ru.empty_material("image_modes")
+    mat, emit = ru.emission_material("image_modes")
     nt = mat.node_tree
-    emit = nt.nodes.new("ShaderNodeEmission")
     coords = nt.nodes.new("ShaderNodeTexCoord")
     mapping = nt.nodes.new("ShaderNodeMapping")
     mapping.inputs["Location"].default_value = (-0.6, -0.6, 0.0)
@@ -271,7 +270,6 @@ def case_image_modes():
     nt.links.new(coords.outputs["UV"], mapping.inputs["Vector"])
     nt.links.new(mapping.outputs["Vector"], image.inputs["Vector"])
     nt.links.new(image.outputs["Color"], emit.inputs["Color"])
-    nt.links.new(emit.outputs["Emission"], out.inputs["Surface"])
     obj.data.materials.append(mat)
     ru.add_camera(scene, (0.0, 0.0, 3.0), (0.0, 0.0, 0.0), lens=50)
     extensions = ["REPEAT", "EXTEND", "CLIP"] + (["MIRROR"] if bpy.app.version >= (3, 5, 0) else [])

@@ -188,11 +188,8 @@ def build_scene(cases):
     tile_world = 2.0
     for i, (name, make) in enumerate(cases):
         row, col = divmod(i, COLS)
-        mat, out = ru.empty_material(f"case{i}")
+        mat, emission = ru.emission_material(f"case{i}")
         nt = mat.node_tree
-        emission = nt.nodes.new("ShaderNodeEmission")
-        emission.inputs["Strength"].default_value = 1.0
-        nt.links.new(emission.outputs["Emission"], out.inputs["Surface"])
         a, b = inputs_ab(nt)
         nt.links.new(make(nt, a, b), emission.inputs["Color"])
         mesh = bpy.data.meshes.new(f"quad{i}")

@@ -265,11 +265,8 @@ def build_scene(cases):
     tile_world = 2.0  # world units per tile; quads are scaled to leave a gap
     for i, case in enumerate(cases):
         row, col = divmod(i, COLS)
-        mat, out = ru.empty_material(f"case{i}")
+        mat, emission = ru.emission_material(f"case{i}")
         nt = mat.node_tree
-        emission = nt.nodes.new("ShaderNodeEmission")
-        emission.inputs["Strength"].default_value = 1.0
-        nt.links.new(emission.outputs["Emission"], out.inputs["Surface"])
         coords = nt.nodes.new("ShaderNodeTexCoord")
         tex, outs = texture_node(nt, case)
         if available(tex.inputs, "Vector") is not None:
