@@ -13,6 +13,7 @@
 #include "mp_types.h"
 #include "mp_patch_eval.h"
 #include "mp_surface.h"
+#include "mp_grid.h"
 #include "mp_bound.h"
 
 /* The whole domain of patch p, no edge rated yet. */

@@ -1,5 +1,5 @@
-/* Dice: evaluate each diceable sub-patch on a (nu+1) x (nv+1) grid of
- * vertices (mp_grid_uv: edge vertices shared with the neighbours, bilinear
+/* Dice: evaluate each diceable sub-patch at the vertices of its stitched
+ * grid (mp_grid.h: edge vertices shared with the neighbours, a regular grid
  * inside), with smooth normals from the surface derivatives. Grids live in
  * fixed-size slots of (max_grid+1)^2 vertices. */
 #include "mp_compat.h"
@@ -7,6 +7,7 @@
 #include "mp_types.h"
 #include "mp_patch_eval.h"
 #include "mp_surface.h"
+#include "mp_grid.h"
 
 __kernel void dice_grids(__global const SubPatch* diceable, uint count,
                          __global const float4* points, __global const uint* patch_info,
@@ -16,10 +17,12 @@ __kernel void dice_grids(__global const SubPatch* diceable, uint count,
                          volatile __global uint* micropolygon_count) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
-  if (!mp_grid_vertex(gid, count, f.max_grid, diceable, &sp, &i, &j)) return;
-  uint nu = MP_INFO_NU(sp.info), nv = MP_INFO_NV(sp.info);
-  if (i == 0u && j == 0u) atomic_add(micropolygon_count, nu * nv);
-  float2 uv = mp_grid_uv(&sp, nu, nv, i, j);
+  float2 uv;
+  if (!mp_grid_vertex(gid, count, f.max_grid, diceable, &sp, &i, &j, &uv)) return;
+  if (i == 0u && j == 0u) {
+    MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
+    atomic_add(micropolygon_count, mp_grid_micropolygons(&g));
+  }
   float3 p, dpdu, dpdv;
   mp_surface_point(points, patch_info, edges, curves, sp.patch, uv.x, uv.y, &p, &dpdu, &dpdv);
   uint flags = patch_info[4 * (ulong)sp.patch + 2];
@@ -35,8 +38,9 @@ __kernel void dice_grids(__global const SubPatch* diceable, uint count,
   grid_n[gid] = (float4)(n, 0.0f);
 }
 
-/* Normals of displaced grids, from the displaced vertices (central
- * differences inside the grid, one-sided on its border), oriented like the
+/* Normals of displaced grids, from the displaced vertices (differences
+ * between each vertex's neighbours along u and v, mp_grid_neighbours;
+ * one-sided on the grid's border), oriented like the
  * surface normal they replace. Where the differences vanish (a collapsed
  * grid edge) the undisplaced normal stays. Runs after every material's
  * displacement (material_program.cl). */
@@ -45,14 +49,15 @@ __kernel void displaced_normals(__global const SubPatch* diceable, uint count, _
                                 __global const float4* grid_p, __global float4* grid_n) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
-  if (!mp_grid_vertex(gid, count, f.max_grid, diceable, &sp, &i, &j)) return;
+  float2 uv;
+  if (!mp_grid_vertex(gid, count, f.max_grid, diceable, &sp, &i, &j, &uv)) return;
   if (!(materials[patch_info[4 * (ulong)sp.patch + 1]].program[1] > 0.0f)) return;
-  uint nu = MP_INFO_NU(sp.info), nv = MP_INFO_NV(sp.info), stride = (uint)f.max_grid + 1u;
-  ulong row = gid - i - (ulong)j * stride; /* vertex (0, 0) of this grid */
-  uint i0 = i > 0u ? i - 1u : 0u, i1 = i < nu ? i + 1u : nu;
-  uint j0 = j > 0u ? j - 1u : 0u, j1 = j < nv ? j + 1u : nv;
-  float3 du = grid_p[row + j * stride + i1].xyz - grid_p[row + j * stride + i0].xyz;
-  float3 dv = grid_p[row + j1 * stride + i].xyz - grid_p[row + j0 * stride + i].xyz;
+  MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
+  ulong base = gid - mp_slot(&g, i, j); /* slot (0, 0) of this grid */
+  uint xm, xp, ym, yp;
+  mp_grid_neighbours(&g, i, j, &xm, &xp, &ym, &yp);
+  float3 du = grid_p[base + xp].xyz - grid_p[base + xm].xyz;
+  float3 dv = grid_p[base + yp].xyz - grid_p[base + ym].xyz;
   float3 n = cross(du, dv);
   float len = length(n);
   float3 old = grid_n[gid].xyz;

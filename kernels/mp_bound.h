@@ -259,8 +259,10 @@ MP_INLINE uint mp_edge_rate_code(float len, FrameParams f) {
 /* Screen length through the middle of the sub-patch, from the middle of edge
  * 3 to the middle of edge 1 (dir 0) or of edge 0 to edge 2 (dir 1): the
  * interior's own size, which may exceed its edges' (a bulge, or a patch with
- * collapsed edges). Only this sub-patch uses it, so it needs no canonical order. */
-MP_INLINE float mp_mid_screen_length(const MP_GLOBAL float4* cp, uint type, const SubPatch* sp, int dir, FrameParams f) {
+ * collapsed edges). *chord is the line's end minus its start on screen. Only
+ * this sub-patch uses it, so it needs no canonical order. */
+MP_INLINE float mp_mid_screen_length(const MP_GLOBAL float4* cp, uint type, const SubPatch* sp, int dir, FrameParams f,
+                                     float2* chord) {
   float2 c0 = mp_corner(sp, 0), c1 = mp_corner(sp, 1), c2 = mp_corner(sp, 2), c3 = mp_corner(sp, 3);
   float2 a = dir == 0 ? 0.5f * (c3 + c0) : 0.5f * (c0 + c1);
   float2 b = dir == 0 ? 0.5f * (c1 + c2) : 0.5f * (c2 + c3);
@@ -270,17 +272,45 @@ MP_INLINE float mp_mid_screen_length(const MP_GLOBAL float4* cp, uint type, cons
     float3 du, dv;
     mp_eval_patch(cp, type, uv.x, uv.y, &p[k], &du, &dv);
   }
-  return mp_polyline_screen_length(p, MP_EDGE_SEGMENTS + 1, f);
+  float len = mp_polyline_screen_length(p, MP_EDGE_SEGMENTS + 1, f);
+  *chord = len >= 0.0f ? mp_project(p[MP_EDGE_SEGMENTS], f) - mp_project(p[0], f) : 0.0f * a;
+  return len;
 }
 
-/* Grid size along one direction: covers both edge rates (so both snap onto
- * the grid) and the interior length, within the largest grid. */
-MP_INLINE uint mp_grid_size(uint code_a, uint code_b, float mid_len, FrameParams f) {
-  uint n = code_a ? MP_CODE_RATE(code_a) : (uint)f.max_grid;
-  n = max(n, code_b ? MP_CODE_RATE(code_b) : (uint)f.max_grid);
-  float interior = mid_len >= 0.0f ? ceil(mid_len / f.micropoly_edge) : 1.0f;
-  n = max(n, (uint)clamp(interior, 1.0f, (float)f.max_grid));
-  return min(n, (uint)f.max_grid);
+/* Longest a micropolygon edge may grow, in target edges, where the interior
+ * is diced by area (below). */
+#define MP_SHEAR_STRETCH 2.0f
+
+/* Interior grid rates (nu, nv) of a sub-patch to dice: its mid-line lengths
+ * over the target edge, within the largest grid. Where the sub-patch's
+ * iso-lines cross at an angle theta on screen (a surface seen towards its
+ * vanishing point), a grid rated by lengths alone would make micropolygons of
+ * sin(theta) times the target area. RenderMan's shading rate is an area, so
+ * the longer direction is diced more coarsely by sin(theta), but by no more
+ * than MP_SHEAR_STRETCH, which bounds how long a micropolygon gets. A grid
+ * one micropolygon across with rate-1 edges on that side becomes a single
+ * strip (mp_grid.h); any other grid keeps at least 2 x 2 so its edges can be
+ * stitched to an interior. */
+MP_INLINE void mp_interior_rates(float mid_u, float mid_v, float2 chord_u, float2 chord_v, const uint* codes,
+                                 FrameParams f, uint* nu, uint* nv) {
+  float lu = sqrt(chord_u.x * chord_u.x + chord_u.y * chord_u.y);
+  float lv = sqrt(chord_v.x * chord_v.x + chord_v.y * chord_v.y);
+  if (mid_u > 0.0f && mid_v > 0.0f && lu > 0.0f && lv > 0.0f) {
+    float sin_theta = fabs(chord_u.x * chord_v.y - chord_u.y * chord_v.x) / (lu * lv);
+    float k = fmax(sin_theta, 1.0f / MP_SHEAR_STRETCH);
+    if (mid_u >= mid_v) mid_u *= k;
+    else mid_v *= k;
+  }
+  float mg = (float)f.max_grid;
+  uint iu = (uint)clamp(mid_u >= 0.0f ? ceil(mid_u / f.micropoly_edge) : 1.0f, 1.0f, mg);
+  uint iv = (uint)clamp(mid_v >= 0.0f ? ceil(mid_v / f.micropoly_edge) : 1.0f, 1.0f, mg);
+  if (iv == 1u && codes[1] == 1u && codes[3] == 1u) {
+    *nu = iu, *nv = 1u;
+  } else if (iu == 1u && codes[0] == 1u && codes[2] == 1u) {
+    *nu = 1u, *nv = 2u;
+  } else {
+    *nu = max(iu, min(2u, (uint)f.max_grid)), *nv = max(iv, min(2u, (uint)f.max_grid));
+  }
 }
 
 /* The bound & split decision for one sub-patch: cull, dice (with grid size)
@@ -334,8 +364,10 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
     score[e] = code ? (float)MP_CODE_RATE(code) : len >= 0.0f ? len / f.micropoly_edge : 3.0e38f;
     any_long |= code == 0u;
   }
-  float mid_u = straddles ? MP_UNMEASURABLE : mp_mid_screen_length(cp, type, sp, 0, f);
-  float mid_v = straddles ? MP_UNMEASURABLE : mp_mid_screen_length(cp, type, sp, 1, f);
+  float2 chord_u, chord_v;
+  float mid_u = mp_mid_screen_length(cp, type, sp, 0, f, &chord_u);
+  float mid_v = mp_mid_screen_length(cp, type, sp, 1, f, &chord_v);
+  if (straddles) mid_u = mid_v = MP_UNMEASURABLE;
   float limit = 1.41421356f * (float)f.max_grid * f.micropoly_edge;
   int long_u = mid_u > limit, long_v = mid_v > limit;
 
@@ -358,8 +390,8 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
     if (ok_u && (su >= sv || !ok_v)) return MP_SPLIT_U;
     if (ok_v) return MP_SPLIT_V;
   }
-  uint nu = mp_grid_size(codes[0], codes[2], mid_u, f);
-  uint nv = mp_grid_size(codes[1], codes[3], mid_v, f);
+  uint nu, nv;
+  mp_interior_rates(mid_u, mid_v, chord_u, chord_v, codes, f, &nu, &nv);
   return MP_DICE | (nu << 8) | (nv << 16);
 }
 

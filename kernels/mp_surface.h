@@ -157,43 +157,4 @@ MP_INLINE float2 mp_patch_uv(const MP_GLOBAL float4* uvs, uint layers, const MP_
   return mp_uv_lerp(a, b, t);
 }
 
-MP_INLINE float2 mp_corner(const SubPatch* sp, int k) {
-  k &= 3;
-#ifdef __OPENCL_VERSION__
-  return (float2)(sp->corner[2 * k], sp->corner[2 * k + 1]);
-#else
-  return float2(sp->corner[2 * k], sp->corner[2 * k + 1]);
-#endif
-}
-
-/* Vertex k of n along the segment a -> b. With a, b binary fractions and n a
- * power of two this is exact, so it does not matter from which end or in
- * which sub-patch a shared edge vertex is computed. */
-MP_INLINE float2 mp_edge_vertex(float2 a, float2 b, uint k, uint n) {
-  return a + (b - a) * ((float)k / (float)n);
-}
-
-/* (u, v) of grid vertex (i, j) of a diceable sub-patch with an nu x nv grid.
- * The grid's outer rows and columns snap to the vertices of their edge (edge
- * rates divide into nu, nv: mp_bound.h), so a sub-patch places exactly the
- * vertices its neighbour places along their shared edge; micropolygons along
- * an edge rated below the grid size collapse into triangles. Inside, the grid
- * is bilinear in the corners. */
-MP_INLINE float2 mp_grid_uv(const SubPatch* sp, uint nu, uint nv, uint i, uint j) {
-  float2 c0 = mp_corner(sp, 0), c1 = mp_corner(sp, 1), c2 = mp_corner(sp, 2), c3 = mp_corner(sp, 3);
-  if (j == 0u || j == nv || i == 0u || i == nu) {
-    /* Edge, its start, its end, grid index along it and grid size along it. */
-    uint e = j == 0u ? 0u : j == nv ? 2u : i == 0u ? 3u : 1u;
-    uint g = (e == 0u || e == 2u) ? i : j, gn = (e == 0u || e == 2u) ? nu : nv;
-    float2 a = e == 0u ? c0 : e == 2u ? c3 : e == 3u ? c0 : c1;
-    float2 b = e == 0u ? c1 : e == 2u ? c2 : e == 3u ? c3 : c2;
-    uint code = MP_EDGE_CODE(sp->rates, e);
-    uint n = code ? MP_CODE_RATE(code) : gn;
-    uint k = (2u * g * n + gn) / (2u * gn);
-    return mp_edge_vertex(a, b, k, n);
-  }
-  float s = (float)i / (float)nu, t = (float)j / (float)nv;
-  return (1.0f - t) * ((1.0f - s) * c0 + s * c1) + t * ((1.0f - s) * c3 + s * c2);
-}
-
 #endif

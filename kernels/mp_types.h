@@ -27,21 +27,6 @@ typedef struct {
 #define MP_INFO_NV(info) (((info) >> 16) & 0xffu)
 #define MP_MAKE_INFO(depth, nu, nv) ((uint)(depth) | ((uint)(nu) << 8) | ((uint)(nv) << 16))
 
-/* The grid vertex (i, j) of diceable sub-patch `*sp` that work-item `gid` of a
- * dice or shade launch handles; grids sit in slots of (max_grid+1)^2 vertices.
- * Returns 0 for work-items past the batch or outside their grid. */
-MP_INLINE int mp_grid_vertex(uint gid, uint count, int max_grid, const MP_GLOBAL SubPatch* diceable, SubPatch* sp,
-                             uint* i, uint* j) {
-  uint stride = (uint)max_grid + 1u;
-  uint slot = gid / (stride * stride);
-  if (slot >= count) return 0;
-  uint local_index = gid - slot * stride * stride;
-  *sp = diceable[slot];
-  *i = local_index % stride;
-  *j = local_index / stride;
-  return *i <= MP_INFO_NU(sp->info) && *j <= MP_INFO_NV(sp->info);
-}
-
 /* Largest grid the dicer accepts (micropolygons per side). */
 #define MP_MAX_GRID 32
 

@@ -1,5 +1,6 @@
 /* Sample: a software rasteriser for micropolygons. Each work-item takes one
- * micropolygon (two triangles of a grid quad), finds the jittered samples it
+ * micropolygon (two triangles of a quad of a stitched grid, mp_grid.h; one of
+ * them empty where the quad has collapsed into a triangle), finds the jittered samples it
  * covers with fixed-point edge functions, and resolves visibility per sample
  * with a 64-bit atomic minimum of (depth, micropolygon id) (the visibility
  * buffer trick of Karis et al. 2021, Nanite). A second pass, run after the
@@ -12,6 +13,7 @@
 #include "mp_types.h"
 #include "mp_hash.h"
 #include "mp_raster.h"
+#include "mp_grid.h"
 
 #define MP_PASS_DEPTH 0u
 #define MP_PASS_ATTRIBUTES 1u
@@ -75,12 +77,16 @@ inline int mp_triangle_covers(const MpTriangle* t, MpFixed2 q, float* la, float*
   return 1;
 }
 
-inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVertex v11, MpRasterVertex v01, uint mp_id,
-                           float opacity, FrameParams f, __global const ushort* offsets, uint pass,
+/* Rasterises the quad's triangles (v00, v10, v11) and (v00, v11, v01) that
+ * `keep` selects (bit 0 and bit 1). */
+inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVertex v11, MpRasterVertex v01, uint keep,
+                           uint mp_id, float opacity, FrameParams f, __global const ushort* offsets, uint pass,
                            volatile __global ulong* keys, __global float* colors, __global uint* normals) {
   MpTriangle tris[2];
   tris[0] = mp_setup_triangle(v00, v10, v11);
   tris[1] = mp_setup_triangle(v00, v11, v01);
+  tris[0].valid &= (int)(keep & 1u);
+  tris[1].valid &= (int)(keep >> 1);
   long xmin = min(min(v00.p.x, v10.p.x), min(v11.p.x, v01.p.x)), xmax = max(max(v00.p.x, v10.p.x), max(v11.p.x, v01.p.x));
   long ymin = min(min(v00.p.y, v10.p.y), min(v11.p.y, v01.p.y)), ymax = max(max(v00.p.y, v10.p.y), max(v11.p.y, v01.p.y));
   int px0 = (int)max(xmin >> MP_SUBPIXEL_BITS, (long)0), px1 = (int)min(xmax >> MP_SUBPIXEL_BITS, (long)f.width - 1);
@@ -145,43 +151,49 @@ void sample_micropolygons(__global const SubPatch* diceable, uint first, uint co
                                    __global float* colors, __global uint* normals, volatile __global ulong* totals) {
   __local ulong area_sum[64];
   __local uint count_sum[64];
-  uint mg = (uint)f.max_grid;
+  uint stride = (uint)f.max_grid + 1u, per_slot = stride * stride;
   uint gid = get_global_id(0);
-  uint slot = first + gid / (mg * mg);
-  uint local_index = gid % (mg * mg);
-  uint i = local_index % mg, j = local_index / mg;
+  uint slot = first + gid / per_slot;
+  uint m = gid % per_slot;
   int live = slot < count;
   SubPatch sp;
+  uint q[4];
   if (live) {
     sp = diceable[slot];
-    live = i < MP_INFO_NU(sp.info) && j < MP_INFO_NV(sp.info);
+    MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
+    live = mp_grid_micropolygon(&g, m, q);
   }
-  MpRasterVertex v[4]; /* (i,j), (i+1,j), (i+1,j+1), (i,j+1) */
+  MpRasterVertex v[4]; /* counter-clockwise in (u, v) */
   long area2 = 0;
+  ulong base = (ulong)slot * per_slot;
   if (live) {
-    uint stride = mg + 1u;
-    ulong base = (ulong)slot * stride * stride;
-    ulong i00 = base + j * stride + i;
-    ulong idx[4] = {i00, i00 + 1, i00 + stride + 1, i00 + stride};
     int ok = 1;
-    for (int k = 0; k < 4; ++k) v[k] = mp_raster_vertex(grid_p[idx[k]], grid_c[idx[k]], grid_n[idx[k]], f, &ok);
+    for (int k = 0; k < 4; ++k) {
+      ulong idx = base + q[k];
+      v[k] = mp_raster_vertex(grid_p[idx], grid_c[idx], grid_n[idx], f, &ok);
+    }
     live = ok;
   }
+  uint keep = 3u;
   if (live) {
     uint flags = patch_info[4 * (ulong)sp.patch + 2];
-    /* Front faces run counter-clockwise on screen, i.e. negative raster area. */
-    long area = mp_edge(v[0].p, v[1].p, v[2].p) + mp_edge(v[0].p, v[2].p, v[3].p);
+    /* Front faces run counter-clockwise on screen, i.e. negative raster area.
+     * Each triangle is culled on its own: a quad of a stitching strip can
+     * turn one triangle away near a silhouette while the other still faces
+     * the camera. */
+    long a0 = mp_edge(v[0].p, v[1].p, v[2].p), a1 = mp_edge(v[0].p, v[2].p, v[3].p);
     if (f.backface_culling && !(flags & MP_PATCH_DOUBLE_SIDED)) {
-      int front = (flags & MP_PATCH_FLIP_ORIENTATION) ? area > 0 : area < 0;
-      live = front;
+      int flip = (flags & MP_PATCH_FLIP_ORIENTATION) != 0u;
+      keep = ((flip ? a0 > 0 : a0 < 0) ? 1u : 0u) | ((flip ? a1 > 0 : a1 < 0) ? 2u : 0u);
+      live = keep != 0u;
     }
-    area2 = live ? (area < 0 ? -area : area) : 0;
+    area2 = ((keep & 1u) ? (a0 < 0 ? -a0 : a0) : 0) + ((keep & 2u) ? (a1 < 0 ? -a1 : a1) : 0);
   }
   mp_count_sampled(get_local_id(0), area2, pass, totals, area_sum, count_sum);
   if (!live) return;
   uint grid_id = mp_hash32(sp.patch);
   for (int k = 0; k < 8; ++k) grid_id = mp_hash_combine(grid_id, as_uint(sp.corner[k]));
-  uint mp_id = mp_hash_combine(grid_id, local_index);
-  float opacity = grid_c[(ulong)slot * (mg + 1u) * (mg + 1u) + j * (mg + 1u) + i].w;
-  mp_raster_quad(v[0], v[1], v[2], v[3], mp_id, opacity, f, offsets, pass, keys, colors, normals);
+  uint mp_id = mp_hash_combine(grid_id, m);
+  float opacity = grid_c[base + q[0]].w;
+  mp_raster_quad(v[0], v[1], v[2], v[3], keep, mp_id, opacity, f, offsets, pass, keys, colors, normals);
 }

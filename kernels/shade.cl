@@ -4,6 +4,7 @@
 #include "mp_patch.h"
 #include "mp_types.h"
 #include "mp_shading.h"
+#include "mp_grid.h"
 
 __kernel void shade_grids(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
                           FrameParams f, __global const float4* grid_p, __global const float4* grid_n,
@@ -11,7 +12,8 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
                           uint light_count, __global float4* grid_c) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
-  if (!mp_grid_vertex(gid, count, f.max_grid, diceable, &sp, &i, &j)) return;
+  float2 uv;
+  if (!mp_grid_vertex(gid, count, f.max_grid, diceable, &sp, &i, &j, &uv)) return;
   DeviceMaterial m = materials[patch_info[4 * (ulong)sp.patch + 1]];
   if (m.program[2] > 0.0f) return; /* shaded by its node program (material_program.cl) */
   float3 c = mp_shade(grid_p[gid].xyz, grid_n[gid].xyz, f.ortho, &m, lights, light_count);

@@ -10,6 +10,7 @@
 #include "mp_shading.h"
 #include "mp_patch_eval.h"
 #include "mp_surface.h"
+#include "mp_grid.h"
 #include "materials/mp_node_lib.h"
 #include "textures/mp_tex_image.h"
 
@@ -91,10 +92,9 @@ inline int mp_program_vertex(uint gid, uint count, FrameParams f, __global const
                              __global const uint* patch_info, __global const DeviceMaterial* materials, int program,
                              SubPatch* sp, uint* material, uint* object, float2* uv) {
   uint i, j;
-  if (!mp_grid_vertex(gid, count, f.max_grid, diceable, sp, &i, &j)) return 0;
+  if (!mp_grid_vertex(gid, count, f.max_grid, diceable, sp, &i, &j, uv)) return 0;
   *material = patch_info[4 * (ulong)sp->patch + 1];
   *object = MP_PATCH_OBJECT(patch_info[4 * (ulong)sp->patch + 2]);
-  *uv = mp_grid_uv(sp, MP_INFO_NU(sp->info), MP_INFO_NV(sp->info), i, j);
   return (int)materials[*material].program[0] == program;
 }
 
@@ -142,22 +142,23 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   MpNodeGlobals g = mp_node_globals(o, p, n, &in, sp.patch, uv);
 #ifdef MP_NODE_USES_NEIGHBOURS
   /* Bump nodes difference their heights towards the next grid vertex along
-   * u and along v (the previous one on the last row), a tenth of the way:
-   * a small step keeps the difference first-order even where a
+   * u and along v (the previous one on the grid's far border), a tenth of
+   * the way: a small step keeps the difference first-order even where a
    * micropolygon spans much of a texture's feature (grazing views). */
-  uint stride = (uint)f.max_grid + 1u, nu = MP_INFO_NU(sp.info), nv = MP_INFO_NV(sp.info);
-  MpNodeGlobals g_dx, g_dy;
-  if (nu > 0u && nv > 0u) {
-    uint i = (gid % (stride * stride)) % stride, j = (gid % (stride * stride)) / stride;
-    uint ni = i < nu ? i + 1u : i - 1u, nj = j < nv ? j + 1u : j - 1u;
-    uint gx = gid - i + ni, gy = gid - j * stride + nj * stride;
-    MpNodeGlobals nx = mp_node_globals(o, grid_p[gx].xyz, grid_n[gx].xyz, &in, sp.patch, mp_grid_uv(&sp, nu, nv, ni, j));
-    MpNodeGlobals ny = mp_node_globals(o, grid_p[gy].xyz, grid_n[gy].xyz, &in, sp.patch, mp_grid_uv(&sp, nu, nv, i, nj));
-    g_dx = mp_node_globals_toward(&g, &nx, 0.1f);
-    g_dy = mp_node_globals_toward(&g, &ny, 0.1f);
-    g.dx = &g_dx;
-    g.dy = &g_dy;
-  }
+  uint stride = (uint)f.max_grid + 1u, here = gid % (stride * stride);
+  MpGridShape shape = mp_grid_shape(&sp, (uint)f.max_grid);
+  uint xm, xp, ym, yp;
+  mp_grid_neighbours(&shape, here % stride, here / stride, &xm, &xp, &ym, &yp);
+  uint sx = xp != here ? xp : xm, sy = yp != here ? yp : ym;
+  ulong gx = gid - here + sx, gy = gid - here + sy;
+  float2 uvx = uv, uvy = uv;
+  mp_slot_uv(&sp, &shape, sx % stride, sx / stride, &uvx);
+  mp_slot_uv(&sp, &shape, sy % stride, sy / stride, &uvy);
+  MpNodeGlobals nx = mp_node_globals(o, grid_p[gx].xyz, grid_n[gx].xyz, &in, sp.patch, uvx);
+  MpNodeGlobals ny = mp_node_globals(o, grid_p[gy].xyz, grid_n[gy].xyz, &in, sp.patch, uvy);
+  MpNodeGlobals g_dx = mp_node_globals_toward(&g, &nx, 0.1f), g_dy = mp_node_globals_toward(&g, &ny, 0.1f);
+  g.dx = &g_dx;
+  g.dy = &g_dy;
 #endif
   MpSurfaceInputs s;
   s.base_color = (float3)(m.color[0], m.color[1], m.color[2]);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <functional>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "mp_types.h"
 #include "mp_patch_eval.h"
 #include "mp_surface.h"
+#include "mp_grid.h"
 #include "mp_bound.h"
 #include "pipeline/frame_params.h"
 #include "pipeline/scene_buffers.h"
@@ -20,10 +22,11 @@ namespace mp::test {
 
 struct DicedGrid {
   SubPatch sp;
-  uint nu = 0, nv = 0;
-  std::vector<glm::vec3> p;   // (nu+1) x (nv+1), i fastest
-  std::vector<glm::vec2> uv;  // the patch parameters of p
-  glm::vec3 at(uint i, uint j) const { return p[size_t(j) * (nu + 1) + i]; }
+  MpGridShape shape;
+  std::vector<glm::vec3> p;                   // the grid's vertices
+  std::vector<glm::vec2> uv;                  // the patch parameters of p
+  std::vector<glm::vec3> slot_p;              // positions by slot (mp_grid.h)
+  std::vector<std::array<uint, 4>> polygons;  // micropolygons, as slots
 };
 
 // Calls `visit` for every grid the pipeline would dice for `scene`, with the
@@ -51,17 +54,25 @@ inline void host_dice(const Scene& scene,
     }
     if (action != MP_DICE) continue;
     g.sp = sp;
-    g.nu = MP_INFO_NU(d), g.nv = MP_INFO_NV(d);
+    g.sp.info = (sp.info & 0xffu) | (d & 0xffff00u);
+    g.shape = mp_grid_shape(&g.sp, uint(f.max_grid));
+    const uint stride = uint(f.max_grid) + 1;
     g.p.clear();
     g.uv.clear();
-    for (uint j = 0; j <= g.nv; ++j)
-      for (uint i = 0; i <= g.nu; ++i) {
-        glm::vec2 uv = mp_grid_uv(&sp, g.nu, g.nv, i, j);
+    g.slot_p.assign(size_t(stride) * stride, glm::vec3(NAN));
+    for (uint j = 0; j < stride; ++j)
+      for (uint i = 0; i < stride; ++i) {
+        glm::vec2 uv;
+        if (!mp_slot_uv(&g.sp, &g.shape, i, j, &uv)) continue;
         float3 P, du, dv;
         mp_surface_point(pb.points.data(), info, pb.edges.data(), pb.curves.data(), sp.patch, uv.x, uv.y, &P, &du, &dv);
         g.p.push_back(P);
         g.uv.push_back(uv);
+        g.slot_p[mp_slot(&g.shape, i, j)] = P;
       }
+    g.polygons.clear();
+    std::array<uint, 4> q;
+    for (uint m = 0; mp_grid_micropolygon(&g.shape, m, q.data()); ++m) g.polygons.push_back(q);
     visit(g, f, pb);
   }
 }

@@ -76,8 +76,11 @@ Key bits(const glm::vec3& p) {
   return {b[0], b[1], b[2]};
 }
 
-// Segments along grid borders whose ends both lie inside the frame, with how
-// many grids produced each (undirected, bit-exact end points).
+// Micropolygon edges whose ends both lie inside the frame, with how many
+// micropolygons use each (undirected, bit-exact end points, collapsed sides
+// skipped, as are micropolygons collapsed to a line). On a closed surface every one must be used exactly twice: inside
+// a grid by its two micropolygons (interior and stitching strips alike), on a
+// grid's border by one micropolygon of each grid sharing that edge.
 size_t count_unmatched_segments(const Scene& scene, size_t* checked) {
   std::map<std::pair<Key, Key>, int> segments;
   host_dice(scene, [&](const DicedGrid& g, const FrameParams& f, const PatchBuffer&) {
@@ -86,13 +89,19 @@ size_t count_unmatched_segments(const Scene& scene, size_t* checked) {
       glm::vec2 r = mp_project(p, f);
       return r.x >= 0 && r.y >= 0 && r.x <= float(f.width) && r.y <= float(f.height);
     };
-    auto add = [&](const glm::vec3& a, const glm::vec3& b) {
-      Key ka = bits(a), kb = bits(b);
-      if (ka == kb || !inside(a) || !inside(b)) return;
-      ++segments[ka < kb ? std::make_pair(ka, kb) : std::make_pair(kb, ka)];
-    };
-    for (uint i = 0; i < g.nu; ++i) add(g.at(i, 0), g.at(i + 1, 0)), add(g.at(i, g.nv), g.at(i + 1, g.nv));
-    for (uint j = 0; j < g.nv; ++j) add(g.at(0, j), g.at(0, j + 1)), add(g.at(g.nu, j), g.at(g.nu, j + 1));
+    for (const auto& q : g.polygons) {
+      std::vector<glm::vec3> ring;
+      for (uint s : q)
+        if (ring.empty() || bits(ring.back()) != bits(g.slot_p[s])) ring.push_back(g.slot_p[s]);
+      if (ring.size() > 1 && bits(ring.back()) == bits(ring.front())) ring.pop_back();
+      if (ring.size() < 3) continue;
+      for (size_t k = 0; k < ring.size(); ++k) {
+        const glm::vec3 &a = ring[k], &b = ring[(k + 1) % ring.size()];
+        if (!inside(a) || !inside(b)) continue;
+        Key ka = bits(a), kb = bits(b);
+        ++segments[ka < kb ? std::make_pair(ka, kb) : std::make_pair(kb, ka)];
+      }
+    }
   });
   size_t unmatched = 0;
   for (const auto& [segment, n] : segments) unmatched += n != 2;

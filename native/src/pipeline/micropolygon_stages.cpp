@@ -23,7 +23,7 @@ cl::Buffer device_buffer(DeviceSession& s, size_t bytes, const char* what) {
 GridBuffers::GridBuffers(DeviceSession& session, cl_uint cap, int max_grid)
     : capacity(cap),
       vertices_per_slot(static_cast<size_t>(max_grid + 1) * static_cast<size_t>(max_grid + 1)),
-      micropolygons_per_slot(static_cast<size_t>(max_grid) * static_cast<size_t>(max_grid)) {
+      micropolygons_per_slot(vertices_per_slot) {
   size_t bytes = capacity * vertices_per_slot * sizeof(cl_float4);
   p = device_buffer(session, bytes, "grid position buffer");
   n = device_buffer(session, bytes, "grid normal buffer");

@@ -1,0 +1,233 @@
+/* Stitched grids: the vertices and micropolygons of a diced sub-patch.
+ *
+ * A diced sub-patch has an interior grid rate (nu, nv) from its own screen
+ * size and, independently, a rate per edge from that edge alone (mp_bound.h).
+ * Its mesh is the layout of the Direct3D 11 tessellator's quad domain: the
+ * edges carry exactly their own vertices (so a neighbour that shares an edge
+ * places the same ones, whatever its interior), the interior is a regular
+ * grid of (nu - 1) x (nv - 1) vertices strictly inside, and a strip of
+ * micropolygons zips each edge to the interior's outer row or column. Strip
+ * steps advance along both sides where they can and along one side only
+ * where the rates differ, which makes that step a triangle (a quad with one
+ * collapsed side). A sub-patch one micropolygon thin (nv = 1 or nu = 1, with
+ * its two short edges of rate 1) is a single strip between its long edges.
+ *
+ * Storage: each grid owns a slot of (max_grid + 1)^2 vertices, addressed as
+ * (i, j) with i fastest. Row 0 holds edge 0 (corner 0 -> 1) and row max_grid
+ * edge 2 (corner 3 -> 2), each at its own rate; column 0 holds the inner
+ * vertices of edge 3 (corner 0 -> 3) and column max_grid those of edge 1
+ * (corner 1 -> 2); interior vertex (i, j) sits at (i, j). Micropolygons per
+ * grid are at most (max_grid - 2)^2 + 4 max_grid < (max_grid + 1)^2, so
+ * sampling launches one work-item per vertex slot and leaves the rest idle.
+ *
+ * Compiles as OpenCL C and C++ (include mp_compat.h and mp_types.h first). */
+#ifndef MP_GRID_H
+#define MP_GRID_H
+
+MP_INLINE float2 mp_corner(const SubPatch* sp, int k) {
+  k &= 3;
+#ifdef __OPENCL_VERSION__
+  return (float2)(sp->corner[2 * k], sp->corner[2 * k + 1]);
+#else
+  return float2(sp->corner[2 * k], sp->corner[2 * k + 1]);
+#endif
+}
+
+/* Vertex k of n along the segment a -> b. With a, b binary fractions and n a
+ * power of two this is exact, so it does not matter from which end or in
+ * which sub-patch a shared edge vertex is computed. */
+MP_INLINE float2 mp_edge_vertex(float2 a, float2 b, uint k, uint n) {
+  return a + (b - a) * ((float)k / (float)n);
+}
+
+/* round(a * b / c) for the small non-negative integers of grid indexing. */
+MP_INLINE uint mp_round_ratio(uint a, uint b, uint c) { return (2u * a * b + c) / (2u * c); }
+
+/* The number of micropolygon edges along edge e of a diced sub-patch: its
+ * rate, or the largest grid for an edge left unrated at the depth limit. */
+MP_INLINE uint mp_dice_edge_rate(const SubPatch* sp, uint e, uint mg) {
+  uint code = MP_EDGE_CODE(sp->rates, e);
+  return code ? MP_CODE_RATE(code) : mg;
+}
+
+typedef struct {
+  uint mg, nu, nv; /* slot side - 1, interior rates */
+  uint n[4];       /* edge rates */
+} MpGridShape;
+
+MP_INLINE MpGridShape mp_grid_shape(const SubPatch* sp, uint mg) {
+  MpGridShape g;
+  g.mg = mg;
+  g.nu = MP_INFO_NU(sp->info);
+  g.nv = MP_INFO_NV(sp->info);
+  for (uint e = 0u; e < 4u; ++e) g.n[e] = mp_dice_edge_rate(sp, e, mg);
+  return g;
+}
+
+MP_INLINE uint mp_slot(const MpGridShape* g, uint i, uint j) { return j * (g->mg + 1u) + i; }
+
+/* Slot of vertex k (0..n[e]) of edge e, counted from its first corner
+ * (edges 0 and 3 from corner 0, edge 1 from corner 1, edge 2 from corner 3). */
+MP_INLINE uint mp_edge_slot(const MpGridShape* g, uint e, uint k) {
+  if (e == 0u) return mp_slot(g, k, 0u);
+  if (e == 2u) return mp_slot(g, k, g->mg);
+  if (e == 3u) return k == 0u ? mp_slot(g, 0u, 0u) : k == g->n[3] ? mp_slot(g, 0u, g->mg) : mp_slot(g, 0u, k);
+  return k == 0u ? mp_slot(g, g->n[0], 0u) : k == g->n[1] ? mp_slot(g, g->n[2], g->mg) : mp_slot(g, g->mg, k);
+}
+
+MP_INLINE int mp_grid_has_interior(const MpGridShape* g) { return g->nu >= 2u && g->nv >= 2u; }
+
+/* The (u, v) on the patch of slot (i, j), if the grid uses that slot. */
+MP_INLINE int mp_slot_uv(const SubPatch* sp, const MpGridShape* g, uint i, uint j, float2* uv) {
+  float2 c0 = mp_corner(sp, 0), c1 = mp_corner(sp, 1), c2 = mp_corner(sp, 2), c3 = mp_corner(sp, 3);
+  uint mg = g->mg;
+  if (j == 0u) {
+    *uv = mp_edge_vertex(c0, c1, i, g->n[0]);
+    return i <= g->n[0];
+  }
+  if (j == mg) {
+    *uv = mp_edge_vertex(c3, c2, i, g->n[2]);
+    return i <= g->n[2];
+  }
+  if (i == 0u) {
+    *uv = mp_edge_vertex(c0, c3, j, g->n[3]);
+    return j < g->n[3];
+  }
+  if (i == mg) {
+    *uv = mp_edge_vertex(c1, c2, j, g->n[1]);
+    return j < g->n[1];
+  }
+  if (!mp_grid_has_interior(g) || i >= g->nu || j >= g->nv) return 0;
+  float s = (float)i / (float)g->nu, t = (float)j / (float)g->nv;
+  *uv = (1.0f - t) * ((1.0f - s) * c0 + s * c1) + t * ((1.0f - s) * c3 + s * c2);
+  return 1;
+}
+
+/* The grid vertex (i, j) of diceable sub-patch `*sp` that work-item `gid` of
+ * a dice or shade launch handles, and its (u, v). Returns 0 for work-items
+ * past the batch or on a slot the grid does not use. */
+MP_INLINE int mp_grid_vertex(uint gid, uint count, int max_grid, const MP_GLOBAL SubPatch* diceable, SubPatch* sp,
+                             uint* i, uint* j, float2* uv) {
+  uint stride = (uint)max_grid + 1u;
+  uint slot = gid / (stride * stride);
+  if (slot >= count) return 0;
+  uint local_index = gid - slot * stride * stride;
+  *sp = diceable[slot];
+  *i = local_index % stride;
+  *j = local_index / stride;
+  MpGridShape g = mp_grid_shape(sp, (uint)max_grid);
+  return mp_slot_uv(sp, &g, *i, *j, uv);
+}
+
+/* Micropolygons of a grid: the interior's quads, then the four strips
+ * (edges 0, 1, 2, 3) or the one strip of a thin grid. */
+MP_INLINE uint mp_grid_micropolygons(const MpGridShape* g) {
+  if (g->nv == 1u) return max(g->n[0], g->n[2]);
+  if (g->nu == 1u) return max(g->n[3], g->n[1]);
+  uint iu = g->nu - 2u, iv = g->nv - 2u;
+  return iu * iv + max(g->n[0], iu) + max(g->n[1], iv) + max(g->n[2], iu) + max(g->n[3], iv);
+}
+
+/* Step s of a strip of `steps` zipping a side of na segments to one of nb:
+ * the vertex indices where the step starts and ends on each side. */
+MP_INLINE void mp_strip_step(uint s, uint steps, uint na, uint nb, uint* a0, uint* a1, uint* b0, uint* b1) {
+  *a0 = mp_round_ratio(s, na, steps);
+  *a1 = mp_round_ratio(s + 1u, na, steps);
+  *b0 = mp_round_ratio(s, nb, steps);
+  *b1 = mp_round_ratio(s + 1u, nb, steps);
+}
+
+/* Slots of micropolygon m's corners, counter-clockwise in (u, v) like the
+ * sub-patch (q[0] -> q[1] -> q[2] -> q[3]); 0 past the last micropolygon. */
+MP_INLINE int mp_grid_micropolygon(const MpGridShape* g, uint m, uint* q) {
+  uint a0, a1, b0, b1;
+  if (g->nv == 1u || g->nu == 1u) {
+    int across_v = g->nv == 1u; /* edge 0 to edge 2; else edge 3 to edge 1 */
+    uint na = across_v ? g->n[0] : g->n[3], nb = across_v ? g->n[2] : g->n[1], steps = max(na, nb);
+    if (m >= steps) return 0;
+    mp_strip_step(m, steps, na, nb, &a0, &a1, &b0, &b1);
+    if (across_v) {
+      q[0] = mp_edge_slot(g, 0u, a0), q[1] = mp_edge_slot(g, 0u, a1);
+      q[2] = mp_edge_slot(g, 2u, b1), q[3] = mp_edge_slot(g, 2u, b0);
+    } else {
+      q[0] = mp_edge_slot(g, 3u, a0), q[1] = mp_edge_slot(g, 1u, b0);
+      q[2] = mp_edge_slot(g, 1u, b1), q[3] = mp_edge_slot(g, 3u, a1);
+    }
+    return 1;
+  }
+  uint iu = g->nu - 2u, iv = g->nv - 2u;
+  if (m < iu * iv) {
+    uint a = m % iu + 1u, b = m / iu + 1u;
+    q[0] = mp_slot(g, a, b), q[1] = mp_slot(g, a + 1u, b);
+    q[2] = mp_slot(g, a + 1u, b + 1u), q[3] = mp_slot(g, a, b + 1u);
+    return 1;
+  }
+  m -= iu * iv;
+  for (uint e = 0u; e < 4u; ++e) {
+    uint inner = (e & 1u) ? iv : iu, steps = max(g->n[e], inner);
+    if (m >= steps) {
+      m -= steps;
+      continue;
+    }
+    mp_strip_step(m, steps, g->n[e], inner, &a0, &a1, &b0, &b1);
+    /* The interior's row or column next to edge e, at inner index b. */
+    uint row = e == 0u ? 1u : g->nv - 1u, col = e == 3u ? 1u : g->nu - 1u;
+    uint i0 = (e & 1u) ? mp_slot(g, col, 1u + b0) : mp_slot(g, 1u + b0, row);
+    uint i1 = (e & 1u) ? mp_slot(g, col, 1u + b1) : mp_slot(g, 1u + b1, row);
+    uint e0 = mp_edge_slot(g, e, a0), e1 = mp_edge_slot(g, e, a1);
+    if (e == 0u) q[0] = e0, q[1] = e1, q[2] = i1, q[3] = i0;
+    else if (e == 1u) q[0] = e0, q[1] = e1, q[2] = i1, q[3] = i0;
+    else if (e == 2u) q[0] = i0, q[1] = i1, q[2] = e1, q[3] = e0;
+    else q[0] = e0, q[1] = i0, q[2] = i1, q[3] = e1;
+    return 1;
+  }
+  return 0;
+}
+
+/* Slot of the vertex across from vertex k of edge e: on the interior's
+ * nearest row or column, or on the opposite edge of a thin grid. */
+MP_INLINE uint mp_across_slot(const MpGridShape* g, uint e, uint k) {
+  uint ne = g->n[e];
+  if (mp_grid_has_interior(g)) {
+    uint along = (e & 1u) ? g->nv : g->nu;
+    uint x = mp_round_ratio(k, along, ne);
+    x = x < 1u ? 1u : x > along - 1u ? along - 1u : x;
+    if (e == 0u) return mp_slot(g, x, 1u);
+    if (e == 2u) return mp_slot(g, x, g->nv - 1u);
+    return mp_slot(g, e == 3u ? 1u : g->nu - 1u, x);
+  }
+  uint opposite = e ^ 2u;
+  return mp_edge_slot(g, opposite, mp_round_ratio(k, g->n[opposite], ne));
+}
+
+/* Neighbouring vertex slots of slot (i, j) towards -u, +u, -v and +v (the
+ * vertex itself where there is none), for differences across the grid. */
+MP_INLINE void mp_grid_neighbours(const MpGridShape* g, uint i, uint j, uint* xm, uint* xp, uint* ym, uint* yp) {
+  uint self = mp_slot(g, i, j), mg = g->mg;
+  *xm = *xp = *ym = *yp = self;
+  if (j == 0u || j == mg) { /* edge 0 or 2, corners included */
+    uint e = j == 0u ? 0u : 2u, n = g->n[e];
+    if (i > 0u) *xm = mp_edge_slot(g, e, i - 1u);
+    if (i < n) *xp = mp_edge_slot(g, e, i + 1u);
+    uint across = i == 0u ? mp_edge_slot(g, 3u, e == 0u ? 1u : g->n[3] - 1u)
+                  : i == n ? mp_edge_slot(g, 1u, e == 0u ? 1u : g->n[1] - 1u)
+                           : mp_across_slot(g, e, i);
+    if (e == 0u) *yp = across;
+    else *ym = across;
+    return;
+  }
+  if (i == 0u || i == mg) { /* inner vertices of edge 3 or 1 */
+    uint e = i == 0u ? 3u : 1u;
+    *ym = mp_edge_slot(g, e, j - 1u);
+    *yp = mp_edge_slot(g, e, j + 1u);
+    if (e == 3u) *xp = mp_across_slot(g, 3u, j);
+    else *xm = mp_across_slot(g, 1u, j);
+    return;
+  }
+  *xm = i > 1u ? mp_slot(g, i - 1u, j) : mp_edge_slot(g, 3u, mp_round_ratio(j, g->n[3], g->nv));
+  *xp = i + 1u < g->nu ? mp_slot(g, i + 1u, j) : mp_edge_slot(g, 1u, mp_round_ratio(j, g->n[1], g->nv));
+  *ym = j > 1u ? mp_slot(g, i, j - 1u) : mp_edge_slot(g, 0u, mp_round_ratio(i, g->n[0], g->nu));
+  *yp = j + 1u < g->nv ? mp_slot(g, i, j + 1u) : mp_edge_slot(g, 2u, mp_round_ratio(i, g->n[2], g->nu));
+}
+
+#endif
