@@ -17,8 +17,7 @@
  * edge 2 (corner 3 -> 2), each at its own rate; column 0 holds the inner
  * vertices of edge 3 (corner 0 -> 3) and column max_grid those of edge 1
  * (corner 1 -> 2); interior vertex (i, j) sits at (i, j). Micropolygons per
- * grid are at most (max_grid - 2)^2 + 4 max_grid < (max_grid + 1)^2, so
- * sampling launches one work-item per vertex slot and leaves the rest idle.
+ * grid are at most (max_grid - 2)^2 + 4 max_grid (MP_GRID_MICROPOLYGON_SLOTS).
  *
  * Compiles as OpenCL C and C++ (include mp_compat.h and mp_types.h first). */
 #ifndef MP_GRID_H
@@ -118,6 +117,10 @@ MP_INLINE int mp_grid_vertex(uint gid, uint count, int max_grid, const MP_GLOBAL
   MpGridShape g = mp_grid_shape(sp, (uint)max_grid);
   return mp_slot_uv(sp, &g, *i, *j, uv);
 }
+
+/* Most micropolygons a grid can have: (mg - 2)^2 interior quads and four
+ * strips of at most mg steps. */
+#define MP_GRID_MICROPOLYGON_SLOTS(mg) ((mg) < 2u ? 1u : ((mg) - 2u) * ((mg) - 2u) + 4u * (mg))
 
 /* Micropolygons of a grid: the interior's quads, then the four strips
  * (edges 0, 1, 2, 3) or the one strip of a thin grid. */

@@ -1,5 +1,5 @@
 /* Sample: a software rasteriser for micropolygons. Each work-item takes one
- * micropolygon (two triangles of a quad of a stitched grid, mp_grid.h; one of
+ * micropolygon at a time (two triangles of a quad of a stitched grid, mp_grid.h; one of
  * them empty where the quad has collapsed into a triangle), finds the jittered samples it
  * covers with fixed-point edge functions, and resolves visibility per sample
  * with a 64-bit atomic minimum of (depth, micropolygon id) (the visibility
@@ -77,6 +77,23 @@ inline int mp_triangle_covers(const MpTriangle* t, MpFixed2 q, float* la, float*
   return 1;
 }
 
+/* Whether edge (a, b) of a triangle can have samples of pixel (px, py) on its
+ * inner side: the edge function at the pixel corner where it is largest
+ * (sample offsets run from 0 to 255/256 of a pixel). */
+inline int mp_edge_reaches_pixel(MpFixed2 a, MpFixed2 b, int px, int py) {
+  MpFixed2 q;
+  q.x = (long)px * MP_SUBPIXEL_ONE + (b.y > a.y ? MP_SUBPIXEL_ONE - 1 : 0);
+  q.y = (long)py * MP_SUBPIXEL_ONE + (b.x < a.x ? MP_SUBPIXEL_ONE - 1 : 0);
+  return -mp_edge(a, b, q) >= 0;
+}
+
+/* Whether the triangle may cover samples of pixel (px, py): a conservative
+ * test that lets thin micropolygons skip most pixels of their bounding box. */
+inline int mp_triangle_reaches_pixel(const MpTriangle* t, int px, int py) {
+  return t->valid && mp_edge_reaches_pixel(t->b.p, t->c.p, px, py) && mp_edge_reaches_pixel(t->c.p, t->a.p, px, py) &&
+         mp_edge_reaches_pixel(t->a.p, t->b.p, px, py);
+}
+
 /* Rasterises the quad's triangles (v00, v10, v11) and (v00, v11, v01) that
  * `keep` selects (bit 0 and bit 1). */
 inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVertex v11, MpRasterVertex v01, uint keep,
@@ -93,7 +110,8 @@ inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVerte
   int py0 = (int)max(ymin >> MP_SUBPIXEL_BITS, (long)0), py1 = (int)min(ymax >> MP_SUBPIXEL_BITS, (long)f.height - 1);
   int spp = f.spp_x * f.spp_y;
   for (int py = py0; py <= py1; ++py)
-    for (int px = px0; px <= px1; ++px)
+    for (int px = px0; px <= px1; ++px) {
+      if (!mp_triangle_reaches_pixel(&tris[0], px, py) && !mp_triangle_reaches_pixel(&tris[1], px, py)) continue;
       for (int s = 0; s < spp; ++s) {
         MpFixed2 q = mp_sample_position(px, py, s, spp, f, offsets);
         if (q.x < xmin || q.x > xmax || q.y < ymin || q.y > ymax) continue;
@@ -120,15 +138,16 @@ inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVerte
           normals[index] = mp_encode_normal(normalize(nrm));
         }
       }
+    }
 }
 
 /* Micropolygons that reach the rasteriser and their total screen area, summed
  * per work-group in local memory (one atomic per group): the dicing density
  * the benchmarks report as micropolygons per pixel of surface. */
-inline void mp_count_sampled(uint l, long area2, uint pass, volatile __global ulong* totals, __local ulong* area_sum,
-                             __local uint* count_sum) {
+inline void mp_count_sampled(uint l, long area2, uint drawn, uint pass, volatile __global ulong* totals,
+                             __local ulong* area_sum, __local uint* count_sum) {
   area_sum[l] = (ulong)area2;
-  count_sum[l] = area2 > 0 ? 1u : 0u;
+  count_sum[l] = drawn;
   barrier(CLK_LOCAL_MEM_FENCE);
   for (uint s = 32u; s > 0u; s >>= 1) {
     if (l < s) {
@@ -143,6 +162,8 @@ inline void mp_count_sampled(uint l, long area2, uint pass, volatile __global ul
   }
 }
 
+/* One work-item per micropolygon: each grid has MP_GRID_MICROPOLYGON_SLOTS
+ * work-items, the ones past its micropolygon count idle. */
 __kernel __attribute__((reqd_work_group_size(64, 1, 1)))
 void sample_micropolygons(__global const SubPatch* diceable, uint first, uint count, __global const uint* patch_info,
                                    FrameParams f, __global const float4* grid_p, __global const float4* grid_c,
@@ -151,21 +172,20 @@ void sample_micropolygons(__global const SubPatch* diceable, uint first, uint co
                                    __global float* colors, __global uint* normals, volatile __global ulong* totals) {
   __local ulong area_sum[64];
   __local uint count_sum[64];
-  uint stride = (uint)f.max_grid + 1u, per_slot = stride * stride;
+  uint stride = (uint)f.max_grid + 1u, per_grid = MP_GRID_MICROPOLYGON_SLOTS((uint)f.max_grid);
   uint gid = get_global_id(0);
-  uint slot = first + gid / per_slot;
-  uint m = gid % per_slot;
+  uint slot = first + gid / per_grid, m = gid % per_grid;
   int live = slot < count;
   SubPatch sp;
+  MpGridShape g;
   uint q[4];
   if (live) {
     sp = diceable[slot];
-    MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
+    g = mp_grid_shape(&sp, (uint)f.max_grid);
     live = mp_grid_micropolygon(&g, m, q);
   }
   MpRasterVertex v[4]; /* counter-clockwise in (u, v) */
-  long area2 = 0;
-  ulong base = (ulong)slot * per_slot;
+  ulong base = (ulong)slot * stride * stride;
   if (live) {
     int ok = 1;
     for (int k = 0; k < 4; ++k) {
@@ -174,23 +194,24 @@ void sample_micropolygons(__global const SubPatch* diceable, uint first, uint co
     }
     live = ok;
   }
-  uint keep = 3u;
+  uint keep = 0u;
+  long area2 = 0;
   if (live) {
+    /* Front faces run counter-clockwise on screen, i.e. negative raster
+     * area. Each triangle is culled on its own: a quad of a stitching strip
+     * can turn one triangle away near a silhouette while the other still
+     * faces the camera. */
     uint flags = patch_info[4 * (ulong)sp.patch + 2];
-    /* Front faces run counter-clockwise on screen, i.e. negative raster area.
-     * Each triangle is culled on its own: a quad of a stitching strip can
-     * turn one triangle away near a silhouette while the other still faces
-     * the camera. */
     long a0 = mp_edge(v[0].p, v[1].p, v[2].p), a1 = mp_edge(v[0].p, v[2].p, v[3].p);
+    keep = 3u;
     if (f.backface_culling && !(flags & MP_PATCH_DOUBLE_SIDED)) {
       int flip = (flags & MP_PATCH_FLIP_ORIENTATION) != 0u;
       keep = ((flip ? a0 > 0 : a0 < 0) ? 1u : 0u) | ((flip ? a1 > 0 : a1 < 0) ? 2u : 0u);
-      live = keep != 0u;
     }
     area2 = ((keep & 1u) ? (a0 < 0 ? -a0 : a0) : 0) + ((keep & 2u) ? (a1 < 0 ? -a1 : a1) : 0);
   }
-  mp_count_sampled(get_local_id(0), area2, pass, totals, area_sum, count_sum);
-  if (!live) return;
+  mp_count_sampled(get_local_id(0), area2, area2 > 0 ? 1u : 0u, pass, totals, area_sum, count_sum);
+  if (!keep) return;
   uint grid_id = mp_hash32(sp.patch);
   for (int k = 0; k < 8; ++k) grid_id = mp_hash_combine(grid_id, as_uint(sp.corner[k]));
   uint mp_id = mp_hash_combine(grid_id, m);

@@ -5,7 +5,10 @@
 #include <vector>
 
 #include "micropoly/error.h"
+#include "pipeline/half_float.h"
 #include "mp_raster.h"
+#include "mp_types.h"
+#include "mp_grid.h"
 
 namespace mp {
 namespace {
@@ -22,8 +25,7 @@ cl::Buffer device_buffer(DeviceSession& s, size_t bytes, const char* what) {
 
 GridBuffers::GridBuffers(DeviceSession& session, cl_uint cap, int max_grid)
     : capacity(cap),
-      vertices_per_slot(static_cast<size_t>(max_grid + 1) * static_cast<size_t>(max_grid + 1)),
-      micropolygons_per_slot(vertices_per_slot) {
+      vertices_per_slot(static_cast<size_t>(max_grid + 1) * static_cast<size_t>(max_grid + 1)) {
   size_t bytes = capacity * vertices_per_slot * sizeof(cl_float4);
   p = device_buffer(session, bytes, "grid position buffer");
   n = device_buffer(session, bytes, "grid normal buffer");
@@ -148,7 +150,7 @@ void SampleStage::run(const cl::Buffer& diceable, cl_uint first, cl_uint count, 
   for (cl_uint pass = 0; pass < 2; ++pass) {
     kernel_.setArg(9, pass);
     cl::Event e;
-    session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(count * grids.micropolygons_per_slot),
+    session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(size_t(count) * MP_GRID_MICROPOLYGON_SLOTS(cl_uint(f.max_grid))),
                                           cl::NDRange(64), nullptr, &e);
     timer.add(Stage::Sample, e);
   }
@@ -170,7 +172,8 @@ ResolveStage::~ResolveStage() {
 }
 
 void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, PixelFilter filter, float filter_width,
-                       bool passes, RenderResult& out, StageTimer& timer) {
+                       bool passes, bool half_color, RenderResult& out, StageTimer& timer) {
+  half_color = half_color && use_pinned_;
   const FrameParams& f = frame.params;
   size_t pixels = static_cast<size_t>(f.width) * static_cast<size_t>(f.height);
   if (pixels != pixels_) {
@@ -229,6 +232,7 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
   kernel_.setArg(13, depth_);
   kernel_.setArg(14, normal_);
   kernel_.setArg(15, passes ? 1 : 0);
+  kernel_.setArg(16, half_color ? 1 : 0);
   size_t gx = ((static_cast<size_t>(f.width) + 7) / 8) * 8, gy = ((static_cast<size_t>(f.height) + 7) / 8) * 8;
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(gx, gy), cl::NDRange(8, 8), nullptr, &e);
@@ -236,7 +240,7 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
   out.width = f.width;
   out.height = f.height;
   out.rgba.resize(pixels * 4);
-  const size_t rgba_bytes = pixels * sizeof(cl_float4);
+  const size_t rgba_bytes = pixels * (half_color ? 4 * sizeof(cl_half) : sizeof(cl_float4));
   if (use_pinned_) {
     if (pinned_bytes_ != rgba_bytes) {
       if (pinned_ptr_) session_.queue().enqueueUnmapMemObject(pinned_, pinned_ptr_);
@@ -259,7 +263,8 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
     session_.queue().enqueueReadBuffer(normal_, CL_FALSE, 0, pixels * 3 * sizeof(cl_float), out.normal.data());
   }
   session_.queue().finish();
-  if (use_pinned_) std::memcpy(out.rgba.data(), pinned_ptr_, rgba_bytes);
+  if (half_color) half_to_float(reinterpret_cast<const uint16_t*>(pinned_ptr_), out.rgba.data(), pixels * 4);
+  else if (use_pinned_) std::memcpy(out.rgba.data(), pinned_ptr_, rgba_bytes);
 }
 
 }  // namespace mp

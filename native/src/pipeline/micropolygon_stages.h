@@ -16,7 +16,6 @@ struct GridBuffers {
   cl::Buffer p, n, c;  // float4 per grid vertex
   cl_uint capacity;    // sub-patches per batch
   size_t vertices_per_slot;
-  size_t micropolygons_per_slot;
 };
 
 class DiceStage {
@@ -76,9 +75,10 @@ class ResolveStage {
   ~ResolveStage();
   ResolveStage(const ResolveStage&) = delete;
   ResolveStage& operator=(const ResolveStage&) = delete;
-  // Resolves pixels and reads them back; Depth and Normal only if `passes`.
+  // Resolves pixels and reads them back; Depth and Normal only if `passes`;
+  // Combined as half floats from a discrete device if `half_color`.
   void run(const SampleStage& samples, const FrameSetup& frame, PixelFilter filter, float filter_width, bool passes,
-           RenderResult& out, StageTimer& timer);
+           bool half_color, RenderResult& out, StageTimer& timer);
 
  private:
   DeviceSession& session_;
