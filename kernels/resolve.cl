@@ -23,8 +23,7 @@ __kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width,
                              __global const float* weights, int use_weights, __global const ulong* keys,
                              __global const float* colors, __global const uint* normals,
                              float4 cam_to_world_x, float4 cam_to_world_y, float4 cam_to_world_z,
-                             __global float4* rgba, __global float* depth, __global float* normal_out, int want_passes,
-                             int half_color) {
+                             __global float4* rgba, __global float* depth, __global float* normal_out, int want_passes) {
   int px = get_global_id(0), py = get_global_id(1);
   if (px >= f.width || py >= f.height) return;
   int spp = f.spp_x * f.spp_y;
@@ -54,10 +53,7 @@ __kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width,
       }
     }
   ulong pixel = (ulong)py * (ulong)f.width + (ulong)px;
-  float4 color = wsum > 0.0f ? sum / wsum : (float4)(0.0f);
-  /* Half floats (for display) fill the first half of the same buffer. */
-  if (half_color) vstore_half4_rte(color, pixel, (__global half*)rgba);
-  else rgba[pixel] = color;
+  rgba[pixel] = wsum > 0.0f ? sum / wsum : (float4)(0.0f);
   if (!want_passes) return;
 
   float zmin = MP_NO_DEPTH;

@@ -77,23 +77,6 @@ inline int mp_triangle_covers(const MpTriangle* t, MpFixed2 q, float* la, float*
   return 1;
 }
 
-/* Whether edge (a, b) of a triangle can have samples of pixel (px, py) on its
- * inner side: the edge function at the pixel corner where it is largest
- * (sample offsets run from 0 to 255/256 of a pixel). */
-inline int mp_edge_reaches_pixel(MpFixed2 a, MpFixed2 b, int px, int py) {
-  MpFixed2 q;
-  q.x = (long)px * MP_SUBPIXEL_ONE + (b.y > a.y ? MP_SUBPIXEL_ONE - 1 : 0);
-  q.y = (long)py * MP_SUBPIXEL_ONE + (b.x < a.x ? MP_SUBPIXEL_ONE - 1 : 0);
-  return -mp_edge(a, b, q) >= 0;
-}
-
-/* Whether the triangle may cover samples of pixel (px, py): a conservative
- * test that lets thin micropolygons skip most pixels of their bounding box. */
-inline int mp_triangle_reaches_pixel(const MpTriangle* t, int px, int py) {
-  return t->valid && mp_edge_reaches_pixel(t->b.p, t->c.p, px, py) && mp_edge_reaches_pixel(t->c.p, t->a.p, px, py) &&
-         mp_edge_reaches_pixel(t->a.p, t->b.p, px, py);
-}
-
 /* Rasterises the quad's triangles (v00, v10, v11) and (v00, v11, v01) that
  * `keep` selects (bit 0 and bit 1). */
 inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVertex v11, MpRasterVertex v01, uint keep,
@@ -110,8 +93,7 @@ inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVerte
   int py0 = (int)max(ymin >> MP_SUBPIXEL_BITS, (long)0), py1 = (int)min(ymax >> MP_SUBPIXEL_BITS, (long)f.height - 1);
   int spp = f.spp_x * f.spp_y;
   for (int py = py0; py <= py1; ++py)
-    for (int px = px0; px <= px1; ++px) {
-      if (!mp_triangle_reaches_pixel(&tris[0], px, py) && !mp_triangle_reaches_pixel(&tris[1], px, py)) continue;
+    for (int px = px0; px <= px1; ++px)
       for (int s = 0; s < spp; ++s) {
         MpFixed2 q = mp_sample_position(px, py, s, spp, f, offsets);
         if (q.x < xmin || q.x > xmax || q.y < ymin || q.y > ymax) continue;
@@ -138,7 +120,6 @@ inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVerte
           normals[index] = mp_encode_normal(normalize(nrm));
         }
       }
-    }
 }
 
 /* Micropolygons that reach the rasteriser and their total screen area, summed

@@ -297,8 +297,6 @@ class ViewportSession:
             native.settings.samples = spp
             native.settings.shading_rate = rate
             native.settings.depth_and_normal_passes = False  # the viewport draws colour only
-            # Its texture holds half floats: half the transfer from a discrete GPU.
-            native.settings.half_float_readback = True
             result = renderer.render(native, lambda p: self._current(generation))
             if result["stats"]["cancelled"] or not self._current(generation):
                 return

@@ -72,29 +72,6 @@ TEST_F(RenderTest, SameSceneRendersBitIdenticallyTwice) {
   EXPECT_EQ(a.normal, b.normal);
 }
 
-// Half-float readback (for display) gives Combined rounded to the nearest
-// half float: within half an ulp of 11 bits of the full-precision render. On
-// devices that share host memory the setting is ignored and the images match.
-TEST_F(RenderTest, HalfFloatReadbackIsCombinedRoundedToHalfPrecision) {
-  Scene s = base_scene(200, 150, 4);
-  s.camera = look_at({2.5f, 2.0f, 4.0f}, {0, 0, 0});
-  s.meshes.push_back(cube_mesh(SubdivScheme::CatmullClark));
-  RenderResult full = renderer_->render(s);
-  s.settings.half_float_readback = true;
-  RenderResult half = renderer_->render(s);
-  ASSERT_GT(coverage(full), 1000.0);
-  ASSERT_EQ(full.rgba.size(), half.rgba.size());
-  size_t worst = 0;
-  double worst_err = 0;
-  for (size_t i = 0; i < full.rgba.size(); ++i) {
-    float a = full.rgba[i], b = half.rgba[i];
-    // Half an ulp of a binary16 normal, relative; 2^-25 absolute below its normal range.
-    double err = std::abs(double(a) - double(b)) / std::max(std::abs(double(a)) * std::ldexp(1.0, -11), std::ldexp(1.0, -25));
-    if (err > worst_err) worst_err = err, worst = i;
-  }
-  EXPECT_LE(worst_err, 1.0) << "value " << worst << ": " << full.rgba[worst] << " read back as " << half.rgba[worst];
-}
-
 // The renderer keeps the last scene's device buffers for a re-render of the
 // same content. Re-rendering at another sample count or size reuses them;
 // any change to geometry, transforms, camera placement, materials or lights

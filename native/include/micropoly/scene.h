@@ -160,10 +160,6 @@ struct RenderSettings {
   int max_split_depth = 26;                    // eye-split and runaway limit
   bool backface_culling = true;                // for single-sided surfaces
   bool depth_and_normal_passes = true;         // resolve and return Depth and Normal
-  // Let Combined cross from a discrete device as 16-bit floats (half the
-  // transfer) and widen it on the host: for display, whose textures hold
-  // half floats anyway. Ignored where the device shares host memory.
-  bool half_float_readback = false;
 };
 
 struct Scene {

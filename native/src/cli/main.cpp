@@ -18,14 +18,13 @@ const char* kUsage =
     "usage: micropoly-render SCENE.rib -o OUT.(png|exr) [--spp N] [--shading-rate R]\n"
     "                        [--device cpu|gpu|INDEX] [--bound-split bounded|breadth]\n"
     "                        [--bound-split-memory MIB] [--stats FILE.json] [--repeat N]\n"
-    "                        [--half-float-readback]\n"
     "       micropoly-render --list-devices\n";
 
 struct Options {
   std::string scene, output, device, stats, bound_split;
   int spp = 0, repeat = 1;
   float shading_rate = 0, memory_mib = 0;
-  bool list_devices = false, half_float_readback = false;
+  bool list_devices = false;
 };
 
 [[noreturn]] void usage_error(const std::string& why) {
@@ -63,7 +62,6 @@ Options parse(int argc, char** argv) {
     else if (a == "--stats") o.stats = value();
     else if (a == "--repeat") o.repeat = static_cast<int>(parse_number(a, value(), 1, 10000));
     else if (a == "--list-devices") o.list_devices = true;
-    else if (a == "--half-float-readback") o.half_float_readback = true;
     else if (!a.empty() && a[0] == '-') usage_error("unknown option " + a);
     else if (o.scene.empty()) o.scene = a;
     else usage_error("more than one scene file given");
@@ -100,8 +98,6 @@ int main(int argc, char** argv) {
     if (!o.bound_split.empty())
       scene.settings.bound_split = o.bound_split == "breadth" ? mp::BoundSplitMethod::Breadth : mp::BoundSplitMethod::Bounded;
     if (o.memory_mib > 0) scene.settings.bound_split_memory_mib = o.memory_mib;
-    // Combined as half floats from a discrete GPU, as the viewport reads it.
-    scene.settings.half_float_readback = o.half_float_readback;
     // Only EXR files hold the Depth and Normal passes.
     auto dot = output.find_last_of('.');
     std::string ext = dot == std::string::npos ? "" : output.substr(dot + 1);

@@ -5,7 +5,6 @@
 #include <vector>
 
 #include "micropoly/error.h"
-#include "pipeline/half_float.h"
 #include "mp_raster.h"
 #include "mp_types.h"
 #include "mp_grid.h"
@@ -172,8 +171,7 @@ ResolveStage::~ResolveStage() {
 }
 
 void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, PixelFilter filter, float filter_width,
-                       bool passes, bool half_color, RenderResult& out, StageTimer& timer) {
-  half_color = half_color && use_pinned_;
+                       bool passes, RenderResult& out, StageTimer& timer) {
   const FrameParams& f = frame.params;
   size_t pixels = static_cast<size_t>(f.width) * static_cast<size_t>(f.height);
   if (pixels != pixels_) {
@@ -232,7 +230,6 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
   kernel_.setArg(13, depth_);
   kernel_.setArg(14, normal_);
   kernel_.setArg(15, passes ? 1 : 0);
-  kernel_.setArg(16, half_color ? 1 : 0);
   size_t gx = ((static_cast<size_t>(f.width) + 7) / 8) * 8, gy = ((static_cast<size_t>(f.height) + 7) / 8) * 8;
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(gx, gy), cl::NDRange(8, 8), nullptr, &e);
@@ -240,7 +237,7 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
   out.width = f.width;
   out.height = f.height;
   out.rgba.resize(pixels * 4);
-  const size_t rgba_bytes = pixels * (half_color ? 4 * sizeof(cl_half) : sizeof(cl_float4));
+  const size_t rgba_bytes = pixels * sizeof(cl_float4);
   if (use_pinned_) {
     if (pinned_bytes_ != rgba_bytes) {
       if (pinned_ptr_) session_.queue().enqueueUnmapMemObject(pinned_, pinned_ptr_);
@@ -263,8 +260,7 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
     session_.queue().enqueueReadBuffer(normal_, CL_FALSE, 0, pixels * 3 * sizeof(cl_float), out.normal.data());
   }
   session_.queue().finish();
-  if (half_color) half_to_float(reinterpret_cast<const uint16_t*>(pinned_ptr_), out.rgba.data(), pixels * 4);
-  else if (use_pinned_) std::memcpy(out.rgba.data(), pinned_ptr_, rgba_bytes);
+  if (use_pinned_) std::memcpy(out.rgba.data(), pinned_ptr_, rgba_bytes);
 }
 
 }  // namespace mp

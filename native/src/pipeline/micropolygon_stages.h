@@ -16,6 +16,7 @@ struct GridBuffers {
   cl::Buffer p, n, c;  // float4 per grid vertex
   cl_uint capacity;    // sub-patches per batch
   size_t vertices_per_slot;
+  size_t micropolygons_per_slot;
 };
 
 class DiceStage {
@@ -75,10 +76,9 @@ class ResolveStage {
   ~ResolveStage();
   ResolveStage(const ResolveStage&) = delete;
   ResolveStage& operator=(const ResolveStage&) = delete;
-  // Resolves pixels and reads them back; Depth and Normal only if `passes`;
-  // Combined as half floats from a discrete device if `half_color`.
+  // Resolves pixels and reads them back; Depth and Normal only if `passes`.
   void run(const SampleStage& samples, const FrameSetup& frame, PixelFilter filter, float filter_width, bool passes,
-           bool half_color, RenderResult& out, StageTimer& timer);
+           RenderResult& out, StageTimer& timer);
 
  private:
   DeviceSession& session_;

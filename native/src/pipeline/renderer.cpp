@@ -166,7 +166,6 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     st.bound_split_launches = bs.launches;
     auto t_resolve = std::chrono::steady_clock::now();
     resolve.run(sample, frame, scene.settings.filter, scene.settings.filter_width, scene.settings.depth_and_normal_passes,
-                scene.settings.half_float_readback,
                 out, timer);
     st.timings_ms.readback = ms_since(t_resolve);
     timer.collect();

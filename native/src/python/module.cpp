@@ -130,8 +130,7 @@ PYBIND11_MODULE(_native, m) {
       .def_readwrite("max_grid_size", &RenderSettings::max_grid_size)
       .def_readwrite("max_split_depth", &RenderSettings::max_split_depth)
       .def_readwrite("backface_culling", &RenderSettings::backface_culling)
-      .def_readwrite("depth_and_normal_passes", &RenderSettings::depth_and_normal_passes)
-      .def_readwrite("half_float_readback", &RenderSettings::half_float_readback);
+      .def_readwrite("depth_and_normal_passes", &RenderSettings::depth_and_normal_passes);
 
   py::class_<Scene>(m, "Scene")
       .def(py::init<>())
