@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <thread>
 #include <vector>
 
 #include "micropoly/error.h"
@@ -18,6 +19,26 @@ cl::Buffer device_buffer(DeviceSession& s, size_t bytes, const char* what) {
                 s.info().name + "' allows " + std::to_string(s.max_alloc_bytes() >> 20) +
                 " MiB: lower the resolution or the samples per pixel");
   return cl::Buffer(s.context(), CL_MEM_READ_WRITE, std::max<size_t>(bytes, 16));
+}
+
+// memcpy over a few threads: one core copies a 1080p float image out of the
+// pinned buffer in about 3 ms, a fifth of a GPU frame.
+void parallel_copy(void* dst, const void* src, size_t bytes) {
+  const size_t min_chunk = size_t(4) << 20;
+  const size_t threads = std::min<size_t>({std::max(1u, std::thread::hardware_concurrency()), 8, bytes / min_chunk});
+  if (threads <= 1) {
+    std::memcpy(dst, src, bytes);
+    return;
+  }
+  const size_t chunk = (bytes / threads + 63) & ~size_t(63);
+  std::vector<std::thread> pool;
+  for (size_t t = 1; t < threads && t * chunk < bytes; ++t)
+    pool.emplace_back([=] {
+      std::memcpy(static_cast<char*>(dst) + t * chunk, static_cast<const char*>(src) + t * chunk,
+                  std::min(chunk, bytes - t * chunk));
+    });
+  std::memcpy(dst, src, std::min(chunk, bytes));
+  for (auto& th : pool) th.join();
 }
 
 }  // namespace
@@ -260,7 +281,7 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
     session_.queue().enqueueReadBuffer(normal_, CL_FALSE, 0, pixels * 3 * sizeof(cl_float), out.normal.data());
   }
   session_.queue().finish();
-  if (use_pinned_) std::memcpy(out.rgba.data(), pinned_ptr_, rgba_bytes);
+  if (use_pinned_) parallel_copy(out.rgba.data(), pinned_ptr_, rgba_bytes);
 }
 
 }  // namespace mp
