@@ -14,14 +14,17 @@ __kernel void dice_grids(__global const SubPatch* diceable, uint count,
                          __global const uint* edges, __global const float4* curves,
                          __global const DeviceMaterial* materials, FrameParams f, __global float4* grid_p,
                          __global float4* grid_n,
-                         volatile __global uint* micropolygon_count) {
+                         volatile __global uint* micropolygon_count, __global uint* grid_micropolygons) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   float2 uv;
   if (!mp_grid_vertex(gid, count, f.max_grid, diceable, &sp, &i, &j, &uv)) return;
   if (i == 0u && j == 0u) {
+    /* Per grid, for sampling to launch exactly the grids' micropolygons. */
     MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
-    atomic_add(micropolygon_count, mp_grid_micropolygons(&g));
+    uint n = mp_grid_micropolygons(&g);
+    grid_micropolygons[gid / (((uint)f.max_grid + 1u) * ((uint)f.max_grid + 1u))] = n;
+    atomic_add(micropolygon_count, n);
   }
   float3 p, dpdu, dpdv;
   mp_surface_point(points, patch_info, edges, curves, sp.patch, uv.x, uv.y, &p, &dpdu, &dpdv);

@@ -17,7 +17,7 @@
  * edge 2 (corner 3 -> 2), each at its own rate; column 0 holds the inner
  * vertices of edge 3 (corner 0 -> 3) and column max_grid those of edge 1
  * (corner 1 -> 2); interior vertex (i, j) sits at (i, j). Micropolygons per
- * grid are at most (max_grid - 2)^2 + 4 max_grid (MP_GRID_MICROPOLYGON_SLOTS).
+ * grid are at most (max_grid - 2)^2 + 4 max_grid.
  *
  * Compiles as OpenCL C and C++ (include mp_compat.h and mp_types.h first). */
 #ifndef MP_GRID_H
@@ -76,29 +76,30 @@ MP_INLINE uint mp_edge_slot(const MpGridShape* g, uint e, uint k) {
 
 MP_INLINE int mp_grid_has_interior(const MpGridShape* g) { return g->nu >= 2u && g->nv >= 2u; }
 
+/* Whether the grid uses slot (i, j) (tested before any (u, v) is computed:
+ * most slots of a small grid are idle). */
+MP_INLINE int mp_slot_live(const MpGridShape* g, uint i, uint j) {
+  uint mg = g->mg;
+  if (j == 0u) return i <= g->n[0];
+  if (j == mg) return i <= g->n[2];
+  if (i == 0u) return j < g->n[3];
+  if (i == mg) return j < g->n[1];
+  return mp_grid_has_interior(g) && i < g->nu && j < g->nv;
+}
+
 /* The (u, v) on the patch of slot (i, j), if the grid uses that slot. */
 MP_INLINE int mp_slot_uv(const SubPatch* sp, const MpGridShape* g, uint i, uint j, float2* uv) {
+  if (!mp_slot_live(g, i, j)) return 0;
   float2 c0 = mp_corner(sp, 0), c1 = mp_corner(sp, 1), c2 = mp_corner(sp, 2), c3 = mp_corner(sp, 3);
   uint mg = g->mg;
-  if (j == 0u) {
-    *uv = mp_edge_vertex(c0, c1, i, g->n[0]);
-    return i <= g->n[0];
+  if (j == 0u) *uv = mp_edge_vertex(c0, c1, i, g->n[0]);
+  else if (j == mg) *uv = mp_edge_vertex(c3, c2, i, g->n[2]);
+  else if (i == 0u) *uv = mp_edge_vertex(c0, c3, j, g->n[3]);
+  else if (i == mg) *uv = mp_edge_vertex(c1, c2, j, g->n[1]);
+  else {
+    float s = (float)i / (float)g->nu, t = (float)j / (float)g->nv;
+    *uv = (1.0f - t) * ((1.0f - s) * c0 + s * c1) + t * ((1.0f - s) * c3 + s * c2);
   }
-  if (j == mg) {
-    *uv = mp_edge_vertex(c3, c2, i, g->n[2]);
-    return i <= g->n[2];
-  }
-  if (i == 0u) {
-    *uv = mp_edge_vertex(c0, c3, j, g->n[3]);
-    return j < g->n[3];
-  }
-  if (i == mg) {
-    *uv = mp_edge_vertex(c1, c2, j, g->n[1]);
-    return j < g->n[1];
-  }
-  if (!mp_grid_has_interior(g) || i >= g->nu || j >= g->nv) return 0;
-  float s = (float)i / (float)g->nu, t = (float)j / (float)g->nv;
-  *uv = (1.0f - t) * ((1.0f - s) * c0 + s * c1) + t * ((1.0f - s) * c3 + s * c2);
   return 1;
 }
 
@@ -117,10 +118,6 @@ MP_INLINE int mp_grid_vertex(uint gid, uint count, int max_grid, const MP_GLOBAL
   MpGridShape g = mp_grid_shape(sp, (uint)max_grid);
   return mp_slot_uv(sp, &g, *i, *j, uv);
 }
-
-/* Most micropolygons a grid can have: (mg - 2)^2 interior quads and four
- * strips of at most mg steps. */
-#define MP_GRID_MICROPOLYGON_SLOTS(mg) ((mg) < 2u ? 1u : ((mg) - 2u) * ((mg) - 2u) + 4u * (mg))
 
 /* Micropolygons of a grid: the interior's quads, then the four strips
  * (edges 0, 1, 2, 3) or the one strip of a thin grid. */
@@ -144,6 +141,7 @@ MP_INLINE void mp_strip_step(uint s, uint steps, uint na, uint nb, uint* a0, uin
  * sub-patch (q[0] -> q[1] -> q[2] -> q[3]); 0 past the last micropolygon. */
 MP_INLINE int mp_grid_micropolygon(const MpGridShape* g, uint m, uint* q) {
   uint a0, a1, b0, b1;
+  if (m >= mp_grid_micropolygons(g)) return 0;
   if (g->nv == 1u || g->nu == 1u) {
     int across_v = g->nv == 1u; /* edge 0 to edge 2; else edge 3 to edge 1 */
     uint na = across_v ? g->n[0] : g->n[3], nb = across_v ? g->n[2] : g->n[1], steps = max(na, nb);

@@ -143,24 +143,35 @@ inline void mp_count_sampled(uint l, long area2, uint drawn, uint pass, volatile
   }
 }
 
-/* One work-item per micropolygon: each grid has MP_GRID_MICROPOLYGON_SLOTS
- * work-items, the ones past its micropolygon count idle. */
+/* One work-item per micropolygon of grids [first, first + count): `offsets`
+ * holds each grid's first micropolygon (an exclusive prefix sum of the
+ * grids' counts, which dicing records), `total` their sum. A work-item finds
+ * its grid by binary search, so no work-item idles on an unused grid slot. */
 __kernel __attribute__((reqd_work_group_size(64, 1, 1)))
-void sample_micropolygons(__global const SubPatch* diceable, uint first, uint count, __global const uint* patch_info,
+void sample_micropolygons(__global const SubPatch* diceable, uint first, uint count, __global const uint* offsets,
+                                   uint total, __global const uint* patch_info,
                                    FrameParams f, __global const float4* grid_p, __global const float4* grid_c,
-                                   __global const float4* grid_n, __global const ushort* offsets, uint pass,
+                                   __global const float4* grid_n, __global const ushort* sample_offsets, uint pass,
                                    volatile __global ulong* keys,
                                    __global float* colors, __global uint* normals, volatile __global ulong* totals) {
   __local ulong area_sum[64];
   __local uint count_sum[64];
-  uint stride = (uint)f.max_grid + 1u, per_grid = MP_GRID_MICROPOLYGON_SLOTS((uint)f.max_grid);
+  uint stride = (uint)f.max_grid + 1u;
   uint gid = get_global_id(0);
-  uint slot = first + gid / per_grid, m = gid % per_grid;
-  int live = slot < count;
+  int live = gid < total && count > 0u;
+  uint slot = first, m = 0u;
   SubPatch sp;
   MpGridShape g;
   uint q[4];
   if (live) {
+    uint lo = 0u, hi = count - 1u;
+    while (lo < hi) {
+      uint mid = (lo + hi + 1u) >> 1;
+      if (offsets[mid] <= gid) lo = mid;
+      else hi = mid - 1u;
+    }
+    slot = first + lo;
+    m = gid - offsets[lo];
     sp = diceable[slot];
     g = mp_grid_shape(&sp, (uint)f.max_grid);
     live = mp_grid_micropolygon(&g, m, q);
@@ -197,5 +208,5 @@ void sample_micropolygons(__global const SubPatch* diceable, uint first, uint co
   for (int k = 0; k < 8; ++k) grid_id = mp_hash_combine(grid_id, as_uint(sp.corner[k]));
   uint mp_id = mp_hash_combine(grid_id, m);
   float opacity = grid_c[base + q[0]].w;
-  mp_raster_quad(v[0], v[1], v[2], v[3], keep, mp_id, opacity, f, offsets, pass, keys, colors, normals);
+  mp_raster_quad(v[0], v[1], v[2], v[3], keep, mp_id, opacity, f, sample_offsets, pass, keys, colors, normals);
 }

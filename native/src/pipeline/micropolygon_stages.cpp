@@ -7,8 +7,6 @@
 
 #include "micropoly/error.h"
 #include "mp_raster.h"
-#include "mp_types.h"
-#include "mp_grid.h"
 
 namespace mp {
 namespace {
@@ -50,6 +48,7 @@ GridBuffers::GridBuffers(DeviceSession& session, cl_uint cap, int max_grid)
   p = device_buffer(session, bytes, "grid position buffer");
   n = device_buffer(session, bytes, "grid normal buffer");
   c = device_buffer(session, bytes, "grid color buffer");
+  micropolygons = device_buffer(session, capacity * sizeof(cl_uint), "grid micropolygon counts");
 }
 
 DiceStage::DiceStage(DeviceSession& session) : session_(session), kernel_(session.program(), "dice_grids") {
@@ -74,6 +73,7 @@ void DiceStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffer
   kernel_.setArg(8, grids.p);
   kernel_.setArg(9, grids.n);
   kernel_.setArg(10, counter_);
+  kernel_.setArg(11, grids.micropolygons);
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(count * grids.vertices_per_slot),
                                         cl::NDRange(64), nullptr, &e);
@@ -153,25 +153,42 @@ void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer) {
 
 void SampleStage::run(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
                       const FrameParams& f, GridBuffers& grids, StageTimer& timer) {
+  if (count == 0) return;
+  // Each grid's first micropolygon: an exclusive prefix sum of the counts
+  // dicing recorded (a few thousand numbers, summed on the host).
+  counts_.resize(count);
+  session_.queue().enqueueReadBuffer(grids.micropolygons, CL_TRUE, first * sizeof(cl_uint), count * sizeof(cl_uint),
+                                     counts_.data());
+  cl_uint total = 0;
+  for (cl_uint& c : counts_) {
+    const cl_uint n = c;
+    c = total;
+    total += n;
+  }
+  if (total == 0) return;
+  if (!grid_offsets_() || grid_offsets_.getInfo<CL_MEM_SIZE>() < grids.capacity * sizeof(cl_uint))
+    grid_offsets_ = device_buffer(session_, grids.capacity * sizeof(cl_uint), "grid micropolygon offsets");
+  session_.queue().enqueueWriteBuffer(grid_offsets_, CL_TRUE, 0, count * sizeof(cl_uint), counts_.data());
   kernel_.setArg(0, diceable);
   kernel_.setArg(1, first);
-  kernel_.setArg(2, first + count);
-  kernel_.setArg(3, scene.patch_info);
-  kernel_.setArg(4, f);
-  kernel_.setArg(5, grids.p);
-  kernel_.setArg(6, grids.c);
-  kernel_.setArg(7, grids.n);
-  kernel_.setArg(8, offsets_);
-  kernel_.setArg(10, keys_);
-  kernel_.setArg(11, colors_);
-  kernel_.setArg(12, normals_);
-  kernel_.setArg(13, totals_);
+  kernel_.setArg(2, count);
+  kernel_.setArg(3, grid_offsets_);
+  kernel_.setArg(4, total);
+  kernel_.setArg(5, scene.patch_info);
+  kernel_.setArg(6, f);
+  kernel_.setArg(7, grids.p);
+  kernel_.setArg(8, grids.c);
+  kernel_.setArg(9, grids.n);
+  kernel_.setArg(10, offsets_);
+  kernel_.setArg(12, keys_);
+  kernel_.setArg(13, colors_);
+  kernel_.setArg(14, normals_);
+  kernel_.setArg(15, totals_);
   // Pass 0 finds each sample's nearest key; pass 1 lets its owner write.
   for (cl_uint pass = 0; pass < 2; ++pass) {
-    kernel_.setArg(9, pass);
+    kernel_.setArg(11, pass);
     cl::Event e;
-    session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(size_t(count) * MP_GRID_MICROPOLYGON_SLOTS(cl_uint(f.max_grid))),
-                                          cl::NDRange(64), nullptr, &e);
+    session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(total), cl::NDRange(64), nullptr, &e);
     timer.add(Stage::Sample, e);
   }
 }

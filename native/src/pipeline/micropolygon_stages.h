@@ -13,8 +13,9 @@ namespace mp {
 
 struct GridBuffers {
   GridBuffers(DeviceSession& session, cl_uint capacity, int max_grid);
-  cl::Buffer p, n, c;  // float4 per grid vertex
-  cl_uint capacity;    // sub-patches per batch
+  cl::Buffer p, n, c;      // float4 per grid vertex
+  cl::Buffer micropolygons;  // uint per grid: its micropolygon count (dice writes it)
+  cl_uint capacity;        // sub-patches per batch
   size_t vertices_per_slot;
   size_t micropolygons_per_slot;
 };
@@ -66,6 +67,8 @@ class SampleStage {
   cl::Kernel kernel_;
   cl::Kernel clear_;
   cl::Buffer keys_, colors_, normals_, offsets_, totals_;
+  cl::Buffer grid_offsets_;  // first micropolygon of each grid of a run
+  std::vector<cl_uint> counts_;
   size_t samples_ = 0;
   int spp_x_ = 0, spp_y_ = 0;
 };
