@@ -518,14 +518,19 @@ class NodeCompiler:
 
     def emit_image(self, node):
         self.headers.add("mp_tex_image.h")
-        if node.projection != "FLAT":
-            self.warn(node, f"{node.projection} projection is not supported; Flat is used")
         index, byte_image = self.resources.image(node.image, lambda what: self.warn(node, what))
         vec = self.input(node, "Vector", VEC)[0] if node.inputs["Vector"].is_linked else self.uv()
         interp = IMAGE_INTERPOLATION.get(node.interpolation, 0)
         ext = IMAGE_EXTENSION.get(node.extension, 0)
-        rgba = self.fn.temp("float4", f"mp_tex_image(g->images, g->image_count, g->texels, {index}, ({vec}).x, "
-                                      f"({vec}).y, {interp}, {ext})")[0]
+        images = f"g->images, g->image_count, g->texels, {index}"
+        if node.projection == "BOX":
+            # Blended by the object-space normal, as Cycles does.
+            blend = _lit(float(node.projection_blend))
+            rgba = self.fn.temp("float4", f"mp_tex_image_box({images}, {vec}, g->N, {blend}, {interp}, {ext})")[0]
+        else:
+            if node.projection in ("SPHERE", "TUBE"):
+                vec = self.fn.temp("float2", f"mp_image_{node.projection.lower()}_uv({vec})")[0]
+            rgba = self.fn.temp("float4", f"mp_tex_image({images}, ({vec}).x, ({vec}).y, {interp}, {ext})")[0]
         # Cycles hands out colour premultiplied by alpha unless the Alpha
         # output is used (or alpha is channel-packed, ignored, or data).
         image = node.image

@@ -98,4 +98,81 @@ MP_INLINE float4 mp_tex_image(const MP_GLOBAL DeviceImage* images, uint image_co
   return c;
 }
 
+/* ---- Projections (the node's Sphere, Tube and Box), as Cycles defines them:
+ * Sphere and Tube first map the unit box [0, 1]^3 to [-1, 1]^3. */
+#define MP_IMAGE_PI 3.14159265358979f
+
+MP_INLINE float2 mp_image_uv(float u, float v) {
+#ifdef __OPENCL_VERSION__
+  return (float2)(u, v);
+#else
+  return float2(u, v);
+#endif
+}
+
+/* Longitude around z and latitude from the south pole, each in [0, 1]. */
+MP_INLINE float2 mp_image_sphere_uv(float3 co) {
+  co = 2.0f * co - MP_F3(1.0f, 1.0f, 1.0f);
+  float len = sqrt(co.x * co.x + co.y * co.y + co.z * co.z);
+  if (!(len > 0.0f)) return mp_image_uv(0.0f, 0.0f);
+  float u = co.x == 0.0f && co.y == 0.0f ? 0.0f : (1.0f - atan2(co.x, co.y) / MP_IMAGE_PI) * 0.5f;
+  return mp_image_uv(u, 1.0f - acos(clamp(co.z / len, -1.0f, 1.0f)) / MP_IMAGE_PI);
+}
+
+/* Longitude around z as for Sphere, height along z. */
+MP_INLINE float2 mp_image_tube_uv(float3 co) {
+  co = 2.0f * co - MP_F3(1.0f, 1.0f, 1.0f);
+  float len = sqrt(co.x * co.x + co.y * co.y);
+  if (!(len > 0.0f)) return mp_image_uv(0.0f, 0.0f);
+  return mp_image_uv((1.0f - atan2(co.x / len, co.y / len) / MP_IMAGE_PI) * 0.5f, (co.z + 1.0f) * 0.5f);
+}
+
+/* Box: the image projected along x, y and z and blended by the object-space
+ * normal n. |n| normalised to sum 1 places the point in a triangle whose
+ * corners are the three projections: near a corner one projection alone,
+ * along the sides a blend of two, in the middle of all three, the blend
+ * zones widening with `blend` (0: hard seams). Each projection is mirrored
+ * on the side of the axis where it would read backwards. */
+MP_INLINE float4 mp_tex_image_box(const MP_GLOBAL DeviceImage* images, uint image_count, const MP_GLOBAL float4* texels,
+                                  int index, float3 co, float3 n, float blend, int interpolation, int extension) {
+  float3 a = MP_F3(fabs(n.x), fabs(n.y), fabs(n.z));
+  float sum = a.x + a.y + a.z;
+  a = sum > 0.0f ? a / sum : MP_F3(1.0f, 0.0f, 0.0f);
+  float limit = 0.5f * (1.0f + blend);
+  float3 w = MP_F3(0.0f, 0.0f, 0.0f);
+  if (a.x > limit * (a.x + a.y) && a.x > limit * (a.x + a.z)) {
+    w.x = 1.0f;
+  } else if (a.y > limit * (a.x + a.y) && a.y > limit * (a.y + a.z)) {
+    w.y = 1.0f;
+  } else if (a.z > limit * (a.x + a.z) && a.z > limit * (a.y + a.z)) {
+    w.z = 1.0f;
+  } else if (blend > 0.0f) {
+    if (a.z < (1.0f - limit) * (a.y + a.x)) {
+      w.x = clamp((a.x / (a.x + a.y) - 0.5f * (1.0f - blend)) / blend, 0.0f, 1.0f);
+      w.y = 1.0f - w.x;
+    } else if (a.x < (1.0f - limit) * (a.y + a.z)) {
+      w.y = clamp((a.y / (a.y + a.z) - 0.5f * (1.0f - blend)) / blend, 0.0f, 1.0f);
+      w.z = 1.0f - w.y;
+    } else if (a.y < (1.0f - limit) * (a.x + a.z)) {
+      w.x = clamp((a.x / (a.x + a.z) - 0.5f * (1.0f - blend)) / blend, 0.0f, 1.0f);
+      w.z = 1.0f - w.x;
+    } else {
+      w = ((2.0f - limit) * a + MP_F3(limit - 1.0f, limit - 1.0f, limit - 1.0f)) / (2.0f * limit - 1.0f);
+    }
+  } else {
+    w.x = 1.0f;
+  }
+  float4 c = MP_F4(0.0f, 0.0f, 0.0f, 0.0f);
+  if (w.x > 0.0f)
+    c += w.x * mp_tex_image(images, image_count, texels, index, n.x < 0.0f ? 1.0f - co.y : co.y, co.z, interpolation,
+                            extension);
+  if (w.y > 0.0f)
+    c += w.y * mp_tex_image(images, image_count, texels, index, n.y > 0.0f ? 1.0f - co.x : co.x, co.z, interpolation,
+                            extension);
+  if (w.z > 0.0f)
+    c += w.z * mp_tex_image(images, image_count, texels, index, n.z > 0.0f ? 1.0f - co.y : co.y, co.x, interpolation,
+                            extension);
+  return c;
+}
+
 #endif

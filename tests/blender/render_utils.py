@@ -107,6 +107,24 @@ def diffuse_material(name, color):
     return m
 
 
+def png_image(name, rgba, colorspace):
+    """Writes rgba ((h, w, 4) in [0, 1], rows bottom to top) as an 8-bit PNG
+    in a temporary folder and loads it back, as an artist's image file would
+    be."""
+    folder = tempfile.mkdtemp(prefix="micropoly_images_")
+    h, w = rgba.shape[:2]
+    img = bpy.data.images.new(name + "_src", w, h, alpha=True)
+    img.pixels.foreach_set(np.ascontiguousarray(rgba, dtype=np.float32).reshape(-1))
+    path = os.path.join(folder, name + ".png")
+    img.filepath_raw = path
+    img.file_format = "PNG"
+    img.save()
+    bpy.data.images.remove(img)
+    loaded = bpy.data.images.load(path)
+    loaded.colorspace_settings.name = colorspace
+    return loaded
+
+
 def setup_cycles(scene, samples=64, adaptive_subdivision=True):
     scene.render.engine = "CYCLES"
     c = scene.cycles

@@ -20,7 +20,6 @@ import math
 import os
 import random
 import sys
-import tempfile
 
 import bpy
 import numpy as np
@@ -40,23 +39,6 @@ def set_displacement_method(mat, method):
         mat.cycles.displacement_method = method
 
 
-IMAGE_DIR = tempfile.mkdtemp(prefix="micropoly_images_")
-
-
-def png_image(name, rgba, colorspace):
-    """Writes rgba ((h, w, 4) in [0, 1], rows bottom to top) as an 8-bit PNG
-    and loads it back, as an artist's image file would be."""
-    h, w = rgba.shape[:2]
-    img = bpy.data.images.new(name + "_src", w, h, alpha=True)
-    img.pixels.foreach_set(np.ascontiguousarray(rgba, dtype=np.float32).reshape(-1))
-    path = os.path.join(IMAGE_DIR, name + ".png")
-    img.filepath_raw = path
-    img.file_format = "PNG"
-    img.save()
-    bpy.data.images.remove(img)
-    loaded = bpy.data.images.load(path)
-    loaded.colorspace_settings.name = colorspace
-    return loaded
 
 
 def height_image():
@@ -65,7 +47,7 @@ def height_image():
     h = 0.5 + 0.25 * np.sin(2 * math.pi * 3 * u) * np.cos(2 * math.pi * 2 * v) + 0.2 * np.cos(2 * math.pi * 5 * u)
     rgba = np.ones((64, 128, 4))
     rgba[..., :3] = h[..., None]
-    return png_image("height", rgba, "Non-Color")
+    return ru.png_image("height", rgba, "Non-Color")
 
 
 def color_image(w=96, h=48):
@@ -75,7 +57,7 @@ def color_image(w=96, h=48):
     rgba[..., 0] = 0.15 + 0.8 * (np.floor(u * 3) % 2)
     rgba[..., 1] = 0.2 + 0.7 * v
     rgba[..., 2] = 0.1 + 0.8 * (np.floor(v * 4) % 2) * (1 - u)
-    return png_image(f"color_{w}x{h}", rgba, "sRGB")
+    return ru.png_image(f"color_{w}x{h}", rgba, "sRGB")
 
 
 def displaced_material(texture, scale):
