@@ -14,17 +14,15 @@ __kernel void dice_grids(__global const SubPatch* diceable, uint count,
                          __global const uint* edges, __global const float4* curves,
                          __global const DeviceMaterial* materials, FrameParams f, __global float4* grid_p,
                          __global float4* grid_n,
-                         volatile __global uint* micropolygon_count, __global uint* grid_micropolygons) {
+                         volatile __global uint* micropolygon_count, __global const uint* vertex_offsets) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   float2 uv;
-  if (!mp_grid_vertex(gid, count, f.max_grid, diceable, &sp, &i, &j, &uv)) return;
+  ulong index;
+  if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
   if (i == 0u && j == 0u) {
-    /* Per grid, for sampling to launch exactly the grids' micropolygons. */
     MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
-    uint n = mp_grid_micropolygons(&g);
-    grid_micropolygons[gid / (((uint)f.max_grid + 1u) * ((uint)f.max_grid + 1u))] = n;
-    atomic_add(micropolygon_count, n);
+    atomic_add(micropolygon_count, mp_grid_micropolygons(&g));
   }
   float3 p, dpdu, dpdv;
   mp_surface_point(points, patch_info, edges, curves, sp.patch, uv.x, uv.y, &p, &dpdu, &dpdv);
@@ -37,8 +35,20 @@ __kernel void dice_grids(__global const SubPatch* diceable, uint count,
                  : mp_patch_normal(points + (ulong)sp.patch * MP_PATCH_POINTS, patch_info[4 * (ulong)sp.patch], uv.x,
                                    uv.y, dpdu, dpdv);
   if (flags & MP_PATCH_FLIP_ORIENTATION) n = -n;
-  grid_p[gid] = (float4)(p, 1.0f);
-  grid_n[gid] = (float4)(n, 0.0f);
+  grid_p[index] = (float4)(p, 1.0f);
+  grid_n[index] = (float4)(n, 0.0f);
+}
+
+/* Vertices and micropolygons of each diceable sub-patch's grid, which the
+ * host sums into the offsets that size the dice, shade and sample launches. */
+__kernel void grid_counts(__global const SubPatch* diceable, uint count, FrameParams f, __global uint* vertices,
+                          __global uint* micropolygons) {
+  uint k = get_global_id(0);
+  if (k >= count) return;
+  SubPatch sp = diceable[k];
+  MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
+  vertices[k] = mp_grid_vertices(&g);
+  micropolygons[k] = mp_grid_micropolygons(&g);
 }
 
 /* Normals of displaced grids, from the displaced vertices (differences
@@ -49,22 +59,24 @@ __kernel void dice_grids(__global const SubPatch* diceable, uint count,
  * displacement (material_program.cl). */
 __kernel void displaced_normals(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
                                 __global const DeviceMaterial* materials, FrameParams f,
-                                __global const float4* grid_p, __global float4* grid_n) {
+                                __global const float4* grid_p, __global float4* grid_n,
+                                __global const uint* vertex_offsets) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   float2 uv;
-  if (!mp_grid_vertex(gid, count, f.max_grid, diceable, &sp, &i, &j, &uv)) return;
+  ulong index;
+  if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
   if (!(materials[patch_info[4 * (ulong)sp.patch + 1]].program[1] > 0.0f)) return;
   MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
-  ulong base = gid - mp_slot(&g, i, j); /* slot (0, 0) of this grid */
+  ulong base = index - mp_slot(&g, i, j); /* slot (0, 0) of this grid */
   uint xm, xp, ym, yp;
   mp_grid_neighbours(&g, i, j, &xm, &xp, &ym, &yp);
   float3 du = grid_p[base + xp].xyz - grid_p[base + xm].xyz;
   float3 dv = grid_p[base + yp].xyz - grid_p[base + ym].xyz;
   float3 n = cross(du, dv);
   float len = length(n);
-  float3 old = grid_n[gid].xyz;
+  float3 old = grid_n[index].xyz;
   if (!(len > 1e-12f * dot(du, du) + 1e-30f)) return;
   n /= len;
-  grid_n[gid] = (float4)(dot(n, old) < 0.0f ? -n : n, 0.0f);
+  grid_n[index] = (float4)(dot(n, old) < 0.0f ? -n : n, 0.0f);
 }

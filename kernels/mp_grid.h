@@ -103,19 +103,55 @@ MP_INLINE int mp_slot_uv(const SubPatch* sp, const MpGridShape* g, uint i, uint 
   return 1;
 }
 
-/* The grid vertex (i, j) of diceable sub-patch `*sp` that work-item `gid` of
- * a dice or shade launch handles, and its (u, v). Returns 0 for work-items
- * past the batch or on a slot the grid does not use. */
-MP_INLINE int mp_grid_vertex(uint gid, uint count, int max_grid, const MP_GLOBAL SubPatch* diceable, SubPatch* sp,
-                             uint* i, uint* j, float2* uv) {
-  uint stride = (uint)max_grid + 1u;
-  uint slot = gid / (stride * stride);
-  if (slot >= count) return 0;
-  uint local_index = gid - slot * stride * stride;
-  *sp = diceable[slot];
-  *i = local_index % stride;
-  *j = local_index / stride;
+/* Vertices of a grid: its edges' (corners once) and the interior's. */
+MP_INLINE uint mp_grid_vertices(const MpGridShape* g) {
+  uint interior = mp_grid_has_interior(g) ? (g->nu - 1u) * (g->nv - 1u) : 0u;
+  return g->n[0] + g->n[1] + g->n[2] + g->n[3] + interior;
+}
+
+/* Slot (i, j) of a grid's vertex number o (o < mp_grid_vertices): edge 0,
+ * edge 2, the inner vertices of edge 3 and of edge 1, then the interior row
+ * by row. */
+MP_INLINE void mp_grid_vertex_slot(const MpGridShape* g, uint o, uint* i, uint* j) {
+  uint mg = g->mg;
+  if (o <= g->n[0]) { *i = o; *j = 0u; return; }
+  o -= g->n[0] + 1u;
+  if (o <= g->n[2]) { *i = o; *j = mg; return; }
+  o -= g->n[2] + 1u;
+  if (o < g->n[3] - 1u) { *i = 0u; *j = o + 1u; return; }
+  o -= g->n[3] - 1u;
+  if (o < g->n[1] - 1u) { *i = mg; *j = o + 1u; return; }
+  o -= g->n[1] - 1u;
+  *i = 1u + o % (g->nu - 1u);
+  *j = 1u + o / (g->nu - 1u);
+}
+
+/* The last k with offsets[k] <= x, for an ascending offsets[0, count). */
+MP_INLINE uint mp_find_grid(const MP_GLOBAL uint* offsets, uint count, uint x) {
+  uint lo = 0u, hi = count - 1u;
+  while (lo < hi) {
+    uint mid = (lo + hi + 1u) >> 1;
+    if (offsets[mid] <= x) lo = mid;
+    else hi = mid - 1u;
+  }
+  return lo;
+}
+
+/* The grid vertex that work-item `gid` of a dice or shade launch handles:
+ * vertex_offsets[0, count] holds each grid's first vertex and, last, the
+ * batch's total (so a launch has exactly one work-item per vertex). Gives
+ * the sub-patch, the vertex's slot (i, j), its (u, v) and its index in the
+ * grid buffers; 0 for work-items past the total. */
+MP_INLINE int mp_grid_vertex(uint gid, uint count, const MP_GLOBAL uint* vertex_offsets, int max_grid,
+                             const MP_GLOBAL SubPatch* diceable, SubPatch* sp, uint* i, uint* j, float2* uv,
+                             ulong* index) {
+  if (count == 0u || gid >= vertex_offsets[count]) return 0;
+  uint k = mp_find_grid(vertex_offsets, count, gid);
+  *sp = diceable[k];
   MpGridShape g = mp_grid_shape(sp, (uint)max_grid);
+  mp_grid_vertex_slot(&g, gid - vertex_offsets[k], i, j);
+  uint stride = (uint)max_grid + 1u;
+  *index = (ulong)k * stride * stride + mp_slot(&g, *i, *j);
   return mp_slot_uv(sp, &g, *i, *j, uv);
 }
 

@@ -88,11 +88,11 @@ inline float3 mp_object_normal_to_camera(__global const DeviceObject* o, float3 
 
 /* The vertex this work-item handles, if its material uses this program,
  * with its (u, v) on the patch. */
-inline int mp_program_vertex(uint gid, uint count, FrameParams f, __global const SubPatch* diceable,
-                             __global const uint* patch_info, __global const DeviceMaterial* materials, int program,
-                             SubPatch* sp, uint* material, uint* object, float2* uv) {
-  uint i, j;
-  if (!mp_grid_vertex(gid, count, f.max_grid, diceable, sp, &i, &j, uv)) return 0;
+inline int mp_program_vertex(uint gid, uint count, __global const uint* vertex_offsets, FrameParams f,
+                             __global const SubPatch* diceable, __global const uint* patch_info,
+                             __global const DeviceMaterial* materials, int program, SubPatch* sp, uint* material,
+                             uint* object, float2* uv, uint* i, uint* j, ulong* index) {
+  if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, sp, i, j, uv, index)) return 0;
   *material = patch_info[4 * (ulong)sp->patch + 1];
   *object = MP_PATCH_OBJECT(patch_info[4 * (ulong)sp->patch + 2]);
   return (int)materials[*material].program[0] == program;
@@ -107,20 +107,22 @@ inline int mp_program_vertex(uint gid, uint count, FrameParams f, __global const
 __kernel void displace_grids(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
                              __global const DeviceMaterial* materials, __global const DeviceObject* objects,
                              FrameParams f, int program, __global float4* grid_p, __global const float4* grid_n,
-                             MP_PROGRAM_INPUT_ARGS) {
-  uint gid = get_global_id(0), material, object;
+                             MP_PROGRAM_INPUT_ARGS, __global const uint* vertex_offsets) {
+  uint gid = get_global_id(0), material, object, i, j;
   SubPatch sp;
   float2 uv;
-  if (!mp_program_vertex(gid, count, f, diceable, patch_info, materials, program, &sp, &material, &object, &uv))
+  ulong index;
+  if (!mp_program_vertex(gid, count, vertex_offsets, f, diceable, patch_info, materials, program, &sp, &material,
+                         &object, &uv, &i, &j, &index))
     return;
   if (!(materials[material].program[1] > 0.0f)) return;
   __global const DeviceObject* o = objects + object;
-  float3 p = grid_p[gid].xyz;
+  float3 p = grid_p[index].xyz;
   MpProgramInputs in = MP_PROGRAM_INPUTS;
-  MpNodeGlobals g = mp_node_globals(o, p, grid_n[gid].xyz, &in, sp.patch, uv);
+  MpNodeGlobals g = mp_node_globals(o, p, grid_n[index].xyz, &in, sp.patch, uv);
   float3 d = mp_node_displacement(&g);
   if (!(isfinite(d.x) && isfinite(d.y) && isfinite(d.z))) return;
-  grid_p[gid] = (float4)(p + mp_object_dir_to_camera(o, d), 1.0f);
+  grid_p[index] = (float4)(p + mp_object_dir_to_camera(o, d), 1.0f);
 }
 
 /* Shades each vertex with the Principled inputs the program computes. */
@@ -128,15 +130,18 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
                                   __global const DeviceMaterial* materials, __global const DeviceObject* objects,
                                   FrameParams f, int program, __global const float4* grid_p,
                                   __global const float4* grid_n, MP_PROGRAM_INPUT_ARGS,
-                                  __global const DeviceLight* lights, uint light_count, __global float4* grid_c) {
-  uint gid = get_global_id(0), material, object;
+                                  __global const DeviceLight* lights, uint light_count, __global float4* grid_c,
+                                  __global const uint* vertex_offsets) {
+  uint gid = get_global_id(0), material, object, i, j;
   SubPatch sp;
   float2 uv;
-  if (!mp_program_vertex(gid, count, f, diceable, patch_info, materials, program, &sp, &material, &object, &uv))
+  ulong index;
+  if (!mp_program_vertex(gid, count, vertex_offsets, f, diceable, patch_info, materials, program, &sp, &material,
+                         &object, &uv, &i, &j, &index))
     return;
   DeviceMaterial m = materials[material];
   if (!(m.program[2] > 0.0f)) return;
-  float3 p = grid_p[gid].xyz, n = grid_n[gid].xyz;
+  float3 p = grid_p[index].xyz, n = grid_n[index].xyz;
   MpProgramInputs in = MP_PROGRAM_INPUTS;
   __global const DeviceObject* o = objects + object;
   MpNodeGlobals g = mp_node_globals(o, p, n, &in, sp.patch, uv);
@@ -145,12 +150,12 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
    * u and along v (the previous one on the grid's far border), a tenth of
    * the way: a small step keeps the difference first-order even where a
    * micropolygon spans much of a texture's feature (grazing views). */
-  uint stride = (uint)f.max_grid + 1u, here = gid % (stride * stride);
+  uint stride = (uint)f.max_grid + 1u;
   MpGridShape shape = mp_grid_shape(&sp, (uint)f.max_grid);
-  uint xm, xp, ym, yp;
-  mp_grid_neighbours(&shape, here % stride, here / stride, &xm, &xp, &ym, &yp);
+  uint here = mp_slot(&shape, i, j), xm, xp, ym, yp;
+  mp_grid_neighbours(&shape, i, j, &xm, &xp, &ym, &yp);
   uint sx = xp != here ? xp : xm, sy = yp != here ? yp : ym;
-  ulong gx = gid - here + sx, gy = gid - here + sy;
+  ulong gx = index - here + sx, gy = index - here + sy;
   float2 uvx = uv, uvy = uv;
   mp_slot_uv(&sp, &shape, sx % stride, sx / stride, &uvx);
   mp_slot_uv(&sp, &shape, sy % stride, sy / stride, &uvy);
@@ -178,5 +183,5 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   int has_normal = s.has_normal && all(isfinite(s.normal)) && length(s.normal) > 1e-6f;
   float3 ns = has_normal ? mp_object_normal_to_camera(o, s.normal) : n;
   float3 c = mp_shade_bumped(p, n, ns, has_normal && s.has_normal == MP_NORMAL_INPUT, f.ortho, &m, lights, light_count);
-  grid_c[gid] = (float4)(c, clamp(s.alpha, 0.0f, 1.0f));
+  grid_c[index] = (float4)(c, clamp(s.alpha, 0.0f, 1.0f));
 }

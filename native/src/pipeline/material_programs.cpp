@@ -65,8 +65,8 @@ void set_grid_args(cl::Kernel& k, const cl::Buffer& diceable, cl_uint count, con
 
 void MaterialPrograms::launch(cl::Kernel& kernel, cl_uint count, GridBuffers& grids, Stage stage, StageTimer& timer) {
   cl::Event e;
-  session_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, round_up_range(count * grids.vertices_per_slot),
-                                        cl::NDRange(64), nullptr, &e);
+  session_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64),
+                                        nullptr, &e);
   timer.add(stage, e);
 }
 
@@ -77,6 +77,7 @@ void MaterialPrograms::displace(const cl::Buffer& diceable, cl_uint count, const
     if (!a.displaces) continue;
     cl::Kernel& k = a.built->displace;
     set_grid_args(k, diceable, count, scene, f, a.index, grids);
+    k.setArg(15, grids.vertex_offsets);
     launch(k, count, grids, Stage::Dice, timer);
   }
   cl::Kernel& k = normals_;
@@ -87,6 +88,7 @@ void MaterialPrograms::displace(const cl::Buffer& diceable, cl_uint count, const
   k.setArg(4, f);
   k.setArg(5, grids.p);
   k.setArg(6, grids.n);
+  k.setArg(7, grids.vertex_offsets);
   launch(k, count, grids, Stage::Dice, timer);
 }
 
@@ -99,6 +101,7 @@ void MaterialPrograms::shade(const cl::Buffer& diceable, cl_uint count, const Sc
     k.setArg(15, scene.lights);
     k.setArg(16, scene.light_count);
     k.setArg(17, grids.c);
+    k.setArg(18, grids.vertex_offsets);
     launch(k, count, grids, Stage::Shade, timer);
   }
 }

@@ -48,7 +48,42 @@ GridBuffers::GridBuffers(DeviceSession& session, cl_uint cap, int max_grid)
   p = device_buffer(session, bytes, "grid position buffer");
   n = device_buffer(session, bytes, "grid normal buffer");
   c = device_buffer(session, bytes, "grid color buffer");
-  micropolygons = device_buffer(session, capacity * sizeof(cl_uint), "grid micropolygon counts");
+  vertex_offsets = device_buffer(session, (capacity + 1) * sizeof(cl_uint), "grid vertex offsets");
+}
+
+GridLayoutStage::GridLayoutStage(DeviceSession& session, cl_uint capacity)
+    : session_(session), kernel_(session.program(), "grid_counts") {
+  vertices_ = device_buffer(session, capacity * sizeof(cl_uint), "grid vertex counts");
+  micropolygons_ = device_buffer(session, capacity * sizeof(cl_uint), "grid micropolygon counts");
+}
+
+void GridLayoutStage::run(const cl::Buffer& diceable, cl_uint count, const FrameParams& f, GridBuffers& grids,
+                          StageTimer& timer) {
+  grids.vertex_total = 0;
+  grids.micropolygon_counts.assign(count, 0);
+  if (count == 0) return;
+  kernel_.setArg(0, diceable);
+  kernel_.setArg(1, count);
+  kernel_.setArg(2, f);
+  kernel_.setArg(3, vertices_);
+  kernel_.setArg(4, micropolygons_);
+  cl::Event e;
+  session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(count), cl::NDRange(64), nullptr, &e);
+  timer.add(Stage::Dice, e);
+  // A few thousand numbers: summed on the host, one round trip per batch.
+  host_.resize(count + 1);
+  session_.queue().enqueueReadBuffer(vertices_, CL_FALSE, 0, count * sizeof(cl_uint), host_.data());
+  session_.queue().enqueueReadBuffer(micropolygons_, CL_TRUE, 0, count * sizeof(cl_uint),
+                                     grids.micropolygon_counts.data());
+  cl_uint total = 0;
+  for (cl_uint k = 0; k < count; ++k) {
+    const cl_uint n = host_[k];
+    host_[k] = total;
+    total += n;
+  }
+  host_[count] = total;
+  grids.vertex_total = total;
+  session_.queue().enqueueWriteBuffer(grids.vertex_offsets, CL_TRUE, 0, (count + 1) * sizeof(cl_uint), host_.data());
 }
 
 DiceStage::DiceStage(DeviceSession& session) : session_(session), kernel_(session.program(), "dice_grids") {
@@ -73,10 +108,10 @@ void DiceStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffer
   kernel_.setArg(8, grids.p);
   kernel_.setArg(9, grids.n);
   kernel_.setArg(10, counter_);
-  kernel_.setArg(11, grids.micropolygons);
+  kernel_.setArg(11, grids.vertex_offsets);
   cl::Event e;
-  session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(count * grids.vertices_per_slot),
-                                        cl::NDRange(64), nullptr, &e);
+  session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64),
+                                        nullptr, &e);
   timer.add(Stage::Dice, e);
 }
 
@@ -100,9 +135,10 @@ void ShadeStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffe
   kernel_.setArg(7, scene.lights);
   kernel_.setArg(8, scene.light_count);
   kernel_.setArg(9, grids.c);
+  kernel_.setArg(10, grids.vertex_offsets);
   cl::Event e;
-  session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(count * grids.vertices_per_slot),
-                                        cl::NDRange(64), nullptr, &e);
+  session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64),
+                                        nullptr, &e);
   timer.add(Stage::Shade, e);
 }
 
@@ -154,21 +190,17 @@ void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer) {
 void SampleStage::run(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
                       const FrameParams& f, GridBuffers& grids, StageTimer& timer) {
   if (count == 0) return;
-  // Each grid's first micropolygon: an exclusive prefix sum of the counts
-  // dicing recorded (a few thousand numbers, summed on the host).
-  counts_.resize(count);
-  session_.queue().enqueueReadBuffer(grids.micropolygons, CL_TRUE, first * sizeof(cl_uint), count * sizeof(cl_uint),
-                                     counts_.data());
+  // Each grid's first micropolygon, from the counts of the batch's layout.
+  offsets_host_.resize(count);
   cl_uint total = 0;
-  for (cl_uint& c : counts_) {
-    const cl_uint n = c;
-    c = total;
-    total += n;
+  for (cl_uint k = 0; k < count; ++k) {
+    offsets_host_[k] = total;
+    total += grids.micropolygon_counts[first + k];
   }
   if (total == 0) return;
   if (!grid_offsets_() || grid_offsets_.getInfo<CL_MEM_SIZE>() < grids.capacity * sizeof(cl_uint))
     grid_offsets_ = device_buffer(session_, grids.capacity * sizeof(cl_uint), "grid micropolygon offsets");
-  session_.queue().enqueueWriteBuffer(grid_offsets_, CL_TRUE, 0, count * sizeof(cl_uint), counts_.data());
+  session_.queue().enqueueWriteBuffer(grid_offsets_, CL_TRUE, 0, count * sizeof(cl_uint), offsets_host_.data());
   kernel_.setArg(0, diceable);
   kernel_.setArg(1, first);
   kernel_.setArg(2, count);

@@ -3,6 +3,8 @@
 // frame. Grids live in fixed slots of (max_grid+1)^2 vertices.
 #pragma once
 
+#include <vector>
+
 #include "cl/device_session.h"
 #include "micropoly/renderer.h"
 #include "pipeline/frame_params.h"
@@ -13,11 +15,29 @@ namespace mp {
 
 struct GridBuffers {
   GridBuffers(DeviceSession& session, cl_uint capacity, int max_grid);
-  cl::Buffer p, n, c;      // float4 per grid vertex
-  cl::Buffer micropolygons;  // uint per grid: its micropolygon count (dice writes it)
-  cl_uint capacity;        // sub-patches per batch
+  cl::Buffer p, n, c;  // float4 per grid vertex
+  cl_uint capacity;    // sub-patches per batch
   size_t vertices_per_slot;
-  size_t micropolygons_per_slot;
+  // The batch's layout (GridLayoutStage): each grid's first vertex, then the
+  // total (capacity + 1 uints), and each grid's micropolygon count.
+  cl::Buffer vertex_offsets;
+  cl_uint vertex_total = 0;
+  std::vector<cl_uint> micropolygon_counts;
+};
+
+// Counts each grid's vertices and micropolygons and sums them into offsets,
+// so that dice, shade and sample launch one work-item per vertex or
+// micropolygon rather than per fixed slot.
+class GridLayoutStage {
+ public:
+  GridLayoutStage(DeviceSession& session, cl_uint capacity);
+  void run(const cl::Buffer& diceable, cl_uint count, const FrameParams& f, GridBuffers& grids, StageTimer& timer);
+
+ private:
+  DeviceSession& session_;
+  cl::Kernel kernel_;
+  cl::Buffer vertices_, micropolygons_;
+  std::vector<cl_uint> host_;
 };
 
 class DiceStage {
@@ -68,7 +88,7 @@ class SampleStage {
   cl::Kernel clear_;
   cl::Buffer keys_, colors_, normals_, offsets_, totals_;
   cl::Buffer grid_offsets_;  // first micropolygon of each grid of a run
-  std::vector<cl_uint> counts_;
+  std::vector<cl_uint> offsets_host_;
   size_t samples_ = 0;
   int spp_x_ = 0, spp_y_ = 0;
 };

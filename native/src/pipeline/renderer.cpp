@@ -32,8 +32,15 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 // and the buffers whose size does not depend on the scene.
 struct Renderer::Impl {
   explicit Impl(const std::string& selector)
-      : session(selector), dice(session), shade(session), sample(session), resolve(session), programs(session) {}
+      : session(selector),
+        layout(session, kDiceBatch),
+        dice(session),
+        shade(session),
+        sample(session),
+        resolve(session),
+        programs(session) {}
   DeviceSession session;
+  GridLayoutStage layout;
   DiceStage dice;
   ShadeStage shade;
   SampleStage sample;
@@ -125,6 +132,7 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     };
     DiceSink sink = [&](const cl::Buffer& diceable, cl_uint count) {
       if (cancelled) return;
+      impl_->layout.run(diceable, count, f, grids, timer);
       dice.run(diceable, count, buffers, f, grids, timer);
       impl_->programs.displace(diceable, count, buffers, f, grids, timer);
       shade.run(diceable, count, buffers, f, grids, timer);
