@@ -228,6 +228,17 @@ def psnr(a, b, peak=None):
     return math.inf if mse == 0 else 10.0 * math.log10(peak * peak / mse)
 
 
+def covered_interior(a, b, margin=2):
+    """Pixels fully covered in both RGBA images and at least `margin` pixels
+    from any pixel that is not (where the two renderers' edges differ)."""
+    inside = (a[..., 3] > 0.999) & (b[..., 3] > 0.999)
+    interior = inside.copy()
+    for axis in (0, 1):
+        for shift in range(1, margin + 1):
+            interior &= np.roll(inside, shift, axis=axis) & np.roll(inside, -shift, axis=axis)
+    return interior
+
+
 def pinholes(rgba, depth):
     """Pixels of crack regions: connected not-fully-covered regions that stay
     2 pixels off the frame's edge, hold fewer than 12 uncovered pixels and are

@@ -74,11 +74,7 @@ def main():
     scene.micropoly.shading_rate = 0.25
     ref = ru.render_passes(scene, "CYCLES", width, height)["rgba"]
     ours = ru.render_passes(scene, "MICROPOLY", width, height)["rgba"]
-    inside = (ref[..., 3] > 0.999) & (ours[..., 3] > 0.999)
-    interior = inside.copy()
-    for axis in (0, 1):
-        for shift in (-2, -1, 1, 2):
-            interior &= np.roll(inside, shift, axis=axis)
+    interior = ru.covered_interior(ref, ours)
     failures = []
     print(f"{'projection':18s} {'PSNR dB':>8s} {'pixels':>7s}")
     for k, (name, _, _) in enumerate(CASES):

@@ -214,11 +214,7 @@ def main():
     ru.setup_cycles(scene, samples=16, adaptive_subdivision=False)
     ref = ru.render_passes(scene, "CYCLES", width, height)["rgba"]
     ours = ru.render_passes(scene, "MICROPOLY", width, height)["rgba"]
-    inside = (ref[..., 3] > 0.999) & (ours[..., 3] > 0.999)
-    interior = inside.copy()
-    for axis in (0, 1):
-        for shift in (-2, -1, 1, 2):
-            interior &= np.roll(inside, shift, axis=axis)
+    interior = ru.covered_interior(ref, ours)
     failures = []
     print(f"{'case':34s} {'PSNR dB':>8s} {'max |diff|':>10s}")
     for i, (name, _) in enumerate(cases):
