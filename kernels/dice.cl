@@ -13,17 +13,12 @@ __kernel void dice_grids(__global const SubPatch* diceable, uint count,
                          __global const float4* points, __global const uint* patch_info,
                          __global const uint* edges, __global const float4* curves,
                          __global const DeviceMaterial* materials, FrameParams f, __global float4* grid_p,
-                         __global float4* grid_n,
-                         volatile __global uint* micropolygon_count, __global const uint* vertex_offsets) {
+                         __global float4* grid_n, __global const uint* vertex_offsets) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   float2 uv;
   ulong index;
   if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
-  if (i == 0u && j == 0u) {
-    MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
-    atomic_add(micropolygon_count, mp_grid_micropolygons(&g));
-  }
   float3 p, dpdu, dpdv;
   mp_surface_point(points, patch_info, edges, curves, sp.patch, uv.x, uv.y, &p, &dpdu, &dpdv);
   uint flags = patch_info[4 * (ulong)sp.patch + 2];
@@ -39,16 +34,16 @@ __kernel void dice_grids(__global const SubPatch* diceable, uint count,
   grid_n[index] = (float4)(n, 0.0f);
 }
 
-/* Vertices and micropolygons of each diceable sub-patch's grid, which the
- * host sums into the offsets that size the dice, shade and sample launches. */
-__kernel void grid_counts(__global const SubPatch* diceable, uint count, FrameParams f, __global uint* vertices,
-                          __global uint* micropolygons) {
+/* Vertices and micropolygons of each diceable sub-patch's grid (interleaved
+ * in `counts`), which the host sums into the offsets that size the dice,
+ * shade and sample launches. */
+__kernel void grid_counts(__global const SubPatch* diceable, uint count, FrameParams f, __global uint* counts) {
   uint k = get_global_id(0);
   if (k >= count) return;
   SubPatch sp = diceable[k];
   MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
-  vertices[k] = mp_grid_vertices(&g);
-  micropolygons[k] = mp_grid_micropolygons(&g);
+  counts[2 * (ulong)k] = mp_grid_vertices(&g);
+  counts[2 * (ulong)k + 1] = mp_grid_micropolygons(&g);
 }
 
 /* Normals of displaced grids, from the displaced vertices (differences

@@ -99,11 +99,7 @@ MP_INLINE void mp_subpatch_net_boxes(const MP_GLOBAL float4* cp, uint type, floa
 /* Raster position of a camera-space point (d > 0 for perspective cameras). */
 MP_INLINE float2 mp_project(float3 p, FrameParams f) {
   float inv = f.ortho ? 1.0f : 1.0f / (-p.z);
-#ifdef __OPENCL_VERSION__
-  return (float2)(f.ax * p.x * inv + f.bx, f.ay * p.y * inv + f.by);
-#else
-  return float2(f.ax * p.x * inv + f.bx, f.ay * p.y * inv + f.by);
-#endif
+  return MP_F2(f.ax * p.x * inv + f.bx, f.ay * p.y * inv + f.by);
 }
 
 /* Range of a * x / d + b over x in [xl, xh], d in [dl, dh] (dl > 0). */
@@ -273,7 +269,7 @@ MP_INLINE float mp_mid_screen_length(const MP_GLOBAL float4* cp, uint type, cons
     mp_eval_patch(cp, type, uv.x, uv.y, &p[k], &du, &dv);
   }
   float len = mp_polyline_screen_length(p, MP_EDGE_SEGMENTS + 1, f);
-  *chord = len >= 0.0f ? mp_project(p[MP_EDGE_SEGMENTS], f) - mp_project(p[0], f) : 0.0f * a;
+  *chord = len >= 0.0f ? mp_project(p[MP_EDGE_SEGMENTS], f) - mp_project(p[0], f) : MP_F2(0.0f, 0.0f);
   return len;
 }
 

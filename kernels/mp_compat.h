@@ -9,6 +9,7 @@
 #define MP_INLINE inline
 #define MP_GLOBAL __global
 #define MP_CONSTANT __constant
+#define MP_F2(x, y) ((float2)((x), (y)))
 #define MP_F3(x, y, z) ((float3)((x), (y), (z)))
 #define MP_F4(x, y, z, w) ((float4)((x), (y), (z), (w)))
 #define MP_XYZ(v) ((v).xyz)
@@ -27,6 +28,7 @@ typedef std::uint16_t ushort;
 #define MP_INLINE inline
 #define MP_GLOBAL
 #define MP_CONSTANT
+#define MP_F2(x, y) (glm::vec2((x), (y)))
 #define MP_F3(x, y, z) (glm::vec3((x), (y), (z)))
 #define MP_F4(x, y, z, w) (glm::vec4((x), (y), (z), (w)))
 #define MP_XYZ(v) (glm::vec3(v))

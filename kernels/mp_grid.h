@@ -25,11 +25,7 @@
 
 MP_INLINE float2 mp_corner(const SubPatch* sp, int k) {
   k &= 3;
-#ifdef __OPENCL_VERSION__
-  return (float2)(sp->corner[2 * k], sp->corner[2 * k + 1]);
-#else
-  return float2(sp->corner[2 * k], sp->corner[2 * k + 1]);
-#endif
+  return MP_F2(sp->corner[2 * k], sp->corner[2 * k + 1]);
 }
 
 /* Vertex k of n along the segment a -> b. With a, b binary fractions and n a
@@ -181,7 +177,6 @@ MP_INLINE int mp_grid_micropolygon(const MpGridShape* g, uint m, uint* q) {
   if (g->nv == 1u || g->nu == 1u) {
     int across_v = g->nv == 1u; /* edge 0 to edge 2; else edge 3 to edge 1 */
     uint na = across_v ? g->n[0] : g->n[3], nb = across_v ? g->n[2] : g->n[1], steps = max(na, nb);
-    if (m >= steps) return 0;
     mp_strip_step(m, steps, na, nb, &a0, &a1, &b0, &b1);
     if (across_v) {
       q[0] = mp_edge_slot(g, 0u, a0), q[1] = mp_edge_slot(g, 0u, a1);
@@ -212,8 +207,7 @@ MP_INLINE int mp_grid_micropolygon(const MpGridShape* g, uint m, uint* q) {
     uint i0 = (e & 1u) ? mp_slot(g, col, 1u + b0) : mp_slot(g, 1u + b0, row);
     uint i1 = (e & 1u) ? mp_slot(g, col, 1u + b1) : mp_slot(g, 1u + b1, row);
     uint e0 = mp_edge_slot(g, e, a0), e1 = mp_edge_slot(g, e, a1);
-    if (e == 0u) q[0] = e0, q[1] = e1, q[2] = i1, q[3] = i0;
-    else if (e == 1u) q[0] = e0, q[1] = e1, q[2] = i1, q[3] = i0;
+    if (e < 2u) q[0] = e0, q[1] = e1, q[2] = i1, q[3] = i0;
     else if (e == 2u) q[0] = i0, q[1] = i1, q[2] = e1, q[3] = e0;
     else q[0] = e0, q[1] = i0, q[2] = i1, q[3] = e1;
     return 1;

@@ -1,7 +1,7 @@
 /* Sample: a software rasteriser for micropolygons. Each work-item takes one
- * micropolygon at a time (two triangles of a quad of a stitched grid, mp_grid.h; one of
- * them empty where the quad has collapsed into a triangle), finds the jittered samples it
- * covers with fixed-point edge functions, and resolves visibility per sample
+ * micropolygon (two triangles of a quad of a stitched grid, mp_grid.h; one of
+ * them empty where the quad has collapsed into a triangle), finds the
+ * jittered samples it covers with fixed-point edge functions, and resolves visibility per sample
  * with a 64-bit atomic minimum of (depth, micropolygon id) (the visibility
  * buffer trick of Karis et al. 2021, Nanite). A second pass, run after the
  * first has finished, lets the one micropolygon whose key won each sample write
@@ -125,10 +125,10 @@ inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVerte
 /* Micropolygons that reach the rasteriser and their total screen area, summed
  * per work-group in local memory (one atomic per group): the dicing density
  * the benchmarks report as micropolygons per pixel of surface. */
-inline void mp_count_sampled(uint l, long area2, uint drawn, uint pass, volatile __global ulong* totals,
-                             __local ulong* area_sum, __local uint* count_sum) {
+inline void mp_count_sampled(uint l, long area2, uint pass, volatile __global ulong* totals, __local ulong* area_sum,
+                             __local uint* count_sum) {
   area_sum[l] = (ulong)area2;
-  count_sum[l] = drawn;
+  count_sum[l] = area2 > 0 ? 1u : 0u;
   barrier(CLK_LOCAL_MEM_FENCE);
   for (uint s = 32u; s > 0u; s >>= 1) {
     if (l < s) {
@@ -144,12 +144,13 @@ inline void mp_count_sampled(uint l, long area2, uint drawn, uint pass, volatile
 }
 
 /* One work-item per micropolygon of grids [first, first + count): `offsets`
- * holds each grid's first micropolygon (an exclusive prefix sum of the
- * grids' counts, which dicing records), `total` their sum. A work-item finds
- * its grid by binary search, so no work-item idles on an unused grid slot. */
+ * holds each grid of the batch's first micropolygon (from the batch's
+ * layout, GridLayoutStage), `base` is the first of these grids' and `total`
+ * their number. A work-item finds its grid by binary search, so no
+ * work-item idles on an unused grid slot. */
 __kernel __attribute__((reqd_work_group_size(64, 1, 1)))
 void sample_micropolygons(__global const SubPatch* diceable, uint first, uint count, __global const uint* offsets,
-                                   uint total, __global const uint* patch_info,
+                                   uint base, uint total, __global const uint* patch_info,
                                    FrameParams f, __global const float4* grid_p, __global const float4* grid_c,
                                    __global const float4* grid_n, __global const ushort* sample_offsets, uint pass,
                                    volatile __global ulong* keys,
@@ -164,24 +165,18 @@ void sample_micropolygons(__global const SubPatch* diceable, uint first, uint co
   MpGridShape g;
   uint q[4];
   if (live) {
-    uint lo = 0u, hi = count - 1u;
-    while (lo < hi) {
-      uint mid = (lo + hi + 1u) >> 1;
-      if (offsets[mid] <= gid) lo = mid;
-      else hi = mid - 1u;
-    }
-    slot = first + lo;
-    m = gid - offsets[lo];
+    slot = first + mp_find_grid(offsets + first, count, base + gid);
+    m = base + gid - offsets[slot];
     sp = diceable[slot];
     g = mp_grid_shape(&sp, (uint)f.max_grid);
     live = mp_grid_micropolygon(&g, m, q);
   }
   MpRasterVertex v[4]; /* counter-clockwise in (u, v) */
-  ulong base = (ulong)slot * stride * stride;
+  ulong grid_base = (ulong)slot * stride * stride;
   if (live) {
     int ok = 1;
     for (int k = 0; k < 4; ++k) {
-      ulong idx = base + q[k];
+      ulong idx = grid_base + q[k];
       v[k] = mp_raster_vertex(grid_p[idx], grid_c[idx], grid_n[idx], f, &ok);
     }
     live = ok;
@@ -202,11 +197,11 @@ void sample_micropolygons(__global const SubPatch* diceable, uint first, uint co
     }
     area2 = ((keep & 1u) ? (a0 < 0 ? -a0 : a0) : 0) + ((keep & 2u) ? (a1 < 0 ? -a1 : a1) : 0);
   }
-  mp_count_sampled(get_local_id(0), area2, area2 > 0 ? 1u : 0u, pass, totals, area_sum, count_sum);
+  mp_count_sampled(get_local_id(0), area2, pass, totals, area_sum, count_sum);
   if (!keep) return;
   uint grid_id = mp_hash32(sp.patch);
   for (int k = 0; k < 8; ++k) grid_id = mp_hash_combine(grid_id, as_uint(sp.corner[k]));
   uint mp_id = mp_hash_combine(grid_id, m);
-  float opacity = grid_c[base + q[0]].w;
+  float opacity = grid_c[grid_base + q[0]].w;
   mp_raster_quad(v[0], v[1], v[2], v[3], keep, mp_id, opacity, f, sample_offsets, pass, keys, colors, normals);
 }

@@ -102,29 +102,21 @@ MP_INLINE float4 mp_tex_image(const MP_GLOBAL DeviceImage* images, uint image_co
  * Sphere and Tube first map the unit box [0, 1]^3 to [-1, 1]^3. */
 #define MP_IMAGE_PI 3.14159265358979f
 
-MP_INLINE float2 mp_image_uv(float u, float v) {
-#ifdef __OPENCL_VERSION__
-  return (float2)(u, v);
-#else
-  return float2(u, v);
-#endif
-}
-
 /* Longitude around z and latitude from the south pole, each in [0, 1]. */
 MP_INLINE float2 mp_image_sphere_uv(float3 co) {
   co = 2.0f * co - MP_F3(1.0f, 1.0f, 1.0f);
   float len = sqrt(co.x * co.x + co.y * co.y + co.z * co.z);
-  if (!(len > 0.0f)) return mp_image_uv(0.0f, 0.0f);
+  if (!(len > 0.0f)) return MP_F2(0.0f, 0.0f);
   float u = co.x == 0.0f && co.y == 0.0f ? 0.0f : (1.0f - atan2(co.x, co.y) / MP_IMAGE_PI) * 0.5f;
-  return mp_image_uv(u, 1.0f - acos(clamp(co.z / len, -1.0f, 1.0f)) / MP_IMAGE_PI);
+  return MP_F2(u, 1.0f - acos(clamp(co.z / len, -1.0f, 1.0f)) / MP_IMAGE_PI);
 }
 
 /* Longitude around z as for Sphere, height along z. */
 MP_INLINE float2 mp_image_tube_uv(float3 co) {
   co = 2.0f * co - MP_F3(1.0f, 1.0f, 1.0f);
   float len = sqrt(co.x * co.x + co.y * co.y);
-  if (!(len > 0.0f)) return mp_image_uv(0.0f, 0.0f);
-  return mp_image_uv((1.0f - atan2(co.x / len, co.y / len) / MP_IMAGE_PI) * 0.5f, (co.z + 1.0f) * 0.5f);
+  if (!(len > 0.0f)) return MP_F2(0.0f, 0.0f);
+  return MP_F2((1.0f - atan2(co.x / len, co.y / len) / MP_IMAGE_PI) * 0.5f, (co.z + 1.0f) * 0.5f);
 }
 
 /* Box: the image projected along x, y and z and blended by the object-space

@@ -76,6 +76,17 @@ def add_camera(scene, location, target, lens=50.0, ortho_scale=None, shift=(0.0,
     return cam
 
 
+def add_tile(scene, name, mesh, row, col, rows, cols, tile=2.0):
+    """Links an object of `mesh` into the scene at tile (row, col) of a
+    rows x cols grid of `tile`-wide cells centred on the origin in the xy
+    plane (row 0 at the top, +y), scaled to leave a gap between tiles."""
+    obj = bpy.data.objects.new(name, mesh)
+    scene.collection.objects.link(obj)
+    obj.location = ((col + 0.5) * tile - cols * tile / 2.0, rows * tile / 2.0 - (row + 0.5) * tile, 0.0)
+    obj.scale = (0.45 * tile, 0.45 * tile, 1.0)
+    return obj
+
+
 def empty_material(name):
     """A node material holding only its Material Output; returns (material, output node)."""
     m = bpy.data.materials.new(name)

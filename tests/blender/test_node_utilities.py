@@ -195,11 +195,7 @@ def build_scene(cases):
         mesh = bpy.data.meshes.new(f"quad{i}")
         mesh.from_pydata([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [], [(0, 1, 2, 3)])
         mesh.materials.append(mat)
-        obj = bpy.data.objects.new(f"quad{i}", mesh)
-        scene.collection.objects.link(obj)
-        obj.location = ((col + 0.5) * tile_world - COLS * tile_world / 2.0,
-                        rows * tile_world / 2.0 - (row + 0.5) * tile_world, 0.0)
-        obj.scale = (0.45 * tile_world, 0.45 * tile_world, 1.0)
+        ru.add_tile(scene, f"quad{i}", mesh, row, col, rows, COLS, tile_world)
     cam = ru.add_camera(scene, (0.0, 0.0, 10.0), (0.0, 0.0, 0.0), ortho_scale=COLS * tile_world)
     cam.rotation_euler = (0.0, 0.0, 0.0)  # straight down, +y up, so tiles read left to right
     scene.micropoly.shading_rate = 0.25

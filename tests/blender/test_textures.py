@@ -289,11 +289,7 @@ def build_scene(cases):
         case["_tile"] = (row, col)
         mesh = tilted_quad(f"quad{i}")
         mesh.materials.append(mat)
-        obj = bpy.data.objects.new(f"quad{i}", mesh)
-        scene.collection.objects.link(obj)
-        obj.location = ((col + 0.5) * tile_world - COLS * tile_world / 2.0,
-                        rows * tile_world / 2.0 - (row + 0.5) * tile_world, 0.0)
-        obj.scale = (0.45 * tile_world, 0.45 * tile_world, 1.0)
+        ru.add_tile(scene, f"quad{i}", mesh, row, col, rows, COLS, tile_world)
 
     cam_data = bpy.data.cameras.new("Camera")
     cam_data.type = "ORTHO"

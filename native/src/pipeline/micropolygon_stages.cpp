@@ -49,51 +49,48 @@ GridBuffers::GridBuffers(DeviceSession& session, cl_uint cap, int max_grid)
   n = device_buffer(session, bytes, "grid normal buffer");
   c = device_buffer(session, bytes, "grid color buffer");
   vertex_offsets = device_buffer(session, (capacity + 1) * sizeof(cl_uint), "grid vertex offsets");
+  micropolygon_offsets = device_buffer(session, (capacity + 1) * sizeof(cl_uint), "grid micropolygon offsets");
 }
 
 GridLayoutStage::GridLayoutStage(DeviceSession& session, cl_uint capacity)
     : session_(session), kernel_(session.program(), "grid_counts") {
-  vertices_ = device_buffer(session, capacity * sizeof(cl_uint), "grid vertex counts");
-  micropolygons_ = device_buffer(session, capacity * sizeof(cl_uint), "grid micropolygon counts");
+  counts_ = device_buffer(session, 2 * size_t(capacity) * sizeof(cl_uint), "grid counts");
 }
 
 void GridLayoutStage::run(const cl::Buffer& diceable, cl_uint count, const FrameParams& f, GridBuffers& grids,
                           StageTimer& timer) {
   grids.vertex_total = 0;
-  grids.micropolygon_counts.assign(count, 0);
+  grids.micropolygon_offsets_host.assign(count + 1, 0);
   if (count == 0) return;
   kernel_.setArg(0, diceable);
   kernel_.setArg(1, count);
   kernel_.setArg(2, f);
-  kernel_.setArg(3, vertices_);
-  kernel_.setArg(4, micropolygons_);
+  kernel_.setArg(3, counts_);
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(count), cl::NDRange(64), nullptr, &e);
   timer.add(Stage::Dice, e);
   // A few thousand numbers: summed on the host, one round trip per batch.
-  host_.resize(count + 1);
-  session_.queue().enqueueReadBuffer(vertices_, CL_FALSE, 0, count * sizeof(cl_uint), host_.data());
-  session_.queue().enqueueReadBuffer(micropolygons_, CL_TRUE, 0, count * sizeof(cl_uint),
-                                     grids.micropolygon_counts.data());
-  cl_uint total = 0;
+  counts_host_.resize(2 * size_t(count));
+  session_.queue().enqueueReadBuffer(counts_, CL_TRUE, 0, counts_host_.size() * sizeof(cl_uint), counts_host_.data());
+  vertex_offsets_host_.resize(count + 1);
+  cl_uint vertices = 0, micropolygons = 0;
   for (cl_uint k = 0; k < count; ++k) {
-    const cl_uint n = host_[k];
-    host_[k] = total;
-    total += n;
+    vertex_offsets_host_[k] = vertices;
+    grids.micropolygon_offsets_host[k] = micropolygons;
+    vertices += counts_host_[2 * k];
+    micropolygons += counts_host_[2 * k + 1];
   }
-  host_[count] = total;
-  grids.vertex_total = total;
-  session_.queue().enqueueWriteBuffer(grids.vertex_offsets, CL_TRUE, 0, (count + 1) * sizeof(cl_uint), host_.data());
+  vertex_offsets_host_[count] = vertices;
+  grids.micropolygon_offsets_host[count] = micropolygons;
+  grids.vertex_total = vertices;
+  micropolygons_ += micropolygons;
+  session_.queue().enqueueWriteBuffer(grids.vertex_offsets, CL_TRUE, 0, (count + 1) * sizeof(cl_uint),
+                                      vertex_offsets_host_.data());
+  session_.queue().enqueueWriteBuffer(grids.micropolygon_offsets, CL_TRUE, 0, (count + 1) * sizeof(cl_uint),
+                                      grids.micropolygon_offsets_host.data());
 }
 
-DiceStage::DiceStage(DeviceSession& session) : session_(session), kernel_(session.program(), "dice_grids") {
-  counter_ = cl::Buffer(session.context(), CL_MEM_READ_WRITE, sizeof(cl_uint));
-}
-
-void DiceStage::begin_frame() {
-  cl_uint zero = 0;
-  session_.queue().enqueueFillBuffer(counter_, zero, 0, sizeof zero);
-}
+DiceStage::DiceStage(DeviceSession& session) : session_(session), kernel_(session.program(), "dice_grids") {}
 
 void DiceStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
                     GridBuffers& grids, StageTimer& timer) {
@@ -107,18 +104,11 @@ void DiceStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffer
   kernel_.setArg(7, f);
   kernel_.setArg(8, grids.p);
   kernel_.setArg(9, grids.n);
-  kernel_.setArg(10, counter_);
-  kernel_.setArg(11, grids.vertex_offsets);
+  kernel_.setArg(10, grids.vertex_offsets);
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64),
                                         nullptr, &e);
   timer.add(Stage::Dice, e);
-}
-
-size_t DiceStage::micropolygons() {
-  cl_uint n = 0;
-  session_.queue().enqueueReadBuffer(counter_, CL_TRUE, 0, sizeof n, &n);
-  return n;
 }
 
 ShadeStage::ShadeStage(DeviceSession& session) : session_(session), kernel_(session.program(), "shade_grids") {}
@@ -190,35 +180,29 @@ void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer) {
 void SampleStage::run(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
                       const FrameParams& f, GridBuffers& grids, StageTimer& timer) {
   if (count == 0) return;
-  // Each grid's first micropolygon, from the counts of the batch's layout.
-  offsets_host_.resize(count);
-  cl_uint total = 0;
-  for (cl_uint k = 0; k < count; ++k) {
-    offsets_host_[k] = total;
-    total += grids.micropolygon_counts[first + k];
-  }
+  // The run's micropolygons, numbered within the batch by its layout.
+  const cl_uint base = grids.micropolygon_offsets_host[first];
+  const cl_uint total = grids.micropolygon_offsets_host[first + count] - base;
   if (total == 0) return;
-  if (!grid_offsets_() || grid_offsets_.getInfo<CL_MEM_SIZE>() < grids.capacity * sizeof(cl_uint))
-    grid_offsets_ = device_buffer(session_, grids.capacity * sizeof(cl_uint), "grid micropolygon offsets");
-  session_.queue().enqueueWriteBuffer(grid_offsets_, CL_TRUE, 0, count * sizeof(cl_uint), offsets_host_.data());
   kernel_.setArg(0, diceable);
   kernel_.setArg(1, first);
   kernel_.setArg(2, count);
-  kernel_.setArg(3, grid_offsets_);
-  kernel_.setArg(4, total);
-  kernel_.setArg(5, scene.patch_info);
-  kernel_.setArg(6, f);
-  kernel_.setArg(7, grids.p);
-  kernel_.setArg(8, grids.c);
-  kernel_.setArg(9, grids.n);
-  kernel_.setArg(10, offsets_);
-  kernel_.setArg(12, keys_);
-  kernel_.setArg(13, colors_);
-  kernel_.setArg(14, normals_);
-  kernel_.setArg(15, totals_);
+  kernel_.setArg(3, grids.micropolygon_offsets);
+  kernel_.setArg(4, base);
+  kernel_.setArg(5, total);
+  kernel_.setArg(6, scene.patch_info);
+  kernel_.setArg(7, f);
+  kernel_.setArg(8, grids.p);
+  kernel_.setArg(9, grids.c);
+  kernel_.setArg(10, grids.n);
+  kernel_.setArg(11, offsets_);
+  kernel_.setArg(13, keys_);
+  kernel_.setArg(14, colors_);
+  kernel_.setArg(15, normals_);
+  kernel_.setArg(16, totals_);
   // Pass 0 finds each sample's nearest key; pass 1 lets its owner write.
   for (cl_uint pass = 0; pass < 2; ++pass) {
-    kernel_.setArg(11, pass);
+    kernel_.setArg(12, pass);
     cl::Event e;
     session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(total), cl::NDRange(64), nullptr, &e);
     timer.add(Stage::Sample, e);

@@ -18,11 +18,12 @@ struct GridBuffers {
   cl::Buffer p, n, c;  // float4 per grid vertex
   cl_uint capacity;    // sub-patches per batch
   size_t vertices_per_slot;
-  // The batch's layout (GridLayoutStage): each grid's first vertex, then the
-  // total (capacity + 1 uints), and each grid's micropolygon count.
-  cl::Buffer vertex_offsets;
+  // The batch's layout (GridLayoutStage): each grid's first vertex and first
+  // micropolygon, then the batch's totals (count + 1 uints each). The
+  // micropolygon offsets are kept on the host too, to size sample launches.
+  cl::Buffer vertex_offsets, micropolygon_offsets;
   cl_uint vertex_total = 0;
-  std::vector<cl_uint> micropolygon_counts;
+  std::vector<cl_uint> micropolygon_offsets_host;
 };
 
 // Counts each grid's vertices and micropolygons and sums them into offsets,
@@ -32,12 +33,15 @@ class GridLayoutStage {
  public:
   GridLayoutStage(DeviceSession& session, cl_uint capacity);
   void run(const cl::Buffer& diceable, cl_uint count, const FrameParams& f, GridBuffers& grids, StageTimer& timer);
+  void begin_frame() { micropolygons_ = 0; }
+  size_t micropolygons() const { return micropolygons_; }  // diced this frame
 
  private:
   DeviceSession& session_;
   cl::Kernel kernel_;
-  cl::Buffer vertices_, micropolygons_;
-  std::vector<cl_uint> host_;
+  cl::Buffer counts_;                 // vertices and micropolygons per grid, interleaved
+  std::vector<cl_uint> counts_host_, vertex_offsets_host_;
+  size_t micropolygons_ = 0;
 };
 
 class DiceStage {
@@ -45,13 +49,10 @@ class DiceStage {
   explicit DiceStage(DeviceSession& session);
   void run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
            GridBuffers& grids, StageTimer& timer);
-  void begin_frame();      // resets the micropolygon counter
-  size_t micropolygons();  // total this frame (blocking read)
 
  private:
   DeviceSession& session_;
   cl::Kernel kernel_;
-  cl::Buffer counter_;
 };
 
 class ShadeStage {
@@ -87,8 +88,6 @@ class SampleStage {
   cl::Kernel kernel_;
   cl::Kernel clear_;
   cl::Buffer keys_, colors_, normals_, offsets_, totals_;
-  cl::Buffer grid_offsets_;  // first micropolygon of each grid of a run
-  std::vector<cl_uint> offsets_host_;
   size_t samples_ = 0;
   int spp_x_ = 0, spp_y_ = 0;
 };

@@ -111,7 +111,7 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     ShadeStage& shade = impl_->shade;
     SampleStage& sample = impl_->sample;
     ResolveStage& resolve = impl_->resolve;
-    dice.begin_frame();
+    impl_->layout.begin_frame();
     if (progress && !progress(0.0f)) {  // cancelled before the frame's buffers are set up
       st.cancelled = true;
       out.width = out.height = 0;
@@ -177,7 +177,7 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
                 out, timer);
     st.timings_ms.readback = ms_since(t_resolve);
     timer.collect();
-    st.micropolygons = dice.micropolygons();
+    st.micropolygons = impl_->layout.micropolygons();
     sample.sampled_totals(st.micropolygons_sampled, st.sampled_area_px);
     st.timings_ms.bound_split = timer.ms(Stage::BoundSplit);
     st.timings_ms.dice = timer.ms(Stage::Dice);
