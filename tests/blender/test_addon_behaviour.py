@@ -160,8 +160,29 @@ def test_rib_export_matches_f12():
     scene = ru.reset_scene()
     bpy.ops.mesh.primitive_monkey_add(size=2.0)
     bpy.context.object.modifiers.new("Subdivision", "SUBSURF")
-    bpy.context.object.data.materials.append(ru.diffuse_material("red", (0.8, 0.2, 0.1)))
+    # Suzanne's color comes from Generated coordinates (its texture space),
+    # the floor's from an image through its UV map: both must reach the RIB.
+    red, _ = ru.empty_material("generated noise")
+    nodes, links = red.node_tree.nodes, red.node_tree.links
+    coords, noise = nodes.new("ShaderNodeTexCoord"), nodes.new("ShaderNodeTexNoise")
+    bsdf = nodes.new("ShaderNodeBsdfDiffuse")
+    noise.inputs["Scale"].default_value = 3.0
+    links.new(coords.outputs["Generated"], noise.inputs["Vector"])
+    links.new(noise.outputs["Color"], bsdf.inputs["Color"])
+    links.new(bsdf.outputs["BSDF"], nodes["Material Output"].inputs["Surface"])
+    bpy.context.object.data.materials.append(red)
     bpy.ops.mesh.primitive_plane_add(size=6.0, location=(0, 0, -1))
+    rows = np.linspace(0.0, 1.0, 8, dtype=np.float32)
+    texels = np.stack(np.broadcast_arrays(rows[:, None], rows[None, ::-1] ** 2, 0.3, 1.0), -1)
+    texels[::2, ::2, :3] *= 0.2  # a checker, so a flipped or shifted image shows
+    floor, _ = ru.empty_material("uv image")
+    nodes, links = floor.node_tree.nodes, floor.node_tree.links
+    image, bsdf = nodes.new("ShaderNodeTexImage"), nodes.new("ShaderNodeBsdfDiffuse")
+    image.image = ru.png_image("rib_checker", texels, "sRGB")
+    image.interpolation = "Closest"
+    links.new(image.outputs["Color"], bsdf.inputs["Color"])
+    links.new(bsdf.outputs["BSDF"], nodes["Material Output"].inputs["Surface"])
+    bpy.context.object.data.materials.append(floor)
     for kind, energy in (("POINT", 400.0), ("SUN", 2.0), ("SPOT", 600.0), ("AREA", 200.0)):
         data = bpy.data.lights.new(kind, kind)
         data.energy = energy
@@ -197,8 +218,14 @@ def test_rib_export_matches_f12():
     same_size = tuple(a.size) == tuple(b.size) == (120, 90)
     diff = float(np.abs(pa - pb).max()) if same_size else 1.0
     covered = float(pa.reshape(-1, 4)[:, 3].mean())
-    check("exported RIB renders in micropoly-render like F12 (within 1/255)",
-          same_size and covered > 0.2 and diff <= 1.0 / 255.0 + 1e-6, f"max diff {diff * 255:.2f}/255, coverage {covered:.2f}")
+    # The textures must show: the floor's colors spread over many values
+    # (not one flat or magenta color).
+    colors = len(np.unique(np.round(pa.reshape(-1, 4)[:, :3] * 255), axis=0))
+    check("exported RIB renders in micropoly-render like F12 (within 1/255), textures included",
+          same_size and covered > 0.2 and colors > 200 and diff <= 1.0 / 255.0 + 1e-6,
+          f"max diff {diff * 255:.2f}/255, coverage {covered:.2f}, {colors} colors")
+    check("the RIB's textures are written beside it",
+          os.path.isfile(os.path.join(folder, "scene_textures", "0.exr")), str(os.listdir(folder)))
 
 
 def main():

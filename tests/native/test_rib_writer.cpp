@@ -5,12 +5,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <sstream>
 #include <string>
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "io/image_io.h"
 #include "micropoly/error.h"
 #include "micropoly/renderer.h"
 #include "renderer_fixture.h"
@@ -21,9 +24,11 @@
 namespace mp::test {
 namespace {
 
+// Texture images go to a folder; the RIB names them by absolute path, so the
+// string reads back from anywhere.
 std::string to_rib(const Scene& scene) {
   std::ostringstream out;
-  write_rib(scene, out);
+  write_rib(scene, out, "", ::testing::TempDir() + "/rib_writer_textures");
   return out.str();
 }
 
@@ -151,6 +156,21 @@ void expect_same_mesh(const Mesh& a, const Mesh& b) {
   EXPECT_EQ(a.face_materials, b.face_materials);
   EXPECT_EQ(a.object_to_world, b.object_to_world);
   EXPECT_EQ(a.double_sided, b.double_sided);
+  EXPECT_EQ(a.uv_layers, b.uv_layers);
+  EXPECT_EQ(a.texspace_location, b.texspace_location);
+  EXPECT_EQ(a.texspace_size, b.texspace_size);
+}
+
+void expect_same_images(const std::vector<Image>& a, const std::vector<Image>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    SCOPED_TRACE("image '" + a[i].name + "'");
+    EXPECT_EQ(a[i].name, b[i].name);
+    EXPECT_EQ(a[i].width, b[i].width);
+    EXPECT_EQ(a[i].height, b[i].height);
+    EXPECT_EQ(a[i].pixels, b[i].pixels);  // bit for bit, row order included
+    EXPECT_EQ(a[i].srgb, b[i].srgb);
+  }
 }
 
 void expect_same_scene(const Scene& a, const Scene& b) {
@@ -171,6 +191,10 @@ void expect_same_scene(const Scene& a, const Scene& b) {
   }
   ASSERT_EQ(a.meshes.size(), b.meshes.size());
   for (size_t i = 0; i < a.meshes.size(); ++i) expect_same_mesh(a.meshes[i], b.meshes[i]);
+  expect_same_images(a.images, b.images);
+  ASSERT_EQ(a.material_programs.size(), b.material_programs.size());
+  for (size_t i = 0; i < a.material_programs.size(); ++i)
+    EXPECT_EQ(a.material_programs[i].source, b.material_programs[i].source);
   ASSERT_EQ(a.bezier_patches.size(), b.bezier_patches.size());
   for (size_t i = 0; i < a.bezier_patches.size(); ++i) {
     const BezierPatches &p = a.bezier_patches[i], &q = b.bezier_patches[i];
@@ -367,6 +391,46 @@ Scene full_scene() {
   mirrored_patch.material = 2;
   mirrored_patch.object_to_world = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(0.3f, 1.8f, 0.0f)), glm::vec3(-0.5f, 0.5f, 0.5f));
   s.bezier_patches.push_back(mirrored_patch);
+
+  // Texturing: a material program reads two UV layers, two images (one sRGB
+  // encoded, one linear, both asymmetric so a flipped row order shows) and
+  // Generated coordinates with an explicit texture space.
+  Image checker{"checker \"sRGB\"", 5, 3, {}, true};
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 5; ++x)
+      checker.pixels.push_back({((x + y) % 2) ? 0.9f : 0.1f, x / 4.0f, y / 3.0f, 1.0f - 0.1f * x});
+  s.images.push_back(checker);
+  Image ramp{"linear ramp", 4, 2, {}, false};
+  for (int i = 0; i < 8; ++i) ramp.pixels.push_back({0.1f * i, 2.5f - 0.3f * i, 1.0f / 3.0f, 1.0f});
+  s.images.push_back(ramp);
+  s.material_programs.push_back(
+      {"textured",
+       "#include \"textures/mp_tex_image.h\"\n"
+       "float3 mp_node_displacement(const MpNodeGlobals* g) { return (float3)(0.0f); }\n"
+       "void mp_node_surface(const MpNodeGlobals* g, MpSurfaceInputs* s) {\n"
+       "  float4 a = mp_tex_image(g->images, g->image_count, g->texels, 0, g->uv[0].x, g->uv[0].y, 0, 0);\n"
+       "  float4 b = mp_tex_image(g->images, g->image_count, g->texels, 1, g->uv[1].x, g->uv[1].y, 1, 1);\n"
+       "  s->base_color = a.xyz * 0.6f + b.xyz * 0.2f + g->generated * 0.2f; }\n"});
+  Material textured = material("textured", Material::Model::Principled, glm::vec3(0.5f));
+  textured.program = 0;
+  textured.program_shades = true;
+  s.materials.push_back(textured);
+  const int textured_index = static_cast<int>(s.materials.size()) - 1;
+  for (const char* name : {"floor", "corner sheet"}) {
+    Mesh& m = *std::find_if(s.meshes.begin(), s.meshes.end(), [&](const Mesh& x) { return x.name == name; });
+    std::vector<glm::vec2> uv0, uv1;
+    for (size_t c = 0; c < m.face_vertex_indices.size(); ++c) {
+      const glm::vec3 p = m.points[static_cast<size_t>(m.face_vertex_indices[c])];
+      uv0.push_back(glm::vec2(p.x, p.y) * 0.37f + glm::vec2(0.1f, 1.0f / 3.0f));
+      uv1.push_back({0.05f * static_cast<float>(c % 7), p.y * 0.3f});  // discontinuous per corner
+    }
+    m.uv_layers = {uv0, uv1};
+    m.material = textured_index;
+    m.face_materials.clear();
+  }
+  s.meshes[0].texspace_location = {0.1f, -0.2f, 0.3f};
+  s.meshes[0].texspace_size = {1.1f, 0.9f, 1.0f / 3.0f};
+  s.meshes[0].face_materials = {1, 1, textured_index, 1, 5, textured_index};
   validate_scene(s);
   return s;
 }
@@ -483,6 +547,16 @@ TEST(RibWriter, DisplayNameAndFileErrors) {
   const std::string path = ::testing::TempDir() + "/rib_writer_file.rib";
   write_rib_file(s, path);
   expect_same_scene(s, read_rib_file(path).scene);
+
+  // Texture images: a file gets a folder beside it, named relative to it;
+  // a stream needs a folder.
+  const Scene textured = full_scene();
+  EXPECT_THROW(write_rib(textured, out), Error);
+  write_rib_file(textured, path);
+  std::ifstream rib(path);
+  const std::string text((std::istreambuf_iterator<char>(rib)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"string imagefile\" \"rib_writer_file_textures/1.exr\""), std::string::npos);
+  expect_same_scene(textured, read_rib_file(path).scene);
 }
 
 // --- the reader's side of the extensions -------------------------------------------------
@@ -513,6 +587,52 @@ TEST(RibWriterExtensions, MaterialTableIndicesAndNames) {
   EXPECT_TRUE(r.warnings.empty());
 }
 
+TEST(RibWriterExtensions, UVLayersPerVertexPerCornerAndReversed) {
+  // Per-vertex UVs are spread to the corners; a reversed orientation reverses
+  // each face's corners with their UVs; Polygon runs merged into one mesh
+  // keep their UVs, a layer one of them lacks reading zeros.
+  const RibResult r = parse(
+      "PointsPolygons [3 4] [0 1 2 0 2 3 1] \"P\" [0 0 0 1 0 0 1 1 0 0 1 0]\n"
+      "  \"vertex float[2] micropoly:uv0\" [0 0 1 0 1 1 0 1]\n"
+      "  \"facevarying float[2] micropoly:uv1\" [1 1 2 2 3 3 4 4 5 5 6 6 7 7]\n"
+      "AttributeBegin\nReverseOrientation\n"
+      "SubdivisionMesh \"catmull-clark\" [3] [0 1 2] \"P\" [0 0 0 1 0 0 1 1 0]\n"
+      "  \"facevarying float[2] micropoly:uv0\" [0 0 1 0 1 1]\n"
+      "  \"constant float[3] micropoly:texspacelocation\" [1 2 3]\n"
+      "AttributeEnd\n"
+      "Polygon \"P\" [0 0 0 1 0 0 0 1 0]\n"
+      "Polygon \"P\" [0 0 0 1 0 0 0 1 0] \"facevarying float[2] micropoly:uv0\" [5 6 7 8 9 10]\n");
+  EXPECT_TRUE(r.warnings.empty());
+  const Scene& s = r.scene;
+  ASSERT_EQ(s.meshes.size(), 3u);
+  using V = std::vector<glm::vec2>;
+  ASSERT_EQ(s.meshes[0].uv_layers.size(), 2u);
+  EXPECT_EQ(s.meshes[0].uv_layers[0], (V{{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}, {1, 0}}));
+  EXPECT_EQ(s.meshes[0].uv_layers[1], (V{{1, 1}, {2, 2}, {3, 3}, {4, 4}, {5, 5}, {6, 6}, {7, 7}}));
+  EXPECT_EQ(s.meshes[1].face_vertex_indices, (std::vector<int>{2, 1, 0}));
+  EXPECT_EQ(s.meshes[1].uv_layers, (std::vector<V>{{{1, 1}, {1, 0}, {0, 0}}}));
+  EXPECT_EQ(s.meshes[1].texspace_location, glm::vec3(1, 2, 3));
+  EXPECT_EQ(s.meshes[2].uv_layers, (std::vector<V>{{{0, 0}, {0, 0}, {0, 0}, {5, 6}, {7, 8}, {9, 10}}}));
+}
+
+TEST(RibWriterExtensions, PngTexturesAreSrgbAndBottomRowFirst) {
+  // A 1 x 2 PNG, red on top: the Scene stores the bottom (blue) row first.
+  RenderResult png;
+  png.width = 1, png.height = 2;
+  png.rgba = {1.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.2f, 1.0f};
+  const std::string dir = ::testing::TempDir();
+  write_image(dir + "/rib_texture.png", png);
+  const RibResult r = read_rib_string("Option \"micropoly\" \"string imagefile\" \"rib_texture.png\"\n",
+                                      dir + "/texture.rib", dir);
+  ASSERT_EQ(r.scene.images.size(), 1u);
+  const Image& im = r.scene.images[0];
+  EXPECT_EQ(im.name, "rib_texture.png");
+  EXPECT_TRUE(im.srgb);  // PNGs hold sRGB-encoded values
+  ASSERT_EQ(im.pixels.size(), 2u);
+  EXPECT_EQ(im.pixels[0], glm::vec4(0.0f, 0.0f, std::round(linear_to_srgb(0.2f) * 255.0f) / 255.0f, 1.0f));
+  EXPECT_EQ(im.pixels[1], glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
+}
+
 TEST(RibWriterExtensions, BadValuesAreErrors) {
   auto expect_error = [](const std::string& text, const std::string& fragment) {
     try {
@@ -532,6 +652,12 @@ TEST(RibWriterExtensions, BadValuesAreErrors) {
   expect_error("Option \"micropoly\" \"string boundsplit\" \"fast\"\n", "boundsplit");
   expect_error("Option \"micropoly\" \"integer backfaceculling\" 2\n", "backfaceculling");
   expect_error("WorldBegin\nLightSource \"micropoly_arealight\" 1 \"string shape\" \"disc\"\nWorldEnd\n", "shape");
+  expect_error("Option \"micropoly\" \"string imagefile\" \"/nonexistent/t.exr\"\n", "/nonexistent/t.exr");
+  expect_error("Option \"micropoly\" \"string imagefile\" \"t.tif\"\n", "only .exr and .png");
+  expect_error("WorldBegin\nPolygon \"P\" [0 0 0 1 0 0 0 1 0] \"facevarying float[2] micropoly:uv0\" [0 0 1 0]\nWorldEnd\n",
+               "micropoly:uv0");
+  expect_error("WorldBegin\nPolygon \"P\" [0 0 0 1 0 0 0 1 0] \"constant float[2] micropoly:texspacesize\" [1 1]\nWorldEnd\n",
+               "texspacesize");
 }
 
 TEST(RibWriterExtensions, AreaLightInCameraSpace) {

@@ -40,6 +40,18 @@ void check_indices(ArgReader& args, const Arg& where, const std::vector<int>& in
                                    std::to_string(npoints) + " points");
 }
 
+// Micropoly's per-mesh parameters (rib_micropoly.cpp reads them).
+bool is_mesh_extension(const std::string& name) {
+  return name == "micropoly:material" || name == "micropoly:texspacelocation" ||
+         name == "micropoly:texspacesize" || name.rfind("micropoly:uv", 0) == 0;
+}
+
+std::vector<int> identity(size_t n) {
+  std::vector<int> v(n);
+  for (size_t i = 0; i < n; ++i) v[i] = static_cast<int>(i);
+  return v;
+}
+
 void fill_polygons(Mesh& mesh, std::vector<int> counts, std::vector<int> indices) {
   mesh.face_vertex_counts = std::move(counts);
   mesh.face_vertex_indices = std::move(indices);
@@ -58,7 +70,7 @@ bool Parser::read_positions(ArgReader& args, const ParamList& params, bool patch
                             std::vector<glm::vec3>* out) {
   const int line = args.request().line;
   for (const Param& p : params.params())
-    if (p.name != "P" && p.name != "Pw" && p.name != "Pz" && p.name != "micropoly:material")
+    if (p.name != "P" && p.name != "Pw" && p.name != "Pz" && (patch || !is_mesh_extension(p.name)))
       warn_once("primvar:" + p.name, p.line, "primitive variable \"" + p.name + "\" is ignored");
   const Param* P = params.find("P");
   const Param* Pw = params.find("Pw");
@@ -107,8 +119,8 @@ void Parser::req_polygon(ArgReader& args) {
   const size_t n = prim.mesh.points.size();
   if (n < 3) args.fail("a polygon needs at least 3 vertices, \"P\" has " + std::to_string(n));
   if (n > static_cast<size_t>(kIntMax)) args.fail("too many vertices");
-  std::vector<int> indices(n);
-  for (size_t i = 0; i < n; ++i) indices[i] = static_cast<int>(i);
+  std::vector<int> indices = identity(n);
+  read_mesh_texturing(args, params, indices, n, &prim.mesh);
   fill_polygons(prim.mesh, {static_cast<int>(n)}, std::move(indices));
   prim.mergeable = true;
   place(std::move(prim), args);
@@ -130,9 +142,10 @@ void Parser::req_general_polygon(ArgReader& args) {
               "holes in general polygons are not supported; only the outer loop is rendered");
   // The outer loop comes first; holes are dropped.
   const int n = loops[0];
+  read_mesh_texturing(args, params, identity(points.size()), points.size(), &prim.mesh);
+  for (auto& layer : prim.mesh.uv_layers) layer.resize(static_cast<size_t>(n));
   prim.mesh.points.assign(points.begin(), points.begin() + n);
-  std::vector<int> indices(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) indices[static_cast<size_t>(i)] = i;
+  std::vector<int> indices = identity(static_cast<size_t>(n));
   fill_polygons(prim.mesh, {n}, std::move(indices));
   prim.mergeable = true;
   place(std::move(prim), args);
@@ -148,6 +161,7 @@ void Parser::req_points_polygons(ArgReader& args) {
   if (!read_positions(args, params, false, &prim.mesh.points)) return;
   check_indices(args, verts_arg, indices, prim.mesh.points.size());
   read_face_materials(args, params, counts.size(), &prim.mesh.face_materials);
+  read_mesh_texturing(args, params, indices, prim.mesh.points.size(), &prim.mesh);
   fill_polygons(prim.mesh, std::move(counts), std::move(indices));
   place(std::move(prim), args);
 }
@@ -166,8 +180,9 @@ void Parser::req_points_general_polygons(ArgReader& args) {
   Primitive prim = make_primitive(Primitive::Kind::Mesh, args);
   if (!read_positions(args, params, false, &prim.mesh.points)) return;
   check_indices(args, verts_arg, all, prim.mesh.points.size());
+  read_mesh_texturing(args, params, all, prim.mesh.points.size(), &prim.mesh);
   // Keep the outer (first) loop of each polygon; holes are dropped.
-  std::vector<int> outer_counts, outer_indices;
+  std::vector<int> outer_counts, outer_indices, outer_corners;
   size_t loop = 0, offset = 0;
   bool holes = false;
   for (int nl : loops) {
@@ -175,6 +190,7 @@ void Parser::req_points_general_polygons(ArgReader& args) {
     outer_counts.push_back(c);
     outer_indices.insert(outer_indices.end(), all.begin() + static_cast<long>(offset),
                          all.begin() + static_cast<long>(offset) + c);
+    for (int k = 0; k < c; ++k) outer_corners.push_back(static_cast<int>(offset) + k);
     for (int k = 0; k < nl; ++k) offset += static_cast<size_t>(counts[loop++]);
     holes = holes || nl > 1;
   }
@@ -182,6 +198,11 @@ void Parser::req_points_general_polygons(ArgReader& args) {
     warn_once("holes", args.request().line,
               "holes in general polygons are not supported; only the outer loop is rendered");
   read_face_materials(args, params, loops.size(), &prim.mesh.face_materials);
+  for (auto& layer : prim.mesh.uv_layers) {
+    std::vector<glm::vec2> kept(outer_corners.size());
+    for (size_t i = 0; i < kept.size(); ++i) kept[i] = layer[static_cast<size_t>(outer_corners[i])];
+    layer = std::move(kept);
+  }
   fill_polygons(prim.mesh, std::move(outer_counts), std::move(outer_indices));
   place(std::move(prim), args);
 }
@@ -229,6 +250,7 @@ void Parser::req_subdivision_mesh(ArgReader& args) {
   const size_t nfaces = counts.size();
   check_indices(args, verts_arg, indices, npoints);
   read_face_materials(args, params, nfaces, &mesh.face_materials);
+  read_mesh_texturing(args, params, indices, npoints, &mesh);
   fill_polygons(mesh, std::move(counts), std::move(indices));
 
   // RenderMan's default without an "interpolateboundary" tag is no boundary

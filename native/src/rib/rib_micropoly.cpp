@@ -5,12 +5,18 @@
 //   Option "micropoly"     render settings without a RenderMan request
 //   Attribute "micropoly"  the shading state as Scene material number i
 //   "uniform integer micropoly:material"  per-face material numbers
+//   "facevarying float[2] micropoly:uvK"  UV layer K of a mesh
+//   "constant float[3] micropoly:texspacelocation" / "...size"  Generated space
 #include <algorithm>
 #include <climits>
 #include <functional>
 #include <initializer_list>
 #include <string>
 
+#include "io/texture_io.h"
+#include "micropoly/error.h"
+#include "rib/rib_file.h"
+#include "mp_patch.h"
 #include "rib/rib_parser.h"
 
 namespace mp::rib {
@@ -38,6 +44,7 @@ void warn_unknown(const ParamList& params, std::initializer_list<const char*> kn
 }  // namespace
 
 void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
+  if (params.find("imagefile")) return read_image_option(args, params);
   RenderSettings& s = result_.scene.settings;
   const std::string method = params.get_string("boundsplit", "");
   if (method == "bounded")
@@ -66,6 +73,31 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
                  warn_once("option-micropoly:" + name, line,
                            "Option \"micropoly\": parameter \"" + name + "\" is ignored");
                });
+}
+
+void Parser::read_image_option(ArgReader& args, const ParamList& params) {
+  const int line = args.request().line;
+  warn_unknown(params, {"image", "imagefile", "imagesrgb"}, [&](const std::string& name) {
+    warn_once("option-micropoly-image:" + name, line,
+              "Option \"micropoly\": parameter \"" + name + "\" is ignored with \"imagefile\"");
+  });
+  const std::string file = params.get_string("imagefile", "");
+  if (file.empty()) args.fail("\"imagefile\" must name a texture file");
+  const std::string path = resolve_path(*source_->base_dir, file);
+  Image image;
+  try {
+    image = read_texture_image(path, Limits::kMaxTexels - texels_);
+  } catch (const Error& e) {
+    args.fail(e.what());
+  }
+  texels_ += image.pixels.size();
+  image.name = params.get_string("image", file);
+  // PNGs hold sRGB-encoded values and EXRs linear ones unless "imagesrgb" says otherwise.
+  const std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : path;
+  int srgb = ext == ".png" || ext == ".PNG" ? 1 : 0;
+  get_int(args, params, "imagesrgb", 0, 1, &srgb);
+  image.srgb = srgb != 0;
+  result_.scene.images.push_back(std::move(image));
 }
 
 void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
@@ -144,6 +176,47 @@ void Parser::read_face_materials(ArgReader& args, const ParamList& params, size_
                               " values");
   const long long count = static_cast<long long>(result_.scene.materials.size());
   *out = args.int_array(*p->value, 0, count - 1, "micropoly:material");
+}
+
+void Parser::read_mesh_texturing(ArgReader& args, const ParamList& params, const std::vector<int>& corners,
+                                 size_t npoints, Mesh* mesh) const {
+  mesh->uv_layers.clear();
+  for (int k = 0; k < MP_MAX_UV_LAYERS; ++k) {
+    const std::string name = "micropoly:uv" + std::to_string(k);
+    const Param* p = params.find(name);
+    if (!p) {
+      // Layers are numbered densely; a gap reads zeros, as a missing layer does.
+      bool later = false;
+      for (int j = k + 1; j < MP_MAX_UV_LAYERS; ++j) later = later || params.find("micropoly:uv" + std::to_string(j));
+      if (!later) break;
+      mesh->uv_layers.emplace_back(corners.size(), glm::vec2(0.0f));
+      continue;
+    }
+    const bool per_corner = p->decl.cls == VarClass::FaceVarying || p->decl.cls == VarClass::FaceVertex;
+    const bool per_vertex = p->decl.cls == VarClass::Vertex || p->decl.cls == VarClass::Varying;
+    const size_t expect = per_corner ? corners.size() : npoints;
+    const std::vector<double>& v = p->value->numbers;
+    if (p->decl.is_string() || p->decl.components() != 2 || !(per_corner || per_vertex) || v.size() != 2 * expect)
+      args.fail_at(p->line, "\"" + name + "\" needs two floats per face corner (facevarying, " +
+                                std::to_string(corners.size()) + ") or per vertex (vertex, " +
+                                std::to_string(npoints) + "), found " + std::to_string(v.size()) + " values");
+    std::vector<glm::vec2> layer(corners.size());
+    for (size_t c = 0; c < corners.size(); ++c) {
+      const size_t i = per_corner ? c : static_cast<size_t>(corners[c]);
+      layer[c] = glm::vec2(static_cast<float>(v[2 * i]), static_cast<float>(v[2 * i + 1]));
+    }
+    mesh->uv_layers.push_back(std::move(layer));
+  }
+  const char* space[] = {"micropoly:texspacelocation", "micropoly:texspacesize"};
+  glm::vec3* out[] = {&mesh->texspace_location, &mesh->texspace_size};
+  for (int i = 0; i < 2; ++i) {
+    const Param* p = params.find(space[i]);
+    if (!p) continue;
+    if (p->decl.is_string() || p->value->numbers.size() != 3)
+      args.fail_at(p->line, std::string("\"") + space[i] + "\" needs three floats");
+    const std::vector<double>& v = p->value->numbers;
+    *out[i] = glm::vec3(static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2]));
+  }
 }
 
 }  // namespace mp::rib

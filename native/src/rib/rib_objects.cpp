@@ -23,9 +23,25 @@ void reverse_faces(Mesh& mesh, size_t first_face, size_t first_index) {
   size_t offset = first_index;
   for (size_t f = first_face; f < mesh.face_vertex_counts.size(); ++f) {
     const size_t n = static_cast<size_t>(mesh.face_vertex_counts[f]);
-    std::reverse(mesh.face_vertex_indices.begin() + static_cast<long>(offset),
-                 mesh.face_vertex_indices.begin() + static_cast<long>(offset + n));
+    const auto flip = [&](auto& corners) {
+      std::reverse(corners.begin() + static_cast<long>(offset), corners.begin() + static_cast<long>(offset + n));
+    };
+    flip(mesh.face_vertex_indices);
+    for (auto& layer : mesh.uv_layers) flip(layer);  // UVs belong to their corners
     offset += n;
+  }
+}
+
+// Appends `src`'s UV layers for its corners to `dst`, which had `dst_corners`
+// corners; a layer one side lacks reads zeros there, as a missing layer does.
+void append_uv_layers(Mesh& dst, size_t dst_corners, const Mesh& src) {
+  const size_t layers = std::max(dst.uv_layers.size(), src.uv_layers.size());
+  dst.uv_layers.resize(layers, std::vector<glm::vec2>(dst_corners, glm::vec2(0.0f)));
+  for (size_t k = 0; k < layers; ++k) {
+    if (k < src.uv_layers.size())
+      dst.uv_layers[k].insert(dst.uv_layers[k].end(), src.uv_layers[k].begin(), src.uv_layers[k].end());
+    else
+      dst.uv_layers[k].resize(dst_corners + src.face_vertex_indices.size(), glm::vec2(0.0f));
   }
 }
 
@@ -99,6 +115,7 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
                                     prim.mesh.face_vertex_counts.begin(),
                                     prim.mesh.face_vertex_counts.end());
       for (int i : prim.mesh.face_vertex_indices) dst.face_vertex_indices.push_back(base + i);
+      append_uv_layers(dst, first_index, prim.mesh);
       if (flip) reverse_faces(dst, first_face, first_index);
       return;
     }

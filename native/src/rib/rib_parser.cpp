@@ -10,7 +10,9 @@ namespace mp::rib {
 
 size_t Primitive::elements() const {
   if (kind == Kind::Patches) return patch_points.size();
-  return mesh.points.size() + mesh.face_vertex_indices.size() + mesh.face_vertex_counts.size();
+  size_t uvs = 0;
+  for (const auto& layer : mesh.uv_layers) uvs += layer.size();
+  return mesh.points.size() + mesh.face_vertex_indices.size() + mesh.face_vertex_counts.size() + uvs;
 }
 
 Parser::Parser() {

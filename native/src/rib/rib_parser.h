@@ -35,6 +35,7 @@ struct Limits {
   static constexpr size_t kMaxSceneElements = size_t(1) << 27;  // points + indices
   static constexpr int kMaxResolution = 65536;
   static constexpr int kMaxPixelSamples = 64;
+  static constexpr size_t kMaxTexels = size_t(1) << 27;  // all texture images together
 };
 
 // Graphics-state attributes (RI spec 3.2, section 4.2). The current
@@ -229,6 +230,13 @@ class Parser {
   // left empty when the parameter is absent.
   void read_face_materials(ArgReader& args, const ParamList& params, size_t faces,
                            std::vector<int>* out) const;
+  // UV layers ("micropoly:uv0".."micropoly:uv3", float[2], per face corner
+  // or per vertex) for the face corners `corners` (vertex indices), and the
+  // Generated texture space ("micropoly:texspacelocation", "...size").
+  void read_mesh_texturing(ArgReader& args, const ParamList& params, const std::vector<int>& corners,
+                           size_t npoints, Mesh* mesh) const;
+  // One texture image named by Option "micropoly" "string imagefile".
+  void read_image_option(ArgReader& args, const ParamList& params);
 
   // State.
   RibResult result_;
@@ -237,6 +245,7 @@ class Parser {
   std::vector<Block> blocks_;
   const Source* source_ = nullptr;
   std::set<std::string> warned_;
+  size_t texels_ = 0;  // read so far, against Limits::kMaxTexels
 
   bool in_world_ = false;
   bool world_done_ = false;    // the first world block has ended

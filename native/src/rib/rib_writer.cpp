@@ -13,10 +13,12 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <ostream>
 
+#include "io/texture_io.h"
 #include "micropoly/error.h"
 #include "rib/rib_lexer.h"
 
@@ -417,6 +419,17 @@ void write_mesh(std::string& o, const Mesh& m, const std::vector<Material>& mate
     o += "\n    \"uniform integer micropoly:material\" ";
     put_ints(o, m.face_materials);
   }
+  // UV layers and the Generated texture space, for material programs.
+  for (size_t k = 0; k < m.uv_layers.size(); ++k) {
+    o += "\n    \"facevarying float[2] micropoly:uv" + std::to_string(k) + "\" ";
+    put_floats(o, &m.uv_layers[k].data()->x, 2 * m.uv_layers[k].size());
+  }
+  if (m.texspace_location != glm::vec3(0.0f) || m.texspace_size != glm::vec3(0.0f)) {
+    o += "\n    \"constant float[3] micropoly:texspacelocation\" ";
+    put_vec3(o, m.texspace_location);
+    o += " \"constant float[3] micropoly:texspacesize\" ";
+    put_vec3(o, m.texspace_size);
+  }
   o += "\nAttributeEnd\n";
 }
 
@@ -442,8 +455,31 @@ void flush(std::ostream& out, std::string& text) {
   if (!out) throw Error("writing RIB failed (stream error)");
 }
 
+// Texture images go to files in `folder` ("<k>.exr"), named in the RIB as
+// `reference`/<k>.exr; one Option "micropoly" per image keeps their order.
+void write_images(std::string& o, const std::vector<Image>& images, const std::string& folder,
+                  const std::string& reference) {
+  if (images.empty()) return;
+  if (folder.empty()) throw Error("the scene has texture images; they need a folder to be written to");
+  std::error_code ec;
+  std::filesystem::create_directories(folder, ec);
+  if (ec) throw Error("cannot create texture folder '" + folder + "': " + ec.message());
+  for (size_t k = 0; k < images.size(); ++k) {
+    const std::string file = std::to_string(k) + ".exr";
+    write_texture_image((std::filesystem::path(folder) / file).string(), images[k]);
+    o += "Option \"micropoly\" \"string image\" ";
+    put_string(o, images[k].name);
+    o += " \"string imagefile\" ";
+    put_string(o, (std::filesystem::path(reference) / file).generic_string());
+    o += " \"integer imagesrgb\" ";
+    put_int(o, images[k].srgb ? 1 : 0);
+    o += '\n';
+  }
+}
+
 // write_rib() after validation.
-void write_valid_scene(const Scene& scene, std::ostream& out, const std::string& display_name) {
+void write_valid_scene(const Scene& scene, std::ostream& out, const std::string& display_name,
+                       const std::string& image_folder, const std::string& image_reference) {
   // A Scene without materials renders with Material{}: write that as material 0.
   std::vector<Material> materials = scene.materials;
   if (materials.empty()) materials.emplace_back();
@@ -453,6 +489,7 @@ void write_valid_scene(const Scene& scene, std::ostream& out, const std::string&
   o += MICROPOLY_VERSION;
   o += "; the micropoly extensions are described in docs/rib.md.\nversion 3.04\n";
   write_options(o, scene.settings);
+  write_images(o, scene.images, image_folder, image_reference);
   o += "FrameBegin 1\n";
   if (!display_name.empty()) {
     o += "Display ";
@@ -486,9 +523,10 @@ void write_valid_scene(const Scene& scene, std::ostream& out, const std::string&
 
 }  // namespace
 
-void write_rib(const Scene& scene, std::ostream& out, const std::string& display_name) {
+void write_rib(const Scene& scene, std::ostream& out, const std::string& display_name,
+               const std::string& image_folder) {
   validate_scene(scene);
-  write_valid_scene(scene, out, display_name);
+  write_valid_scene(scene, out, display_name, image_folder, image_folder);
 }
 
 void write_rib_file(const Scene& scene, const std::string& path, const std::string& display_name) {
@@ -496,7 +534,10 @@ void write_rib_file(const Scene& scene, const std::string& path, const std::stri
   std::ofstream file(path, std::ios::binary | std::ios::trunc);
   if (!file) throw Error("cannot open '" + path + "' for writing: " + std::strerror(errno));
   try {
-    write_valid_scene(scene, file, display_name);
+    // Textures beside the file, named relative to it: scene.rib -> scene_textures/.
+    const std::filesystem::path rib(path);
+    const std::string folder = rib.stem().string() + "_textures";
+    write_valid_scene(scene, file, display_name, (rib.parent_path() / folder).string(), folder);
     file.close();
   } catch (const Error& e) {
     throw Error("cannot write '" + path + "': " + e.what());

@@ -14,10 +14,15 @@ namespace mp {
 
 // Writes `scene` (checked with validate_scene() first; throws mp::Error if it
 // is not valid or the stream fails). A non-empty `display_name` adds a Display
-// request, so micropoly-render needs no -o.
-void write_rib(const Scene& scene, std::ostream& out, const std::string& display_name = {});
+// request, so micropoly-render needs no -o. Texture images (Scene::images)
+// are written as `image_folder`/<k>.exr (created if missing) and named by
+// that path in the RIB; a scene with images needs a folder.
+void write_rib(const Scene& scene, std::ostream& out, const std::string& display_name = {},
+               const std::string& image_folder = {});
 
-// Same, to a file; throws mp::Error when the file cannot be written.
+// Same, to a file; throws mp::Error when the file cannot be written. Texture
+// images go beside it: scene.rib gets scene_textures/<k>.exr, named relative
+// to the RIB file, so the two move together.
 void write_rib_file(const Scene& scene, const std::string& path, const std::string& display_name = {});
 
 }  // namespace mp
