@@ -54,6 +54,9 @@ struct Renderer::Impl {
   // building and uploading patches.
   std::unique_ptr<SceneBuffers> scene_buffers;
   uint64_t scene_key = 0;
+  // Object-space patches of the last scenes' shapes: a moved camera or
+  // object re-places them instead of rebuilding (patch_cache.h).
+  PatchCache patch_cache;
 };
 
 Renderer::Renderer(const std::string& selector) : impl_(std::make_unique<Impl>(selector)) {}
@@ -91,7 +94,7 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     const uint64_t key = scene_fingerprint(scene);
     if (!impl_->scene_buffers || impl_->scene_key != key) {
       impl_->scene_buffers.reset();  // free the old scene's device memory first
-      HostSceneData host = prepare_scene_data(scene);
+      HostSceneData host = prepare_scene_data(scene, &impl_->patch_cache);
       impl_->scene_buffers = std::make_unique<SceneBuffers>(upload_scene_data(s.context(), s.queue(), host));
       impl_->scene_key = key;
     } else {

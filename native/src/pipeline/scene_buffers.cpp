@@ -61,17 +61,57 @@ float max_scale(const glm::mat4& m) {
   return std::max({glm::length(glm::vec3(m[0])), glm::length(glm::vec3(m[1])), glm::length(glm::vec3(m[2]))});
 }
 
-// Tags patches [first, size) with their object and, for displaced
-// materials, the displacement bound in camera space (mp_patch.h).
-void finish_object_patches(PatchBuffer& patches, size_t first, uint32_t object, const Scene& scene, float scale) {
-  for (size_t p = first; p < patches.size(); ++p) {
-    patches.info[p].z |= object << 8;
-    const unsigned mi = patches.info[p].y;
-    if (mi < scene.materials.size()) {
-      const Material& m = scene.materials[mi];
-      if (m.program >= 0 && m.program_displaces) patches.points[p * MP_PATCH_POINTS].w = m.displacement_bound * scale;
+// Appends an object-space shape (patch_cache.h) as object `object`: control
+// points and edge curves carried to camera space, edge-curve references
+// rebased, and the object's materials (per face through the patch's
+// primitive id), sidedness and displacement bound filled in.
+void place_shape(const PatchBuffer& shape, const glm::mat4& to_camera, const Mesh* mesh, int set_material,
+                 bool double_sided, uint32_t object, const Scene& scene, PatchBuffer& out) {
+  const glm::dmat4 m(to_camera);
+  // Edge curves' second half is a cubic of normals (mp_patch.h); normals map
+  // by the inverse transpose. The kernels normalise it and orient it like the
+  // patch, so its scale and sign do not matter.
+  const glm::dmat3 normal_map = glm::transpose(glm::inverse(glm::dmat3(m)));
+  unsigned flags = object << 8;
+  if (double_sided) flags |= MP_PATCH_DOUBLE_SIDED;
+  // A mirroring transform turns counter-clockwise faces clockwise; the
+  // pipeline flips the geometric normal instead of reordering control points.
+  if (glm::determinant(glm::dmat3(m)) < 0.0) flags |= MP_PATCH_FLIP_ORIENTATION;
+  const float bound_scale = max_scale(to_camera);
+  auto point = [&](const glm::vec4& p) {
+    const glm::dvec4 q = m * glm::dvec4(glm::dvec3(p), 1.0);
+    return glm::vec4(float(q.x), float(q.y), float(q.z), 0.0f);
+  };
+
+  const size_t first = out.size();
+  const uint32_t curve_base = uint32_t(out.curves.size() / MP_CURVE_FLOAT4S);
+  out.points.reserve(out.points.size() + shape.points.size());
+  for (const glm::vec4& p : shape.points) out.points.push_back(point(p));
+  out.info.reserve(out.info.size() + shape.info.size());
+  for (size_t p = 0; p < shape.size(); ++p) {
+    glm::uvec4 info = shape.info[p];
+    const int material = mesh ? (mesh->face_materials.empty() ? mesh->material : mesh->face_materials[info.w])
+                              : set_material;
+    info.y = unsigned(material);
+    info.z = flags;
+    out.info.push_back(info);
+    if (size_t(material) < scene.materials.size()) {
+      const Material& mat = scene.materials[size_t(material)];
+      if (mat.program >= 0 && mat.program_displaces)
+        out.points[(first + p) * MP_PATCH_POINTS].w = mat.displacement_bound * bound_scale;
     }
   }
+  out.edges.reserve(out.edges.size() + shape.edges.size());
+  for (uint32_t ref : shape.edges) out.edges.push_back(ref == MP_NO_CURVE ? ref : ref + (curve_base << 1));
+  out.curves.reserve(out.curves.size() + shape.curves.size());
+  for (size_t c = 0; c < shape.curves.size(); c += MP_CURVE_FLOAT4S) {
+    for (int k = 0; k < 4; ++k) out.curves.push_back(point(shape.curves[c + size_t(k)]));
+    for (int k = 4; k < MP_CURVE_FLOAT4S; ++k) {
+      const glm::dvec3 n = normal_map * glm::dvec3(glm::vec3(shape.curves[c + size_t(k)]));
+      out.curves.emplace_back(float(n.x), float(n.y), float(n.z), 0.0f);
+    }
+  }
+  out.uvs.insert(out.uvs.end(), shape.uvs.begin(), shape.uvs.end());
 }
 
 DeviceLight to_device(const Light& l, const glm::mat4& world_to_camera) {
@@ -114,31 +154,26 @@ cl::Buffer upload(cl::Context& context, cl::CommandQueue& queue, const std::vect
 
 }  // namespace
 
-HostSceneData prepare_scene_data(const Scene& scene) {
+HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
   HostSceneData out;
   const glm::mat4& w2c = scene.camera.world_to_camera;
   for (const Mesh& mesh : scene.meshes)
     out.patches.uv_layers = std::max(out.patches.uv_layers, int(mesh.uv_layers.size()));
   // Each surface's patches share their edges' curves (patch_edges.h), so
   // neighbouring patches dice watertight; separate surfaces do not.
-  for (const Mesh& mesh : scene.meshes) {
-    glm::mat4 to_camera = w2c * mesh.object_to_world;
-    const size_t first = out.patches.size();
-    if (mesh.scheme == SubdivScheme::CatmullClark)
-      append_subdiv_patches(mesh, to_camera, out.patches);
-    else
-      append_polygon_patches(mesh, to_camera, out.patches);
-    share_patch_edges(out.patches, first);
-    finish_object_patches(out.patches, first, uint32_t(out.objects.size()), scene, max_scale(to_camera));
-    out.objects.push_back(to_device_object(to_camera, mesh.texspace_location, mesh.texspace_size, mesh.points));
-  }
-  for (const BezierPatches& set : scene.bezier_patches) {
-    const size_t first = out.patches.size();
-    glm::mat4 to_camera = w2c * set.object_to_world;
-    append_bezier_patches(set, to_camera, out.patches);
-    share_patch_edges(out.patches, first);
-    finish_object_patches(out.patches, first, uint32_t(out.objects.size()), scene, max_scale(to_camera));
-    out.objects.push_back(to_device_object(to_camera, glm::vec3(0.0f), glm::vec3(0.0f), set.control_points));
+  std::vector<PatchCache::Surface> surfaces;
+  for (const Mesh& mesh : scene.meshes) surfaces.push_back({&mesh, nullptr});
+  for (const BezierPatches& set : scene.bezier_patches) surfaces.push_back({nullptr, &set});
+  PatchCache local;
+  const auto shapes = (cache ? cache : &local)->shapes(surfaces, out.patches.uv_layers);
+  for (size_t i = 0; i < surfaces.size(); ++i) {
+    const Mesh* mesh = surfaces[i].mesh;
+    const BezierPatches* set = surfaces[i].set;
+    const glm::mat4 to_camera = w2c * (mesh ? mesh->object_to_world : set->object_to_world);
+    place_shape(*shapes[i], to_camera, mesh, set ? set->material : 0, mesh ? mesh->double_sided : set->double_sided,
+                uint32_t(out.objects.size()), scene, out.patches);
+    out.objects.push_back(mesh ? to_device_object(to_camera, mesh->texspace_location, mesh->texspace_size, mesh->points)
+                               : to_device_object(to_camera, glm::vec3(0.0f), glm::vec3(0.0f), set->control_points));
   }
   if (scene.materials.empty()) out.materials.push_back(to_device(Material{}));
   for (const Material& m : scene.materials) out.materials.push_back(to_device(m));

@@ -6,6 +6,7 @@
 #include "cl/cl.h"
 #include "micropoly/scene.h"
 #include "mp_types.h"
+#include "pipeline/patch_cache.h"
 #include "subdiv/patch_buffer.h"
 
 namespace mp {
@@ -20,7 +21,9 @@ struct HostSceneData {
   std::vector<DeviceImage> images;
   std::vector<glm::vec4> texels;      // every image's pixels, one after the other
 };
-HostSceneData prepare_scene_data(const Scene& scene);
+// Surfaces' object-space patches come from `cache` when given (kept by the
+// caller between scenes; patch_cache.h), else they are built for this call.
+HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache = nullptr);
 
 struct SceneBuffers {
   cl::Buffer points;      // float4 x MP_PATCH_POINTS per patch

@@ -42,6 +42,35 @@ class Hasher {
 
 }  // namespace
 
+uint64_t mesh_shape_key(const Mesh& m, int uv_layers) {
+  Hasher h;
+  h.value(uint32_t(1));  // meshes and patch sets never share a key
+  h.value(uv_layers);
+  h.value(m.scheme);
+  h.values(m.points);
+  h.values(m.face_vertex_counts);
+  h.values(m.face_vertex_indices);
+  if (m.scheme == SubdivScheme::CatmullClark) {
+    h.values(m.crease_vertices);
+    h.values(m.crease_sharpness);
+    h.values(m.corner_vertices);
+    h.values(m.corner_sharpness);
+    h.values(m.hole_faces);
+    h.value(m.boundary);
+  }
+  h.value(m.uv_layers.size());
+  for (const auto& layer : m.uv_layers) h.values(layer);
+  return h.result();
+}
+
+uint64_t patch_set_shape_key(const BezierPatches& set, int uv_layers) {
+  Hasher h;
+  h.value(uint32_t(2));
+  h.value(uv_layers);
+  h.values(set.control_points);
+  return h.result();
+}
+
 uint64_t scene_fingerprint(const Scene& scene) {
   Hasher h;
   h.value(scene.camera.world_to_camera);

@@ -14,4 +14,11 @@ namespace mp {
 
 uint64_t scene_fingerprint(const Scene& scene);
 
+// Fingerprints of what a surface's object-space patches depend on (its
+// shape, tags and UVs, and the number of UV layers the scene's patches
+// carry), but not its name, transform, materials or sidedness: equal meshes
+// placed several times (instances, duplicates) share one key.
+uint64_t mesh_shape_key(const Mesh& mesh, int uv_layers);
+uint64_t patch_set_shape_key(const BezierPatches& set, int uv_layers);
+
 }  // namespace mp
