@@ -11,6 +11,7 @@ flight at its next progress check (between bound & split launches and sample
 chunks). Refinement follows `refinement_passes`: a quarter-resolution image
 with one sample first, then the full view at the viewport sample count."""
 
+import atexit
 import math
 import threading
 import time
@@ -168,6 +169,18 @@ _LIVE = weakref.WeakSet()
 
 def live_sessions():
     return list(_LIVE)
+
+
+def _close_live_sessions():
+    # When Python shuts down (Blender quits, or a background script fails)
+    # with a render in flight, a worker thread inside the native renderer
+    # would be torn down as it next takes the GIL, which aborts the process.
+    # Stop every session first: each returns at its next progress check.
+    for session in list(_LIVE):
+        session.close(timeout=2.0)
+
+
+atexit.register(_close_live_sessions)
 
 
 class ViewportSession:

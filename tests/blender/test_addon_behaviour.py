@@ -228,10 +228,49 @@ def test_rib_export_matches_f12():
           os.path.isfile(os.path.join(folder, "scene_textures", "0.exr")), str(os.listdir(folder)))
 
 
+_EXIT_MID_RENDER = """
+import sys, time, bpy
+sys.path.insert(0, {tests!r})
+import render_utils as ru
+ru.enable_addon()
+scene = ru.reset_scene()
+bpy.ops.mesh.primitive_monkey_add()
+bpy.context.object.modifiers.new("Subdivision", "SUBSURF")
+ru.add_camera(scene, (0, -4, 0), (0, 0, 0))
+scene.render.engine = "MICROPOLY"
+from micropoly import export, viewport
+depsgraph = bpy.context.evaluated_depsgraph_get()
+view = viewport.view_from_camera(scene, depsgraph, 1280, 720)
+session = viewport.ViewportSession("")
+session.request(export.export_scene(depsgraph, view=view), view, 64, 0.5)
+time.sleep({delay})
+raise SystemExit(3)  # Python shuts down with the viewport render in flight
+"""
+
+
+def test_exit_with_viewport_render_in_flight():
+    # Blender quitting (here: a background script ending) while a viewport
+    # render runs must end the process normally, not abort it.
+    if not bpy.app.binary_path or not os.path.isfile(bpy.app.binary_path):
+        print("skip exit test: no Blender executable (bpy module)")
+        return
+    for delay in (0.0, 0.3):
+        script = os.path.join(tempfile.mkdtemp(prefix="mp-exit-"), "exit.py")
+        with open(script, "w") as f:
+            f.write(_EXIT_MID_RENDER.format(tests=os.path.dirname(os.path.abspath(__file__)), delay=delay))
+        proc = subprocess.run([bpy.app.binary_path, "-b", "--factory-startup", "--python-exit-code", "1",
+                               "--python", script], capture_output=True, text=True, timeout=300, env=os.environ)
+        out = proc.stdout + proc.stderr
+        check(f"Blender exits cleanly with a viewport render in flight (after {delay} s)",
+              proc.returncode in (1, 3) and "terminate called" not in out,
+              f"exit code {proc.returncode}: {out.strip()[-300:]}")
+
+
 def main():
     print(f"Blender {bpy.app.version_string}")
     for test in (test_nan_mesh, test_empty_scene, test_camera_inside_object, test_cancel_is_quick,
-                 test_rib_export_matches_f12, test_animation, test_old_blend_files):
+                 test_rib_export_matches_f12, test_animation, test_old_blend_files,
+                 test_exit_with_viewport_render_in_flight):
         try:
             test()
         except Exception:

@@ -1,6 +1,7 @@
 #include "cl/device_session.h"
 
 #include <cstdlib>
+#include <mutex>
 
 #include "cl/program_cache.h"
 #include "micropoly/error.h"
@@ -14,6 +15,12 @@ struct FoundDevice {
 };
 
 std::vector<FoundDevice> enumerate() {
+  // The ICD loader and drivers load their platforms on the first call; two
+  // threads making that call together can see no platforms at all (the
+  // add-on lists devices on a background thread while a render may start).
+  // One lock for the process serialises discovery; it guards no data.
+  static std::mutex discovery;
+  std::lock_guard<std::mutex> lock(discovery);
   std::vector<FoundDevice> out;
   std::vector<cl::Platform> platforms;
   try {

@@ -302,8 +302,15 @@ PYBIND11_MODULE(_native, m) {
   bind_rib(m);
 
   m.def("list_devices", [] {
+    std::vector<DeviceInfo> devices;
+    {
+      // The first call starts the OpenCL drivers (tens of milliseconds):
+      // other Python threads run meanwhile.
+      py::gil_scoped_release release;
+      devices = list_devices();
+    }
     py::list out;
-    for (auto& d : list_devices()) {
+    for (auto& d : devices) {
       py::dict e;
       e["index"] = d.index;
       e["name"] = d.name;
