@@ -134,13 +134,35 @@ MP_INLINE float mp_bump_shadowing(float3 ng, float3 n, float3 l) {
   return -g * g * g + g * g + g;
 }
 
+/* Blender 4.0's version (Cycles' bump_shadowing_term since 4.0, after Conty
+ * Estevez, Lecocq and Stein, "A Microfacet-Based Shadowing Function to Solve
+ * the Bump Terminator Problem", 2019): no light from the wrong side of the
+ * smooth surface ns for the bumped normal n; with the material's Bump Map
+ * Correction, the Smith GGX shadowing G1 at the light's angle to ns, with
+ * alpha^2 = min(tan^2(angle between n and ns) / 8, 1). */
+MP_INLINE float mp_bump_shadowing_v4(float3 ns, float3 n, float3 l, int correction) {
+  float cos_nsl = dot(ns, l), cos_nsn = dot(ns, n), cos_nl = dot(n, l);
+  if (cos_nsl * cos_nsn * cos_nl < 0.0f) return 0.0f;
+  if (!correction) return 1.0f;
+  float cos_i = fabs(cos_nsl), cos_d = fabs(cos_nsn);
+  if (cos_d >= 1.0f || cos_i >= 1.0f) return 1.0f;
+  if (cos_i < 1e-6f) return 0.0f;
+  float alpha2 = fmin(fmax(0.125f * (1.0f / (cos_d * cos_d) - 1.0f), 0.0f), 1.0f);
+  float tan2_i = 1.0f / (cos_i * cos_i) - 1.0f;
+  float lambda = 0.5f * (sqrt(1.0f + alpha2 * tan2_i) - 1.0f);
+  return 1.0f / (1.0f + lambda);
+}
+
 /* Radiance leaving point p towards the eye, with a shading normal `n`
  * (e.g. bumped) on the side of the geometric normal `ng`: both flip together
  * when the surface is seen from behind, so a bumped normal that tilts away
  * from the viewer near a silhouette is not flipped on its own. bsdf_normal:
  * n is a BSDF's own normal, different from the surface's, which Cycles keeps
  * from reflecting the view below the surface (mp_valid_reflection_normal)
- * and whose diffuse light it shadows by the surface (mp_bump_shadowing). */
+ * and whose diffuse light it shadows by the surface (mp_bump_shadowing):
+ * 1 as Blender 3.x does; 2 (3 without Bump Map Correction) as 4.0 and later
+ * do, where the diffuse lobe keeps the normal as it is (mp_bump_shadowing_v4)
+ * and only the specular lobe is kept from reflecting below the surface. */
 MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal, int ortho, const DeviceMaterial* m,
                                  MP_GLOBAL const DeviceLight* lights, uint light_count) {
   float3 cs = MP_F3(m->color[0], m->color[1], m->color[2]);
@@ -150,7 +172,9 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal,
   float3 v = ortho ? MP_F3(0.0f, 0.0f, 1.0f) : normalize(-p);
   float3 ngf = dot(ng, v) < 0.0f ? -ng : ng;
   float3 nf = dot(ng, v) < 0.0f ? -n : n; /* faceforward */
+  float3 nd = nf;                          /* the diffuse lobe's normal */
   if (bsdf_normal) nf = mp_valid_reflection_normal(ngf, v, nf);
+  if (bsdf_normal <= 1) nd = nf;
   float ka = m->coeffs[0], kd = m->coeffs[1], ks = m->coeffs[2], roughness = m->coeffs[3];
   float inv_roughness = 1.0f / fmax(roughness, 1e-4f);
   float metallic = m->principled[0];
@@ -166,9 +190,11 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal,
       continue;
     }
     float3 l;
-    float3 e; /* light color times cos(incidence), i.e. irradiance for physical lights */
+    float3 e;  /* light color times cos(incidence), i.e. irradiance for physical lights */
+    float3 ed; /* the same for the diffuse lobe's normal */
     if (type == MP_LIGHT_AREA) {
       e = cl * mp_area_irradiance(lt, p, nf, &l);
+      ed = bsdf_normal >= 2 ? cl * mp_area_irradiance(lt, p, nd, &l) : e;
     } else {
       if (type == MP_LIGHT_DISTANT) {
         l = -mp_light_f3(lt->direction);
@@ -185,9 +211,12 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal,
         cl *= atten;
       }
       e = cl * fmax(dot(nf, l), 0.0f);
+      ed = cl * fmax(dot(nd, l), 0.0f);
     }
+    if (bsdf_normal >= 2)
+      diffuse += ed * mp_bump_shadowing_v4(ngf, nd, l, bsdf_normal == 2);
     if (!(e.x > 0.0f || e.y > 0.0f || e.z > 0.0f)) continue;
-    diffuse += bsdf_normal ? e * mp_bump_shadowing(ngf, nf, l) : e;
+    if (bsdf_normal <= 1) diffuse += bsdf_normal ? e * mp_bump_shadowing(ngf, nf, l) : e;
     if (model == MP_MODEL_PRINCIPLED) {
       float vh = fmax(dot(v, normalize(l + v)), 0.0f);
       float3 fresnel = f0 + (MP_F3(1.0f, 1.0f, 1.0f) - f0) * pow(1.0f - vh, 5.0f);

@@ -76,16 +76,55 @@ class MeshCache:
             del self.arrays[key]
 
 
-def _uv_layers(mesh, names, n_loops):
-    """(len(names), n_loops, 2) UVs per face corner; "" names the active render
-    UV map; a map the mesh lacks reads zero, as in Cycles."""
-    out = np.zeros((len(names), n_loops, 2), dtype=np.float32)
+def _uv_layer(mesh, name):
+    """The UV map of that name; "" names the active render UV map."""
     layers = mesh.uv_layers
+    if name:
+        return layers.get(name)
+    return next((l for l in layers if l.active_render), None) or layers.active
+
+
+def _tangents(mesh, layer, n_loops, counts):
+    """(n_loops, 4): MikkTSpace tangent xyz and bitangent sign per face corner
+    for UV map `layer`, as Blender computes them for normal maps (and Cycles
+    too); zeros where Blender computes none (faces of more than four sides),
+    which the Normal Map node replaces with tangents from the UVs."""
+    out = np.zeros((n_loops, 4), dtype=np.float32)
+    if counts.size and counts.max() > 4:
+        return out  # Blender refuses (with an error report) rather than skip those faces
+    try:
+        mesh.calc_tangents(uvmap=layer.name)
+    except RuntimeError:
+        return out
+    try:
+        flat = np.empty(n_loops * 3, dtype=np.float32)
+        mesh.loops.foreach_get("tangent", flat)
+        out[:, :3] = flat.reshape(-1, 3)
+        sign = np.empty(n_loops, dtype=np.float32)
+        mesh.loops.foreach_get("bitangent_sign", sign)
+        out[:, 3] = sign
+    finally:
+        mesh.free_tangents()
+    return out
+
+
+def _uv_layers(mesh, names, n_loops, counts):
+    """(len(names), n_loops, 2) per face corner: a name is a UV map ("" the
+    active render one), or ("tangent", map, k) for half k of that map's
+    tangents (xy, then z and the bitangent sign). A map the mesh lacks reads
+    zero, as in Cycles."""
+    out = np.zeros((len(names), n_loops, 2), dtype=np.float32)
+    tangents = {}
     for k, name in enumerate(names):
-        if name:
-            layer = layers.get(name)
-        else:
-            layer = next((l for l in layers if l.active_render), None) or layers.active
+        if isinstance(name, tuple):
+            layer = _uv_layer(mesh, name[1])
+            if layer is None:
+                continue
+            if name[1] not in tangents:
+                tangents[name[1]] = _tangents(mesh, layer, n_loops, counts)
+            out[k] = tangents[name[1]][:, 2 * name[2]:2 * name[2] + 2]
+            continue
+        layer = _uv_layer(mesh, name)
         if layer is None:
             continue
         flat = np.empty(n_loops * 2, dtype=np.float32)
@@ -109,7 +148,7 @@ def _mesh_arrays(mesh, with_creases, uv_names=()):
     mesh.polygons.foreach_get("material_index", material_index)
     arrays = dict(points=points.reshape(-1, 3), counts=counts, indices=indices, material_index=material_index)
     if uv_names:
-        arrays["uv_layers"] = _uv_layers(mesh, uv_names, n_loops)
+        arrays["uv_layers"] = _uv_layers(mesh, uv_names, n_loops, counts)
     if with_creases:
         edge_crease = _float_attribute(mesh, "crease_edge", lambda m: m.edges, "crease", n_edges)
         creased = np.nonzero(edge_crease > 0.0)[0]

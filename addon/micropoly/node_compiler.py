@@ -98,6 +98,9 @@ class NoResources:
     def uv_layer(self, name):
         return 0
 
+    def tangent_layers(self, name):
+        return -1, -1
+
     def image(self, image, warn):
         return -1, False
 
@@ -352,6 +355,8 @@ class NodeCompiler:
             return self.emit_displacement(node)
         if t == "BUMP":
             return self.emit_bump(node)
+        if t == "NORMAL_MAP":
+            return self.emit_normal_map(node)
         if t in TEXTURE_HEADERS:
             return self.emit_texture(node)
         self.warn(node, "is not supported; its outputs take their default values")
@@ -516,6 +521,25 @@ class NodeCompiler:
         return {"Normal": self.fn.temp(VEC, f"mp_bump(g, {h}(g), g->dx ? {h}(g->dx) : 0.0f, "
                                             f"g->dy ? {h}(g->dy) : 0.0f, {strength}, {distance}, {invert}, {n_in})")}
 
+    def emit_normal_map(self, node):
+        """Normal Map: tangent space from the UV map's tangents (mp_normal_map_tangent),
+        or object space."""
+        strength = self.input(node, "Strength", FLOAT)[0]
+        color = self.input(node, "Color", VEC)[0]
+        if node.space == "TANGENT":
+            self.uses_neighbours = True  # the tangent from UV differences, where there are none
+            uv = self.resources.uv_layer(node.uv_map)
+            ta, tb = self.resources.tangent_layers(node.uv_map)
+            # Blender 4.0 scales the map's tilt by Strength instead of blending normals.
+            v4 = 1 if self.version >= 400 else 0
+            expr = f"mp_normal_map_tangent(g, {uv}, {ta}, {tb}, {strength}, {color}, {v4})"
+        else:
+            if node.space in ("WORLD", "BLENDER_WORLD"):
+                self.warn(node, "world space is not supported; the map is read in object space")
+            blender = 1 if node.space.startswith("BLENDER") else 0
+            expr = f"mp_normal_map_object(g, {blender}, {strength}, {color})"
+        return {"Normal": self.fn.temp(VEC, expr)}
+
     def emit_image(self, node):
         self.headers.add("mp_tex_image.h")
         index, byte_image = self.resources.image(node.image, lambda what: self.warn(node, what))
@@ -594,10 +618,24 @@ class NodeCompiler:
     def _assignment(self, shader, field, socket, kind, strength):
         expr = self.input(shader, socket, kind)[0]
         if field == "normal":
-            return f"  s->normal = {expr};\n  s->has_normal = MP_NORMAL_INPUT;\n"
+            return f"  s->normal = {expr};\n  s->has_normal = {self._normal_input_mode()};\n"
         if strength is not None:
             expr = f"{expr} * {self.input(shader, strength, FLOAT)[0] if strength in shader.inputs else '1.0f'}"
         return f"  s->{field} = {expr};\n"
+
+    def _normal_input_mode(self):
+        """How Cycles treats a BSDF's Normal input in the running Blender:
+        3.x keeps it from reflecting the view below the surface and shadows
+        its diffuse light by the smooth surface (Chiang et al.); 4.0 and later
+        reject light from the wrong side of the smooth surface and, with the
+        material's Bump Map Correction (on by default), soften the rest with
+        a GGX shadowing term (Conty Estevez et al.)."""
+        if self.version < 400:
+            return "MP_NORMAL_INPUT"
+        cycles = getattr(self.material, "cycles", None)
+        if getattr(cycles, "use_bump_map_correction", True):
+            return "MP_NORMAL_INPUT_V4"
+        return "MP_NORMAL_INPUT_V4_UNCORRECTED"
 
     def _surface_assignments(self, shader):
         """(field, socket, kind, strength socket) for every linked Principled input."""

@@ -182,6 +182,12 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   m.emission[0] = s.emission.x, m.emission[1] = s.emission.y, m.emission[2] = s.emission.z;
   int has_normal = s.has_normal && all(isfinite(s.normal)) && length(s.normal) > 1e-6f;
   float3 ns = has_normal ? mp_object_normal_to_camera(o, s.normal) : n;
-  float3 c = mp_shade_bumped(p, n, ns, has_normal && s.has_normal == MP_NORMAL_INPUT, f.ortho, &m, lights, light_count);
+  /* A BSDF's own normal: shaded as the running Blender's Cycles does (mp_shade_bumped). */
+  int bsdf_normal = !has_normal                                       ? 0
+                    : s.has_normal == MP_NORMAL_INPUT                 ? 1
+                    : s.has_normal == MP_NORMAL_INPUT_V4              ? 2
+                    : s.has_normal == MP_NORMAL_INPUT_V4_UNCORRECTED ? 3
+                                                                      : 0;
+  float3 c = mp_shade_bumped(p, n, ns, bsdf_normal, f.ortho, &m, lights, light_count);
   grid_c[index] = (float4)(c, clamp(s.alpha, 0.0f, 1.0f));
 }

@@ -44,6 +44,10 @@ typedef struct {
  * Cycles keeps from reflecting the view direction below the surface. */
 #define MP_NORMAL_SET 1
 #define MP_NORMAL_INPUT 2
+/* The same as Blender 4.0 and later shade it (mp_shade_bumped), with and
+ * without the material's Bump Map Correction. */
+#define MP_NORMAL_INPUT_V4 3
+#define MP_NORMAL_INPUT_V4_UNCORRECTED 4
 
 /* Bump node: the normal tilted by the height's gradient over the surface,
  * from heights at the point and a small step along u and v (hc, hx, hy),
@@ -66,6 +70,65 @@ MP_INLINE float3 mp_bump(const MpNodeGlobals* g, float hc, float hx, float hy, f
   n = strength * n + (1.0f - strength) * n_in;
   len = length(n);
   return len > 0.0f ? n / len : n_in;
+}
+
+/* Normal Map node, as Cycles evaluates it: the color is mapped to [-1, 1],
+ * then read in tangent space (below) or as an object-space normal, and the
+ * result is blended with the surface normal by strength. Everything here is
+ * object space, like MpNodeGlobals. */
+MP_INLINE float3 mp_normal_map_strength(const MpNodeGlobals* g, float3 n, float strength) {
+  if (strength != 1.0f) n = g->N + (n - g->N) * fmax(strength, 0.0f);
+  float len = length(n);
+  return len > 0.0f && isfinite(len) ? n / len : g->N;
+}
+
+/* Tangent space, for the UV map in layer `uv`. Layers `ta` and `tb` hold
+ * its tangents (tangent xy, then tangent z and the bitangent sign: MikkTSpace
+ * tangents per face corner, as Blender computes them and Cycles interpolates
+ * them), or are -1. Where there are none, or they are zero (a mesh Blender
+ * computes no tangents for), the tangent is the direction of increasing U
+ * on the surface, from the UV differences to the grid neighbours, made
+ * orthogonal to the normal. `v4`: Blender 4.0's Strength (below). */
+MP_INLINE float3 mp_normal_map_tangent(const MpNodeGlobals* g, int uv, int ta, int tb, float strength,
+                                       float3 color, int v4) {
+  float3 n = g->N;
+  float3 t = MP_F3(0.0f, 0.0f, 0.0f);
+  float sign = 1.0f;
+  if (ta >= 0 && tb >= 0) {
+    t = MP_F3(g->uv[ta].x, g->uv[ta].y, g->uv[tb].x);
+    sign = g->uv[tb].y < 0.0f ? -1.0f : 1.0f;
+  }
+  if (!(dot(t, t) > 0.0f)) {
+    if (g->dx == 0 || g->dy == 0) return n;
+    float3 p1 = g->dx->P - g->P, p2 = g->dy->P - g->P;
+    float3 uv1 = g->dx->uv[uv] - g->uv[uv], uv2 = g->dy->uv[uv] - g->uv[uv];
+    float det = uv1.x * uv2.y - uv2.x * uv1.y;
+    if (!(fabs(det) > 0.0f)) return n;
+    float3 du = (p1 * uv2.y - p2 * uv1.y) / det; /* dP/dU */
+    float3 dv = (p2 * uv1.x - p1 * uv2.x) / det; /* dP/dV */
+    t = du - n * dot(n, du);
+    if (!(dot(t, t) > 0.0f)) return n;
+    t = normalize(t);
+    sign = dot(cross(n, t), dv) < 0.0f ? -1.0f : 1.0f;
+  }
+  float3 c = 2.0f * (color - MP_F3(0.5f, 0.5f, 0.5f));
+  if (v4) {
+    /* Blender 4.0: strength scales the tilt, never pushing the normal below
+     * the surface; no blend afterwards. */
+    c.x *= strength, c.y *= strength;
+    c.z = 1.0f + (c.z - 1.0f) * fmin(fmax(strength, 0.0f), 1.0f);
+    strength = 1.0f;
+  }
+  float3 b = sign * cross(n, t);
+  return mp_normal_map_strength(g, c.x * t + c.y * b + c.z * n, strength);
+}
+
+/* Object space; Blender's own object space has y and z flipped. */
+MP_INLINE float3 mp_normal_map_object(const MpNodeGlobals* g, int blender_space, float strength, float3 color) {
+  float3 c = 2.0f * (color - MP_F3(0.5f, 0.5f, 0.5f));
+  if (blender_space) c.y = -c.y, c.z = -c.z;
+  float len = length(c);
+  return mp_normal_map_strength(g, len > 0.0f ? c / len : g->N, strength);
 }
 
 MP_INLINE float mp_nl_safe_div(float a, float b) { return b != 0.0f ? a / b : 0.0f; }
