@@ -57,6 +57,12 @@
  * data); mp_patch_uv in mp_surface.h evaluates them watertight. */
 #define MP_MAX_UV_LAYERS 4
 
+/* Smooth shading normals: 4 float4 per patch at patch_normals[4 * patch],
+ * the normals at corners (0,0), (1,0), (1,1), (0,1) (camera space on the
+ * device, not normalised), interpolated bilinearly; all zero for a patch
+ * shaded with its own surface normal (mp_patch_shading_normal). */
+#define MP_PATCH_NORMALS 4
+
 /* Interior point indices in the 4x4 net and the index of their partners. */
 #define MP_INTERIOR_0 5
 #define MP_INTERIOR_1 6

@@ -7,6 +7,7 @@
 #define MP_SHADING_H
 
 #include "mp_compat.h"
+#include "mp_patch.h"
 #include "mp_types.h"
 
 #define MP_PI 3.14159265358979f
@@ -162,16 +163,20 @@ MP_INLINE float mp_bump_shadowing_v4(float3 ns, float3 n, float3 l, int correcti
  * and whose diffuse light it shadows by the surface (mp_bump_shadowing):
  * 1 as Blender 3.x does; 2 (3 without Bump Map Correction) as 4.0 and later
  * do, where the diffuse lobe keeps the normal as it is (mp_bump_shadowing_v4)
- * and only the specular lobe is kept from reflecting below the surface. */
-MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal, int ortho, const DeviceMaterial* m,
-                                 MP_GLOBAL const DeviceLight* lights, uint light_count) {
+ * and only the specular lobe is kept from reflecting below the surface.
+ * faced: ng and n already face the viewer's side of the surface (smooth
+ * shading normals, which the geometry faced: mp_face_shading_normal), so a
+ * smooth normal turning away near a silhouette is not flipped. */
+MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal, int faced, int ortho,
+                                 const DeviceMaterial* m, MP_GLOBAL const DeviceLight* lights, uint light_count) {
   float3 cs = MP_F3(m->color[0], m->color[1], m->color[2]);
   float3 emission = MP_F3(m->emission[0], m->emission[1], m->emission[2]);
   int model = (int)m->color[3];
   if (model == MP_MODEL_CONSTANT) return cs + emission;
   float3 v = ortho ? MP_F3(0.0f, 0.0f, 1.0f) : normalize(-p);
-  float3 ngf = dot(ng, v) < 0.0f ? -ng : ng;
-  float3 nf = dot(ng, v) < 0.0f ? -n : n; /* faceforward */
+  int back = !faced && dot(ng, v) < 0.0f;
+  float3 ngf = back ? -ng : ng;
+  float3 nf = back ? -n : n; /* faceforward */
   float3 nd = nf;                          /* the diffuse lobe's normal */
   if (bsdf_normal) nf = mp_valid_reflection_normal(ngf, v, nf);
   if (bsdf_normal <= 1) nd = nf;
@@ -236,9 +241,26 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal,
 }
 
 /* Radiance leaving point p with normal n towards the eye. */
-MP_INLINE float3 mp_shade(float3 p, float3 n, int ortho, const DeviceMaterial* m,
+MP_INLINE float3 mp_shade(float3 p, float3 n, int faced, int ortho, const DeviceMaterial* m,
                           MP_GLOBAL const DeviceLight* lights, uint light_count) {
-  return mp_shade_bumped(p, n, n, 0, ortho, m, lights, light_count);
+  return mp_shade_bumped(p, n, n, 0, faced, ortho, m, lights, light_count);
+}
+
+/* The smooth shading normal of a patch at (u, v) (mp_patch.h,
+ * MP_PATCH_NORMALS), made to face the viewer as the surface normal `ng`
+ * does, as Cycles flips a smooth normal with the geometric one on back
+ * faces; zero when the patch has none. */
+MP_INLINE float3 mp_face_shading_normal(const MP_GLOBAL float4* normals, uint patch, float u, float v, float3 ng,
+                                        float3 p, int ortho) {
+  const MP_GLOBAL float4* c = normals + (ulong)patch * MP_PATCH_NORMALS;
+  float3 n = (1.0f - u) * (1.0f - v) * MP_XYZ(c[0]) + u * (1.0f - v) * MP_XYZ(c[1]) + u * v * MP_XYZ(c[2]) +
+             (1.0f - u) * v * MP_XYZ(c[3]);
+  float len = length(n);
+  if (!(len > 0.0f) || !isfinite(len)) return MP_F3(0.0f, 0.0f, 0.0f);
+  n = n / len;
+  if (dot(n, ng) < 0.0f) n = -n;
+  float3 view = ortho ? MP_F3(0.0f, 0.0f, 1.0f) : -p;
+  return dot(ng, view) < 0.0f ? -n : n;
 }
 
 #endif

@@ -7,16 +7,29 @@
 #include "mp_grid.h"
 
 __kernel void shade_grids(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
-                          FrameParams f, __global const float4* grid_p, __global const float4* grid_n,
+                          FrameParams f, __global const float4* grid_p, __global float4* grid_n,
                           __global const DeviceMaterial* materials, __global const DeviceLight* lights,
-                          uint light_count, __global float4* grid_c, __global const uint* vertex_offsets) {
+                          uint light_count, __global float4* grid_c, __global const uint* vertex_offsets,
+                          __global const float4* patch_normals) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   float2 uv;
   ulong index;
   if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
   DeviceMaterial m = materials[patch_info[4 * (ulong)sp.patch + 1]];
+  float3 p = grid_p[index].xyz, n = grid_n[index].xyz;
+  /* Smooth-shaded polygons: their interpolated normal replaces the surface's
+   * for shading, node programs and the Normal pass (w = 1: already faced).
+   * Displaced surfaces keep the normal of their displaced grid. */
+  int faced = 0;
+  if (!(m.program[1] > 0.0f)) {
+    float3 ns = mp_face_shading_normal(patch_normals, sp.patch, uv.x, uv.y, n, p, f.ortho);
+    if (dot(ns, ns) > 0.0f) {
+      n = ns, faced = 1;
+      grid_n[index] = (float4)(ns, 1.0f);
+    }
+  }
   if (m.program[2] > 0.0f) return; /* shaded by its node program (material_program.cl) */
-  float3 c = mp_shade(grid_p[index].xyz, grid_n[index].xyz, f.ortho, &m, lights, light_count);
+  float3 c = mp_shade(p, n, faced, f.ortho, &m, lights, light_count);
   grid_c[index] = (float4)(c, m.opacity[3]);
 }

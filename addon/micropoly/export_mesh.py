@@ -136,7 +136,26 @@ def _uv_layers(mesh, names, n_loops, counts):
     return out
 
 
-def _mesh_arrays(mesh, with_creases, uv_names=()):
+def _corner_normals(mesh, n_polys, n_loops):
+    """(n_loops, 3) shading normals per face corner when any face is shaded
+    smooth (or the mesh has custom normals), else None (flat faces). They
+    are Blender's own corner normals, so sharp edges, Auto Smooth and custom
+    normals count as in Cycles."""
+    smooth = np.zeros(n_polys, dtype=bool)
+    if n_polys:
+        mesh.polygons.foreach_get("use_smooth", smooth)
+    if not smooth.any() and not getattr(mesh, "has_custom_normals", False):
+        return None
+    out = np.empty(n_loops * 3, dtype=np.float32)
+    if hasattr(mesh, "corner_normals"):  # Blender 4.1 and later
+        mesh.corner_normals.foreach_get("vector", out)
+    else:
+        mesh.calc_normals_split()
+        mesh.loops.foreach_get("normal", out)
+    return out.reshape(-1, 3)
+
+
+def _mesh_arrays(mesh, with_creases, uv_names=(), smooth_normals=False):
     n_verts, n_polys, n_loops, n_edges = len(mesh.vertices), len(mesh.polygons), len(mesh.loops), len(mesh.edges)
     points = np.empty(n_verts * 3, dtype=np.float32)
     mesh.vertices.foreach_get("co", points)
@@ -149,6 +168,10 @@ def _mesh_arrays(mesh, with_creases, uv_names=()):
     arrays = dict(points=points.reshape(-1, 3), counts=counts, indices=indices, material_index=material_index)
     if uv_names:
         arrays["uv_layers"] = _uv_layers(mesh, uv_names, n_loops, counts)
+    if smooth_normals:
+        normals = _corner_normals(mesh, n_polys, n_loops)
+        if normals is not None:
+            arrays["corner_normals"] = normals
     if with_creases:
         edge_crease = _float_attribute(mesh, "crease_edge", lambda m: m.edges, "crease", n_edges)
         creased = np.nonzero(edge_crease > 0.0)[0]
@@ -184,7 +207,7 @@ def export_object(native_scene, materials, cache, obj, matrix, warnings, is_inst
         mesh = cage if cage is not None else obj.to_mesh()
         try:
             arrays = _mesh_arrays(mesh, with_creases=subsurf is not None and subsurf.use_creases,
-                                  uv_names=materials.uv_names)
+                                  uv_names=materials.uv_names, smooth_normals=subsurf is None)
         finally:
             if cage is None:
                 obj.to_mesh_clear()
@@ -209,6 +232,7 @@ def export_object(native_scene, materials, cache, obj, matrix, warnings, is_inst
         crease_vertices=arrays.get("crease_vertices", empty_i), crease_sharpness=arrays.get("crease_sharpness", empty_f),
         corner_vertices=arrays.get("corner_vertices", empty_i), corner_sharpness=arrays.get("corner_sharpness", empty_f),
         boundary=boundary, double_sided=double_sided, uv_layers=arrays.get("uv_layers", empty_f),
+        corner_normals=arrays.get("corner_normals", empty_f),
         **_texture_space(obj.original.data))
     return True
 

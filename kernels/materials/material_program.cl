@@ -188,6 +188,6 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
                     : s.has_normal == MP_NORMAL_INPUT_V4              ? 2
                     : s.has_normal == MP_NORMAL_INPUT_V4_UNCORRECTED ? 3
                                                                       : 0;
-  float3 c = mp_shade_bumped(p, n, ns, bsdf_normal, f.ortho, &m, lights, light_count);
+  float3 c = mp_shade_bumped(p, n, ns, bsdf_normal, grid_n[index].w > 0.5f, f.ortho, &m, lights, light_count);
   grid_c[index] = (float4)(c, clamp(s.alpha, 0.0f, 1.0f));
 }

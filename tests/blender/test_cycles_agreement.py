@@ -23,11 +23,12 @@ W, H = 160, 120
 CYCLES_SAMPLES = 128
 
 
-def suzanne(scene, subdivided=True, location=(0.0, 0.0, 0.0)):
+def suzanne(scene, subdivided=True, location=(0.0, 0.0, 0.0), smooth=False):
     bpy.ops.mesh.primitive_monkey_add(size=2.0, location=location)
     obj = bpy.context.object
     if subdivided:
         obj.modifiers.new("Subdivision", "SUBSURF").render_levels = 2
+    if subdivided or smooth:
         bpy.ops.object.shade_smooth()
     obj.data.materials.append(ru.diffuse_material("grey", (0.8, 0.8, 0.8)))
     return obj
@@ -104,6 +105,16 @@ def case_polygon_mesh():
     return compare("polygon Suzanne and floor, sun light", scene, {"psnr", "passes"})
 
 
+def case_smooth_polygon_mesh():
+    # Shade Smooth without subdivision: Blender's corner normals, interpolated
+    # across each face, shade it and fill the Normal pass, as in Cycles.
+    scene = ru.reset_scene()
+    suzanne(scene, subdivided=False, smooth=True)
+    light(scene, "POINT", energy=800.0)
+    ru.add_camera(scene, (1.5, -5.5, 1.5), (0, 0, 0))
+    return compare("smooth-shaded polygon Suzanne, point light", scene, {"psnr", "passes"})
+
+
 def case_orthographic():
     scene = ru.reset_scene()
     suzanne(scene)
@@ -157,7 +168,7 @@ def case_instances():
     return compare("collection instances and linked duplicates, sun light", scene, set())
 
 
-CASES = [case_instances, case_subdivided_suzanne, case_polygon_mesh, case_orthographic, case_shifted_camera, case_disk_light]
+CASES = [case_instances, case_subdivided_suzanne, case_polygon_mesh, case_smooth_polygon_mesh, case_orthographic, case_shifted_camera, case_disk_light]
 
 
 def main():

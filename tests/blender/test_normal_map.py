@@ -8,8 +8,8 @@ with Cycles at >= 30 dB PSNR on the pixels both cover:
   - tangent space, an image normal map (Non-Color) through the UV map, on a
     subdivided UV sphere (tangents per face corner of the cage, interpolated
     over the limit surface, as Cycles does with adaptive subdivision);
-  - the same map at strength 0.6 on a flat-shaded polygon UV sphere (the
-    map tilts each face's own normal, with the face's tangents);
+  - the same map at strength 0.6 on a smooth-shaded polygon UV sphere (the
+    map tilts the interpolated corner normals);
   - object space, a procedural map on a torus: the surface's own normal
     plus a Noise texture's color as detail, as a baked map holds it;
   - tangent space on a cylinder seen end-on: its caps are n-gons, for which
@@ -117,11 +117,9 @@ def case_sphere(subdivided, strength):
     bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, segments=32, ring_count=16)
     obj = bpy.context.active_object
     obj.rotation_euler = (0.2, 0.0, 0.5)
+    bpy.ops.object.shade_smooth()
     if subdivided:
-        bpy.ops.object.shade_smooth()
         obj.modifiers.new("Subdivision", "SUBSURF")
-    else:
-        bpy.ops.object.shade_flat()  # polygon meshes render flat-shaded (docs/blender.md)
     obj.data.materials.append(normal_mapped_material("nmap_sphere", "TANGENT", strength, normal_map_image()))
     kind = "subdivided" if subdivided else "polygon"
     return compare(scene, f"tangent space, {kind} sphere, strength {strength}", (0.0, -4.0, 0.8), (0, 0, 0))

@@ -157,6 +157,7 @@ void expect_same_mesh(const Mesh& a, const Mesh& b) {
   EXPECT_EQ(a.object_to_world, b.object_to_world);
   EXPECT_EQ(a.double_sided, b.double_sided);
   EXPECT_EQ(a.uv_layers, b.uv_layers);
+  EXPECT_EQ(a.corner_normals, b.corner_normals);
   EXPECT_EQ(a.texspace_location, b.texspace_location);
   EXPECT_EQ(a.texspace_size, b.texspace_size);
 }
@@ -428,6 +429,12 @@ Scene full_scene() {
     m.material = textured_index;
     m.face_materials.clear();
   }
+  // Smooth shading normals on two polygon meshes (one an n-gon).
+  for (const char* name : {"floor", "pentagon"}) {
+    Mesh& m = *std::find_if(s.meshes.begin(), s.meshes.end(), [&](const Mesh& x) { return x.name == name; });
+    for (size_t c = 0; c < m.face_vertex_indices.size(); ++c)
+      m.corner_normals.push_back(glm::normalize(glm::vec3(0.1f * float(c % 5), -0.2f, 1.0f)));
+  }
   s.meshes[0].texspace_location = {0.1f, -0.2f, 0.3f};
   s.meshes[0].texspace_size = {1.1f, 0.9f, 1.0f / 3.0f};
   s.meshes[0].face_materials = {1, 1, textured_index, 1, 5, textured_index};
@@ -613,6 +620,27 @@ TEST(RibWriterExtensions, UVLayersPerVertexPerCornerAndReversed) {
   EXPECT_EQ(s.meshes[1].uv_layers, (std::vector<V>{{{1, 1}, {1, 0}, {0, 0}}}));
   EXPECT_EQ(s.meshes[1].texspace_location, glm::vec3(1, 2, 3));
   EXPECT_EQ(s.meshes[2].uv_layers, (std::vector<V>{{{0, 0}, {0, 0}, {0, 0}, {5, 6}, {7, 8}, {9, 10}}}));
+}
+
+TEST(RibWriterExtensions, ShadingNormals) {
+  // RenderMan's "N": per vertex on a Polygon, per corner on PointsPolygons
+  // (reversed with the face), flat normals filled in for a merged polygon
+  // without them, and ignored (with a warning) on a Catmull-Clark mesh.
+  const RibResult r = parse(
+      "Polygon \"P\" [0 0 0 1 0 0 0 1 0] \"N\" [0 0 1 0 0.6 0.8 0.6 0 0.8]\n"
+      "Polygon \"P\" [0 0 1 1 0 1 0 1 1]\n"
+      "AttributeBegin\nReverseOrientation\n"
+      "PointsPolygons [3] [0 1 2] \"P\" [0 0 0 1 0 0 0 1 0] \"facevarying normal N\" [0 0 1 0 0 2 0 0 3]\n"
+      "AttributeEnd\n"
+      "SubdivisionMesh \"catmull-clark\" [3] [0 1 2] \"P\" [0 0 0 1 0 0 0 1 0] \"N\" [0 0 1 0 0 1 0 0 1]\n");
+  const Scene& s = r.scene;
+  ASSERT_EQ(s.meshes.size(), 3u);
+  using N = std::vector<glm::vec3>;
+  EXPECT_EQ(s.meshes[0].corner_normals, (N{{0, 0, 1}, {0, 0.6f, 0.8f}, {0.6f, 0, 0.8f}, {0, 0, 1}, {0, 0, 1}, {0, 0, 1}}));
+  EXPECT_EQ(s.meshes[1].corner_normals, (N{{0, 0, 3}, {0, 0, 2}, {0, 0, 1}}));
+  EXPECT_TRUE(s.meshes[2].corner_normals.empty());
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings[0].find("\"N\""), std::string::npos);
 }
 
 TEST(RibWriterExtensions, PngTexturesAreSrgbAndBottomRowFirst) {

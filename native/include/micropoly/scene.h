@@ -41,6 +41,11 @@ struct Mesh {
   // face (each ptex sub-face of a subdivided non-quad) UVs interpolate
   // bilinearly, as OpenSubdiv's face-varying "linear all" rule does.
   std::vector<std::vector<glm::vec2>> uv_layers;
+  // Shading normals per face corner (object space), for polygon meshes that
+  // are shaded smooth: interpolated across each face (bilinearly, like UVs).
+  // Empty: flat faces. Ignored for Catmull-Clark meshes (their limit surface
+  // is smooth by itself).
+  std::vector<glm::vec3> corner_normals;
 };
 
 // Bicubic patches already converted to Bezier form: 16 control points per

@@ -126,6 +126,7 @@ void ShadeStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffe
   kernel_.setArg(8, scene.light_count);
   kernel_.setArg(9, grids.c);
   kernel_.setArg(10, grids.vertex_offsets);
+  kernel_.setArg(11, scene.patch_normals);
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64),
                                         nullptr, &e);

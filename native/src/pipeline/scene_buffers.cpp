@@ -112,6 +112,11 @@ void place_shape(const PatchBuffer& shape, const glm::mat4& to_camera, const Mes
     }
   }
   out.uvs.insert(out.uvs.end(), shape.uvs.begin(), shape.uvs.end());
+  out.normals.reserve(out.normals.size() + shape.normals.size());
+  for (const glm::vec4& n : shape.normals) {
+    const glm::dvec3 m = normal_map * glm::dvec3(glm::vec3(n));
+    out.normals.emplace_back(float(m.x), float(m.y), float(m.z), 0.0f);
+  }
 }
 
 DeviceLight to_device(const Light& l, const glm::mat4& world_to_camera) {
@@ -199,6 +204,7 @@ SceneBuffers upload_scene_data(cl::Context& context, cl::CommandQueue& queue, co
   b.objects = upload(context, queue, data.objects);
   b.lights = upload(context, queue, data.lights);
   b.patch_uvs = upload(context, queue, data.patches.uvs);
+  b.patch_normals = upload(context, queue, data.patches.normals);
   b.images = upload(context, queue, data.images);
   b.texels = upload(context, queue, data.texels);
   b.uv_layers = static_cast<cl_uint>(data.patches.uv_layers);

@@ -34,6 +34,7 @@ struct SceneBuffers {
   cl::Buffer objects;
   cl::Buffer lights;
   cl::Buffer patch_uvs;   // 2 float4 per patch and UV layer (kernels/mp_patch.h)
+  cl::Buffer patch_normals;  // 4 float4 per patch: smooth shading normals at its corners
   cl::Buffer images;      // DeviceImage per image
   cl::Buffer texels;      // float4
   cl_uint patch_count = 0;

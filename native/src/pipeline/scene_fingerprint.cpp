@@ -60,6 +60,7 @@ uint64_t mesh_shape_key(const Mesh& m, int uv_layers) {
   }
   h.value(m.uv_layers.size());
   for (const auto& layer : m.uv_layers) h.values(layer);
+  if (m.scheme == SubdivScheme::None) h.values(m.corner_normals);
   return h.result();
 }
 
@@ -95,6 +96,7 @@ uint64_t scene_fingerprint(const Scene& scene) {
     h.value(m.texspace_size);
     h.value(m.uv_layers.size());
     for (const auto& layer : m.uv_layers) h.values(layer);
+    h.values(m.corner_normals);
   }
   h.value(scene.bezier_patches.size());
   for (const BezierPatches& b : scene.bezier_patches) {

@@ -231,8 +231,9 @@ PYBIND11_MODULE(_native, m) {
              const Array<int>& face_materials, const Array<int>& crease_vertices, const Array<float>& crease_sharpness,
              const Array<int>& corner_vertices, const Array<float>& corner_sharpness, const Array<int>& hole_faces,
              const std::string& boundary, bool double_sided, std::vector<float> texspace_location,
-             std::vector<float> texspace_size, const Array<float>& uv_layers) {
+             std::vector<float> texspace_size, const Array<float>& uv_layers, const Array<float>& corner_normals) {
             Mesh mesh;
+            mesh.corner_normals = to_points(corner_normals, "corner_normals");
             if (uv_layers.size() > 0) {
               if (uv_layers.ndim() != 3 || uv_layers.shape(2) != 2)
                 throw Error("mesh '" + name + "': uv_layers must be a (layers, face corners, 2) array");
@@ -273,8 +274,9 @@ PYBIND11_MODULE(_native, m) {
           py::arg("boundary") = "edge_and_corner", py::arg("double_sided") = true,
           py::arg("texspace_location") = std::vector<float>{0, 0, 0},
           py::arg("texspace_size") = std::vector<float>{0, 0, 0}, py::arg("uv_layers") = Array<float>(),
+          py::arg("corner_normals") = Array<float>(),
           "Adds a mesh; uv_layers is (layers, face corners, 2): UV layer k is what material programs read as "
-          "UV layer k.")
+          "UV layer k; corner_normals (face corners, 3), object space, shade a polygon mesh smooth.")
       .def(
           "add_image",
           [](Scene& s, const std::string& name, const Array<float>& pixels, bool srgb) {

@@ -40,9 +40,9 @@ void check_indices(ArgReader& args, const Arg& where, const std::vector<int>& in
                                    std::to_string(npoints) + " points");
 }
 
-// Micropoly's per-mesh parameters (rib_micropoly.cpp reads them).
+// Per-mesh parameters rib_micropoly.cpp reads (Micropoly's, and "N").
 bool is_mesh_extension(const std::string& name) {
-  return name == "micropoly:material" || name == "micropoly:texspacelocation" ||
+  return name == "micropoly:material" || name == "N" || name == "micropoly:texspacelocation" ||
          name == "micropoly:texspacesize" || name.rfind("micropoly:uv", 0) == 0;
 }
 
@@ -120,7 +120,7 @@ void Parser::req_polygon(ArgReader& args) {
   if (n < 3) args.fail("a polygon needs at least 3 vertices, \"P\" has " + std::to_string(n));
   if (n > static_cast<size_t>(kIntMax)) args.fail("too many vertices");
   std::vector<int> indices = identity(n);
-  read_mesh_texturing(args, params, indices, n, &prim.mesh);
+  read_mesh_primvars(args, params, indices, n, &prim.mesh);
   fill_polygons(prim.mesh, {static_cast<int>(n)}, std::move(indices));
   prim.mergeable = true;
   place(std::move(prim), args);
@@ -142,8 +142,9 @@ void Parser::req_general_polygon(ArgReader& args) {
               "holes in general polygons are not supported; only the outer loop is rendered");
   // The outer loop comes first; holes are dropped.
   const int n = loops[0];
-  read_mesh_texturing(args, params, identity(points.size()), points.size(), &prim.mesh);
+  read_mesh_primvars(args, params, identity(points.size()), points.size(), &prim.mesh);
   for (auto& layer : prim.mesh.uv_layers) layer.resize(static_cast<size_t>(n));
+  if (!prim.mesh.corner_normals.empty()) prim.mesh.corner_normals.resize(static_cast<size_t>(n));
   prim.mesh.points.assign(points.begin(), points.begin() + n);
   std::vector<int> indices = identity(static_cast<size_t>(n));
   fill_polygons(prim.mesh, {n}, std::move(indices));
@@ -161,7 +162,7 @@ void Parser::req_points_polygons(ArgReader& args) {
   if (!read_positions(args, params, false, &prim.mesh.points)) return;
   check_indices(args, verts_arg, indices, prim.mesh.points.size());
   read_face_materials(args, params, counts.size(), &prim.mesh.face_materials);
-  read_mesh_texturing(args, params, indices, prim.mesh.points.size(), &prim.mesh);
+  read_mesh_primvars(args, params, indices, prim.mesh.points.size(), &prim.mesh);
   fill_polygons(prim.mesh, std::move(counts), std::move(indices));
   place(std::move(prim), args);
 }
@@ -180,7 +181,7 @@ void Parser::req_points_general_polygons(ArgReader& args) {
   Primitive prim = make_primitive(Primitive::Kind::Mesh, args);
   if (!read_positions(args, params, false, &prim.mesh.points)) return;
   check_indices(args, verts_arg, all, prim.mesh.points.size());
-  read_mesh_texturing(args, params, all, prim.mesh.points.size(), &prim.mesh);
+  read_mesh_primvars(args, params, all, prim.mesh.points.size(), &prim.mesh);
   // Keep the outer (first) loop of each polygon; holes are dropped.
   std::vector<int> outer_counts, outer_indices, outer_corners;
   size_t loop = 0, offset = 0;
@@ -202,6 +203,11 @@ void Parser::req_points_general_polygons(ArgReader& args) {
     std::vector<glm::vec2> kept(outer_corners.size());
     for (size_t i = 0; i < kept.size(); ++i) kept[i] = layer[static_cast<size_t>(outer_corners[i])];
     layer = std::move(kept);
+  }
+  if (!prim.mesh.corner_normals.empty()) {
+    std::vector<glm::vec3> kept(outer_corners.size());
+    for (size_t i = 0; i < kept.size(); ++i) kept[i] = prim.mesh.corner_normals[static_cast<size_t>(outer_corners[i])];
+    prim.mesh.corner_normals = std::move(kept);
   }
   fill_polygons(prim.mesh, std::move(outer_counts), std::move(outer_indices));
   place(std::move(prim), args);
@@ -250,7 +256,12 @@ void Parser::req_subdivision_mesh(ArgReader& args) {
   const size_t nfaces = counts.size();
   check_indices(args, verts_arg, indices, npoints);
   read_face_materials(args, params, nfaces, &mesh.face_materials);
-  read_mesh_texturing(args, params, indices, npoints, &mesh);
+  read_mesh_primvars(args, params, indices, npoints, &mesh);
+  if (!mesh.corner_normals.empty() && mesh.scheme == SubdivScheme::CatmullClark) {
+    warn_once("subdiv-N", line, "\"N\" on a Catmull-Clark SubdivisionMesh is ignored: the limit surface's own "
+                                "normals shade it");
+    mesh.corner_normals.clear();
+  }
   fill_polygons(mesh, std::move(counts), std::move(indices));
 
   // RenderMan's default without an "interpolateboundary" tag is no boundary

@@ -178,7 +178,7 @@ void Parser::read_face_materials(ArgReader& args, const ParamList& params, size_
   *out = args.int_array(*p->value, 0, count - 1, "micropoly:material");
 }
 
-void Parser::read_mesh_texturing(ArgReader& args, const ParamList& params, const std::vector<int>& corners,
+void Parser::read_mesh_primvars(ArgReader& args, const ParamList& params, const std::vector<int>& corners,
                                  size_t npoints, Mesh* mesh) const {
   mesh->uv_layers.clear();
   for (int k = 0; k < MP_MAX_UV_LAYERS; ++k) {
@@ -206,6 +206,23 @@ void Parser::read_mesh_texturing(ArgReader& args, const ParamList& params, const
       layer[c] = glm::vec2(static_cast<float>(v[2 * i]), static_cast<float>(v[2 * i + 1]));
     }
     mesh->uv_layers.push_back(std::move(layer));
+  }
+  // Shading normals: RenderMan's "N" (vertex normals, or per face corner).
+  mesh->corner_normals.clear();
+  if (const Param* p = params.find("N")) {
+    const bool per_corner = p->decl.cls == VarClass::FaceVarying || p->decl.cls == VarClass::FaceVertex;
+    const size_t expect = per_corner ? corners.size() : npoints;
+    const std::vector<double>& v = p->value->numbers;
+    if (p->decl.is_string() || p->decl.components() != 3 || p->decl.cls == VarClass::Constant ||
+        p->decl.cls == VarClass::Uniform || v.size() != 3 * expect)
+      args.fail_at(p->line, "\"N\" needs one normal per vertex (" + std::to_string(npoints) +
+                                ") or per face corner (facevarying, " + std::to_string(corners.size()) + "), found " +
+                                std::to_string(v.size()) + " values");
+    mesh->corner_normals.resize(corners.size());
+    for (size_t c = 0; c < corners.size(); ++c) {
+      const size_t i = per_corner ? c : static_cast<size_t>(corners[c]);
+      mesh->corner_normals[c] = glm::vec3(float(v[3 * i]), float(v[3 * i + 1]), float(v[3 * i + 2]));
+    }
   }
   const char* space[] = {"micropoly:texspacelocation", "micropoly:texspacesize"};
   glm::vec3* out[] = {&mesh->texspace_location, &mesh->texspace_size};

@@ -28,6 +28,7 @@ void reverse_faces(Mesh& mesh, size_t first_face, size_t first_index) {
     };
     flip(mesh.face_vertex_indices);
     for (auto& layer : mesh.uv_layers) flip(layer);  // UVs belong to their corners
+    if (!mesh.corner_normals.empty()) flip(mesh.corner_normals);
     offset += n;
   }
 }
@@ -52,6 +53,38 @@ void mirror_patches_u(std::vector<glm::vec3>& cps, size_t first) {
       std::swap(cps[p + 4 * j + 0], cps[p + 4 * j + 3]);
       std::swap(cps[p + 4 * j + 1], cps[p + 4 * j + 2]);
     }
+}
+
+// Appends `src`'s corner normals; when only one side has them, the other's
+// corners get their face's normal (flat), so both shade as they would alone.
+void append_corner_normals(Mesh& dst, const Mesh& src) {
+  if (dst.corner_normals.empty() && src.corner_normals.empty()) return;
+  auto flat = [](const Mesh& m, std::vector<glm::vec3>& out) {
+    size_t c = 0;
+    for (size_t f = 0; f < m.face_vertex_counts.size(); ++f) {
+      const size_t n = static_cast<size_t>(m.face_vertex_counts[f]);
+      glm::vec3 normal(0.0f);  // Newell's method: any simple polygon
+      for (size_t k = 0; k < n; ++k) {
+        const glm::vec3 a = m.points[static_cast<size_t>(m.face_vertex_indices[c + k])];
+        const glm::vec3 b = m.points[static_cast<size_t>(m.face_vertex_indices[c + (k + 1) % n])];
+        normal += glm::vec3((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y));
+      }
+      out.insert(out.end(), n, normal);
+      c += n;
+    }
+  };
+  const size_t dst_faces = dst.face_vertex_counts.size() - src.face_vertex_counts.size();
+  if (dst.corner_normals.empty()) {
+    std::vector<glm::vec3> normals;
+    Mesh before = dst;  // the faces dst had before this append
+    before.face_vertex_counts.resize(dst_faces);
+    flat(before, normals);
+    dst.corner_normals = std::move(normals);
+  }
+  if (src.corner_normals.empty())
+    flat(src, dst.corner_normals);
+  else
+    dst.corner_normals.insert(dst.corner_normals.end(), src.corner_normals.begin(), src.corner_normals.end());
 }
 
 }  // namespace
@@ -116,6 +149,7 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
                                     prim.mesh.face_vertex_counts.end());
       for (int i : prim.mesh.face_vertex_indices) dst.face_vertex_indices.push_back(base + i);
       append_uv_layers(dst, first_index, prim.mesh);
+      append_corner_normals(dst, prim.mesh);
       if (flip) reverse_faces(dst, first_face, first_index);
       return;
     }

@@ -231,9 +231,10 @@ class Parser {
   void read_face_materials(ArgReader& args, const ParamList& params, size_t faces,
                            std::vector<int>* out) const;
   // UV layers ("micropoly:uv0".."micropoly:uv3", float[2], per face corner
-  // or per vertex) for the face corners `corners` (vertex indices), and the
-  // Generated texture space ("micropoly:texspacelocation", "...size").
-  void read_mesh_texturing(ArgReader& args, const ParamList& params, const std::vector<int>& corners,
+  // or per vertex) for the face corners `corners` (vertex indices), the
+  // Generated texture space ("micropoly:texspacelocation", "...size") and,
+  // for polygon meshes, shading normals ("N", per face corner or vertex).
+  void read_mesh_primvars(ArgReader& args, const ParamList& params, const std::vector<int>& corners,
                            size_t npoints, Mesh* mesh) const;
   // One texture image named by Option "micropoly" "string imagefile".
   void read_image_option(ArgReader& args, const ParamList& params);

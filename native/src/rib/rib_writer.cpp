@@ -419,6 +419,11 @@ void write_mesh(std::string& o, const Mesh& m, const std::vector<Material>& mate
     o += "\n    \"uniform integer micropoly:material\" ";
     put_ints(o, m.face_materials);
   }
+  // Smooth shading normals (RenderMan's "N"; polygon meshes only).
+  if (!m.corner_normals.empty() && m.scheme == SubdivScheme::None) {
+    o += "\n    \"facevarying normal N\" ";
+    put_points(o, m.corner_normals);
+  }
   // UV layers and the Generated texture space, for material programs.
   for (size_t k = 0; k < m.uv_layers.size(); ++k) {
     o += "\n    \"facevarying float[2] micropoly:uv" + std::to_string(k) + "\" ";

@@ -75,6 +75,14 @@ void validate_mesh(const Mesh& m, size_t materials) {
     for (const glm::vec2& uv : m.uv_layers[k])
       if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) fail(what, m.name, "UV map " + std::to_string(k) + " has a NaN or infinite value");
   }
+  if (!m.corner_normals.empty()) {
+    if (m.corner_normals.size() != m.face_vertex_indices.size())
+      fail(what, m.name, "has " + std::to_string(m.corner_normals.size()) + " corner normals; it needs one per face corner (" +
+                             std::to_string(m.face_vertex_indices.size()) + ") or none");
+    for (const glm::vec3& n : m.corner_normals)
+      if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z))
+        fail(what, m.name, "has a NaN or infinite corner normal");
+  }
   check_material_index(m.material, materials, what, m.name);
   if (!m.face_materials.empty()) {
     if (m.face_materials.size() != m.face_vertex_counts.size())

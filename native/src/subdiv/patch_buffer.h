@@ -19,6 +19,10 @@ struct PatchBuffer {
   // (MP_PATCH_UV_* in kernels/mp_patch.h). Set uv_layers before appending.
   int uv_layers = 0;
   std::vector<glm::vec4> uvs;
+  // Smooth shading normals at the patch's corners (0,0), (1,0), (1,1), (0,1),
+  // 4 per patch (MP_PATCH_NORMALS in kernels/mp_patch.h); zero for patches
+  // shaded with their own surface normal.
+  std::vector<glm::vec4> normals;
   size_t size() const { return info.size(); }
 };
 

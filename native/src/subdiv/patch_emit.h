@@ -37,9 +37,16 @@ inline PatchInfoCommon make_patch_info_common(const glm::mat4& to_space, bool do
 
 // Corner UVs of one patch for every UV layer: corner (0,0), (1,0), (1,1),
 // (0,1) of layer k at [4k .. 4k+3]; null for a patch without UVs (zeros).
+// Corner normals likewise (4, object space), null for none.
 inline void append_device_patch(const DevicePatch& patch, unsigned type, int material, int prim_id,
                                 const PatchInfoCommon& common, PatchBuffer& out,
-                                const glm::vec2* corner_uvs = nullptr) {
+                                const glm::vec2* corner_uvs = nullptr, const glm::dvec3* corner_normals = nullptr) {
+  // Normals map by the inverse transpose; the kernels normalise them.
+  const glm::dmat3 normal_map = glm::transpose(glm::inverse(glm::dmat3(common.to_space)));
+  for (int c = 0; c < 4; ++c) {
+    const glm::dvec3 n = corner_normals ? normal_map * corner_normals[c] : glm::dvec3(0.0);
+    out.normals.emplace_back(float(n.x), float(n.y), float(n.z), 0.0f);
+  }
   for (const glm::dvec3& p : patch) {
     glm::dvec4 q = common.to_space * glm::dvec4(p, 1.0);
     out.points.emplace_back(float(q.x), float(q.y), float(q.z), 0.0f);  // w: displacement bound (mp_patch.h)

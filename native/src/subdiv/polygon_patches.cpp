@@ -49,13 +49,17 @@ void append_polygon_patches(const Mesh& mesh, const glm::mat4& to_space, PatchBu
   std::vector<glm::dvec3> corners;
   std::vector<glm::dvec2> uvs;                       // [layer * n + corner]
   std::vector<glm::vec2> patch_uvs(size_t(4 * layers));  // append_device_patch's layout
+  const bool smooth = !mesh.corner_normals.empty();
+  std::vector<glm::dvec3> normals;                   // the face's corner normals, when smooth
   size_t first = 0;
   for (size_t face = 0; face < mesh.face_vertex_counts.size(); ++face) {
     const int n = mesh.face_vertex_counts[face];
     corners.clear();
     uvs.assign(size_t(n * layers), glm::dvec2(0.0));
+    normals.clear();
     for (int k = 0; k < n; ++k) {
       corners.emplace_back(mesh.points[mesh.face_vertex_indices[first + k]]);
+      if (smooth) normals.emplace_back(mesh.corner_normals[first + k]);
       for (int l = 0; l < layers; ++l) uvs[size_t(l * n + k)] = glm::dvec2(subdiv_detail::corner_uv(mesh, l, first + k));
     }
     first += size_t(n);
@@ -64,11 +68,12 @@ void append_polygon_patches(const Mesh& mesh, const glm::mat4& to_space, PatchBu
     if (n == 4) {
       for (size_t i = 0; i < uvs.size(); ++i) patch_uvs[i] = glm::vec2(uvs[i]);
       subdiv_detail::append_device_patch(bilinear_patch(corners[0], corners[1], corners[2], corners[3]),
-                                         MP_PATCH_BEZIER, material, int(face), common, out, patch_uvs.data());
+                                         MP_PATCH_BEZIER, material, int(face), common, out, patch_uvs.data(),
+                                         smooth ? normals.data() : nullptr);
       continue;
     }
-    // The split quads carry the same bilinear blend of the face's UVs as of
-    // its points: centroid, edge midpoints, corner.
+    // The split quads carry the same bilinear blend of the face's UVs and
+    // normals as of its points: centroid, edge midpoints, corner.
     auto quad = [n](const auto* v, int k, auto* out4) {
       std::decay_t<decltype(v[0])> centroid(0.0);
       for (int i = 0; i < n; ++i) centroid += v[i];
@@ -85,8 +90,10 @@ void append_polygon_patches(const Mesh& mesh, const glm::mat4& to_space, PatchBu
         quad(uvs.data() + l * n, k, t);
         for (int c = 0; c < 4; ++c) patch_uvs[size_t(4 * l + c)] = glm::vec2(t[c]);
       }
+      glm::dvec3 qn[4];
+      if (smooth) quad(normals.data(), k, qn);
       subdiv_detail::append_device_patch(bilinear_patch(q[0], q[1], q[2], q[3]), MP_PATCH_BEZIER, material,
-                                         int(face), common, out, patch_uvs.data());
+                                         int(face), common, out, patch_uvs.data(), smooth ? qn : nullptr);
     }
   }
 }
