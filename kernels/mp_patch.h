@@ -28,6 +28,7 @@
  * Flags bits 8-31 hold the patch's object index (DeviceObject, mp_types.h). */
 #define MP_PATCH_DOUBLE_SIDED 1u
 #define MP_PATCH_FLIP_ORIENTATION 2u
+#define MP_PATCH_SMOOTH_NORMALS 4u /* has corner normals (MP_PATCH_NORMALS) */
 #define MP_PATCH_OBJECT(flags) ((flags) >> 8)
 
 /* The w of the first control point is the patch's displacement bound: how

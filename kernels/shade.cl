@@ -22,7 +22,7 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
    * for shading, node programs and the Normal pass (w = 1: already faced).
    * Displaced surfaces keep the normal of their displaced grid. */
   int faced = 0;
-  if (!(m.program[1] > 0.0f)) {
+  if ((patch_info[4 * (ulong)sp.patch + 2] & MP_PATCH_SMOOTH_NORMALS) && !(m.program[1] > 0.0f)) {
     float3 ns = mp_face_shading_normal(patch_normals, sp.patch, uv.x, uv.y, n, p, f.ortho);
     if (dot(ns, ns) > 0.0f) {
       n = ns, faced = 1;

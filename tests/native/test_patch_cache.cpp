@@ -52,8 +52,12 @@ Scene instanced_scene() {
   std::vector<glm::vec2> uvs;
   for (int v : floor.face_vertex_indices) uvs.push_back(glm::vec2(floor.points[size_t(v)]) * 0.25f);
   floor.uv_layers = {uvs};
+  for (int v : floor.face_vertex_indices)  // smooth-shaded, tilted normals
+    floor.corner_normals.push_back(glm::normalize(glm::vec3(floor.points[size_t(v)].x * 0.2f, 0.1f, 1.0f)));
   floor.material = 3;
-  floor.object_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.0f, -1.0f));
+  floor.object_to_world = glm::scale(glm::rotate(glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.0f, -1.0f)), 0.3f,
+                                                 glm::vec3(1, 0, 0)),
+                                     glm::vec3(1.0f, 2.5f, 1.0f));  // normals need the inverse transpose
   s.meshes.push_back(floor);
   BezierPatches set;
   for (int j = 0; j < 4; ++j)
@@ -135,6 +139,12 @@ TEST(PatchCache, PlacedShapesMatchPatchesBuiltInCameraSpace) {
         const uint32_t rb = d.edges[p * MP_EDGE_REFS + size_t(r)];
         ASSERT_EQ(ra == MP_NO_CURVE, rb == MP_NO_CURVE);
         if (ra != MP_NO_CURVE) EXPECT_EQ(ra, rb + (uint32_t(curve) << 1));
+      }
+      for (int c = 0; c < MP_PATCH_NORMALS; ++c) {  // smooth normals: same direction, or both none
+        const glm::vec3 na(placed.normals[(patch + p) * MP_PATCH_NORMALS + size_t(c)]);
+        const glm::vec3 nb(d.normals[p * MP_PATCH_NORMALS + size_t(c)]);
+        ASSERT_EQ(glm::length(na) > 0.0f, glm::length(nb) > 0.0f);
+        if (glm::length(nb) > 0.0f) EXPECT_GT(glm::dot(glm::normalize(na), glm::normalize(nb)), 0.99999f);
       }
       for (int k = 0; k < 2 * layers; ++k)
         EXPECT_EQ(placed.uvs[(patch + p) * 2 * size_t(layers) + size_t(k)], d.uvs[p * 2 * size_t(layers) + size_t(k)]);

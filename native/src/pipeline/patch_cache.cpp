@@ -6,6 +6,7 @@
 #include <mutex>
 #include <thread>
 
+#include "mp_patch.h"
 #include "pipeline/scene_fingerprint.h"
 
 namespace mp {
@@ -25,8 +26,9 @@ std::shared_ptr<const PatchBuffer> build_shape(const PatchCache::Surface& s, int
     append_bezier_patches(*s.set, identity, *buffer);
   }
   share_patch_edges(*buffer, 0);
-  // Materials and flags belong to the object, not the shape: placed later.
-  for (glm::uvec4& info : buffer->info) info.y = 0, info.z = 0;
+  // Materials and flags belong to the object, not the shape: placed later
+  // (all but whether the patch has smooth normals, which is the shape's).
+  for (glm::uvec4& info : buffer->info) info.y = 0, info.z &= MP_PATCH_SMOOTH_NORMALS;
   return buffer;
 }
 

@@ -51,7 +51,8 @@ inline void append_device_patch(const DevicePatch& patch, unsigned type, int mat
     glm::dvec4 q = common.to_space * glm::dvec4(p, 1.0);
     out.points.emplace_back(float(q.x), float(q.y), float(q.z), 0.0f);  // w: displacement bound (mp_patch.h)
   }
-  out.info.emplace_back(type, unsigned(material), common.flags, unsigned(prim_id));
+  out.info.emplace_back(type, unsigned(material), common.flags | (corner_normals ? MP_PATCH_SMOOTH_NORMALS : 0u),
+                        unsigned(prim_id));
   for (int k = 0; k < out.uv_layers; ++k) {
     if (corner_uvs == nullptr) {
       out.uvs.emplace_back(0.0f), out.uvs.emplace_back(0.0f);
