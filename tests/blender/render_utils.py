@@ -87,6 +87,16 @@ def add_tile(scene, name, mesh, row, col, rows, cols, tile=2.0):
     return obj
 
 
+def add_sun(scene, rotation, energy=3.0):
+    """A sun light of strength `energy` turned by Euler angles `rotation`."""
+    data = bpy.data.lights.new("Sun", "SUN")
+    data.energy = energy
+    obj = bpy.data.objects.new("Sun", data)
+    obj.rotation_euler = rotation
+    scene.collection.objects.link(obj)
+    return obj
+
+
 def empty_material(name):
     """A node material holding only its Material Output; returns (material, output node)."""
     m = bpy.data.materials.new(name)

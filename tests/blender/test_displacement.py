@@ -96,11 +96,7 @@ def add_surface(shape):
 
 
 def sun(scene):
-    data = bpy.data.lights.new("Sun", "SUN")
-    data.energy = 3.0
-    obj = bpy.data.objects.new("Sun", data)
-    obj.rotation_euler = (0.6, 0.2, 0.3)
-    scene.collection.objects.link(obj)
+    ru.add_sun(scene, (0.6, 0.2, 0.3))
 
 
 def render_both(scene, w=W, h=H, samples=16, cycles_samples=16):

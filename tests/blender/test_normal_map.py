@@ -91,11 +91,7 @@ def normal_mapped_material(name, space, strength, image=None):
 
 
 def sun(scene):
-    data = bpy.data.lights.new("Sun", "SUN")
-    data.energy = 3.0
-    obj = bpy.data.objects.new("Sun", data)
-    obj.rotation_euler = (0.7, 0.3, 0.4)
-    scene.collection.objects.link(obj)
+    ru.add_sun(scene, (0.7, 0.3, 0.4))
 
 
 def compare(scene, label, camera, target):

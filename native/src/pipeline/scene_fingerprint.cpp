@@ -40,12 +40,8 @@ class Hasher {
   uint64_t h_ = 0xcbf29ce484222325ull;
 };
 
-}  // namespace
-
-uint64_t mesh_shape_key(const Mesh& m, int uv_layers) {
-  Hasher h;
-  h.value(uint32_t(1));  // meshes and patch sets never share a key
-  h.value(uv_layers);
+// What a mesh's patches are built from, in object space (patch_cache.h).
+void hash_mesh_shape(Hasher& h, const Mesh& m) {
   h.value(m.scheme);
   h.values(m.points);
   h.values(m.face_vertex_counts);
@@ -57,10 +53,20 @@ uint64_t mesh_shape_key(const Mesh& m, int uv_layers) {
     h.values(m.corner_sharpness);
     h.values(m.hole_faces);
     h.value(m.boundary);
+  } else {
+    h.values(m.corner_normals);
   }
   h.value(m.uv_layers.size());
   for (const auto& layer : m.uv_layers) h.values(layer);
-  if (m.scheme == SubdivScheme::None) h.values(m.corner_normals);
+}
+
+}  // namespace
+
+uint64_t mesh_shape_key(const Mesh& m, int uv_layers) {
+  Hasher h;
+  h.value(uint32_t(1));  // meshes and patch sets never share a key
+  h.value(uv_layers);
+  hash_mesh_shape(h, m);
   return h.result();
 }
 
@@ -78,25 +84,13 @@ uint64_t scene_fingerprint(const Scene& scene) {
   h.value(scene.meshes.size());
   for (const Mesh& m : scene.meshes) {
     h.text(m.name);
-    h.value(m.scheme);
-    h.values(m.points);
-    h.values(m.face_vertex_counts);
-    h.values(m.face_vertex_indices);
-    h.values(m.crease_vertices);
-    h.values(m.crease_sharpness);
-    h.values(m.corner_vertices);
-    h.values(m.corner_sharpness);
-    h.values(m.hole_faces);
-    h.value(m.boundary);
+    hash_mesh_shape(h, m);
     h.value(m.material);
     h.values(m.face_materials);
     h.value(m.object_to_world);
     h.value(m.double_sided);
     h.value(m.texspace_location);
     h.value(m.texspace_size);
-    h.value(m.uv_layers.size());
-    for (const auto& layer : m.uv_layers) h.values(layer);
-    h.values(m.corner_normals);
   }
   h.value(scene.bezier_patches.size());
   for (const BezierPatches& b : scene.bezier_patches) {
