@@ -88,7 +88,7 @@ class SampleStage {
   cl::Kernel kernel_;
   cl::Kernel clear_;
   cl::Buffer keys_, colors_, normals_, offsets_, totals_;
-  size_t samples_ = 0;
+  size_t sample_capacity_ = 0;  // samples the buffers hold (they only grow)
   int spp_x_ = 0, spp_y_ = 0;
 };
 
