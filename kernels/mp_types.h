@@ -67,13 +67,16 @@ typedef struct {
 
 /* Per object, for material programs: camera -> object space (rows of a 3x4
  * matrix), object -> camera (rows of a 3x4; displacement vectors use its
- * linear part) and the texture space that maps object space onto Generated
- * coordinates: generated = (P - location) / (2 size) + 1/2. */
+ * linear part), the texture space that maps object space onto Generated
+ * coordinates: generated = (P - location) / (2 size) + 1/2, and object <->
+ * world for nodes that work in world space. */
 typedef struct {
   float to_object[12];
   float to_camera[12];
   float texspace_location[4];
   float texspace_size[4];
+  float to_world[12];   /* object -> world (rows of a 3x4) */
+  float from_world[12]; /* world -> object */
 } DeviceObject;
 
 /* A texture image (scene.h Image): its texels are width * height float4

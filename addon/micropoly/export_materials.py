@@ -105,7 +105,8 @@ class MaterialTable:
                     program = self.native.add_material_program(key, compiled.source)
                     self.programs[compiled.source] = program
                 params.update(program=program, program_displaces=compiled.displaces,
-                              program_shades=compiled.shades, displacement_bound=compiled.displacement_bound)
+                              program_shades=compiled.shades, displacement_bound=compiled.displacement_bound,
+                              displacement_bound_world=compiled.displacement_world)
             self.native.add_material(name=key, **params)
             self.index[key] = self.native.material_count - 1
         return self.index[key]

@@ -68,11 +68,12 @@ def _dims(s):
 
 
 class CompiledMaterial:
-    def __init__(self, source, displaces, shades, displacement_bound):
+    def __init__(self, source, displaces, shades, displacement_bound, displacement_world=False):
         self.source = source
         self.displaces = displaces
         self.shades = shades
         self.displacement_bound = displacement_bound
+        self.displacement_world = displacement_world  # the bound is in world units
 
 
 class _Function:
@@ -117,6 +118,7 @@ class NodeCompiler:
         self.fn = None
         self.helpers = []          # extra functions (Bump heights), emitted before the main two
         self.uses_neighbours = False
+        self.displacement_world = False
         self.groups = []           # the Group nodes whose trees are being compiled, outermost first
 
     # ---- helpers ----------------------------------------------------------
@@ -443,11 +445,14 @@ class NodeCompiler:
     def emit_displacement(self, node):
         if node.inputs["Normal"].is_linked:
             self.warn(node, "a linked Normal input is not supported; the surface normal is used")
-        if getattr(node, "space", "OBJECT") != "OBJECT":
-            self.warn(node, "World space is not supported; Object space is used")
         h, mid, scale = (self.input(node, k, FLOAT) for k in ("Height", "Midlevel", "Scale"))
         self.height_info = (h, mid, scale)
-        return {"Displacement": self.fn.temp(VEC, f"(({h[0]}) - ({mid[0]})) * ({scale[0]}) * g->N")}
+        amount = f"(({h[0]}) - ({mid[0]})) * ({scale[0]})"
+        if getattr(node, "space", "OBJECT") == "WORLD":
+            # World units along the world-space normal: the bound is in world units too.
+            self.displacement_world = True
+            return {"Displacement": self.fn.temp(VEC, f"mp_displacement_world(g, {amount})")}
+        return {"Displacement": self.fn.temp(VEC, f"{amount} * g->N")}
 
     def emit_texture(self, node):
         t, fn, ver = node.type, self.fn, self.version
@@ -534,10 +539,9 @@ class NodeCompiler:
             v4 = 1 if self.version >= 400 else 0
             expr = f"mp_normal_map_tangent(g, {uv}, {ta}, {tb}, {strength}, {color}, {v4})"
         else:
-            if node.space in ("WORLD", "BLENDER_WORLD"):
-                self.warn(node, "world space is not supported; the map is read in object space")
             blender = 1 if node.space.startswith("BLENDER") else 0
-            expr = f"mp_normal_map_object(g, {blender}, {strength}, {color})"
+            world = 1 if node.space in ("WORLD", "BLENDER_WORLD") else 0
+            expr = f"mp_normal_map_object(g, {blender}, {world}, {strength}, {color})"
         return {"Normal": self.fn.temp(VEC, expr)}
 
     def emit_image(self, node):
@@ -613,7 +617,7 @@ class NodeCompiler:
         if self.uses_neighbours:
             includes = "#define MP_NODE_USES_NEIGHBOURS 1\n" + includes
         source = includes + "".join(self.helpers) + disp_src + surf_src
-        return CompiledMaterial(source, displaces, shades, bound)
+        return CompiledMaterial(source, displaces, shades, bound, displaces and self.displacement_world)
 
     def _assignment(self, shader, field, socket, kind, strength):
         expr = self.input(shader, socket, kind)[0]

@@ -49,6 +49,7 @@ inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, f
   MpNodeGlobals g;
   g.P = (float3)(mp_row3(o->to_object, 0, p, 1.0f), mp_row3(o->to_object, 1, p, 1.0f), mp_row3(o->to_object, 2, p, 1.0f));
   g.N = mp_camera_normal_to_object(o, n);
+  g.object = o;
   float3 loc = (float3)(o->texspace_location[0], o->texspace_location[1], o->texspace_location[2]);
   float3 size = (float3)(o->texspace_size[0], o->texspace_size[1], o->texspace_size[2]);
   float3 rel = g.P - loc;

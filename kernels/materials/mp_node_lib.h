@@ -21,6 +21,7 @@ typedef struct MpNodeGlobals {
   float3 N;
   float3 generated;
   float3 uv[MP_MAX_UV_LAYERS];
+  MP_GLOBAL const DeviceObject* object; /* object <-> world (world-space nodes), or null */
   MP_GLOBAL const DeviceImage* images;
   MP_GLOBAL const float4* texels;
   uint image_count;
@@ -48,6 +49,39 @@ typedef struct {
  * without the material's Bump Map Correction. */
 #define MP_NORMAL_INPUT_V4 3
 #define MP_NORMAL_INPUT_V4_UNCORRECTED 4
+
+/* World-space vectors for nodes that work in world space: a direction from
+ * world to object space, and an object-space normal to world space and back
+ * (normals map by the inverse transpose). Without an object, unchanged. */
+MP_INLINE float3 mp_nl_rows(const MP_GLOBAL float* m, float3 v) {
+  return MP_F3(m[0] * v.x + m[1] * v.y + m[2] * v.z, m[4] * v.x + m[5] * v.y + m[6] * v.z,
+               m[8] * v.x + m[9] * v.y + m[10] * v.z);
+}
+MP_INLINE float3 mp_nl_columns(const MP_GLOBAL float* m, float3 v) {
+  return MP_F3(m[0] * v.x + m[4] * v.y + m[8] * v.z, m[1] * v.x + m[5] * v.y + m[9] * v.z,
+               m[2] * v.x + m[6] * v.y + m[10] * v.z);
+}
+MP_INLINE float3 mp_world_dir_to_object(const MpNodeGlobals* g, float3 v) {
+  return g->object ? mp_nl_rows(g->object->from_world, v) : v;
+}
+MP_INLINE float3 mp_object_normal_to_world(const MpNodeGlobals* g, float3 n) {
+  if (!g->object) return n;
+  float3 w = mp_nl_columns(g->object->from_world, n);
+  float len = length(w);
+  return len > 0.0f ? w / len : n;
+}
+MP_INLINE float3 mp_world_normal_to_object(const MpNodeGlobals* g, float3 n) {
+  if (!g->object) return n;
+  float3 o = mp_nl_columns(g->object->to_world, n);
+  float len = length(o);
+  return len > 0.0f ? o / len : n;
+}
+
+/* Displacement node in World space: height along the world-space normal,
+ * in world units (Cycles), as an object-space vector. */
+MP_INLINE float3 mp_displacement_world(const MpNodeGlobals* g, float amount) {
+  return mp_world_dir_to_object(g, mp_object_normal_to_world(g, g->N) * amount);
+}
 
 /* Bump node: the normal tilted by the height's gradient over the surface,
  * from heights at the point and a small step along u and v (hc, hx, hy),
@@ -123,12 +157,15 @@ MP_INLINE float3 mp_normal_map_tangent(const MpNodeGlobals* g, int uv, int ta, i
   return mp_normal_map_strength(g, c.x * t + c.y * b + c.z * n, strength);
 }
 
-/* Object space; Blender's own object space has y and z flipped. */
-MP_INLINE float3 mp_normal_map_object(const MpNodeGlobals* g, int blender_space, float strength, float3 color) {
+/* Object or world space; Blender's own spaces have y and z flipped. */
+MP_INLINE float3 mp_normal_map_object(const MpNodeGlobals* g, int blender_space, int world, float strength,
+                                      float3 color) {
   float3 c = 2.0f * (color - MP_F3(0.5f, 0.5f, 0.5f));
   if (blender_space) c.y = -c.y, c.z = -c.z;
   float len = length(c);
-  return mp_normal_map_strength(g, len > 0.0f ? c / len : g->N, strength);
+  if (!(len > 0.0f)) return mp_normal_map_strength(g, g->N, strength);
+  c = c / len;
+  return mp_normal_map_strength(g, world ? mp_world_normal_to_object(g, c) : c, strength);
 }
 
 MP_INLINE float mp_nl_safe_div(float a, float b) { return b != 0.0f ? a / b : 0.0f; }

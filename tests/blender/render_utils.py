@@ -57,6 +57,11 @@ def reset_scene():
     scene = bpy.context.scene
     world = bpy.data.worlds.new("World")
     world.color = (0.0, 0.0, 0.0)
+    # Blender 5.0 gives a new world a node tree with a grey Background.
+    if world.use_nodes and world.node_tree is not None:
+        for node in world.node_tree.nodes:
+            if node.type == "BACKGROUND":
+                node.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
     scene.world = world
     return scene
 

@@ -118,10 +118,20 @@ def lit_psnr(scene, label):
     return value
 
 
-def case_displaced(shape, texture):
+def case_displaced(shape, texture, space="OBJECT"):
     scene = ru.reset_scene()
     obj = add_surface(shape)
-    obj.data.materials.append(displaced_material(texture, 0.4 if texture in ("noise", "image") else 0.3))
+    mat = displaced_material(texture, 0.4 if texture in ("noise", "image") else 0.3)
+    if space == "WORLD":
+        # World units along the world normal: in object space this
+        # flattened, tilted plane would displace 10x less.
+        disp = next(n for n in mat.node_tree.nodes if n.type == "DISPLACEMENT")
+        disp.space = "WORLD"
+        disp.inputs["Scale"].default_value = 0.8
+        obj.scale = (1.0, 1.0, 0.1)
+        obj.rotation_euler = (0.35, 0.0, 0.3)
+        shape = "tilted flattened plane, world space,"
+    obj.data.materials.append(mat)
     if shape == "sphere":
         ru.add_camera(scene, (0.0, -4.0, 0.6), (0.0, 0.0, 0.0), lens=40)
     else:  # low enough that the bumps stand out against the background
@@ -299,6 +309,7 @@ def main():
     for shape in ("plane", "sphere"):
         for texture in ("noise", "voronoi", "image"):
             failures += case_displaced(shape, texture)
+    failures += case_displaced("plane", "noise", space="WORLD")
     failures += case_textured()
     failures += case_bump("node") + case_bump("method")
     failures += case_image_modes()

@@ -12,6 +12,7 @@ with Cycles at >= 30 dB PSNR on the pixels both cover:
     map tilts the interpolated corner normals);
   - object space, a procedural map on a torus: the surface's own normal
     plus a Noise texture's color as detail, as a baked map holds it;
+  - world space, a constant map on a plane turned 60 degrees;
   - tangent space on a cylinder seen end-on: its caps are n-gons, for which
     Blender computes no tangents, so the tangent comes from the UVs' own
     directions on the surface (exact on a flat cap).
@@ -130,6 +131,26 @@ def case_object_space():
     return compare(scene, "object space, procedural, subdivided torus", (0.0, -3.5, 2.0), (0, 0, 0))
 
 
+def case_world_space():
+    # A world-space map on a plane turned 60 degrees about x: a constant
+    # world normal 15 degrees off the plane's own. Read in object space the
+    # same colour would point 60 degrees elsewhere.
+    scene = ru.reset_scene()
+    bpy.ops.mesh.primitive_plane_add(size=2.0)
+    obj = bpy.context.active_object
+    obj.rotation_euler = (math.radians(60.0), 0.0, 0.0)
+    mat = ru.diffuse_material("nmap_world", (0.8, 0.8, 0.8))
+    nt = mat.node_tree
+    nmap = nt.nodes.new("ShaderNodeNormalMap")
+    nmap.space = "WORLD"
+    n = np.array([math.sin(math.radians(15.0)), -math.sin(math.radians(60.0)), math.cos(math.radians(60.0))])
+    n /= np.linalg.norm(n)
+    nmap.inputs["Color"].default_value = (*(0.5 + 0.5 * n), 1.0)
+    nt.links.new(nmap.outputs["Normal"], next(n for n in nt.nodes if n.type == "BSDF_DIFFUSE").inputs["Normal"])
+    obj.data.materials.append(mat)
+    return compare(scene, "world space, constant map, turned plane", (0.0, -3.0, 1.2), (0, 0, 0))
+
+
 def case_ngon_caps():
     scene = ru.reset_scene()
     bpy.ops.mesh.primitive_cylinder_add(vertices=24, radius=1.0, depth=1.0, end_fill_type="NGON")
@@ -141,7 +162,7 @@ def case_ngon_caps():
 def main():
     failures = []
     for case in (lambda: case_sphere(True, 1.0), lambda: case_sphere(False, 0.6), case_object_space,
-                 case_ngon_caps):
+                 case_world_space, case_ngon_caps):
         failures += case()
     if failures:
         print("FAIL: " + "; ".join(failures))

@@ -106,6 +106,13 @@ void expect_same_material(const Material& a, const Material& b) {
       EXPECT_EQ(a.specular, b.specular);
       break;
   }
+  EXPECT_EQ(a.program, b.program);
+  if (a.program >= 0) {
+    EXPECT_EQ(a.program_displaces, b.program_displaces);
+    EXPECT_EQ(a.program_shades, b.program_shades);
+    EXPECT_EQ(a.displacement_bound, b.displacement_bound);
+    EXPECT_EQ(a.displacement_bound_world, b.displacement_bound_world);
+  }
 }
 
 void expect_same_light(const Light& a, const Light& b) {
@@ -415,6 +422,8 @@ Scene full_scene() {
   Material textured = material("textured", Material::Model::Principled, glm::vec3(0.5f));
   textured.program = 0;
   textured.program_shades = true;
+  textured.displacement_bound = 0.25f;
+  textured.displacement_bound_world = true;  // written and read back, though this program does not displace
   s.materials.push_back(textured);
   const int textured_index = static_cast<int>(s.materials.size()) - 1;
   for (const char* name : {"floor", "corner sheet"}) {

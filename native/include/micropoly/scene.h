@@ -83,6 +83,9 @@ struct Material {
   bool program_displaces = false;
   bool program_shades = false;
   float displacement_bound = 0.0f;
+  // The bound is in world units rather than object units (a Displacement
+  // node in World space: its distance does not scale with the object).
+  bool displacement_bound_world = false;
 };
 
 // A material node tree translated to OpenCL C: `source` defines

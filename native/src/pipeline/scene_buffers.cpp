@@ -36,8 +36,8 @@ DeviceMaterial to_device(const Material& m) {
 }
 
 // Camera <-> object transforms and texture space of one surface.
-DeviceObject to_device_object(const glm::mat4& to_camera, glm::vec3 texspace_location, glm::vec3 texspace_size,
-                              const std::vector<glm::vec3>& points) {
+DeviceObject to_device_object(const glm::mat4& to_camera, const glm::mat4& to_world, glm::vec3 texspace_location,
+                              glm::vec3 texspace_size, const std::vector<glm::vec3>& points) {
   if (texspace_size == glm::vec3(0.0f) && !points.empty()) {
     glm::vec3 lo(3e38f), hi(-3e38f);
     for (const glm::vec3& p : points) lo = glm::min(lo, p), hi = glm::max(hi, p);
@@ -46,10 +46,13 @@ DeviceObject to_device_object(const glm::mat4& to_camera, glm::vec3 texspace_loc
   }
   DeviceObject o{};
   const glm::mat4 to_object = glm::inverse(to_camera);
+  const glm::mat4 from_world = glm::inverse(to_world);
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 4; ++c) {
       o.to_object[4 * r + c] = to_object[c][r];  // glm is column-major
       o.to_camera[4 * r + c] = to_camera[c][r];
+      o.to_world[4 * r + c] = to_world[c][r];
+      o.from_world[4 * r + c] = from_world[c][r];
     }
   put(o.texspace_location, texspace_location, 0.0f);
   put(o.texspace_size, texspace_size, 0.0f);
@@ -98,7 +101,8 @@ void place_shape(const PatchBuffer& shape, const glm::mat4& to_camera, const Mes
     if (size_t(material) < scene.materials.size()) {
       const Material& mat = scene.materials[size_t(material)];
       if (mat.program >= 0 && mat.program_displaces)
-        out.points[(first + p) * MP_PATCH_POINTS].w = mat.displacement_bound * bound_scale;
+        out.points[(first + p) * MP_PATCH_POINTS].w =
+            mat.displacement_bound * (mat.displacement_bound_world ? 1.0f : bound_scale);  // camera = world units
     }
   }
   out.edges.reserve(out.edges.size() + shape.edges.size());
@@ -177,8 +181,10 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
     const glm::mat4 to_camera = w2c * (mesh ? mesh->object_to_world : set->object_to_world);
     place_shape(*shapes[i], to_camera, mesh, set ? set->material : 0, mesh ? mesh->double_sided : set->double_sided,
                 uint32_t(out.objects.size()), scene, out.patches);
-    out.objects.push_back(mesh ? to_device_object(to_camera, mesh->texspace_location, mesh->texspace_size, mesh->points)
-                               : to_device_object(to_camera, glm::vec3(0.0f), glm::vec3(0.0f), set->control_points));
+    const glm::mat4& to_world = mesh ? mesh->object_to_world : set->object_to_world;
+    out.objects.push_back(mesh ? to_device_object(to_camera, to_world, mesh->texspace_location, mesh->texspace_size,
+                                                  mesh->points)
+                               : to_device_object(to_camera, to_world, glm::vec3(0.0f), glm::vec3(0.0f), set->control_points));
   }
   if (scene.materials.empty()) out.materials.push_back(to_device(Material{}));
   for (const Material& m : scene.materials) out.materials.push_back(to_device(m));

@@ -106,6 +106,7 @@ uint64_t scene_fingerprint(const Scene& scene) {
     h.value(m.ka), h.value(m.kd), h.value(m.ks), h.value(m.roughness);
     h.value(m.specular_color), h.value(m.metallic), h.value(m.specular), h.value(m.emission);
     h.value(m.program), h.value(m.program_displaces), h.value(m.program_shades), h.value(m.displacement_bound);
+    h.value(m.displacement_bound_world);
   }
   h.value(scene.lights.size());
   for (const Light& l : scene.lights) {

@@ -158,8 +158,9 @@ PYBIND11_MODULE(_native, m) {
           [](Scene& s, const std::string& name, const std::string& model, std::vector<float> color,
              std::vector<float> opacity, float ka, float kd, float ks, float roughness, std::vector<float> specular_color,
              std::vector<float> emission, float metallic, float specular, int program, bool program_displaces,
-             bool program_shades, float displacement_bound) {
+             bool program_shades, float displacement_bound, bool displacement_bound_world) {
             Material mat;
+            mat.displacement_bound_world = displacement_bound_world;
             mat.program = program;
             mat.program_displaces = program_displaces;
             mat.program_shades = program_shades;
@@ -185,7 +186,7 @@ PYBIND11_MODULE(_native, m) {
           py::arg("ks") = 0.5f, py::arg("roughness") = 0.1f, py::arg("specular_color") = std::vector<float>{1, 1, 1},
           py::arg("emission") = std::vector<float>{0, 0, 0}, py::arg("metallic") = 0.0f, py::arg("specular") = 0.5f,
           py::arg("program") = -1, py::arg("program_displaces") = false, py::arg("program_shades") = false,
-          py::arg("displacement_bound") = 0.0f,
+          py::arg("displacement_bound") = 0.0f, py::arg("displacement_bound_world") = false,
           "Adds a material (constant, matte, plastic or principled; see scene.h); returns its index.")
       .def(
           "add_material_program",

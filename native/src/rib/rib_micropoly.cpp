@@ -103,7 +103,7 @@ void Parser::read_image_option(ArgReader& args, const ParamList& params) {
 void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
   const int line = args.request().line;
   warn_unknown(params, {"material", "materialname", "program", "programdisplaces", "programshades",
-                        "displacementbound"}, [&](const std::string& name) {
+                        "displacementbound", "displacementworld"}, [&](const std::string& name) {
     warn_once("attribute-micropoly:" + name, line,
               "Attribute \"micropoly\": parameter \"" + name + "\" is ignored");
   });
@@ -133,6 +133,9 @@ void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
     get_int(args, params, "programshades", 0, 1, &flag);
     use.shades = flag != 0;
     use.displacement_bound = params.get_float("displacementbound", 0.0f);
+    flag = 0;
+    get_int(args, params, "displacementworld", 0, 1, &flag);
+    use.displacement_world = flag != 0;
     if (!(use.displacement_bound >= 0.0f)) args.fail("\"displacementbound\" must be a non-negative number");
   }
   define_material(index, params.get_string("materialname", attrs_.surface.name), use);
@@ -151,6 +154,7 @@ void Parser::define_material(int index, const std::string& name, const MaterialP
   m.program_displaces = use.displaces;
   m.program_shades = use.shades;
   m.displacement_bound = use.displacement_bound;
+  m.displacement_bound_world = use.displacement_world;
   std::vector<Material>& materials = result_.scene.materials;
   const size_t i = static_cast<size_t>(index);
   if (i == materials.size()) {

@@ -224,6 +224,7 @@ class Parser {
     int program = -1;
     bool displaces = false, shades = false;
     float displacement_bound = 0.0f;
+    bool displacement_world = false;
   };
   void define_material(int index, const std::string& name, const MaterialProgramUse& use);
   // Per-face Scene material indices ("uniform integer micropoly:material"),

@@ -38,7 +38,8 @@ std::vector<float> Parser::material_key(const Material& m) {
           m.specular_color.x, m.specular_color.y, m.specular_color.z,
           m.emission.x, m.emission.y, m.emission.z,
           m.metallic, m.specular, static_cast<float>(m.program), m.displacement_bound,
-          static_cast<float>(m.program_displaces), static_cast<float>(m.program_shades)};
+          static_cast<float>(m.program_displaces), static_cast<float>(m.program_shades),
+          static_cast<float>(m.displacement_bound_world)};
 }
 
 int Parser::material_index(const Attributes& attrs) {

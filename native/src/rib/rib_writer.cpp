@@ -342,6 +342,7 @@ void write_material(std::string& o, const Material& m, int index, const char* in
     param(o, "integer programdisplaces", static_cast<long long>(m.program_displaces ? 1 : 0));
     param(o, "integer programshades", static_cast<long long>(m.program_shades ? 1 : 0));
     param(o, "float displacementbound", m.displacement_bound);
+    if (m.displacement_bound_world) param(o, "integer displacementworld", static_cast<long long>(1));
   }
   o += '\n';
 }
