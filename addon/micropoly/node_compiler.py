@@ -259,12 +259,18 @@ class NodeCompiler:
         t = node.type
         fn = self.fn
         if t == "TEX_COORD":
-            if getattr(node, "object", None) is not None:
-                self.warn(node, "Object coordinates of another object are not supported; using this object's")
             for name in ("Camera", "Window", "Reflection"):
                 if node.outputs[name].is_linked:
                     self.warn(node, f"the {name} output is not supported yet; it gives zero")
-            outs = {"Generated": ("g->generated", VEC, None), "Object": ("g->P", VEC, None),
+            obj_coords = "g->P"
+            other = getattr(node, "object", None)
+            if other is not None and node.outputs["Object"].is_linked:
+                # That object's placement is part of the program: moving it
+                # gives a new program (a new source), as editing the tree does.
+                m = other.matrix_world.inverted()
+                rows = ", ".join("(float4)(" + ", ".join(_lit(m[r][c]) for c in range(4)) + ")" for r in range(3))
+                obj_coords = fn.temp(VEC, f"mp_point_in_space(g, {rows})")[0]
+            outs = {"Generated": ("g->generated", VEC, None), "Object": (obj_coords, VEC, None),
                     "Normal": ("g->N", VEC, None)}
             if node.outputs["UV"].is_linked:
                 outs["UV"] = (self.uv(), VEC, None)
