@@ -210,7 +210,7 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal,
         float atten = 1.0f / d2;
         if (type == MP_LIGHT_SPOT) {
           float cosangle = -dot(l, mp_light_f3(lt->direction));
-          atten *= cosangle > 0.0f ? pow(cosangle, lt->cone[2]) : 0.0f;
+          atten *= cosangle > 0.0f ? MP_POWR(cosangle, lt->cone[2]) : 0.0f;
           atten *= mp_smoothstep(lt->cone[0], lt->cone[1], cosangle);
         }
         cl *= atten;
@@ -224,10 +224,11 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal,
     if (bsdf_normal <= 1) diffuse += bsdf_normal ? e * mp_bump_shadowing(ngf, nf, l) : e;
     if (model == MP_MODEL_PRINCIPLED) {
       float vh = fmax(dot(v, normalize(l + v)), 0.0f);
-      float3 fresnel = f0 + (MP_F3(1.0f, 1.0f, 1.0f) - f0) * pow(1.0f - vh, 5.0f);
+      float t = 1.0f - vh, t2 = t * t;
+      float3 fresnel = f0 + (MP_F3(1.0f, 1.0f, 1.0f) - f0) * (t2 * t2 * t);  /* Schlick: (1 - vh)^5 */
       specular += e * fresnel * mp_ggx_specular(nf, l, v, alpha);
     } else
-      specular += (e / fmax(dot(nf, l), 1e-6f)) * pow(fmax(dot(nf, normalize(l + v)), 0.0f), inv_roughness);
+      specular += (e / fmax(dot(nf, l), 1e-6f)) * MP_POWR(fmax(dot(nf, normalize(l + v)), 0.0f), inv_roughness);
   }
   if (model == MP_MODEL_PRINCIPLED) {
     /* Lambert: albedo / pi per unit irradiance; a uniform ambient radiance A

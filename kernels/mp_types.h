@@ -48,6 +48,7 @@ typedef struct {
   int backface_culling;
   uint seed;
   int crop_x0, crop_y0;     /* crop origin in the whole image: sample patterns follow whole-image pixels */
+  int normal_pass;          /* samples keep their normal (the Normal pass is wanted) */
 } FrameParams;
 
 /* Materials (see scene.h): color.w = model. */

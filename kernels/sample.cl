@@ -117,7 +117,7 @@ inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVerte
           float3 col = (la * t->a.c_over_d + lb * t->b.c_over_d + lc * t->c.c_over_d) * w;
           float3 nrm = (la * t->a.n_over_d + lb * t->b.n_over_d + lc * t->c.n_over_d) * w;
           vstore3(col, index, colors);
-          normals[index] = mp_encode_normal(normalize(nrm));
+          if (f.normal_pass) normals[index] = mp_encode_normal(normalize(nrm));
         }
       }
 }

@@ -53,6 +53,7 @@ FrameSetup make_frame_setup(const Scene& scene) {
   // nearer than the near clip plane is clipped per sample anyway.
   f.eye_epsilon = std::max(0.5f * f.clip_near, 1e-6f);
   f.backface_culling = s.backface_culling ? 1 : 0;
+  f.normal_pass = s.depth_and_normal_passes ? 1 : 0;
   f.seed = 0u;
   f.crop_x0 = out.crop_x0;
   f.crop_y0 = out.crop_y0;
