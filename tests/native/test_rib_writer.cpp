@@ -695,6 +695,9 @@ TEST(RibWriterExtensions, BadValuesAreErrors) {
                "micropoly:uv0");
   expect_error("WorldBegin\nPolygon \"P\" [0 0 0 1 0 0 0 1 0] \"constant float[2] micropoly:texspacesize\" [1 1]\nWorldEnd\n",
                "texspacesize");
+  expect_error("WorldBegin\nPointsPolygons [3] [0 1 2] \"P\" [0 0 0 1 0 0 0 1 0] \"facevarying normal N\" [0 0 1 0 0 1]\nWorldEnd\n",
+               "\"N\" needs one normal per vertex");
+  expect_error("WorldBegin\nPolygon \"P\" [0 0 0 1 0 0 0 1 0] \"uniform normal N\" [0 0 1]\nWorldEnd\n", "\"N\"");
 }
 
 TEST(RibWriterExtensions, AreaLightInCameraSpace) {

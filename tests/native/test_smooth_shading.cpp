@@ -12,6 +12,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "micropoly/error.h"
 #include "micropoly/renderer.h"
 #include "renderer_fixture.h"
 #include "scene_fixtures.h"
@@ -110,6 +111,23 @@ TEST_F(SmoothShadingTest, NormalsFacingAwayAtTheSilhouetteAreNotFlipped) {
   ASSERT_GT(rim, 20);
   EXPECT_GT(away, 0) << "the view does not reach normals that face away";
   EXPECT_EQ(dark_rim, 0);
+}
+
+TEST(SmoothShadingInput, BadCornerNormalsAreRejectedNamingTheMesh) {
+  Scene s = sphere_scene(true);
+  s.meshes[0].corner_normals.pop_back();  // one short of the face corners
+  try {
+    validate_scene(s);
+    ADD_FAILURE() << "a short corner-normal list was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("sphere"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("corner normals"), std::string::npos) << e.what();
+  }
+  s = sphere_scene(true);
+  s.meshes[0].corner_normals[5].y = std::nanf("");
+  EXPECT_THROW(validate_scene(s), Error);
+  s.meshes[0].corner_normals.clear();  // none: flat faces
+  EXPECT_NO_THROW(validate_scene(s));
 }
 
 }  // namespace
