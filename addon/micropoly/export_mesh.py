@@ -87,8 +87,9 @@ def _uv_layer(mesh, name):
 def _tangents(mesh, layer, n_loops, counts):
     """(n_loops, 4): MikkTSpace tangent xyz and bitangent sign per face corner
     for UV map `layer`, as Blender computes them for normal maps (and Cycles
-    too); zeros where Blender computes none (faces of more than four sides),
-    which the Normal Map node replaces with tangents from the UVs."""
+    too); all zeros for a mesh with a face of more than four sides, which
+    Blender computes none for: the Normal Map node then takes its tangents
+    from the UVs."""
     out = np.zeros((n_loops, 4), dtype=np.float32)
     if counts.size and counts.max() > 4:
         return out  # Blender refuses (with an error report) rather than skip those faces
