@@ -16,32 +16,42 @@
 #include "mp_grid.h"
 #include "mp_bound.h"
 
-/* The whole domain of patch p, no edge rated yet. */
-inline SubPatch mp_root_subpatch(uint p) {
+/* Root r of a pass over patch_count patches in one or more views: the whole
+ * domain of patch r % patch_count in view r / patch_count, no edge rated yet. */
+inline SubPatch mp_root_subpatch(uint r, uint patch_count) {
+  uint p = r % patch_count;
   SubPatch sp;
   sp.corner[0] = 0.0f; sp.corner[1] = 0.0f;
   sp.corner[2] = 1.0f; sp.corner[3] = 0.0f;
   sp.corner[4] = 1.0f; sp.corner[5] = 1.0f;
   sp.corner[6] = 0.0f; sp.corner[7] = 1.0f;
   sp.patch = p;
-  sp.info = 0u;
+  sp.info = (r / patch_count) << 24;
   sp.rates = 0u;
   return sp;
 }
 
+/* The view a sub-patch belongs to: the pass's own (f), or one of several
+ * (shadow maps) by the view index in its info. */
+inline FrameParams mp_subpatch_view(const SubPatch* sp, FrameParams f, __global const FrameParams* views,
+                                    uint view_count) {
+  return view_count > 0u ? views[MP_INFO_VIEW(sp->info)] : f;
+}
+
 /* ---- breadth-first ------------------------------------------------------ */
 
-/* Initial queue: one whole-domain sub-patch per patch. */
-__kernel void bs_init_queue(__global SubPatch* queue, uint n) {
+/* Initial queue: one whole-domain sub-patch per patch and view. */
+__kernel void bs_init_queue(__global SubPatch* queue, uint n, uint patch_count) {
   uint i = get_global_id(0);
   if (i >= n) return;
-  queue[i] = mp_root_subpatch(i);
+  queue[i] = mp_root_subpatch(i, patch_count);
 }
 
 __kernel void bs_breadth_classify(__global SubPatch* queue, uint n,
                                   __global const float4* points, __global const uint* patch_info,
                                   __global const uint* edges, __global const float4* curves,
-                                  FrameParams f, __global uint* decision,
+                                  FrameParams f, __global const FrameParams* views, uint view_count,
+                                  __global const uchar* page_masks, __global uint* decision,
                                   __global uint* dice_flag, __global uint* split_flag) {
   uint i = get_global_id(0);
   if (i > n) return;
@@ -51,7 +61,7 @@ __kernel void bs_breadth_classify(__global SubPatch* queue, uint n,
     return;
   }
   SubPatch sp = queue[i];
-  uint d = mp_classify(points, patch_info, edges, curves, &sp, f);
+  uint d = mp_classify(points, patch_info, edges, curves, &sp, mp_subpatch_view(&sp, f, views, view_count), page_masks);
   uint action = MP_DECISION_ACTION(d);
   queue[i] = sp; /* with the edge rates measured here */
   decision[i] = d;
@@ -69,7 +79,7 @@ __kernel void bs_breadth_scatter(__global const SubPatch* queue, uint n, __globa
   uint action = MP_DECISION_ACTION(d);
   SubPatch sp = queue[i];
   if (action == MP_DICE) {
-    sp.info = (sp.info & 0xffu) | (d & 0xffff00u);
+    sp.info = MP_DICED_INFO(sp.info, d);
     diceable[dice_offset[i]] = sp;
   } else if (action >= MP_SPLIT_U) {
     SubPatch a, b;
@@ -84,7 +94,7 @@ __kernel void bs_breadth_scatter(__global const SubPatch* queue, uint n, __globa
 /* Counters shared by all workers (one small buffer). */
 #define BS_POOL_HEAD 0   /* next ring index to take */
 #define BS_POOL_TAIL 1   /* next ring index to write */
-#define BS_NEXT_PATCH 2  /* next input patch to take */
+#define BS_NEXT_ROOT 2   /* next input root (patch and view) to take */
 #define BS_DICE_COUNT 3  /* diceable sub-patches written */
 #define BS_BUSY 4        /* workers left with work after this launch */
 #define BS_IDLE 5        /* workers that ran out of work in this launch */
@@ -93,8 +103,9 @@ __kernel void bs_breadth_scatter(__global const SubPatch* queue, uint n, __globa
 
 __kernel void bs_bounded_step(__global const float4* points, __global const uint* patch_info,
                               __global const uint* edges, __global const float4* curves,
-                              uint patch_count, FrameParams f,
-                              __global SubPatch* stacks, __global uint* stack_sizes, uint stack_depth,
+                              uint patch_count, uint root_count, FrameParams f,
+                              __global const FrameParams* views, uint view_count,
+                              __global const uchar* page_masks, __global SubPatch* stacks, __global uint* stack_sizes, uint stack_depth,
                               __global SubPatch* ring, uint ring_capacity,
                               uint ring_head0, uint ring_tail0, uint donate_limit,
                               __global SubPatch* diceable, uint dice_capacity,
@@ -112,13 +123,13 @@ __kernel void bs_bounded_step(__global const float4* points, __global const uint
       if (r < ring_tail0) {
         stack[size++] = ring[r % ring_capacity];
       } else {
-        uint p = atomic_inc(&counters[BS_NEXT_PATCH]);
-        if (p >= patch_count) break;
-        stack[size++] = mp_root_subpatch(p);
+        uint r = atomic_inc(&counters[BS_NEXT_ROOT]);
+        if (r >= root_count) break;
+        stack[size++] = mp_root_subpatch(r, patch_count);
       }
     }
     SubPatch sp = stack[--size];
-    uint d = mp_classify(points, patch_info, edges, curves, &sp, f);
+    uint d = mp_classify(points, patch_info, edges, curves, &sp, mp_subpatch_view(&sp, f, views, view_count), page_masks);
     uint action = MP_DECISION_ACTION(d);
     if (action == MP_DICE) {
       uint slot = atomic_inc(&counters[BS_DICE_COUNT]);
@@ -126,7 +137,7 @@ __kernel void bs_bounded_step(__global const float4* points, __global const uint
         stack[size++] = sp; /* batch full: keep it for after the flush */
         break;
       }
-      sp.info = (sp.info & 0xffu) | (d & 0xffff00u);
+      sp.info = MP_DICED_INFO(sp.info, d);
       diceable[slot] = sp;
     } else if (action >= MP_SPLIT_U) {
       SubPatch a, b;

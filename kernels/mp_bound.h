@@ -96,11 +96,39 @@ MP_INLINE void mp_subpatch_net_boxes(const MP_GLOBAL float4* cp, uint type, floa
   }
 }
 
-/* Raster position of a camera-space point (d > 0 for perspective cameras). */
-MP_INLINE float2 mp_project(float3 p, FrameParams f) {
-  float inv = f.ortho ? 1.0f : 1.0f / (-p.z);
-  return MP_F2(f.ax * p.x * inv + f.bx, f.ay * p.y * inv + f.by);
+/* Boxes (camera space) holding the sub-patch's net, widened by the patch's
+ * displacement bound (mp_patch.h) so that culling and splitting never clip
+ * displaced geometry: the sub-patch's surface lies in their convex hull. */
+MP_INLINE void mp_subpatch_hull(const MP_GLOBAL float4* cp, uint type, const SubPatch* sp, float3* lo, float3* hi) {
+  float u0 = fmin(fmin(sp->corner[0], sp->corner[2]), fmin(sp->corner[4], sp->corner[6]));
+  float u1 = fmax(fmax(sp->corner[0], sp->corner[2]), fmax(sp->corner[4], sp->corner[6]));
+  float v0 = fmin(fmin(sp->corner[1], sp->corner[3]), fmin(sp->corner[5], sp->corner[7]));
+  float v1 = fmax(fmax(sp->corner[1], sp->corner[3]), fmax(sp->corner[5], sp->corner[7]));
+  mp_subpatch_net_boxes(cp, type, u0, v0, u1, v1, lo, hi);
+  float reach = MP_PATCH_DISPLACEMENT_BOUND(cp);
+  if (reach > 0.0f)
+    for (int k = 0; k < 16; ++k) {
+      lo[k] -= MP_F3(reach, reach, reach);
+      hi[k] += MP_F3(reach, reach, reach);
+    }
 }
+
+/* A camera-space point in the view's space (FrameParams.view). */
+MP_INLINE float3 mp_to_view(float3 p, FrameParams f) {
+  if (!f.has_view) return p;
+  const float* m = f.view;
+  return MP_F3(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
+               m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]);
+}
+
+/* Raster position of a view-space point (d > 0 for perspective views). */
+MP_INLINE float2 mp_project_view(float3 v, FrameParams f) {
+  float inv = f.ortho ? 1.0f : 1.0f / (-v.z);
+  return MP_F2(f.ax * v.x * inv + f.bx, f.ay * v.y * inv + f.by);
+}
+
+/* Raster position of a camera-space point in the view. */
+MP_INLINE float2 mp_project(float3 p, FrameParams f) { return mp_project_view(mp_to_view(p, f), f); }
 
 /* Range of a * x / d + b over x in [xl, xh], d in [dl, dh] (dl > 0). */
 MP_INLINE void mp_project_range(float xl, float xh, float dl, float dh, float a, float b, int ortho, float* lo, float* hi) {
@@ -117,7 +145,23 @@ MP_INLINE void mp_project_range(float xl, float xh, float dl, float dh, float a,
   *hi = fmax(r0, r1);
 }
 
-/* Raster/depth bound of the boxes. Only meaningful when dmin > 0 (or ortho). */
+/* Camera-space boxes [lo[k], hi[k]] as boxes of the view's space: each
+ * box's centre moves, its half extents go through |rotation| (exact for
+ * boxes that are points, as Bezier nets' are). */
+MP_INLINE void mp_boxes_to_view(float3* lo, float3* hi, FrameParams f) {
+  if (!f.has_view) return;
+  const float* m = f.view;
+  for (int k = 0; k < 16; ++k) {
+    float3 c = mp_to_view(0.5f * (lo[k] + hi[k]), f), h = 0.5f * (hi[k] - lo[k]);
+    float3 e = MP_F3(fabs(m[0]) * h.x + fabs(m[1]) * h.y + fabs(m[2]) * h.z,
+                     fabs(m[4]) * h.x + fabs(m[5]) * h.y + fabs(m[6]) * h.z,
+                     fabs(m[8]) * h.x + fabs(m[9]) * h.y + fabs(m[10]) * h.z);
+    lo[k] = c - e;
+    hi[k] = c + e;
+  }
+}
+
+/* Raster/depth bound of view-space boxes. Only meaningful when dmin > 0 (or ortho). */
 MP_INLINE MpBound mp_bound_boxes(const float3* lo, const float3* hi, FrameParams f) {
   MpBound b;
   b.dmin = 3.0e38f;
@@ -185,14 +229,18 @@ MP_INLINE void mp_net_space_lengths(const float3* lo, const float3* hi, float* l
  * both halves of a transition edge (mp_patch.h) and must be cut at its middle. */
 #define MP_UNMEASURABLE -1.0f
 
-MP_INLINE int mp_camera_point_usable(float3 p, FrameParams f) { return f.ortho || -p.z > f.eye_epsilon; }
+MP_INLINE int mp_view_point_usable(float3 v, FrameParams f) { return f.ortho || -v.z > f.eye_epsilon; }
 
-MP_INLINE float mp_polyline_screen_length(const float3* p, int count, FrameParams f) {
+/* Screen length of a camera-space polyline in the view; the points are
+ * left in the view's space. */
+MP_INLINE float mp_polyline_screen_length(float3* p, int count, FrameParams f) {
   float len = 0.0f;
-  for (int k = 0; k < count; ++k)
-    if (!mp_camera_point_usable(p[k], f)) return MP_UNMEASURABLE;
+  for (int k = 0; k < count; ++k) {
+    p[k] = mp_to_view(p[k], f);
+    if (!mp_view_point_usable(p[k], f)) return MP_UNMEASURABLE;
+  }
   for (int k = 0; k + 1 < count; ++k) {
-    float2 d = mp_project(p[k + 1], f) - mp_project(p[k], f);
+    float2 d = mp_project_view(p[k + 1], f) - mp_project_view(p[k], f);
     len += sqrt(d.x * d.x + d.y * d.y);
   }
   return len;
@@ -269,7 +317,7 @@ MP_INLINE float mp_mid_screen_length(const MP_GLOBAL float4* cp, uint type, cons
     mp_eval_patch(cp, type, uv.x, uv.y, &p[k], &du, &dv);
   }
   float len = mp_polyline_screen_length(p, MP_EDGE_SEGMENTS + 1, f);
-  *chord = len >= 0.0f ? mp_project(p[MP_EDGE_SEGMENTS], f) - mp_project(p[0], f) : MP_F2(0.0f, 0.0f);
+  *chord = len >= 0.0f ? mp_project_view(p[MP_EDGE_SEGMENTS], f) - mp_project_view(p[0], f) : MP_F2(0.0f, 0.0f);
   return len;
 }
 
@@ -309,30 +357,46 @@ MP_INLINE void mp_interior_rates(float mid_u, float mid_v, float2 chord_u, float
   }
 }
 
+/* Whether a shadow view renders any page under the raster rectangle: its
+ * page mask pyramid (levels of side, side / 2, ... 1 bytes per side, each
+ * byte set where a page below it is rendered) is read at the level where
+ * the rectangle spans at most two cells per axis. */
+MP_INLINE int mp_page_mask_overlaps(const MP_GLOBAL uchar* mask, int side, float xmin, float ymin, float xmax,
+                                    float ymax) {
+  float last = (float)(side * 128 - 1);
+  int x0 = (int)(fmin(fmax(xmin, 0.0f), last)) >> 7, x1 = (int)(fmin(fmax(xmax, 0.0f), last)) >> 7;
+  int y0 = (int)(fmin(fmax(ymin, 0.0f), last)) >> 7, y1 = (int)(fmin(fmax(ymax, 0.0f), last)) >> 7;
+  uint offset = 0u;
+  int k = 0, n = side;
+  while ((x1 >> k) - (x0 >> k) > 1 || (y1 >> k) - (y0 >> k) > 1) {
+    offset += (uint)(n * n);
+    n >>= 1;
+    ++k;
+  }
+  for (int y = y0 >> k; y <= y1 >> k; ++y)
+    for (int x = x0 >> k; x <= x1 >> k; ++x)
+      if (mask[offset + (uint)(y * n + x)]) return 1;
+  return 0;
+}
+
 /* The bound & split decision for one sub-patch: cull, dice (with grid size)
  * or split across edges 0 and 2 (MP_SPLIT_U) or 1 and 3 (MP_SPLIT_V). Rates of
  * edges measured here are stored into *sp for its children or its dicing. A
  * pure function of its inputs, so every bound & split strategy reaches the
- * same diced set. */
+ * same diced set. The view is f's (the camera or a shadow map); shadow views
+ * also cull what lies under none of their rendered pages (page_masks). */
 MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint* patch_info,
                            const MP_GLOBAL uint* edges, const MP_GLOBAL float4* curves, SubPatch* sp,
-                           FrameParams f) {
+                           FrameParams f, const MP_GLOBAL uchar* page_masks) {
   const MP_GLOBAL float4* cp = points + (ulong)sp->patch * MP_PATCH_POINTS;
   uint type = patch_info[4 * (ulong)sp->patch];
-  float u0 = fmin(fmin(sp->corner[0], sp->corner[2]), fmin(sp->corner[4], sp->corner[6]));
-  float u1 = fmax(fmax(sp->corner[0], sp->corner[2]), fmax(sp->corner[4], sp->corner[6]));
-  float v0 = fmin(fmin(sp->corner[1], sp->corner[3]), fmin(sp->corner[5], sp->corner[7]));
-  float v1 = fmax(fmax(sp->corner[1], sp->corner[3]), fmax(sp->corner[5], sp->corner[7]));
+  /* Ray visibility: objects hidden from the camera still cast shadows, and
+   * objects that cast none stay out of the lights' views. */
+  uint flags = patch_info[4 * (ulong)sp->patch + 2];
+  if (flags & (f.view_kind == MP_VIEW_SHADOW ? MP_PATCH_NO_SHADOW : MP_PATCH_NO_CAMERA)) return MP_CULL;
   float3 lo[16], hi[16];
-  mp_subpatch_net_boxes(cp, type, u0, v0, u1, v1, lo, hi);
-  /* Displacement moves the surface at most this far (mp_patch.h): widen the
-   * hull so culling and splitting never clip displaced geometry. */
-  float reach = MP_PATCH_DISPLACEMENT_BOUND(cp);
-  if (reach > 0.0f)
-    for (int k = 0; k < 16; ++k) {
-      lo[k] -= MP_F3(reach, reach, reach);
-      hi[k] += MP_F3(reach, reach, reach);
-    }
+  mp_subpatch_hull(cp, type, sp, lo, hi);
+  mp_boxes_to_view(lo, hi, f);
   MpBound b = mp_bound_boxes(lo, hi, f);
   uint depth = MP_INFO_DEPTH(sp->info);
   int can_split = (int)depth < f.max_depth;
@@ -342,6 +406,10 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
   if (straddles && !can_split) return MP_CULL;
   if (!straddles && (b.xmax < -f.ribbon || b.ymax < -f.ribbon || b.xmin > (float)f.width + f.ribbon ||
                      b.ymin > (float)f.height + f.ribbon))
+    return MP_CULL;
+  if (!straddles && f.view_kind == MP_VIEW_SHADOW && page_masks &&
+      !mp_page_mask_overlaps(page_masks + f.page_mask, f.page_side, b.xmin - f.ribbon, b.ymin - f.ribbon,
+                             b.xmax + f.ribbon, b.ymax + f.ribbon))
     return MP_CULL;
 
   /* Rate every edge that has none yet; score = length in target edges. */
@@ -409,7 +477,7 @@ MP_INLINE void mp_split(const SubPatch* sp, uint action, SubPatch* a, SubPatch* 
   uint y_first = r[2] > 1u ? r[2] - 1u : r[2], y_second = r[2] > 1u ? r[2] - 1u : r[2];
   float2 ca[4] = {c[0], x, y, c[3]}, cb[4] = {x, c[1], c[2], y};
   uint ra[4] = {x_first, 0u, y_second, r[3]}, rb[4] = {x_second, r[1], y_first, 0u};
-  uint info = MP_MAKE_INFO(MP_INFO_DEPTH(sp->info) + 1u, 0u, 0u);
+  uint info = MP_MAKE_INFO(MP_INFO_DEPTH(sp->info) + 1u, 0u, 0u) | (sp->info & MP_INFO_VIEW_BITS);
   a->patch = b->patch = sp->patch;
   a->info = b->info = info;
   a->rates = b->rates = 0u;

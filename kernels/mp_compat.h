@@ -29,6 +29,7 @@ typedef glm::vec2 float2;
 typedef std::uint32_t uint;
 typedef std::uint64_t ulong;
 typedef std::uint16_t ushort;
+typedef std::uint8_t uchar;
 #define MP_INLINE inline
 #define MP_GLOBAL
 #define MP_CONSTANT
@@ -53,6 +54,9 @@ inline uint min(uint a, uint b) { return std::min(a, b); }
 inline float mix(float a, float b, float t) { return a + (b - a) * t; }
 inline glm::vec3 mix(glm::vec3 a, glm::vec3 b, float t) { return a + (b - a) * t; }
 inline uint as_uint(float f) { uint u; std::memcpy(&u, &f, 4); return u; }
+inline float as_float(uint u) { float f; std::memcpy(&f, &u, 4); return f; }
+inline int max(int a, int b) { return std::max(a, b); }
+inline int min(int a, int b) { return std::min(a, b); }
 // OpenCL's float overloads (the C library's take and return double).
 inline float pow(float x, float y) { return std::pow(x, y); }
 inline float cos(float x) { return std::cos(x); }

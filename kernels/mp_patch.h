@@ -29,6 +29,8 @@
 #define MP_PATCH_DOUBLE_SIDED 1u
 #define MP_PATCH_FLIP_ORIENTATION 2u
 #define MP_PATCH_SMOOTH_NORMALS 4u /* has corner normals (MP_PATCH_NORMALS) */
+#define MP_PATCH_NO_SHADOW 8u      /* casts no shadows (not in the lights' views) */
+#define MP_PATCH_NO_CAMERA 16u     /* not seen by the camera (still casts shadows) */
 #define MP_PATCH_OBJECT(flags) ((flags) >> 8)
 
 /* The w of the first control point is the patch's displacement bound: how

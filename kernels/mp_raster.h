@@ -62,6 +62,48 @@ MP_INLINE int mp_edge_owns(MpFixed2 a, MpFixed2 b) {
 
 MP_INLINE int mp_edge_inside(long e, int owns) { return e > 0 || (e == 0 && owns); }
 
+/* A triangle set up for coverage tests: vertices ordered so that inside
+ * means all three edge functions >= 0 (with the tie rule on ties); `swapped`
+ * tells the caller that b and c were exchanged to get there. */
+typedef struct {
+  MpFixed2 a, b, c;
+  int own0, own1, own2;
+  float inv_area;
+  int valid, swapped;
+} MpEdgeTriangle;
+
+MP_INLINE MpEdgeTriangle mp_edge_triangle(MpFixed2 a, MpFixed2 b, MpFixed2 c) {
+  MpEdgeTriangle t;
+  long area = mp_edge(a, b, c);
+  t.valid = area != 0;
+  t.swapped = area > 0; /* make the orientation uniform; culling happened before */
+  if (t.swapped) {
+    MpFixed2 tmp = b;
+    b = c;
+    c = tmp;
+    area = -area;
+  }
+  t.a = a;
+  t.b = b;
+  t.c = c;
+  t.own0 = mp_edge_owns(b, c);
+  t.own1 = mp_edge_owns(c, a);
+  t.own2 = mp_edge_owns(a, b);
+  t.inv_area = t.valid ? 1.0f / (float)(-area) : 0.0f;
+  return t;
+}
+
+/* Barycentrics (of a, b, c as ordered in t) of q if the triangle covers it. */
+MP_INLINE int mp_edge_triangle_covers(const MpEdgeTriangle* t, MpFixed2 q, float* la, float* lb, float* lc) {
+  if (!t->valid) return 0;
+  long e0 = -mp_edge(t->b, t->c, q), e1 = -mp_edge(t->c, t->a, q), e2 = -mp_edge(t->a, t->b, q);
+  if (!(mp_edge_inside(e0, t->own0) && mp_edge_inside(e1, t->own1) && mp_edge_inside(e2, t->own2))) return 0;
+  *la = (float)e0 * t->inv_area;
+  *lb = (float)e1 * t->inv_area;
+  *lc = (float)e2 * t->inv_area;
+  return 1;
+}
+
 /* Octahedral encoding of a unit vector into 2 x 16 bits (Cigolle et al. 2014). */
 MP_INLINE uint mp_encode_normal(float3 n) {
   float s = fabs(n.x) + fabs(n.y) + fabs(n.z);

@@ -9,6 +9,7 @@
 #include "mp_compat.h"
 #include "mp_patch.h"
 #include "mp_types.h"
+#include "mp_shadow.h"
 
 #define MP_PI 3.14159265358979f
 #define MP_AREA_MAX_VERTICES 18  /* a 16-gon plus one vertex from horizon clipping, plus slack */
@@ -77,6 +78,66 @@ MP_INLINE float mp_area_irradiance(MP_GLOBAL const DeviceLight* lt, float3 p, fl
   }
   return mp_polygon_irradiance(n, verts, count);
 }
+
+/* Irradiance factor (projected solid angle over the emitting area) of a
+ * point or spot light with a radius r (DeviceLight.cone[3]) at p with
+ * normal n: the radiance of its intensity spread over a disk of radius r,
+ * the light as Cycles samples it (docs/blender-conventions.md): a disk at
+ * the light facing p, or (direction[3] = 1, Blender 4.1's point light
+ * without soft falloff) a sphere, whose silhouette is the smaller disk
+ * r sqrt(1 - r^2/d^2) at d - r^2/d. Far from the light it is the point
+ * light's cos / d^2 times d^2 / (d^2 + r^2) (the disk) or 1 (the sphere). */
+MP_INLINE float mp_sized_light_factor(MP_GLOBAL const DeviceLight* lt, float3 to_light, float d2, float3 n) {
+  float r = lt->cone[3], d = sqrt(d2);
+  int sphere = lt->direction[3] > 0.5f;
+  float3 l = to_light / d;
+  if (r < 0.05f * d) {
+    float c = fmax(dot(n, l), 0.0f);
+    return sphere ? c / d2 : c / (d2 + r * r);
+  }
+  if (sphere && d <= r) return fmax(dot(n, l), 0.0f) / (r * r); /* inside: half its radiance's pi */
+  float rr = sphere ? r * sqrt(1.0f - r * r / d2) : r;
+  float3 c = sphere ? to_light * (1.0f - r * r / d2) : to_light;
+  float3 a = fabs(l.x) < 0.9f ? MP_F3(1.0f, 0.0f, 0.0f) : MP_F3(0.0f, 1.0f, 0.0f);
+  float3 u = normalize(cross(l, a)), w = cross(l, u);
+  float k = rr * sqrt(MP_PI / (0.5f * (float)MP_ELLIPSE_SIDES * sin(2.0f * MP_PI / (float)MP_ELLIPSE_SIDES)));
+  float3 verts[MP_AREA_MAX_VERTICES];
+  for (int i = 0; i < MP_ELLIPSE_SIDES; ++i) {
+    float t = 2.0f * MP_PI * (float)i / (float)MP_ELLIPSE_SIDES;
+    verts[i] = c + k * ((float)cos(t) * u + (float)sin(t) * w);
+  }
+  return mp_polygon_irradiance(n, verts, MP_ELLIPSE_SIDES) / (MP_PI * r * r);
+}
+
+/* A spot light's cone at p: cos(angle to the axis)^beam times the smooth
+ * step between the cone's inner and outer angles. A spot with a radius is
+ * a disk of lights facing p, each evaluating the cone from its own
+ * position, as Cycles does per light sample: the mask averages over the
+ * disk, which blurs the cone's edge by its angular size. */
+MP_INLINE float mp_spot_mask(MP_GLOBAL const DeviceLight* lt, float3 p) {
+  float3 c = mp_light_f3(lt->position), axis = mp_light_f3(lt->direction);
+  float r = lt->cone[3];
+  int taps = r > 0.0f ? 8 : 1;
+  float3 w = normalize(p - c);
+  float3 a = fabs(w.x) < 0.9f ? MP_F3(1.0f, 0.0f, 0.0f) : MP_F3(0.0f, 1.0f, 0.0f);
+  float3 u = normalize(cross(w, a)), v = cross(w, u);
+  float sum = 0.0f;
+  for (int k = 0; k < taps; ++k) {
+    float2 d = taps > 1 ? mp_disk_tap(k, taps) : MP_F2(0.0f, 0.0f);
+    float cosangle = dot(normalize(p - (c + r * (d.x * u + d.y * v))), axis);
+    float m = cosangle > 0.0f ? MP_POWR(cosangle, lt->cone[2]) : 0.0f;
+    sum += m * mp_smoothstep(lt->cone[0], lt->cone[1], cosangle);
+  }
+  return sum / (float)taps;
+}
+
+/* What shading needs to shadow a vertex: the maps (mp_shadow.h), the
+ * receiver's geometric normal (its tangent plane) and pixel footprint. */
+typedef struct {
+  const MpShadowMaps* maps;
+  float3 normal;
+  float footprint;
+} MpShadowQuery;
 
 /* GGX / Trowbridge-Reitz with Smith's separable masking-shadowing. */
 MP_INLINE float mp_ggx_specular(float3 n, float3 l, float3 v, float alpha) {
@@ -168,7 +229,8 @@ MP_INLINE float mp_bump_shadowing_v4(float3 ns, float3 n, float3 l, int correcti
  * shading normals, which the geometry faced: mp_face_shading_normal), so a
  * smooth normal turning away near a silhouette is not flipped. */
 MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal, int faced, int ortho,
-                                 const DeviceMaterial* m, MP_GLOBAL const DeviceLight* lights, uint light_count) {
+                                 const DeviceMaterial* m, MP_GLOBAL const DeviceLight* lights, uint light_count,
+                                 const MpShadowQuery* shadow) {
   float3 cs = MP_F3(m->color[0], m->color[1], m->color[2]);
   float3 emission = MP_F3(m->emission[0], m->emission[1], m->emission[2]);
   int model = (int)m->color[3];
@@ -203,20 +265,26 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal,
     } else {
       if (type == MP_LIGHT_DISTANT) {
         l = -mp_light_f3(lt->direction);
+        e = cl * fmax(dot(nf, l), 0.0f);
+        ed = cl * fmax(dot(nd, l), 0.0f);
       } else {
         float3 to_light = mp_light_f3(lt->position) - p;
         float d2 = fmax(dot(to_light, to_light), 1e-20f);
         l = to_light / sqrt(d2);
-        float atten = 1.0f / d2;
-        if (type == MP_LIGHT_SPOT) {
-          float cosangle = -dot(l, mp_light_f3(lt->direction));
-          atten *= cosangle > 0.0f ? MP_POWR(cosangle, lt->cone[2]) : 0.0f;
-          atten *= mp_smoothstep(lt->cone[0], lt->cone[1], cosangle);
+        if (type == MP_LIGHT_SPOT) cl *= mp_spot_mask(lt, p);
+        if (lt->cone[3] > 0.0f) {
+          e = cl * mp_sized_light_factor(lt, to_light, d2, nf);
+          ed = bsdf_normal >= 2 ? cl * mp_sized_light_factor(lt, to_light, d2, nd) : e;
+        } else {
+          e = cl * (fmax(dot(nf, l), 0.0f) / d2);
+          ed = cl * (fmax(dot(nd, l), 0.0f) / d2);
         }
-        cl *= atten;
       }
-      e = cl * fmax(dot(nf, l), 0.0f);
-      ed = cl * fmax(dot(nd, l), 0.0f);
+    }
+    if (shadow && (e.x > 0.0f || e.y > 0.0f || e.z > 0.0f || ed.x > 0.0f || ed.y > 0.0f || ed.z > 0.0f)) {
+      float vis = mp_shadow_visibility(shadow->maps, k, p, shadow->normal, shadow->footprint);
+      e *= vis;
+      ed *= vis;
     }
     if (bsdf_normal >= 2)
       diffuse += ed * mp_bump_shadowing_v4(ngf, nd, l, bsdf_normal == 2);
@@ -243,8 +311,8 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal,
 
 /* Radiance leaving point p with normal n towards the eye. */
 MP_INLINE float3 mp_shade(float3 p, float3 n, int faced, int ortho, const DeviceMaterial* m,
-                          MP_GLOBAL const DeviceLight* lights, uint light_count) {
-  return mp_shade_bumped(p, n, n, 0, faced, ortho, m, lights, light_count);
+                          MP_GLOBAL const DeviceLight* lights, uint light_count, const MpShadowQuery* shadow) {
+  return mp_shade_bumped(p, n, n, 0, faced, ortho, m, lights, light_count, shadow);
 }
 
 /* The smooth shading normal of a patch at (u, v) (mp_patch.h,

@@ -8,8 +8,10 @@
 /* A piece of a patch: the parametric quadrilateral with corners
  * (corner[2k], corner[2k+1]), k = 0..3, counter-clockwise in (u, v), of patch
  * `patch`. Edge k runs from corner k to corner k+1. `info` packs the split
- * depth (bits 0-7) and, once the sub-patch is diceable, its grid size in
- * micropolygons (nu: bits 8-15, nv: bits 16-23). `rates` holds one byte per
+ * depth (bits 0-7), once the sub-patch is diceable its grid size in
+ * micropolygons (nu: bits 8-15, nv: bits 16-23), and the view it belongs to
+ * in a pass that renders several views at once (bits 24-31; shadow maps,
+ * FrameParams below). `rates` holds one byte per
  * edge: 0 while the edge is still to be measured (or too long to dice), else
  * 1 + log2 of the number of micropolygon edges along it (see mp_bound.h). */
 typedef struct {
@@ -25,15 +27,30 @@ typedef struct {
 #define MP_INFO_DEPTH(info) ((info) & 0xffu)
 #define MP_INFO_NU(info) (((info) >> 8) & 0xffu)
 #define MP_INFO_NV(info) (((info) >> 16) & 0xffu)
+#define MP_INFO_VIEW(info) ((info) >> 24)
 #define MP_MAKE_INFO(depth, nu, nv) ((uint)(depth) | ((uint)(nu) << 8) | ((uint)(nv) << 16))
+#define MP_INFO_VIEW_BITS 0xff000000u
+/* A diceable sub-patch's info: its depth and view, and the grid size of its
+ * bound & split decision word (mp_bound.h). */
+#define MP_DICED_INFO(info, decision) (((info) & (0xffu | MP_INFO_VIEW_BITS)) | ((decision) & 0xffff00u))
+/* Views one pass renders at most (the 8 bits of MP_INFO_VIEW). */
+#define MP_MAX_PASS_VIEWS 256
 
 /* Largest grid the dicer accepts (micropolygons per side). */
 #define MP_MAX_GRID 32
 
-/* Per-frame constants, passed by value to every kernel. Camera space is
- * right-handed looking down -Z; d = -z is the depth in front of the eye.
- * Raster position: rx = ax * x / d + bx, ry = ay * y / d + by (perspective),
- * with d replaced by 1 for orthographic cameras. Raster y points down. */
+/* What a view's samples are for (FrameParams.view_kind). */
+#define MP_VIEW_CAMERA 0 /* the image: color, depth and passes */
+#define MP_VIEW_SHADOW 1 /* a light's shadow map: depth only, into its pages */
+
+/* Per-view constants, passed by value to every kernel (the camera's), or as
+ * an array indexed by MP_INFO_VIEW in passes that render several views at
+ * once (shadow maps). Patches live in the camera's space, right-handed
+ * looking down -Z; a view other than the camera's first moves points into
+ * its own space by `view` (has_view). There d = -z is the depth in front
+ * of the eye. Raster position: rx = ax * x / d + bx, ry = ay * y / d + by
+ * (perspective), with d replaced by 1 for orthographic views. Raster y
+ * points down in the camera's view. */
 typedef struct {
   float ax, bx, ay, by;
   int ortho;
@@ -49,6 +66,17 @@ typedef struct {
   uint seed;
   int crop_x0, crop_y0;     /* crop origin in the whole image: sample patterns follow whole-image pixels */
   int normal_pass;          /* samples keep their normal (the Normal pass is wanted) */
+  /* The view (see above). */
+  int has_view;             /* 0: the camera's space itself */
+  float view[12];           /* camera space -> view space, rows of a rigid 3x4 */
+  int view_kind;            /* MP_VIEW_CAMERA or MP_VIEW_SHADOW */
+  /* Shadow views (mp_shadow.h): the map's page table, its pages per side,
+   * the table slot of its raster's page (0, 0) (a clipmap level's window
+   * wraps around its table) and the first byte of its page mask pyramid. */
+  uint page_table;
+  int page_side;
+  int page_origin_x, page_origin_y;
+  uint page_mask;
 } FrameParams;
 
 /* Materials (see scene.h): color.w = model. */
@@ -63,7 +91,8 @@ typedef struct {
   float specular[4];        /* specular color (plastic) */
   float emission[4];
   float principled[4];      /* metallic, specular, 0, 0 */
-  float program[4];         /* compiled node program index or -1, displaces (1/0), surface program (1/0), 0 */
+  float program[4];         /* compiled node program index or -1, displaces (1/0), surface program (1/0),
+                               program computes the alpha (1/0) */
 } DeviceMaterial;
 
 /* Per object, for material programs: camera -> object space (rows of a 3x4
@@ -107,5 +136,41 @@ typedef struct {
   float axis_u[4];          /* area: half extent along u, w = shape */
   float axis_v[4];          /* area: half extent along v */
 } DeviceLight;
+
+/* Shadow maps of a light (mp_shadow.h), one record per light in the
+ * light's order; kind MP_SHADOW_NONE for lights that cast no shadows. */
+#define MP_SHADOW_NONE 0u
+#define MP_SHADOW_SUN 1u  /* clipmap levels along the light */
+#define MP_SHADOW_CUBE 2u /* six perspective faces around the light, with mips */
+/* The light's shape, for soft shadows. */
+#define MP_SHADOW_SHAPE_POINT 0u     /* no size: hard shadows */
+#define MP_SHADOW_SHAPE_DISK 1u      /* sun: size[0] = tan(half angle); point and spot: radius, facing the receiver */
+#define MP_SHADOW_SHAPE_RECTANGLE 2u /* area: half extents along light-space x, y */
+#define MP_SHADOW_SHAPE_ELLIPSE 3u
+typedef struct {
+  float to_light[12];  /* camera space -> light space (rows of a rigid 3x4) */
+  uint kind;
+  uint shape;
+  float size[2];
+  uint page_table;     /* the light's first page-table entry */
+  int level0;          /* sun: its finest level's texels are 2^level0 scene units */
+  uint levels;         /* sun: clipmap levels (records from level_records) */
+  uint level_records;
+  int level_bias;      /* levels (mips) coarser than the footprint asks for: a short budget */
+  float z_top;         /* sun: light-space z from which view depth counts down */
+  float cone_cos;      /* spot: cosine of the cone's half angle (receivers outside get no light); else -2 */
+  uint one_sided;      /* area: only receivers on the light's -z side get light */
+} DeviceShadow;
+
+/* A sun's clipmap level: window-relative light-space x, y = x + offset,
+ * texels of `texel` scene units, and the table slot of the window's page
+ * (0, 0) (the table wraps around). */
+typedef struct {
+  float offset[2];
+  float texel;
+  uint page_table;
+  int origin_x, origin_y;
+  float pad[2];
+} DeviceShadowLevel;
 
 #endif

@@ -41,40 +41,20 @@ inline MpRasterVertex mp_raster_vertex(float4 p, float4 c, float4 n, FrameParams
   return v;
 }
 
-/* A triangle set up for coverage tests: vertices ordered so that inside
- * means all three edge functions >= 0 (with the tie rule on ties). */
+/* A triangle set up for coverage tests (mp_edge_triangle) with the
+ * attributes of its vertices in the same order. */
 typedef struct {
+  MpEdgeTriangle e;
   MpRasterVertex a, b, c;
-  int own0, own1, own2;
-  float inv_area;
-  int valid;
 } MpTriangle;
 
 inline MpTriangle mp_setup_triangle(MpRasterVertex a, MpRasterVertex b, MpRasterVertex c) {
   MpTriangle t;
-  long area = mp_edge(a.p, b.p, c.p);
-  t.valid = area != 0;
-  if (area > 0) { /* make the orientation uniform; culling happened before */
-    MpRasterVertex tmp = b; b = c; c = tmp;
-    area = -area;
-  }
-  t.a = a; t.b = b; t.c = c;
-  t.own0 = mp_edge_owns(b.p, c.p);
-  t.own1 = mp_edge_owns(c.p, a.p);
-  t.own2 = mp_edge_owns(a.p, b.p);
-  t.inv_area = t.valid ? 1.0f / (float)(-area) : 0.0f;
+  t.e = mp_edge_triangle(a.p, b.p, c.p);
+  t.a = a;
+  t.b = t.e.swapped ? c : b;
+  t.c = t.e.swapped ? b : c;
   return t;
-}
-
-/* Barycentrics of q if the triangle covers it. */
-inline int mp_triangle_covers(const MpTriangle* t, MpFixed2 q, float* la, float* lb, float* lc) {
-  if (!t->valid) return 0;
-  long e0 = -mp_edge(t->b.p, t->c.p, q), e1 = -mp_edge(t->c.p, t->a.p, q), e2 = -mp_edge(t->a.p, t->b.p, q);
-  if (!(mp_edge_inside(e0, t->own0) && mp_edge_inside(e1, t->own1) && mp_edge_inside(e2, t->own2))) return 0;
-  *la = (float)e0 * t->inv_area;
-  *lb = (float)e1 * t->inv_area;
-  *lc = (float)e2 * t->inv_area;
-  return 1;
 }
 
 /* Rasterises the quad's triangles (v00, v10, v11) and (v00, v11, v01) that
@@ -85,8 +65,8 @@ inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVerte
   MpTriangle tris[2];
   tris[0] = mp_setup_triangle(v00, v10, v11);
   tris[1] = mp_setup_triangle(v00, v11, v01);
-  tris[0].valid &= (int)(keep & 1u);
-  tris[1].valid &= (int)(keep >> 1);
+  tris[0].e.valid &= (int)(keep & 1u);
+  tris[1].e.valid &= (int)(keep >> 1);
   long xmin = min(min(v00.p.x, v10.p.x), min(v11.p.x, v01.p.x)), xmax = max(max(v00.p.x, v10.p.x), max(v11.p.x, v01.p.x));
   long ymin = min(min(v00.p.y, v10.p.y), min(v11.p.y, v01.p.y)), ymax = max(max(v00.p.y, v10.p.y), max(v11.p.y, v01.p.y));
   int px0 = (int)max(xmin >> MP_SUBPIXEL_BITS, (long)0), px1 = (int)min(xmax >> MP_SUBPIXEL_BITS, (long)f.width - 1);
@@ -99,9 +79,9 @@ inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVerte
         if (q.x < xmin || q.x > xmax || q.y < ymin || q.y > ymax) continue;
         float la, lb, lc;
         int k = 0;
-        if (!mp_triangle_covers(&tris[0], q, &la, &lb, &lc)) {
+        if (!mp_edge_triangle_covers(&tris[0].e, q, &la, &lb, &lc)) {
           k = 1;
-          if (!mp_triangle_covers(&tris[1], q, &la, &lb, &lc)) continue;
+          if (!mp_edge_triangle_covers(&tris[1].e, q, &la, &lb, &lc)) continue;
         }
         const MpTriangle* t = &tris[k];
         float inv_d = la * t->a.inv_d + lb * t->b.inv_d + lc * t->c.inv_d;

@@ -10,7 +10,9 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
                           FrameParams f, __global const float4* grid_p, __global float4* grid_n,
                           __global const DeviceMaterial* materials, __global const DeviceLight* lights,
                           uint light_count, __global float4* grid_c, __global const uint* vertex_offsets,
-                          __global const float4* patch_normals) {
+                          __global const float4* patch_normals, uint use_shadows,
+                          __global const DeviceShadow* shadows, __global const DeviceShadowLevel* shadow_levels,
+                          __global const uint* shadow_pages, __global const uint* shadow_pool) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   float2 uv;
@@ -18,6 +20,9 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
   if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
   DeviceMaterial m = materials[patch_info[4 * (ulong)sp.patch + 1]];
   float3 p = grid_p[index].xyz, n = grid_n[index].xyz;
+  /* Shadows compare with the surface's own tangent plane (mp_shadow.h). */
+  MpShadowMaps maps = {shadows, shadow_levels, shadow_pages, shadow_pool};
+  MpShadowQuery shadow = {&maps, n, mp_pixel_footprint(-p.z, f)};
   /* Smooth-shaded polygons: their interpolated normal replaces the surface's
    * for shading, node programs and the Normal pass (w = 1: already faced).
    * Displaced surfaces keep the normal of their displaced grid. */
@@ -30,6 +35,6 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
     }
   }
   if (m.program[2] > 0.0f) return; /* shaded by its node program (material_program.cl) */
-  float3 c = mp_shade(p, n, faced, f.ortho, &m, lights, light_count);
+  float3 c = mp_shade(p, n, faced, f.ortho, &m, lights, light_count, use_shadows ? &shadow : 0);
   grid_c[index] = (float4)(c, m.opacity[3]);
 }

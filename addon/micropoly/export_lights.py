@@ -40,6 +40,28 @@ def _spot_cone(spot_size, spot_blend):
     return outer, outer - math.acos(cos_inner)
 
 
+def casts_shadow(light):
+    """The light's Cast Shadow toggle as Cycles reads it: light.cycles.cast_shadow
+    in Blender 3.x (light.use_shadow there is EEVEE's), light.use_shadow from 4.0."""
+    cycles = getattr(light, "cycles", None)
+    if cycles is not None and hasattr(cycles, "cast_shadow"):
+        return bool(cycles.cast_shadow)
+    return bool(getattr(light, "use_shadow", True))
+
+
+def _shadow_settings(light):
+    """What shapes a light's shadows: its cast-shadow toggle and its size
+    (Radius of point and spot lights, with Soft Falloff from Blender 4.1;
+    Angle of suns; area lights' size is their shape)."""
+    s = {"cast_shadows": casts_shadow(light)}
+    if light.type in ("POINT", "SPOT"):
+        s["radius"] = max(float(light.shadow_soft_size), 0.0)
+        s["soft_falloff"] = bool(getattr(light, "use_soft_falloff", True))
+    elif light.type == "SUN":
+        s["angle"] = min(max(float(light.angle), 0.0), math.pi)
+    return s
+
+
 def export_light(native_scene, obj, matrix, warnings):
     light = obj.data
     color = list(light.color)
@@ -47,16 +69,18 @@ def export_light(native_scene, obj, matrix, warnings):
     rotation = matrix.to_3x3()
     direction = list((rotation @ Vector((0.0, 0.0, -1.0))).normalized())
     power = float(light.energy)
+    shadows = _shadow_settings(light)
     if light.type == "SUN":
-        native_scene.add_light("distant", color=color, intensity=power, direction=direction)
+        native_scene.add_light("distant", color=color, intensity=power, direction=direction, **shadows)
     elif light.type == "POINT":
-        native_scene.add_light("point", color=color, intensity=power / (4.0 * math.pi), position=position)
+        native_scene.add_light("point", color=color, intensity=power / (4.0 * math.pi), position=position,
+                               **shadows)
     elif light.type == "SPOT":
         cone, delta = _spot_cone(light.spot_size, light.spot_blend)
         # Cycles in Blender 3.x also weights the cone by cos(angle to the axis).
         native_scene.add_light("spot", color=color, intensity=power / (4.0 * math.pi), position=position,
                                direction=direction, cone_angle=cone, cone_delta_angle=delta,
-                               beam_distribution=1.0 if bpy.app.version < (4, 0, 0) else 0.0)
+                               beam_distribution=1.0 if bpy.app.version < (4, 0, 0) else 0.0, **shadows)
     elif light.type == "AREA":
         scale = matrix.to_scale()
         size_u = light.size * abs(scale.x)
@@ -70,4 +94,4 @@ def export_light(native_scene, obj, matrix, warnings):
         radiance = power / ((math.pi if bpy.app.version >= (4, 0, 0) else 4.0) * area)
         native_scene.add_light("area", color=color, intensity=radiance, position=position,
                                direction=direction, shape="ellipse" if light.shape in ("DISK", "ELLIPSE")
-                               else "rectangle", axis_u=axis_u, size_u=size_u, size_v=size_v)
+                               else "rectangle", axis_u=axis_u, size_u=size_u, size_v=size_v, **shadows)

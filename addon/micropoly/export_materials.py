@@ -2,7 +2,7 @@
 """Blender materials -> native Principled materials.
 
 The node connected to the active Material Output's Surface socket decides:
-Principled BSDF and Diffuse BSDF give their constant inputs, an Emission
+Principled BSDF (its Alpha as opacity) and Diffuse BSDF give their constant inputs, an Emission
 shader gives emission; anything else falls back to the material's viewport
 color, metallic and roughness."""
 
@@ -39,10 +39,11 @@ def material_parameters(material):
     elif node.type == "BSDF_PRINCIPLED":
         strength = float(_input(node, "Emission Strength", default=1.0))
         emission = _input(node, "Emission Color", "Emission", default=(0, 0, 0, 1))
+        alpha = min(max(float(_input(node, "Alpha", default=1.0)), 0.0), 1.0)
         params.update(color=list(_input(node, "Base Color"))[:3], metallic=float(_input(node, "Metallic")),
                       roughness=float(_input(node, "Roughness")),
                       specular=float(_input(node, "Specular IOR Level", "Specular", default=0.5)),
-                      emission=[c * strength for c in list(emission)[:3]])
+                      emission=[c * strength for c in list(emission)[:3]], opacity=[alpha] * 3)
     elif node.type == "BSDF_DIFFUSE":
         params.update(color=list(_input(node, "Color"))[:3], specular=0.0, roughness=1.0)
     elif node.type == "EMISSION":
@@ -106,7 +107,7 @@ class MaterialTable:
                     self.programs[compiled.source] = program
                 params.update(program=program, program_displaces=compiled.displaces,
                               program_shades=compiled.shades, displacement_bound=compiled.displacement_bound,
-                              displacement_bound_world=compiled.displacement_world)
+                              displacement_bound_world=compiled.displacement_world, program_alpha=compiled.alpha)
             self.native.add_material(name=key, **params)
             self.index[key] = self.native.material_count - 1
         return self.index[key]

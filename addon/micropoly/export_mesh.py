@@ -189,8 +189,19 @@ def _mesh_arrays(mesh, with_creases, uv_names=(), smooth_normals=False):
     return arrays
 
 
+def ray_visibility(obj):
+    """(seen by the camera, casts shadows): Object > Visibility > Ray
+    Visibility, as Cycles reads it (visible_camera and visible_shadow since
+    Blender 3.0)."""
+    return bool(getattr(obj, "visible_camera", True)), bool(getattr(obj, "visible_shadow", True))
+
+
 def export_object(native_scene, materials, cache, obj, matrix, warnings, is_instance=False):
-    """Adds one mesh instance; returns False when it has no faces."""
+    """Adds one mesh instance; returns False when it has no faces or nothing
+    it would be seen in (neither the camera nor shadows)."""
+    visible_camera, cast_shadows = ray_visibility(obj)
+    if not visible_camera and not cast_shadows:
+        return False
     subsurf, only = subdivision_modifier(obj)
     if subsurf is not None and not only:
         warnings.append(f"'{obj.name}' renders its subdivided mesh as polygons: Micropoly renders the exact "
@@ -233,8 +244,8 @@ def export_object(native_scene, materials, cache, obj, matrix, warnings, is_inst
         crease_vertices=arrays.get("crease_vertices", empty_i), crease_sharpness=arrays.get("crease_sharpness", empty_f),
         corner_vertices=arrays.get("corner_vertices", empty_i), corner_sharpness=arrays.get("corner_sharpness", empty_f),
         boundary=boundary, double_sided=double_sided, uv_layers=arrays.get("uv_layers", empty_f),
-        corner_normals=arrays.get("corner_normals", empty_f),
-        **_texture_space(obj.original.data))
+        corner_normals=arrays.get("corner_normals", empty_f), visible_camera=visible_camera,
+        cast_shadows=cast_shadows, **_texture_space(obj.original.data))
     return True
 
 

@@ -68,10 +68,11 @@ def _dims(s):
 
 
 class CompiledMaterial:
-    def __init__(self, source, displaces, shades, displacement_bound, displacement_world=False):
+    def __init__(self, source, displaces, shades, displacement_bound, displacement_world=False, alpha=False):
         self.source = source
         self.displaces = displaces
         self.shades = shades
+        self.alpha = alpha  # the program computes the surface's alpha (which shadow views read too)
         self.displacement_bound = displacement_bound
         self.displacement_world = displacement_world  # the bound is in world units
 
@@ -623,7 +624,8 @@ class NodeCompiler:
         if self.uses_neighbours:
             includes = "#define MP_NODE_USES_NEIGHBOURS 1\n" + includes
         source = includes + "".join(self.helpers) + disp_src + surf_src
-        return CompiledMaterial(source, displaces, shades, bound, displaces and self.displacement_world)
+        return CompiledMaterial(source, displaces, shades, bound, displaces and self.displacement_world,
+                                alpha=any(a[0] == "alpha" for a in assigns))
 
     def _assignment(self, shader, field, socket, kind, strength):
         expr = self.input(shader, socket, kind)[0]

@@ -2,7 +2,7 @@
 """Micropoly's settings, stored on the scene as scene.micropoly."""
 
 import bpy
-from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
 FILTERS = [
     ("BLACKMAN_HARRIS", "Blackman-Harris", "Blackman-Harris window, as Cycles uses"),
@@ -36,6 +36,14 @@ class MicropolySceneSettings(bpy.types.PropertyGroup):
     filter_type: EnumProperty(name="Pixel Filter", items=FILTERS, default="BLACKMAN_HARRIS")
     filter_width: FloatProperty(name="Filter Width", description="Pixel filter width in pixels",
                                 default=1.5, min=0.5, max=8.0, subtype="PIXEL")
+    use_shadows: BoolProperty(name="Shadows", description="Lights cast shadows (each light's Cast Shadow "
+                              "and each object's Shadow ray visibility still apply)", default=True)
+    shadow_memory: FloatProperty(name="Shadow Memory", description="Device memory for the shadow maps' pages, "
+                                 "in MiB; when the view needs more, shadows get coarser", default=256.0, min=8.0,
+                                 max=65536.0)
+    shadow_shading_rate: FloatProperty(name="Shadow Shading Rate", description="Area of a shadow map's "
+                                       "micropolygons in its texels; smaller is finer and slower", default=4.0,
+                                       min=0.25, max=64.0)
 
 
 class MicropolyMaterialSettings(bpy.types.PropertyGroup):

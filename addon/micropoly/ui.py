@@ -74,6 +74,66 @@ class MICROPOLY_PT_bound_split(MicropolyPanel, bpy.types.Panel):
         row.prop(settings, "bound_split_memory")
 
 
+class MICROPOLY_PT_shadows(MicropolyPanel, bpy.types.Panel):
+    bl_label = "Shadows"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw_header(self, context):
+        self.layout.prop(context.scene.micropoly, "use_shadows", text="")
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        settings = context.scene.micropoly
+        layout.active = settings.use_shadows
+        layout.prop(settings, "shadow_memory")
+        layout.prop(settings, "shadow_shading_rate")
+
+
+class MICROPOLY_PT_light_shadow(MicropolyPanel, bpy.types.Panel):
+    """Light > Shadow: the settings Micropoly reads, under the names the running Blender gives them."""
+    bl_label = "Shadow"
+    bl_context = "data"
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES and context.light is not None
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        light = context.light
+        cycles = getattr(light, "cycles", None)
+        if cycles is not None and hasattr(cycles, "cast_shadow"):
+            layout.prop(cycles, "cast_shadow")
+        elif hasattr(light, "use_shadow"):
+            layout.prop(light, "use_shadow", text="Cast Shadow")
+        if light.type in ("POINT", "SPOT"):
+            layout.prop(light, "shadow_soft_size", text="Radius")
+            if hasattr(light, "use_soft_falloff"):
+                layout.prop(light, "use_soft_falloff")
+        elif light.type == "SUN":
+            layout.prop(light, "angle")
+
+
+class MICROPOLY_PT_object_visibility(MicropolyPanel, bpy.types.Panel):
+    """Object > Visibility: the ray visibility Micropoly reads (camera and shadow)."""
+    bl_label = "Micropoly Visibility"
+    bl_context = "object"
+
+    @classmethod
+    def poll(cls, context):
+        obj = context.object
+        return context.engine in cls.COMPAT_ENGINES and obj is not None and hasattr(obj, "visible_shadow")
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        col = layout.column(heading="Ray Visibility")
+        col.prop(context.object, "visible_camera", text="Camera")
+        col.prop(context.object, "visible_shadow", text="Shadow")
+
+
 class MICROPOLY_PT_film(MicropolyPanel, bpy.types.Panel):
     bl_label = "Film"
 
@@ -103,8 +163,9 @@ class MICROPOLY_PT_material_displacement(MicropolyPanel, bpy.types.Panel):
         layout.prop(mat.micropoly, "displacement_bound")
 
 
-CLASSES = (MICROPOLY_PT_sampling, MICROPOLY_PT_dicing, MICROPOLY_PT_bound_split, MICROPOLY_PT_film,
-           MICROPOLY_PT_material_displacement)
+CLASSES = (MICROPOLY_PT_sampling, MICROPOLY_PT_dicing, MICROPOLY_PT_bound_split, MICROPOLY_PT_shadows,
+           MICROPOLY_PT_film, MICROPOLY_PT_material_displacement, MICROPOLY_PT_light_shadow,
+           MICROPOLY_PT_object_visibility)
 
 
 def _standard_panels():

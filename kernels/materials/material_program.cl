@@ -132,7 +132,10 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
                                   FrameParams f, int program, __global const float4* grid_p,
                                   __global const float4* grid_n, MP_PROGRAM_INPUT_ARGS,
                                   __global const DeviceLight* lights, uint light_count, __global float4* grid_c,
-                                  __global const uint* vertex_offsets) {
+                                  __global const uint* vertex_offsets, uint use_shadows,
+                                  __global const DeviceShadow* shadows, __global const DeviceShadowLevel* shadow_levels,
+                                  __global const uint* shadow_pages, __global const uint* shadow_pool,
+                                  uint alpha_only) {
   uint gid = get_global_id(0), material, object, i, j;
   SubPatch sp;
   float2 uv;
@@ -142,6 +145,8 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
     return;
   DeviceMaterial m = materials[material];
   if (!(m.program[2] > 0.0f)) return;
+  /* A shadow view needs only the alpha, and only of programs that compute it. */
+  if (alpha_only && !(m.program[3] > 0.0f)) return;
   float3 p = grid_p[index].xyz, n = grid_n[index].xyz;
   MpProgramInputs in = MP_PROGRAM_INPUTS;
   __global const DeviceObject* o = objects + object;
@@ -176,6 +181,10 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   s.normal = g.N;
   s.has_normal = 0;
   mp_node_surface(&g, &s);
+  if (alpha_only) {
+    grid_c[index].w = clamp(s.alpha, 0.0f, 1.0f);
+    return;
+  }
   m.color[0] = s.base_color.x, m.color[1] = s.base_color.y, m.color[2] = s.base_color.z;
   m.principled[0] = clamp(s.metallic, 0.0f, 1.0f);
   m.principled[1] = fmax(s.specular, 0.0f);
@@ -189,6 +198,11 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
                     : s.has_normal == MP_NORMAL_INPUT_V4              ? 2
                     : s.has_normal == MP_NORMAL_INPUT_V4_UNCORRECTED ? 3
                                                                       : 0;
-  float3 c = mp_shade_bumped(p, n, ns, bsdf_normal, grid_n[index].w > 0.5f, f.ortho, &m, lights, light_count);
+  /* Shadows compare with the surface's tangent plane (for smooth-shaded
+   * polygons, which shade.cl gave their interpolated normal, that normal's). */
+  MpShadowMaps maps = {shadows, shadow_levels, shadow_pages, shadow_pool};
+  MpShadowQuery shadow = {&maps, n, mp_pixel_footprint(-p.z, f)};
+  float3 c = mp_shade_bumped(p, n, ns, bsdf_normal, grid_n[index].w > 0.5f, f.ortho, &m, lights, light_count,
+                             use_shadows ? &shadow : 0);
   grid_c[index] = (float4)(c, clamp(s.alpha, 0.0f, 1.0f));
 }

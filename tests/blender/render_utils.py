@@ -151,7 +151,31 @@ def png_image(name, rgba, colorspace):
     return loaded
 
 
-def setup_cycles(scene, samples=64, adaptive_subdivision=True):
+def set_cast_shadow(light, on):
+    """A light's Cast Shadow toggle, as each Blender version names it for
+    Cycles (light.cycles.cast_shadow in 3.x, light.use_shadow from 4.0; in
+    3.x use_shadow is EEVEE's, so both are set)."""
+    if hasattr(light, "cycles") and hasattr(light.cycles, "cast_shadow"):
+        light.cycles.cast_shadow = on
+    if hasattr(light, "use_shadow"):
+        light.use_shadow = on
+
+
+def save_png(path, rows):
+    """Writes an (h, w, 3 or 4) float image, rows top first, values in
+    [0, 1] (display-ready), as an 8-bit PNG: for looking at test renders."""
+    h, w = rows.shape[:2]
+    rgba = np.ones((h, w, 4), dtype=np.float32)
+    rgba[..., :rows.shape[2]] = np.clip(rows[..., :4], 0.0, 1.0)
+    img = bpy.data.images.new("save_png", w, h, alpha=True)
+    img.pixels.foreach_set(np.ascontiguousarray(rgba[::-1]).reshape(-1))
+    img.filepath_raw = path
+    img.file_format = "PNG"
+    img.save()
+    bpy.data.images.remove(img)
+
+
+def setup_cycles(scene, samples=64, adaptive_subdivision=True, shadows=False):
     scene.render.engine = "CYCLES"
     c = scene.cycles
     c.device = "CPU"
@@ -179,14 +203,11 @@ def setup_cycles(scene, samples=64, adaptive_subdivision=True):
                     mod.adaptive_pixel_size = 1.0
                 elif hasattr(obj, "cycles") and hasattr(obj.cycles, "use_adaptive_subdivision"):
                     obj.cycles.use_adaptive_subdivision = True
+    # Lights cast shadows only where a test asks for them; Micropoly reads
+    # the same toggle, so both renderers agree on it.
     for obj in scene.objects:
         if obj.type == "LIGHT":
-            if hasattr(obj.data, "cycles") and hasattr(obj.data.cycles, "cast_shadow"):
-                obj.data.cycles.cast_shadow = False
-            if hasattr(obj.data, "use_shadow"):
-                obj.data.use_shadow = False
-            if hasattr(obj, "visible_shadow"):
-                pass
+            set_cast_shadow(obj.data, shadows)
 
 
 def _load_exr(path, height, width):

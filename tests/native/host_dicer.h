@@ -43,7 +43,7 @@ inline void host_dice(const Scene& scene,
   while (!stack.empty()) {
     SubPatch sp = stack.back();
     stack.pop_back();
-    const uint d = mp_classify(pb.points.data(), info, pb.edges.data(), pb.curves.data(), &sp, f);
+    const uint d = mp_classify(pb.points.data(), info, pb.edges.data(), pb.curves.data(), &sp, f, nullptr);
     const uint action = MP_DECISION_ACTION(d);
     if (action >= MP_SPLIT_U) {
       SubPatch a, b;
@@ -54,7 +54,7 @@ inline void host_dice(const Scene& scene,
     }
     if (action != MP_DICE) continue;
     g.sp = sp;
-    g.sp.info = (sp.info & 0xffu) | (d & 0xffff00u);
+    g.sp.info = MP_DICED_INFO(sp.info, d);
     g.shape = mp_grid_shape(&g.sp, uint(f.max_grid));
     const uint stride = uint(f.max_grid) + 1;
     g.p.clear();

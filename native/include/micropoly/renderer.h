@@ -26,8 +26,33 @@ std::vector<DeviceInfo> list_devices();
 // Device time per stage (OpenCL profiling) except `upload` (host patch
 // building and transfer), `readback` (wall time of resolve plus the copy of
 // the image to the host) and `total` (wall time of the whole render call).
+// shadow_mark: marking the shadow pages the camera needs; shadow: rendering
+// the lights' views (their bound & split, dicing and sampling); shadows_wall:
+// wall time of both with the host's allocation between them.
 struct StageTimings {
   double upload = 0, bound_split = 0, dice = 0, shade = 0, sample = 0, resolve = 0, readback = 0, total = 0;
+  double shadow_mark = 0, shadow = 0, shadows_wall = 0;
+};
+
+// Shadow maps of one light (kernels/mp_shadow.h).
+struct ShadowLightStats {
+  int light = 0;          // index in Scene::lights
+  size_t pages = 0;       // pages its receivers use this frame
+  size_t bytes = 0;       // their memory plus the light's page table
+};
+
+// The frame's shadow maps: pages are 128 x 128 texels of 4 bytes.
+struct ShadowStats {
+  int lights = 0;                 // lights with shadow maps
+  int level_bias = 0;             // maps coarser than the pixels ask for, to keep to the budget
+  size_t views = 0;               // maps (levels, faces at a mip) rendered this frame
+  size_t pages_requested = 0;     // pages the camera's receivers need
+  size_t pages_rendered = 0;      // of which rendered this frame (the others were kept)
+  size_t pages_missing = 0;       // left out for want of memory
+  size_t micropolygons = 0;       // diced for the lights' views
+  size_t budget_bytes = 0;        // RenderSettings::shadow_memory_mib
+  size_t peak_bytes = 0;          // shadow map device memory held: pages, page tables, requests, masks, views
+  std::vector<ShadowLightStats> per_light;
 };
 
 struct RenderStats {
@@ -50,6 +75,7 @@ struct RenderStats {
   // The scene's device buffers were those of the previous render (same
   // geometry, camera placement, materials, lights and images).
   bool scene_reused = false;
+  ShadowStats shadows;
   StageTimings timings_ms;
   std::string to_json() const;
 };

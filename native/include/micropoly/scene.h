@@ -46,6 +46,10 @@ struct Mesh {
   // Empty: flat faces. Ignored for Catmull-Clark meshes (their limit surface
   // is smooth by itself).
   std::vector<glm::vec3> corner_normals;
+  // Ray visibility (Blender's Object > Visibility): seen by the camera, and
+  // casting shadows (in the lights' shadow maps).
+  bool visible_camera = true;
+  bool cast_shadows = true;
 };
 
 // Bicubic patches already converted to Bezier form: 16 control points per
@@ -56,6 +60,8 @@ struct BezierPatches {
   int material = 0;
   glm::mat4 object_to_world{1.0f};
   bool double_sided = true;
+  bool visible_camera = true;  // as Mesh
+  bool cast_shadows = true;
 };
 
 // Materials. Constant, Matte and Plastic follow RenderMan's shaders (Cs,
@@ -82,6 +88,9 @@ struct Material {
   int program = -1;
   bool program_displaces = false;
   bool program_shades = false;
+  // The program computes the alpha (opacity), which the shadow views then
+  // evaluate too, so that a texture's cut-outs cast cut-out shadows.
+  bool program_alpha = false;
   float displacement_bound = 0.0f;
   // The bound is in world units rather than object units (a Displacement
   // node in World space: its distance does not scale with the object).
@@ -118,6 +127,13 @@ struct Image {
 // radians) and is raised to beam_distribution, as RenderMan's spotlight.
 // Area lights are rectangles or ellipses centred on `position`, with
 // `size_u` along `axis_u` and `size_v` along direction x axis_u.
+// Shadows (every type but ambient, with cast_shadows): shadow maps made by
+// the pipeline itself (kernels/mp_shadow.h), soft by the light's size:
+// `radius` for point and spot lights, `angle` (the angular diameter) for
+// distant lights, the area for area lights. A point or spot light with a
+// radius is a disk of that radius facing the lit point, as Cycles' point
+// light with soft falloff; without soft_falloff (Blender 4.1 and later) a
+// sphere, which lights as the point does while it is above the horizon.
 struct Light {
   enum class Type { Ambient, Distant, Point, Spot, Area };
   enum class Shape { Rectangle, Ellipse };
@@ -132,6 +148,10 @@ struct Light {
   Shape shape = Shape::Rectangle;          // area lights
   glm::vec3 axis_u{1.0f, 0.0f, 0.0f};
   float size_u = 1.0f, size_v = 1.0f;
+  bool cast_shadows = true;
+  float radius = 0.0f;                     // point and spot lights
+  bool soft_falloff = true;
+  float angle = 0.0f;                      // distant lights, radians
 };
 
 // Camera: right-handed camera space, looking down -Z with +Y up (Blender's
@@ -168,6 +188,12 @@ struct RenderSettings {
   int max_split_depth = 26;                    // eye-split and runaway limit
   bool backface_culling = true;                // for single-sided surfaces
   bool depth_and_normal_passes = true;         // resolve and return Depth and Normal
+  // Shadow maps (kernels/mp_shadow.h): on for lights that cast shadows; the
+  // device memory their pages, page tables and requests may take; the area
+  // of a shadow view's micropolygons in texels of its map.
+  bool shadows = true;
+  float shadow_memory_mib = 256.0f;
+  float shadow_shading_rate = 4.0f;
 };
 
 struct Scene {

@@ -1,5 +1,6 @@
 #include "cl/device_session.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <mutex>
 
@@ -108,6 +109,14 @@ DeviceSession::DeviceSession(const std::string& selector) {
   } catch (const cl::Error& e) {
     throw Error("OpenCL device '" + info_.name + "': " + describe_cl_error(e));
   }
+}
+
+cl::Buffer DeviceSession::allocate(size_t bytes, const char* what) {
+  if (bytes > max_alloc_)
+    throw Error(std::string("the ") + what + " needs " + std::to_string(bytes >> 20) + " MiB in one buffer but the device '" +
+                info_.name + "' allows " + std::to_string(max_alloc_ >> 20) +
+                " MiB: lower the resolution or the samples per pixel");
+  return cl::Buffer(context_, CL_MEM_READ_WRITE, std::max<size_t>(bytes, 16));
 }
 
 }  // namespace mp

@@ -22,6 +22,9 @@ class DeviceSession {
   double program_build_ms() const { return build_ms_; }
   bool program_cache_hit() const { return cache_hit_; }
   size_t max_alloc_bytes() const { return max_alloc_; }
+  // A read-write device buffer of `bytes` (at least 16); an mp::Error that
+  // names `what` when the device cannot hold that much in one buffer.
+  cl::Buffer allocate(size_t bytes, const char* what);
 
  private:
   DeviceInfo info_;

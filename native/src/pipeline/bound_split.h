@@ -67,6 +67,15 @@ class TalliedBuffer {
   size_t bytes_ = 0;
 };
 
+// The views a pass renders: none (the frame's own view, `frame`), or up to
+// MP_MAX_PASS_VIEWS FrameParams in a device buffer (shadow maps), each patch
+// once per view; shadow views also come with their page masks.
+struct PassViews {
+  cl::Buffer views;       // FrameParams per view (empty: the frame's view)
+  cl_uint count = 0;
+  cl::Buffer page_masks;  // shadow views' page mask pyramids (mp_bound.h)
+};
+
 struct BoundSplitContext {
   DeviceSession& session;
   const SceneBuffers& scene;
@@ -74,6 +83,9 @@ struct BoundSplitContext {
   StageTimer& timer;
   const DiceSink& sink;
   const ProgressCallback& progress;
+  const PassViews& views;
+  // Roots: every patch in every view.
+  cl_uint root_count() const { return scene.patch_count * std::max<cl_uint>(views.count, 1); }
 };
 
 // Device buffers of the bounded method, kept between frames so a renderer

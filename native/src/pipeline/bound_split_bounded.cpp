@@ -21,7 +21,7 @@ namespace mp {
 namespace {
 
 // Counter slots, as BS_* in kernels/bound_split.cl.
-enum Counter { kPoolHead = 0, kPoolTail = 1, kNextPatch = 2, kDiceCount = 3, kBusy = 4, kIdle = 5, kMaxBusy = 6, kCounters = 8 };
+enum Counter { kPoolHead = 0, kPoolTail = 1, kNextRoot = 2, kDiceCount = 3, kBusy = 4, kIdle = 5, kMaxBusy = 6, kCounters = 8 };
 constexpr cl_uint kStepsPerLaunch = 16;  // sub-patches a worker handles per launch
 constexpr size_t kMaxWorkers = size_t(1) << 20;
 
@@ -68,32 +68,36 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
     step.setArg(1, ctx.scene.patch_info);
     step.setArg(2, ctx.scene.patch_edges);
     step.setArg(3, ctx.scene.edge_curves);
+    const cl_uint root_count = ctx.root_count();
     step.setArg(4, ctx.scene.patch_count);
-    step.setArg(5, ctx.frame);
-    step.setArg(6, ws.stacks);
-    step.setArg(7, ws.sizes);
-    step.setArg(8, stack_depth);
-    step.setArg(9, ws.ring);
-    step.setArg(10, ring_capacity);
-    step.setArg(14, ws.diceable);
-    step.setArg(15, dice_capacity);
-    step.setArg(16, ws.counters);
-    step.setArg(17, kStepsPerLaunch);
+    step.setArg(5, root_count);
+    step.setArg(6, ctx.frame);
+    step.setArg(7, ctx.views.views);
+    step.setArg(8, ctx.views.count);
+    step.setArg(9, ctx.views.page_masks);
+    step.setArg(10, ws.stacks);
+    step.setArg(11, ws.sizes);
+    step.setArg(12, stack_depth);
+    step.setArg(13, ws.ring);
+    step.setArg(14, ring_capacity);
+    step.setArg(18, ws.diceable);
+    step.setArg(19, dice_capacity);
+    step.setArg(20, ws.counters);
+    step.setArg(21, kStepsPerLaunch);
 
     auto whole_groups = [&](size_t n) { return std::min(workers, std::max<size_t>(64, (n + 63) / 64 * 64)); };
     // More workers than a few dice batches' worth would mostly hold work they
     // cannot hand on until the next flush, so growth stops there.
     const size_t useful = 4 * static_cast<size_t>(dice_capacity);
-    const cl_uint patch_count = ctx.scene.patch_count;
-    size_t launch = whole_groups(std::min<size_t>(patch_count, useful));
-    cl_uint head = 0, tail = 0, next_patch = 0, dice_count = 0, hungry = static_cast<cl_uint>(launch);
+    size_t launch = whole_groups(std::min<size_t>(root_count, useful));
+    cl_uint head = 0, tail = 0, next_root = 0, dice_count = 0, hungry = static_cast<cl_uint>(launch);
     for (;;) {
-      cl_uint c[kCounters] = {head, tail, next_patch, dice_count, 0, 0, 0, 0};
+      cl_uint c[kCounters] = {head, tail, next_root, dice_count, 0, 0, 0, 0};
       queue.enqueueWriteBuffer(ws.counters, CL_FALSE, 0, sizeof c, c);
-      step.setArg(11, head);
-      step.setArg(12, tail);
+      step.setArg(15, head);
+      step.setArg(16, tail);
       // Hand out at most as many children as there will be idle workers.
-      step.setArg(13, hungry);
+      step.setArg(17, hungry);
       cl::Event e;
       queue.enqueueNDRangeKernel(step, cl::NullRange, cl::NDRange(launch), cl::NDRange(64), nullptr, &e);
       ctx.timer.add(Stage::BoundSplit, e);
@@ -104,20 +108,20 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
       const cl_uint head0 = head;
       head = std::min(c[kPoolHead], tail);
       tail = std::min({c[kPoolTail], tail + hungry, head0 + ring_capacity});
-      next_patch = std::min(c[kNextPatch], patch_count);
+      next_root = std::min(c[kNextRoot], root_count);
       dice_count = std::min(c[kDiceCount], dice_capacity);
       const size_t busy = c[kBusy];
-      const size_t pending = (tail - head) + (patch_count - next_patch);
+      const size_t pending = (tail - head) + (root_count - next_root);
       launch = whole_groups(std::max<size_t>(c[kMaxBusy], std::min(2 * busy + pending, useful)));
       hungry = static_cast<cl_uint>(launch > busy ? launch - busy : 0);
       if (head == tail) head = tail = 0;  // keep ring indices small
-      bool done = busy == 0 && head == tail && next_patch >= patch_count;
+      bool done = busy == 0 && head == tail && next_root >= root_count;
       if (dice_count == dice_capacity || (done && dice_count > 0)) {
         ctx.sink(ws.diceable, dice_count);
         dice_count = 0;
       }
       if (done) break;
-      if (ctx.progress && !ctx.progress(0.95f * static_cast<float>(next_patch) / static_cast<float>(std::max(patch_count, 1u)))) {
+      if (ctx.progress && !ctx.progress(0.95f * static_cast<float>(next_root) / static_cast<float>(std::max(root_count, 1u)))) {
         result.cancelled = true;
         break;
       }

@@ -23,11 +23,12 @@ BoundSplitResult bound_split_breadth(BoundSplitContext& ctx, cl_uint dice_capaci
     cl::Kernel init(s.program(), "bs_init_queue"), classify(s.program(), "bs_breadth_classify"),
         scatter(s.program(), "bs_breadth_scatter");
 
-    cl_uint n = ctx.scene.patch_count;
+    cl_uint n = ctx.root_count();
     const size_t rec = sizeof(SubPatch);
     queue_in.reserve(context, n * rec);
     init.setArg(0, queue_in.get());
     init.setArg(1, n);
+    init.setArg(2, ctx.scene.patch_count);
     cl::Event e0;
     queue.enqueueNDRangeKernel(init, cl::NullRange, round_up_range(n), cl::NDRange(64), nullptr, &e0);
     ctx.timer.add(Stage::BoundSplit, e0);
@@ -43,9 +44,12 @@ BoundSplitResult bound_split_breadth(BoundSplitContext& ctx, cl_uint dice_capaci
       classify.setArg(4, ctx.scene.patch_edges);
       classify.setArg(5, ctx.scene.edge_curves);
       classify.setArg(6, ctx.frame);
-      classify.setArg(7, decision.get());
-      classify.setArg(8, dice_flag.get());
-      classify.setArg(9, split_flag.get());
+      classify.setArg(7, ctx.views.views);
+      classify.setArg(8, ctx.views.count);
+      classify.setArg(9, ctx.views.page_masks);
+      classify.setArg(10, decision.get());
+      classify.setArg(11, dice_flag.get());
+      classify.setArg(12, split_flag.get());
       cl::Event e1;
       queue.enqueueNDRangeKernel(classify, cl::NullRange, round_up_range(n + 1), cl::NDRange(64), nullptr, &e1);
       ctx.timer.add(Stage::BoundSplit, e1);

@@ -8,11 +8,12 @@ namespace mp {
 void MaterialPrograms::prepare(const Scene& scene, RenderStats& stats) {
   active_.clear();
   displaces_ = false;
-  std::vector<bool> displaces(scene.material_programs.size(), false), shades(displaces);
+  std::vector<bool> displaces(scene.material_programs.size(), false), shades(displaces), alpha(displaces);
   for (const Material& m : scene.materials) {
     if (m.program < 0) continue;
     displaces[m.program] = displaces[m.program] || m.program_displaces;
     shades[m.program] = shades[m.program] || m.program_shades;
+    alpha[m.program] = alpha[m.program] || (m.program_shades && m.program_alpha);
   }
   for (size_t i = 0; i < scene.material_programs.size(); ++i) {
     if (!displaces[i] && !shades[i]) continue;
@@ -34,7 +35,7 @@ void MaterialPrograms::prepare(const Scene& scene, RenderStats& stats) {
       it = built_.emplace(mp.source, std::move(built)).first;
     }
     active_.push_back({it->second.get(), static_cast<cl_int>(i), static_cast<bool>(displaces[i]),
-                       static_cast<bool>(shades[i])});
+                       static_cast<bool>(shades[i]), static_cast<bool>(alpha[i])});
     displaces_ = displaces_ || displaces[i];
   }
 }
@@ -71,7 +72,7 @@ void MaterialPrograms::launch(cl::Kernel& kernel, cl_uint count, GridBuffers& gr
 }
 
 void MaterialPrograms::displace(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
-                                const FrameParams& f, GridBuffers& grids, StageTimer& timer) {
+                                const FrameParams& f, GridBuffers& grids, StageTimer& timer, bool normals) {
   if (!displaces_) return;
   for (Active& a : active_) {
     if (!a.displaces) continue;
@@ -80,6 +81,7 @@ void MaterialPrograms::displace(const cl::Buffer& diceable, cl_uint count, const
     k.setArg(15, grids.vertex_offsets);
     launch(k, count, grids, Stage::Dice, timer);
   }
+  if (!normals) return;
   cl::Kernel& k = normals_;
   k.setArg(0, diceable);
   k.setArg(1, count);
@@ -93,15 +95,29 @@ void MaterialPrograms::displace(const cl::Buffer& diceable, cl_uint count, const
 }
 
 void MaterialPrograms::shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
+                             const FrameParams& f, GridBuffers& grids, const ShadowInputs& shadows,
+                             StageTimer& timer) {
+  run_shade(diceable, count, scene, f, grids, shadows, false, timer);
+}
+
+void MaterialPrograms::alpha(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
                              const FrameParams& f, GridBuffers& grids, StageTimer& timer) {
+  run_shade(diceable, count, scene, f, grids, ShadowInputs{}, true, timer);
+}
+
+void MaterialPrograms::run_shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
+                                 const FrameParams& f, GridBuffers& grids, const ShadowInputs& shadows,
+                                 bool alpha_only, StageTimer& timer) {
   for (Active& a : active_) {
-    if (!a.shades) continue;
+    if (!(alpha_only ? a.alpha : a.shades)) continue;
     cl::Kernel& k = a.built->shade;
     set_grid_args(k, diceable, count, scene, f, a.index, grids);
     k.setArg(15, scene.lights);
     k.setArg(16, scene.light_count);
     k.setArg(17, grids.c);
     k.setArg(18, grids.vertex_offsets);
+    shadows.set_args(k, 19);
+    k.setArg(24, cl_uint(alpha_only ? 1 : 0));
     launch(k, count, grids, Stage::Shade, timer);
   }
 }

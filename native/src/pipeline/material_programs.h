@@ -25,12 +25,17 @@ class MaterialPrograms {
       : session_(session), normals_(session.program(), "displaced_normals") {}
   // Builds what the scene's materials use; adds the build time to `stats`.
   void prepare(const Scene& scene, RenderStats& stats);
-  // Displacement of every program that displaces, then the normals of the
-  // displaced grids from their new vertices.
+  // Displacement of every program that displaces, then (unless a pass
+  // needs positions only) the normals of the displaced grids from their new
+  // vertices.
   void displace(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
-                GridBuffers& grids, StageTimer& timer);
+                GridBuffers& grids, StageTimer& timer, bool normals = true);
   // Shades the vertices whose materials compute their Principled inputs.
   void shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+             GridBuffers& grids, const ShadowInputs& shadows, StageTimer& timer);
+  // Only the alpha (grid_c's w) of the vertices whose programs compute it:
+  // what a shadow view needs.
+  void alpha(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
              GridBuffers& grids, StageTimer& timer);
 
  private:
@@ -41,9 +46,11 @@ class MaterialPrograms {
   struct Active {
     Built* built;
     cl_int index;  // the scene's program index, as DeviceMaterial.program[0]
-    bool displaces, shades;
+    bool displaces, shades, alpha;
   };
   void launch(cl::Kernel& kernel, cl_uint count, GridBuffers& grids, Stage stage, StageTimer& timer);
+  void run_shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+                 GridBuffers& grids, const ShadowInputs& shadows, bool alpha_only, StageTimer& timer);
 
   DeviceSession& session_;
   std::unordered_map<std::string, std::unique_ptr<Built>> built_;  // by source

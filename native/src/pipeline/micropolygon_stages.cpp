@@ -11,13 +11,7 @@
 namespace mp {
 namespace {
 
-cl::Buffer device_buffer(DeviceSession& s, size_t bytes, const char* what) {
-  if (bytes > s.max_alloc_bytes())
-    throw Error(std::string("the ") + what + " needs " + std::to_string(bytes >> 20) + " MiB in one buffer but the device '" +
-                s.info().name + "' allows " + std::to_string(s.max_alloc_bytes() >> 20) +
-                " MiB: lower the resolution or the samples per pixel");
-  return cl::Buffer(s.context(), CL_MEM_READ_WRITE, std::max<size_t>(bytes, 16));
-}
+cl::Buffer device_buffer(DeviceSession& s, size_t bytes, const char* what) { return s.allocate(bytes, what); }
 
 // memcpy over a few threads: one core copies a 1080p float image out of the
 // pinned buffer in about 3 ms, a fifth of a GPU frame.
@@ -113,8 +107,16 @@ void DiceStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffer
 
 ShadeStage::ShadeStage(DeviceSession& session) : session_(session), kernel_(session.program(), "shade_grids") {}
 
+void ShadowInputs::set_args(cl::Kernel& kernel, cl_uint first) const {
+  kernel.setArg(first, static_cast<cl_uint>(enabled ? 1 : 0));
+  kernel.setArg(first + 1, shadows);
+  kernel.setArg(first + 2, levels);
+  kernel.setArg(first + 3, pages);
+  kernel.setArg(first + 4, pool);
+}
+
 void ShadeStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
-                     GridBuffers& grids, StageTimer& timer) {
+                     GridBuffers& grids, const ShadowInputs& shadows, StageTimer& timer) {
   kernel_.setArg(0, diceable);
   kernel_.setArg(1, count);
   kernel_.setArg(2, scene.patch_info);
@@ -127,6 +129,7 @@ void ShadeStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffe
   kernel_.setArg(9, grids.c);
   kernel_.setArg(10, grids.vertex_offsets);
   kernel_.setArg(11, scene.patch_normals);
+  shadows.set_args(kernel_, 12);
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64),
                                         nullptr, &e);

@@ -44,6 +44,15 @@ class GridLayoutStage {
   size_t micropolygons_ = 0;
 };
 
+// The shadow maps that shading reads (kernels/mp_shadow.h; built by
+// ShadowMaps): none unless `enabled`.
+struct ShadowInputs {
+  bool enabled = false;
+  cl::Buffer shadows, levels, pages, pool;
+  // Sets them as a kernel's arguments first, first + 1, ... first + 4.
+  void set_args(cl::Kernel& kernel, cl_uint first) const;
+};
+
 class DiceStage {
  public:
   explicit DiceStage(DeviceSession& session);
@@ -59,7 +68,7 @@ class ShadeStage {
  public:
   explicit ShadeStage(DeviceSession& session);
   void run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
-           GridBuffers& grids, StageTimer& timer);
+           GridBuffers& grids, const ShadowInputs& shadows, StageTimer& timer);
 
  private:
   DeviceSession& session_;

@@ -49,9 +49,22 @@ std::string RenderStats::to_json() const {
   j += "  \"program_cache_hit\": " + std::string(program_cache_hit ? "true" : "false") + ",\n";
   j += "  \"cancelled\": " + std::string(cancelled ? "true" : "false") + ",\n";
   j += "  \"scene_reused\": " + std::string(scene_reused ? "true" : "false") + ",\n";
+  const ShadowStats& sh = shadows;
+  j += "  \"shadows\": {\"lights\": " + std::to_string(sh.lights) + ", \"level_bias\": " + std::to_string(sh.level_bias) +
+       ", \"views\": " + std::to_string(sh.views) + ", \"pages_requested\": " + std::to_string(sh.pages_requested) +
+       ", \"pages_rendered\": " + std::to_string(sh.pages_rendered) + ", \"pages_missing\": " +
+       std::to_string(sh.pages_missing) + ", \"micropolygons\": " + std::to_string(sh.micropolygons) +
+       ", \"budget_bytes\": " + std::to_string(sh.budget_bytes) + ", \"peak_bytes\": " + std::to_string(sh.peak_bytes) +
+       ", \"per_light\": [";
+  for (size_t i = 0; i < sh.per_light.size(); ++i)
+    j += std::string(i ? ", " : "") + "{\"light\": " + std::to_string(sh.per_light[i].light) + ", \"pages\": " +
+         std::to_string(sh.per_light[i].pages) + ", \"bytes\": " + std::to_string(sh.per_light[i].bytes) + "}";
+  j += "]},\n";
   j += "  \"timings_ms\": {\"upload\": " + num(timings_ms.upload) + ", \"bound_split\": " + num(timings_ms.bound_split) +
        ", \"dice\": " + num(timings_ms.dice) + ", \"shade\": " + num(timings_ms.shade) + ", \"sample\": " +
-       num(timings_ms.sample) + ", \"resolve\": " + num(timings_ms.resolve) + ", \"readback\": " + num(timings_ms.readback) + ", \"total\": " + num(timings_ms.total) + "}\n";
+       num(timings_ms.sample) + ", \"resolve\": " + num(timings_ms.resolve) + ", \"readback\": " + num(timings_ms.readback) +
+       ", \"shadow_mark\": " + num(timings_ms.shadow_mark) + ", \"shadow\": " + num(timings_ms.shadow) +
+       ", \"shadows_wall\": " + num(timings_ms.shadows_wall) + ", \"total\": " + num(timings_ms.total) + "}\n";
   j += "}\n";
   return j;
 }

@@ -13,6 +13,7 @@
 #include "pipeline/micropolygon_stages.h"
 #include "pipeline/scene_buffers.h"
 #include "pipeline/scene_fingerprint.h"
+#include "pipeline/shadow_maps.h"
 
 namespace mp {
 namespace {
@@ -38,7 +39,8 @@ struct Renderer::Impl {
         shade(session),
         sample(session),
         resolve(session),
-        programs(session) {}
+        programs(session),
+        shadow_maps(session) {}
   DeviceSession session;
   GridLayoutStage layout;
   DiceStage dice;
@@ -46,6 +48,7 @@ struct Renderer::Impl {
   SampleStage sample;
   ResolveStage resolve;
   MaterialPrograms programs;
+  ShadowMaps shadow_maps;
   std::unique_ptr<GridBuffers> grids;
   BoundedWorkspace bounded;
   bool first_render = true;
@@ -114,7 +117,6 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     ShadeStage& shade = impl_->shade;
     SampleStage& sample = impl_->sample;
     ResolveStage& resolve = impl_->resolve;
-    impl_->layout.begin_frame();
     if (progress && !progress(0.0f)) {  // cancelled before the frame's buffers are set up
       st.cancelled = true;
       out.width = out.height = 0;
@@ -133,13 +135,37 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       if (!cancelled && progress && !progress(p)) cancelled = true;
       return !cancelled;
     };
+    // Bound & split of the scene in one pass: the camera's view, or the
+    // lights' views of the shadow maps.
+    BoundSplitRunner run_pass = [&](const FrameParams& pass_frame, const PassViews& views, const DiceSink& pass_sink) {
+      BoundSplitContext ctx{s, buffers, pass_frame, timer, pass_sink, keep_going, views};
+      BoundSplitResult r;
+      if (buffers.patch_count == 0 || cancelled) return r;
+      if (scene.settings.bound_split == BoundSplitMethod::Bounded) {
+        size_t budget = static_cast<size_t>(std::max(0.0f, scene.settings.bound_split_memory_mib) * 1048576.0);
+        r = bound_split_bounded(ctx, budget, capacity, impl_->bounded);
+      } else {
+        r = bound_split_breadth(ctx, capacity);
+      }
+      st.bound_split_peak_bytes = std::max(st.bound_split_peak_bytes, r.peak_bytes);
+      st.bound_split_launches += r.launches;
+      r.cancelled = r.cancelled || cancelled;
+      return r;
+    };
+    // The shadow maps first: shading the camera's view reads them.
+    auto t_shadows = std::chrono::steady_clock::now();
+    const bool shadows_done = impl_->shadow_maps.render(scene, frame, buffers, {impl_->layout, dice, impl_->programs, grids},
+                                                        run_pass, timer, st.shadows);
+    st.timings_ms.shadows_wall = ms_since(t_shadows);
+    const ShadowInputs& shadows = impl_->shadow_maps.inputs();
+    impl_->layout.begin_frame();
     DiceSink sink = [&](const cl::Buffer& diceable, cl_uint count) {
       if (cancelled) return;
       impl_->layout.run(diceable, count, f, grids, timer);
       dice.run(diceable, count, buffers, f, grids, timer);
       impl_->programs.displace(diceable, count, buffers, f, grids, timer);
-      shade.run(diceable, count, buffers, f, grids, timer);
-      impl_->programs.shade(diceable, count, buffers, f, grids, timer);
+      shade.run(diceable, count, buffers, f, grids, shadows, timer);
+      impl_->programs.shade(diceable, count, buffers, f, grids, shadows, timer);
       const cl_uint chunk = progress ? kSampleChunk : count;
       for (cl_uint first = 0; first < count && !cancelled; first += chunk) {
         sample.run(diceable, first, std::min(chunk, count - first), buffers, f, grids, timer);
@@ -155,17 +181,9 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       s.queue().finish();  // clearing a large sample buffer takes a while: look again
       keep_going(0.0f);
     }
-    BoundSplitContext ctx{s, buffers, f, timer, sink, keep_going};
     BoundSplitResult bs;
-    if (buffers.patch_count > 0 && !cancelled) {
-      if (scene.settings.bound_split == BoundSplitMethod::Bounded) {
-        size_t budget = static_cast<size_t>(std::max(0.0f, scene.settings.bound_split_memory_mib) * 1048576.0);
-        bs = bound_split_bounded(ctx, budget, capacity, impl_->bounded);
-      } else {
-        bs = bound_split_breadth(ctx, capacity);
-      }
-    }
-    if (cancelled || bs.cancelled) {
+    if (shadows_done) bs = run_pass(f, PassViews{}, sink);
+    if (!shadows_done || cancelled || bs.cancelled) {
       s.queue().finish();
       st.cancelled = true;
       st.timings_ms.total = ms_since(t_start);
@@ -173,8 +191,6 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       out.rgba.clear(), out.depth.clear(), out.normal.clear();
       return;
     }
-    st.bound_split_peak_bytes = bs.peak_bytes;
-    st.bound_split_launches = bs.launches;
     auto t_resolve = std::chrono::steady_clock::now();
     resolve.run(sample, frame, scene.settings.filter, scene.settings.filter_width, scene.settings.depth_and_normal_passes,
                 out, timer);
@@ -187,6 +203,8 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     st.timings_ms.shade = timer.ms(Stage::Shade);
     st.timings_ms.sample = timer.ms(Stage::Sample);
     st.timings_ms.resolve = timer.ms(Stage::Resolve);
+    st.timings_ms.shadow_mark = timer.ms(Stage::ShadowMark);
+    st.timings_ms.shadow = timer.ms(Stage::Shadow);
   } catch (const cl::Error& e) {
     throw Error("rendering on '" + s.info().name + "': " + describe_cl_error(e));
   }

@@ -32,6 +32,7 @@ DeviceMaterial to_device(const Material& m) {
   d.program[0] = static_cast<float>(m.program);
   d.program[1] = m.program >= 0 && m.program_displaces ? 1.0f : 0.0f;
   d.program[2] = m.program >= 0 && m.program_shades ? 1.0f : 0.0f;
+  d.program[3] = m.program >= 0 && m.program_shades && m.program_alpha ? 1.0f : 0.0f;
   return d;
 }
 
@@ -68,15 +69,18 @@ float max_scale(const glm::mat4& m) {
 // points and edge curves carried to camera space, edge-curve references
 // rebased, and the object's materials (per face through the patch's
 // primitive id), sidedness and displacement bound filled in.
-void place_shape(const PatchBuffer& shape, const glm::mat4& to_camera, const Mesh* mesh, int set_material,
-                 bool double_sided, uint32_t object, const Scene& scene, PatchBuffer& out) {
+void place_shape(const PatchBuffer& shape, const glm::mat4& to_camera, const Mesh* mesh, const BezierPatches* set,
+                 uint32_t object, const Scene& scene, PatchBuffer& out) {
   const glm::dmat4 m(to_camera);
   // Edge curves' second half is a cubic of normals (mp_patch.h); normals map
   // by the inverse transpose. The kernels normalise it and orient it like the
   // patch, so its scale and sign do not matter.
   const glm::dmat3 normal_map = glm::transpose(glm::inverse(glm::dmat3(m)));
   unsigned flags = object << 8;
-  if (double_sided) flags |= MP_PATCH_DOUBLE_SIDED;
+  if (mesh ? mesh->double_sided : set->double_sided) flags |= MP_PATCH_DOUBLE_SIDED;
+  if (!(mesh ? mesh->cast_shadows : set->cast_shadows)) flags |= MP_PATCH_NO_SHADOW;
+  if (!(mesh ? mesh->visible_camera : set->visible_camera)) flags |= MP_PATCH_NO_CAMERA;
+  const int set_material = set ? set->material : 0;
   // A mirroring transform turns counter-clockwise faces clockwise; the
   // pipeline flips the geometric normal instead of reordering control points.
   if (glm::determinant(glm::dmat3(m)) < 0.0) flags |= MP_PATCH_FLIP_ORIENTATION;
@@ -137,7 +141,12 @@ DeviceLight to_device(const Light& l, const glm::mat4& world_to_camera) {
   put(d.direction, len > 0.0f ? dir / len : glm::vec3(0, 0, -1), 0.0f);
   float outer = std::clamp(l.cone_angle, 0.0f, 3.14159265f);
   float inner = std::clamp(l.cone_angle - l.cone_delta_angle, 0.0f, outer);
-  d.cone[0] = std::cos(outer), d.cone[1] = std::cos(inner), d.cone[2] = l.beam_distribution, d.cone[3] = 0.0f;
+  d.cone[0] = std::cos(outer), d.cone[1] = std::cos(inner), d.cone[2] = l.beam_distribution;
+  // A point or spot light's radius, and whether it is a sphere rather than
+  // a disk facing the lit point (mp_shading.h).
+  const bool sized = l.type == Light::Type::Point || l.type == Light::Type::Spot;
+  d.cone[3] = sized ? l.radius : 0.0f;
+  d.direction[3] = sized && !l.soft_falloff ? 1.0f : 0.0f;
   if (l.type == Light::Type::Area) {
     // Half extents in camera space; v completes a right-handed frame with the
     // emission direction.
@@ -179,8 +188,7 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
     const Mesh* mesh = surfaces[i].mesh;
     const BezierPatches* set = surfaces[i].set;
     const glm::mat4 to_camera = w2c * (mesh ? mesh->object_to_world : set->object_to_world);
-    place_shape(*shapes[i], to_camera, mesh, set ? set->material : 0, mesh ? mesh->double_sided : set->double_sided,
-                uint32_t(out.objects.size()), scene, out.patches);
+    place_shape(*shapes[i], to_camera, mesh, set, uint32_t(out.objects.size()), scene, out.patches);
     const glm::mat4& to_world = mesh ? mesh->object_to_world : set->object_to_world;
     out.objects.push_back(mesh ? to_device_object(to_camera, to_world, mesh->texspace_location, mesh->texspace_size,
                                                   mesh->points)

@@ -78,9 +78,10 @@ uint64_t patch_set_shape_key(const BezierPatches& set, int uv_layers) {
   return h.result();
 }
 
-uint64_t scene_fingerprint(const Scene& scene) {
-  Hasher h;
-  h.value(scene.camera.world_to_camera);
+namespace {
+
+// Surfaces, materials and images (scene_fingerprint and geometry_fingerprint).
+void hash_surfaces(Hasher& h, const Scene& scene) {
   h.value(scene.meshes.size());
   for (const Mesh& m : scene.meshes) {
     h.text(m.name);
@@ -91,6 +92,8 @@ uint64_t scene_fingerprint(const Scene& scene) {
     h.value(m.double_sided);
     h.value(m.texspace_location);
     h.value(m.texspace_size);
+    h.value(m.visible_camera);
+    h.value(m.cast_shadows);
   }
   h.value(scene.bezier_patches.size());
   for (const BezierPatches& b : scene.bezier_patches) {
@@ -98,6 +101,8 @@ uint64_t scene_fingerprint(const Scene& scene) {
     h.value(b.material);
     h.value(b.object_to_world);
     h.value(b.double_sided);
+    h.value(b.visible_camera);
+    h.value(b.cast_shadows);
   }
   h.value(scene.materials.size());
   for (const Material& m : scene.materials) {
@@ -106,18 +111,49 @@ uint64_t scene_fingerprint(const Scene& scene) {
     h.value(m.ka), h.value(m.kd), h.value(m.ks), h.value(m.roughness);
     h.value(m.specular_color), h.value(m.metallic), h.value(m.specular), h.value(m.emission);
     h.value(m.program), h.value(m.program_displaces), h.value(m.program_shades), h.value(m.displacement_bound);
-    h.value(m.displacement_bound_world);
+    h.value(m.displacement_bound_world), h.value(m.program_alpha);
   }
-  h.value(scene.lights.size());
-  for (const Light& l : scene.lights) {
-    h.value(l.type), h.value(l.color), h.value(l.intensity), h.value(l.position), h.value(l.direction);
-    h.value(l.cone_angle), h.value(l.cone_delta_angle), h.value(l.beam_distribution);
-    h.value(l.shape), h.value(l.axis_u), h.value(l.size_u), h.value(l.size_v);
-  }
+  h.value(scene.material_programs.size());
+  for (const MaterialProgram& p : scene.material_programs) h.text(p.source);
   h.value(scene.images.size());
   for (const Image& im : scene.images) {
     h.value(im.width), h.value(im.height), h.value(im.srgb);
     h.values(im.pixels);
+  }
+}
+
+void hash_light(Hasher& h, const Light& l) {
+  h.value(l.type), h.value(l.position), h.value(l.direction);
+  h.value(l.cone_angle), h.value(l.cone_delta_angle), h.value(l.beam_distribution);
+  h.value(l.shape), h.value(l.axis_u), h.value(l.size_u), h.value(l.size_v);
+  h.value(l.cast_shadows), h.value(l.radius), h.value(l.soft_falloff), h.value(l.angle);
+}
+
+}  // namespace
+
+uint64_t geometry_fingerprint(const Scene& scene) {
+  Hasher h;
+  hash_surfaces(h, scene);
+  return h.result();
+}
+
+uint64_t shadow_light_key(const Light& light, uint64_t geometry_key, const RenderSettings& settings, float z_top) {
+  Hasher h;
+  h.value(geometry_key);
+  hash_light(h, light);
+  h.value(settings.shadow_shading_rate), h.value(settings.max_grid_size), h.value(settings.max_split_depth);
+  h.value(z_top);
+  return h.result();
+}
+
+uint64_t scene_fingerprint(const Scene& scene) {
+  Hasher h;
+  h.value(scene.camera.world_to_camera);
+  hash_surfaces(h, scene);
+  h.value(scene.lights.size());
+  for (const Light& l : scene.lights) {
+    hash_light(h, l);
+    h.value(l.color), h.value(l.intensity);
   }
   return h.result();
 }

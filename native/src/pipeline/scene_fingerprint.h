@@ -14,6 +14,17 @@ namespace mp {
 
 uint64_t scene_fingerprint(const Scene& scene);
 
+// What the scene's shadow maps' contents depend on besides each light
+// (kernels/mp_shadow.h): the surfaces in world space, with their materials'
+// displacement and opacity and the images displacement can read. Not the
+// camera, and not the lights.
+uint64_t geometry_fingerprint(const Scene& scene);
+
+// What one light's shadow pages depend on: the geometry, the light's place,
+// shape and size, the settings that dice the shadow views, and (suns) the
+// depth their maps count from.
+uint64_t shadow_light_key(const Light& light, uint64_t geometry_key, const RenderSettings& settings, float z_top);
+
 // Fingerprints of what a surface's object-space patches depend on (its
 // shape, tags and UVs, and the number of UV layers the scene's patches
 // carry), but not its name, transform, materials or sidedness: equal meshes

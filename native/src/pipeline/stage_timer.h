@@ -2,17 +2,33 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <vector>
 
 #include "cl/cl.h"
 
 namespace mp {
 
-enum class Stage { Upload, BoundSplit, Dice, Shade, Sample, Resolve, Count };
+// ShadowMark and Shadow: the shadow maps' page marking, and their rendering
+// (bound & split, dice and sampling of the lights' views).
+enum class Stage { Upload, BoundSplit, Dice, Shade, Sample, Resolve, ShadowMark, Shadow, Count };
 
 class StageTimer {
  public:
-  void add(Stage stage, const cl::Event& event) { pending_.push_back({stage, event}); }
+  void add(Stage stage, const cl::Event& event) { pending_.push_back({redirect_ ? *redirect_ : stage, event}); }
+  // While a Redirect lives, every event counts for its stage (the shadow
+  // pass runs the same stages as the camera's).
+  class Redirect {
+   public:
+    Redirect(StageTimer& timer, Stage stage) : timer_(timer), previous_(timer.redirect_) { timer.redirect_ = stage; }
+    ~Redirect() { timer_.redirect_ = previous_; }
+    Redirect(const Redirect&) = delete;
+    Redirect& operator=(const Redirect&) = delete;
+
+   private:
+    StageTimer& timer_;
+    std::optional<Stage> previous_;
+  };
   // Sums the events recorded so far; call after they have completed.
   void collect() {
     for (auto& [stage, event] : pending_) {
@@ -26,6 +42,7 @@ class StageTimer {
 
  private:
   std::vector<std::pair<Stage, cl::Event>> pending_;
+  std::optional<Stage> redirect_;
   std::array<double, static_cast<size_t>(Stage::Count)> ms_{};
 };
 

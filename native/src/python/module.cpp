@@ -70,6 +70,26 @@ py::dict stats_dict(const RenderStats& s) {
   d["program_cache_hit"] = s.program_cache_hit;
   d["cancelled"] = s.cancelled;
   d["scene_reused"] = s.scene_reused;
+  py::dict sh;
+  sh["lights"] = s.shadows.lights;
+  sh["level_bias"] = s.shadows.level_bias;
+  sh["views"] = s.shadows.views;
+  sh["pages_requested"] = s.shadows.pages_requested;
+  sh["pages_rendered"] = s.shadows.pages_rendered;
+  sh["pages_missing"] = s.shadows.pages_missing;
+  sh["micropolygons"] = s.shadows.micropolygons;
+  sh["budget_bytes"] = s.shadows.budget_bytes;
+  sh["peak_bytes"] = s.shadows.peak_bytes;
+  py::list per_light;
+  for (const ShadowLightStats& l : s.shadows.per_light) {
+    py::dict e;
+    e["light"] = l.light;
+    e["pages"] = l.pages;
+    e["bytes"] = l.bytes;
+    per_light.append(e);
+  }
+  sh["per_light"] = per_light;
+  d["shadows"] = sh;
   t["upload"] = s.timings_ms.upload;
   t["bound_split"] = s.timings_ms.bound_split;
   t["dice"] = s.timings_ms.dice;
@@ -77,6 +97,9 @@ py::dict stats_dict(const RenderStats& s) {
   t["sample"] = s.timings_ms.sample;
   t["resolve"] = s.timings_ms.resolve;
   t["readback"] = s.timings_ms.readback;
+  t["shadow_mark"] = s.timings_ms.shadow_mark;
+  t["shadow"] = s.timings_ms.shadow;
+  t["shadows_wall"] = s.timings_ms.shadows_wall;
   t["total"] = s.timings_ms.total;
   d["timings_ms"] = t;
   return d;
@@ -130,7 +153,10 @@ PYBIND11_MODULE(_native, m) {
       .def_readwrite("max_grid_size", &RenderSettings::max_grid_size)
       .def_readwrite("max_split_depth", &RenderSettings::max_split_depth)
       .def_readwrite("backface_culling", &RenderSettings::backface_culling)
-      .def_readwrite("depth_and_normal_passes", &RenderSettings::depth_and_normal_passes);
+      .def_readwrite("depth_and_normal_passes", &RenderSettings::depth_and_normal_passes)
+      .def_readwrite("shadows", &RenderSettings::shadows)
+      .def_readwrite("shadow_memory_mib", &RenderSettings::shadow_memory_mib)
+      .def_readwrite("shadow_shading_rate", &RenderSettings::shadow_shading_rate);
 
   py::class_<Scene>(m, "Scene")
       .def(py::init<>())
@@ -158,8 +184,9 @@ PYBIND11_MODULE(_native, m) {
           [](Scene& s, const std::string& name, const std::string& model, std::vector<float> color,
              std::vector<float> opacity, float ka, float kd, float ks, float roughness, std::vector<float> specular_color,
              std::vector<float> emission, float metallic, float specular, int program, bool program_displaces,
-             bool program_shades, float displacement_bound, bool displacement_bound_world) {
+             bool program_shades, float displacement_bound, bool displacement_bound_world, bool program_alpha) {
             Material mat;
+            mat.program_alpha = program_alpha;
             mat.displacement_bound_world = displacement_bound_world;
             mat.program = program;
             mat.program_displaces = program_displaces;
@@ -187,6 +214,7 @@ PYBIND11_MODULE(_native, m) {
           py::arg("emission") = std::vector<float>{0, 0, 0}, py::arg("metallic") = 0.0f, py::arg("specular") = 0.5f,
           py::arg("program") = -1, py::arg("program_displaces") = false, py::arg("program_shades") = false,
           py::arg("displacement_bound") = 0.0f, py::arg("displacement_bound_world") = false,
+          py::arg("program_alpha") = false,
           "Adds a material (constant, matte, plastic or principled; see scene.h); returns its index.")
       .def(
           "add_material_program",
@@ -200,8 +228,13 @@ PYBIND11_MODULE(_native, m) {
           "add_light",
           [](Scene& s, const std::string& type, std::vector<float> color, float intensity, std::vector<float> position,
              std::vector<float> direction, float cone_angle, float cone_delta_angle, float beam_distribution,
-             const std::string& shape, std::vector<float> axis_u, float size_u, float size_v) {
+             const std::string& shape, std::vector<float> axis_u, float size_u, float size_v, bool cast_shadows,
+             float radius, bool soft_falloff, float angle) {
             Light l;
+            l.cast_shadows = cast_shadows;
+            l.radius = radius;
+            l.soft_falloff = soft_falloff;
+            l.angle = angle;
             if (type == "ambient") l.type = Light::Type::Ambient;
             else if (type == "distant") l.type = Light::Type::Distant;
             else if (type == "point") l.type = Light::Type::Point;
@@ -224,7 +257,9 @@ PYBIND11_MODULE(_native, m) {
           py::arg("position") = std::vector<float>{0, 0, 0}, py::arg("direction") = std::vector<float>{0, 0, -1},
           py::arg("cone_angle") = 0.5235988f, py::arg("cone_delta_angle") = 0.0872665f, py::arg("beam_distribution") = 2.0f,
           py::arg("shape") = "rectangle", py::arg("axis_u") = std::vector<float>{1, 0, 0}, py::arg("size_u") = 1.0f,
-          py::arg("size_v") = 1.0f, "Adds a light in world space (units: scene.h).")
+          py::arg("size_v") = 1.0f, py::arg("cast_shadows") = true, py::arg("radius") = 0.0f,
+          py::arg("soft_falloff") = true, py::arg("angle") = 0.0f,
+          "Adds a light in world space (units and shadows: scene.h).")
       .def(
           "add_mesh",
           [](Scene& s, const std::string& name, const Array<float>& points, const Array<int>& face_vertex_counts,
@@ -232,8 +267,11 @@ PYBIND11_MODULE(_native, m) {
              const Array<int>& face_materials, const Array<int>& crease_vertices, const Array<float>& crease_sharpness,
              const Array<int>& corner_vertices, const Array<float>& corner_sharpness, const Array<int>& hole_faces,
              const std::string& boundary, bool double_sided, std::vector<float> texspace_location,
-             std::vector<float> texspace_size, const Array<float>& uv_layers, const Array<float>& corner_normals) {
+             std::vector<float> texspace_size, const Array<float>& uv_layers, const Array<float>& corner_normals,
+             bool visible_camera, bool cast_shadows) {
             Mesh mesh;
+            mesh.visible_camera = visible_camera;
+            mesh.cast_shadows = cast_shadows;
             mesh.corner_normals = to_points(corner_normals, "corner_normals");
             if (uv_layers.size() > 0) {
               if (uv_layers.ndim() != 3 || uv_layers.shape(2) != 2)
@@ -275,7 +313,7 @@ PYBIND11_MODULE(_native, m) {
           py::arg("boundary") = "edge_and_corner", py::arg("double_sided") = true,
           py::arg("texspace_location") = std::vector<float>{0, 0, 0},
           py::arg("texspace_size") = std::vector<float>{0, 0, 0}, py::arg("uv_layers") = Array<float>(),
-          py::arg("corner_normals") = Array<float>(),
+          py::arg("corner_normals") = Array<float>(), py::arg("visible_camera") = true, py::arg("cast_shadows") = true,
           "Adds a mesh; uv_layers is (layers, face corners, 2): UV layer k is what material programs read as "
           "UV layer k; corner_normals (face corners, 3), object space, shade a polygon mesh smooth.")
       .def(

@@ -107,6 +107,10 @@ void validate_scene(const Scene& scene) {
     throw Error("crop window must satisfy 0 <= min < max <= 1");
   if (!(s.bound_split_memory_mib > 0) || !std::isfinite(s.bound_split_memory_mib))
     throw Error("bound & split memory budget must be a positive number of MiB");
+  if (!(s.shadow_memory_mib > 0) || !std::isfinite(s.shadow_memory_mib))
+    throw Error("shadow map memory budget must be a positive number of MiB");
+  if (!(s.shadow_shading_rate > 0) || !std::isfinite(s.shadow_shading_rate))
+    throw Error("shadow shading rate must be a positive number");
 
   const Camera& c = scene.camera;
   if (!finite(c.world_to_camera)) throw Error("camera transform contains NaN or infinite values");
@@ -136,6 +140,10 @@ void validate_scene(const Scene& scene) {
         !std::isfinite(l.cone_angle + l.cone_delta_angle + l.beam_distribution) || !finite(l.axis_u) ||
         !std::isfinite(l.size_u + l.size_v) || l.size_u < 0 || l.size_v < 0)
       fail("light", std::to_string(i), "has NaN or infinite values");
+    if (!(l.radius >= 0) || !std::isfinite(l.radius))
+      fail("light", std::to_string(i), "needs a finite, non-negative radius");
+    if (!(l.angle >= 0) || !(l.angle <= 3.14159266f))
+      fail("light", std::to_string(i), "needs an angle between 0 and pi");
   }
   for (const Mesh& m : scene.meshes) validate_mesh(m, scene.materials.size());
   for (const Image& im : scene.images) {

@@ -1,0 +1,532 @@
+/* Shadow maps: virtual, paged depth maps of each light, rendered by the
+ * micropolygon pipeline itself (RenderMan's shadow maps, in the paged form
+ * of Unreal's virtual shadow maps), and their lookups while shading.
+ *
+ * Every light that casts shadows is a set of virtual maps of 16384 x 16384
+ * texels, cut into pages of 128 x 128 texels that exist only where a
+ * receiver the camera sees needs them:
+ *
+ *  - a sun: clipmap levels, orthographic along the light, level l with
+ *    texels of 2^l scene units, each a window of 128 x 128 pages around the
+ *    camera whose page table wraps around (a page keeps its slot while the
+ *    camera moves);
+ *  - a point, spot or area light: the six faces of a cube around the light
+ *    (90 degree perspective views), each with mips m = 0..7 of 16384 >> m
+ *    texels.
+ *
+ * A receiver at camera depth d covers a pixel of d / max(|ax|, |ay|) scene
+ * units (the pixel footprint); it reads the level (or mip) whose texels are
+ * no larger than that, so shadow detail follows the screen. A coarse pass of
+ * the camera's bound & split marks the pages its sub-patches need
+ * (shadow.cl); the host gives them physical pages from a pool of fixed size
+ * (the shadow memory budget) and the light's views render them.
+ *
+ * Filtering compares each texel with the receiver's tangent plane where the
+ * texel's ray meets it (receiver-plane depth, so a tilted receiver does not
+ * shadow itself), bilinearly; soft shadows estimate the occluders' distance
+ * from the texels in a search region and filter over the light's shape
+ * scaled by it (percentage-closer soft shadows, Fernando 2005), which widens
+ * the penumbra with the distance from the occluder as an area light's does.
+ *
+ * Shared by the kernels (shadow.cl, shade.cl, material programs) and the
+ * host (pipeline/shadow_maps.cpp, tests), so both agree on every index. */
+#ifndef MP_SHADOW_H
+#define MP_SHADOW_H
+
+#include "mp_compat.h"
+#include "mp_types.h"
+
+#define MP_PAGE_SIZE 128          /* texels per page side */
+#define MP_PAGE_TEXELS 16384      /* texels per page */
+#define MP_MAP_PAGES 128          /* pages per side of a full virtual map */
+#define MP_MAP_TEXELS 16384       /* texels per side of a full virtual map */
+#define MP_CUBE_MIPS 8            /* 16384 down to one page */
+#define MP_CUBE_FACE_ENTRIES 21845 /* page-table entries of one face, all mips */
+#define MP_MAX_SUN_LEVELS 24
+
+/* A page-table entry: the physical page in the pool, whether the page holds
+ * depths (resident) and whether this frame's shadow pass renders it. */
+#define MP_PAGE_RESIDENT 0x80000000u
+#define MP_PAGE_RENDER 0x40000000u
+#define MP_PAGE_PHYSICAL(e) ((e) & 0x3fffffffu)
+/* A texel no surface covers (+infinity as float bits: never in front). */
+#define MP_SHADOW_EMPTY 0x7f800000u
+
+/* Texels per side of cube mip m, and the table entries before it in a face. */
+MP_INLINE int mp_cube_mip_texels(int m) { return MP_MAP_TEXELS >> m; }
+MP_INLINE uint mp_cube_mip_entries(int m) {
+  uint n = 0u;
+  for (int k = 0; k < m; ++k) n += (uint)((MP_MAP_PAGES >> k) * (MP_MAP_PAGES >> k));
+  return n;
+}
+
+/* The cube face a light-space direction falls on: +X, -X, +Y, -Y, +Z, -Z. */
+MP_INLINE int mp_cube_face(float3 q) {
+  float ax = fabs(q.x), ay = fabs(q.y), az = fabs(q.z);
+  if (ax >= ay && ax >= az) return q.x >= 0.0f ? 0 : 1;
+  if (ay >= az) return q.y >= 0.0f ? 2 : 3;
+  return q.z >= 0.0f ? 4 : 5;
+}
+
+/* Light space -> the face's view space (a rotation; the face looks down -Z):
+ * with a the face's axis and s its sign, (x, y, z) = (-s q[a+1], q[a+2], -s q[a]). */
+MP_INLINE float3 mp_cube_face_view(int face, float3 q) {
+  int a = face >> 1;
+  float s = (face & 1) ? -1.0f : 1.0f;
+  float qa = a == 0 ? q.x : a == 1 ? q.y : q.z;
+  float q1 = a == 0 ? q.y : a == 1 ? q.z : q.x;
+  float q2 = a == 0 ? q.z : a == 1 ? q.x : q.y;
+  return MP_F3(-s * q1, q2, -s * qa);
+}
+
+/* Its inverse. */
+MP_INLINE float3 mp_cube_face_unview(int face, float3 v) {
+  int a = face >> 1;
+  float s = (face & 1) ? -1.0f : 1.0f;
+  float qa = -s * v.z, q1 = -s * v.x, q2 = v.y;
+  return a == 0 ? MP_F3(qa, q1, q2) : a == 1 ? MP_F3(q2, qa, q1) : MP_F3(q1, q2, qa);
+}
+
+MP_INLINE float3 mp_xform_point(const MP_GLOBAL float* m, float3 p) {
+  return MP_F3(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
+               m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]);
+}
+
+MP_INLINE float3 mp_xform_dir(const MP_GLOBAL float* m, float3 v) {
+  return MP_F3(m[0] * v.x + m[1] * v.y + m[2] * v.z, m[4] * v.x + m[5] * v.y + m[6] * v.z,
+               m[8] * v.x + m[9] * v.y + m[10] * v.z);
+}
+
+/* Scene units covered by one pixel at camera depth d (orthographic: any d). */
+MP_INLINE float mp_pixel_footprint(float d, FrameParams f) {
+  float scale = fmax(fabs(f.ax), fabs(f.ay));
+  return (f.ortho ? 1.0f : d) / scale;
+}
+
+/* floor(log2(x)) for x > 0, from the float's exponent, so every device and
+ * the host agree exactly (log2 may differ in the last place). */
+MP_INLINE int mp_floor_log2(float x) {
+  uint b = as_uint(x);
+  int e = (int)((b >> 23) & 0xffu);
+  if (e == 0) return -127;
+  return e - 127;
+}
+
+MP_INLINE int mp_ceil_log2(float x) {
+  int l = mp_floor_log2(x);
+  uint b = as_uint(x);
+  return (b & 0x7fffffu) ? l + 1 : l;
+}
+
+/* Level (sun) of the finest clipmap whose texels are no larger than the
+ * footprint, before the light's bias and clamping. */
+MP_INLINE int mp_sun_level_for(float footprint) { return mp_floor_log2(footprint); }
+
+/* Mip of a cube face whose texels, at face depth z, are no larger than the
+ * footprint: texel = z * 2^(m+1) / 16384. */
+MP_INLINE int mp_cube_mip_for(float footprint, float z) {
+  return mp_floor_log2(footprint * (float)(MP_MAP_TEXELS / 2) / fmax(z, 1e-30f));
+}
+
+/* Raster rectangle (texels of a face `texels` wide) onto which the part of
+ * the light-space box [lo, hi] inside the face's frustum projects; 0 when
+ * that part is empty. Points in a face's frustum have depth >= |x|, |y| in
+ * its view, which bounds the depths that matter for boxes beside the light. */
+MP_INLINE int mp_cube_face_box(int face, float3 lo, float3 hi, float texels, float* x0, float* y0, float* x1,
+                               float* y1) {
+  float3 a = mp_cube_face_view(face, lo), b = mp_cube_face_view(face, hi);
+  float3 vlo = fmin(a, b), vhi = fmax(a, b);
+  float mx = vlo.x > 0.0f ? vlo.x : vhi.x < 0.0f ? -vhi.x : 0.0f;
+  float my = vlo.y > 0.0f ? vlo.y : vhi.y < 0.0f ? -vhi.y : 0.0f;
+  float dhi = -vlo.z, dlo = fmax(fmax(-vhi.z, fmax(mx, my)), 1e-30f);
+  if (!(dhi > 0.0f) || dlo > dhi) return 0;
+  float umin = vlo.x >= 0.0f ? vlo.x / dhi : vlo.x / dlo, umax = vhi.x >= 0.0f ? vhi.x / dlo : vhi.x / dhi;
+  float wmin = vlo.y >= 0.0f ? vlo.y / dhi : vlo.y / dlo, wmax = vhi.y >= 0.0f ? vhi.y / dlo : vhi.y / dhi;
+  if (umin > 1.0f || umax < -1.0f || wmin > 1.0f || wmax < -1.0f) return 0;
+  float h = 0.5f * texels;
+  *x0 = (fmax(umin, -1.0f) + 1.0f) * h;
+  *x1 = (fmin(umax, 1.0f) + 1.0f) * h;
+  *y0 = (fmax(wmin, -1.0f) + 1.0f) * h;
+  *y1 = (fmin(wmax, 1.0f) + 1.0f) * h;
+  return 1;
+}
+
+/* One map of a light, as lookups see it. */
+typedef struct {
+  uint table;        /* first page-table entry */
+  int side;          /* pages per side */
+  int origin_x, origin_y;
+  int face;          /* cube face, or -1 for a sun level */
+  float scale;       /* sun: texels per scene unit; cube: texels per unit of x/d, half the side */
+  float off_x, off_y, z_top;
+} MpShadowMap;
+
+typedef struct {
+  const MP_GLOBAL DeviceShadow* shadows; /* one per light (kind MP_SHADOW_NONE for lights without) */
+  const MP_GLOBAL DeviceShadowLevel* levels;
+  const MP_GLOBAL uint* pages;  /* page tables */
+  const MP_GLOBAL uint* pool;   /* physical pages, MP_PAGE_TEXELS float depths each */
+} MpShadowMaps;
+
+MP_INLINE MpShadowMap mp_sun_map(const MP_GLOBAL DeviceShadow* sh, const MP_GLOBAL DeviceShadowLevel* lv) {
+  MpShadowMap m;
+  m.table = lv->page_table;
+  m.side = MP_MAP_PAGES;
+  m.origin_x = lv->origin_x;
+  m.origin_y = lv->origin_y;
+  m.face = -1;
+  m.scale = 1.0f / lv->texel;
+  m.off_x = lv->offset[0];
+  m.off_y = lv->offset[1];
+  m.z_top = sh->z_top;
+  return m;
+}
+
+MP_INLINE MpShadowMap mp_cube_map(const MP_GLOBAL DeviceShadow* sh, int face, int mip) {
+  MpShadowMap m;
+  m.table = sh->page_table + (uint)face * MP_CUBE_FACE_ENTRIES + mp_cube_mip_entries(mip);
+  m.side = MP_MAP_PAGES >> mip;
+  m.origin_x = m.origin_y = 0;
+  m.face = face;
+  m.scale = 0.5f * (float)mp_cube_mip_texels(mip);
+  m.off_x = m.off_y = m.z_top = 0.0f;
+  return m;
+}
+
+/* Raster position (texels) and view depth of light-space point q. */
+MP_INLINE float3 mp_shadow_project(const MpShadowMap* m, float3 q) {
+  if (m->face < 0) return MP_F3((q.x + m->off_x) * m->scale, (q.y + m->off_y) * m->scale, m->z_top - q.z);
+  float3 v = mp_cube_face_view(m->face, q);
+  float d = -v.z;
+  return MP_F3((v.x / d + 1.0f) * m->scale, (v.y / d + 1.0f) * m->scale, d);
+}
+
+/* Scene units one texel of the map covers at view depth d. */
+MP_INLINE float mp_shadow_texel_size(const MpShadowMap* m, float d) {
+  return m->face < 0 ? 1.0f / m->scale : d / m->scale;
+}
+
+/* View depth where the ray of raster point (x, y) meets the plane through q
+ * with normal n (light space); `fallback` where it runs along the plane. */
+MP_INLINE float mp_shadow_plane_depth(const MpShadowMap* m, float x, float y, float3 q, float3 n, float fallback) {
+  if (m->face < 0) {
+    if (!(fabs(n.z) > 1e-6f)) return fallback;
+    float lx = x / m->scale - m->off_x, ly = y / m->scale - m->off_y;
+    float z = q.z - (n.x * (lx - q.x) + n.y * (ly - q.y)) / n.z;
+    return m->z_top - z;
+  }
+  float3 dir = mp_cube_face_unview(m->face, MP_F3(x / m->scale - 1.0f, y / m->scale - 1.0f, -1.0f));
+  float nd = dot(n, dir);
+  if (!(fabs(nd) > 1e-6f)) return fallback;
+  float t = dot(n, q) / nd;
+  return t > 0.0f ? t : fallback;
+}
+
+/* Depth stored at texel (ix, iy) of the map; 0 when its page is not
+ * resident. A cube face's filters that reach past its edge read its edge
+ * texels (the neighbouring face's first ones see nearly the same); outside
+ * a clipmap level's window there is nothing (a coarser level covers it). */
+MP_INLINE int mp_shadow_texel(const MpShadowMaps* in, const MpShadowMap* m, int ix, int iy, float* depth) {
+  int texels = m->side * MP_PAGE_SIZE;
+  if (m->face >= 0) {
+    ix = clamp(ix, 0, texels - 1);
+    iy = clamp(iy, 0, texels - 1);
+  }
+  if (ix < 0 || iy < 0 || ix >= texels || iy >= texels) return 0;
+  int sx = ((ix >> 7) + m->origin_x) & (m->side - 1), sy = ((iy >> 7) + m->origin_y) & (m->side - 1);
+  uint e = in->pages[m->table + (uint)(sy * m->side + sx)];
+  if (!(e & MP_PAGE_RESIDENT)) return 0;
+  uint bits = in->pool[(ulong)MP_PAGE_PHYSICAL(e) * MP_PAGE_TEXELS + (ulong)((iy & 127) * MP_PAGE_SIZE + (ix & 127))];
+  *depth = as_float(bits);
+  return 1;
+}
+
+/* Fraction of the bilinear footprint around raster point (x, y) that sees
+ * the light from the receiver plane (q, n); *missing when a texel's page is
+ * not resident. Each texel is compared with the plane's depth on its own ray,
+ * less `bias` (scene units). */
+MP_INLINE float mp_shadow_bilinear(const MpShadowMaps* in, const MpShadowMap* m, float x, float y, float3 q, float3 n,
+                                   float qdepth, float bias, int* missing) {
+  float fx = x - 0.5f, fy = y - 0.5f;
+  float bx = floor(fx), by = floor(fy);
+  int ix = (int)bx, iy = (int)by;
+  float wx = fx - bx, wy = fy - by;
+  float lit = 0.0f;
+  for (int k = 0; k < 4; ++k) {
+    int dx = k & 1, dy = k >> 1;
+    float w = (dx ? wx : 1.0f - wx) * (dy ? wy : 1.0f - wy);
+    float d;
+    if (!mp_shadow_texel(in, m, ix + dx, iy + dy, &d)) {
+      *missing = 1;
+      return 1.0f;
+    }
+    float r = mp_shadow_plane_depth(m, (float)(ix + dx) + 0.5f, (float)(iy + dy) + 0.5f, q, n, qdepth);
+    if (r - bias <= d) lit += w;
+  }
+  return lit;
+}
+
+/* Occluders around raster point (x, y), bilinearly: each of the four
+ * texels whose depth lies in front of the receiver plane by more than
+ * `bias`, with an occluder-to-receiver ratio (mp_kernel_point: the depth
+ * difference for suns, over the occluder's depth for local lights) of at
+ * least min_ratio, adds its weight to *weight and weight x ratio to *sum. */
+MP_INLINE void mp_shadow_blockers(const MpShadowMaps* in, const MpShadowMap* m, float x, float y, float3 q, float3 n,
+                                  float qdepth, float bias, int sun, float min_ratio, float* weight, float* sum,
+                                  int* missing) {
+  float fx = x - 0.5f, fy = y - 0.5f;
+  float bx = floor(fx), by = floor(fy);
+  int ix = (int)bx, iy = (int)by;
+  float wx = fx - bx, wy = fy - by;
+  for (int k = 0; k < 4; ++k) {
+    int dx = k & 1, dy = k >> 1;
+    float d;
+    if (!mp_shadow_texel(in, m, ix + dx, iy + dy, &d)) {
+      *missing = 1;
+      return;
+    }
+    float r = mp_shadow_plane_depth(m, (float)(ix + dx) + 0.5f, (float)(iy + dy) + 0.5f, q, n, qdepth);
+    if (!(r - bias > d)) continue;
+    float ratio = sun ? r - d : (r - d) / fmax(d, 1e-20f);
+    if (ratio < min_ratio) continue;
+    float w = (dx ? wx : 1.0f - wx) * (dy ? wy : 1.0f - wy);
+    *weight += w;
+    *sum += w * ratio;
+  }
+}
+
+/* Depth bias in texels of the map at the receiver. The receiver plane takes
+ * care of a flat receiver's slope; the bias covers the rest: the shadow
+ * view's micropolygons and the camera's sample the surface at other points,
+ * and a curved surface leaves its tangent plane by a distance that, seen
+ * along a grazing light, grows as the light lowers. So a constant part and
+ * one that grows with the tangent of the light's angle to the normal. */
+#define MP_SHADOW_BIAS_TEXELS 0.5f
+#define MP_SHADOW_SLOPE_BIAS_TEXELS 0.5f
+#define MP_SHADOW_MAX_SLOPE 8.0f
+/* Soft shadows' taps lie off the receiver, where its tangent plane leaves
+ * a curved surface: their bias grows by this fraction of their distance. */
+#define MP_SHADOW_SOFT_BIAS 0.05f
+/* Taps of the blocker search and of the soft filter. */
+#define MP_SHADOW_TAPS 16
+/* The blocker search reaches occluders up to halfway from the receiver to a
+ * local light (the search kernel is the light's shape scaled by f / (1 - f)
+ * for a fraction f of the way). */
+#define MP_SHADOW_SEARCH_SCALE 1.0f
+/* Texels across the search and filter kernels' radius. */
+#define MP_SHADOW_SEARCH_TEXELS 8.0f
+#define MP_SHADOW_FILTER_TEXELS 4.0f
+
+/* Tap k of n over the unit disk (Vogel's spiral: even density, no two taps
+ * on one ray). */
+MP_INLINE float2 mp_disk_tap(int k, int n) {
+  float r = sqrt(((float)k + 0.5f) / (float)n);
+  float a = 2.39996323f * (float)k;
+  return MP_F2(r * cos(a), r * sin(a));
+}
+
+/* A point of the light's shape, as an offset from its centre in light
+ * space (local lights) or in the light's xy plane (the sun, as tangents of
+ * the angle): d in the unit disk (or square, for rectangles) scaled to a
+ * disk facing the receiver direction `toward` for point and spot lights, to
+ * a rectangle or ellipse in the light's plane for area lights. */
+MP_INLINE float3 mp_light_shape_point(const MP_GLOBAL DeviceShadow* sh, float2 d, float3 toward) {
+  if (sh->shape == MP_SHADOW_SHAPE_RECTANGLE || sh->shape == MP_SHADOW_SHAPE_ELLIPSE)
+    return MP_F3(d.x * sh->size[0], d.y * sh->size[1], 0.0f);
+  if (sh->kind == MP_SHADOW_SUN) return MP_F3(d.x * sh->size[0], d.y * sh->size[0], 0.0f);
+  float3 w = normalize(toward);
+  float3 a = fabs(w.x) < 0.9f ? MP_F3(1.0f, 0.0f, 0.0f) : MP_F3(0.0f, 1.0f, 0.0f);
+  float3 u = normalize(cross(w, a)), v = cross(w, u);
+  return sh->size[0] * (d.x * u + d.y * v);
+}
+
+/* Filter tap k of n over the light's shape (mp_light_shape_point): even
+ * density over a disk (Vogel's spiral) or a 4 x 4 grid over a rectangle. */
+MP_INLINE float3 mp_light_shape_tap(const MP_GLOBAL DeviceShadow* sh, int k, int n, float3 toward) {
+  if (sh->shape == MP_SHADOW_SHAPE_RECTANGLE) {
+    int side = 4, i = k % side, j = (k / side) % side;
+    return mp_light_shape_point(sh, MP_F2(((float)i + 0.5f) / (float)side * 2.0f - 1.0f,
+                                          ((float)j + 0.5f) / (float)side * 2.0f - 1.0f), toward);
+  }
+  return mp_light_shape_point(sh, mp_disk_tap(k, n), toward);
+}
+
+/* Blocker search tap k of n: from the shape's centre (k = 0) out to its
+ * edge at even steps of radius, so that the small regions where occluders
+ * near the receiver can stand get taps too; *reach is the radius (0..1). */
+MP_INLINE float3 mp_search_tap(const MP_GLOBAL DeviceShadow* sh, int k, int n, float3 toward, float* reach) {
+  float r = (float)k / (float)(n - 1), a = 2.39996323f * (float)k;
+  *reach = r;
+  return mp_light_shape_point(sh, MP_F2(r * cos(a), r * sin(a)), toward);
+}
+
+/* Radius of the light's shape (the search and filter kernels' extent). */
+MP_INLINE float mp_light_shape_radius(const MP_GLOBAL DeviceShadow* sh) {
+  if (sh->shape == MP_SHADOW_SHAPE_RECTANGLE) return sqrt(sh->size[0] * sh->size[0] + sh->size[1] * sh->size[1]);
+  return fmax(sh->size[0], sh->size[1]);
+}
+
+/* The map of a light that point q falls on at detail `level` (sun: level
+ * index from level0; cube: mip). */
+MP_INLINE MpShadowMap mp_shadow_map_at(const MpShadowMaps* in, const MP_GLOBAL DeviceShadow* sh, float3 q, int level) {
+  if (sh->kind == MP_SHADOW_SUN) return mp_sun_map(sh, in->levels + sh->level_records + (uint)level);
+  return mp_cube_map(sh, mp_cube_face(q), level);
+}
+
+MP_INLINE int mp_shadow_level_count(const MP_GLOBAL DeviceShadow* sh) {
+  return sh->kind == MP_SHADOW_SUN ? (int)sh->levels : MP_CUBE_MIPS;
+}
+
+/* The level whose texels (at q) are about `size` scene units over `texels`,
+ * no finer than `finest`. */
+MP_INLINE int mp_shadow_level_for_size(const MP_GLOBAL DeviceShadow* sh, float3 q, float size, float texels, int finest) {
+  int count = mp_shadow_level_count(sh);
+  float per = size / texels;
+  int l;
+  if (sh->kind == MP_SHADOW_SUN) {
+    l = mp_ceil_log2(fmax(per, 1e-30f)) - sh->level0;
+  } else {
+    float3 a = MP_F3(fabs(q.x), fabs(q.y), fabs(q.z));
+    float z = fmax(a.x, fmax(a.y, a.z));
+    l = mp_ceil_log2(fmax(per * (float)(MP_MAP_TEXELS / 2) / fmax(z, 1e-30f), 1e-30f));
+  }
+  return clamp(max(l, finest), 0, count - 1);
+}
+
+/* Where the light grazes a receiver (normal n, light space), a texel
+ * stretches across 1 / |cos| of it along the light: the footprint a map
+ * must resolve shrinks by |cos|, down to a half (one level finer) so
+ * that grazing surfaces do not ask for unbounded detail. */
+#define MP_SHADOW_MIN_GRAZING 1.0f
+MP_INLINE float mp_shadow_grazing(const MP_GLOBAL DeviceShadow* sh, float3 q, float3 n) {
+  float ln = length(n);
+  if (!(ln > 0.0f)) return 1.0f;
+  float c = sh->kind == MP_SHADOW_SUN ? n.z / ln : dot(n, q) / (ln * fmax(length(q), 1e-30f));
+  return clamp(fabs(c), MP_SHADOW_MIN_GRAZING, 1.0f);
+}
+
+/* The bias of a receiver at q with normal n (light space), in texels. */
+MP_INLINE float mp_shadow_bias_texels(const MP_GLOBAL DeviceShadow* sh, float3 q, float3 n) {
+  float ln = length(n);
+  float c = !(ln > 0.0f) ? 1.0f : sh->kind == MP_SHADOW_SUN ? n.z / ln : dot(n, q) / (ln * fmax(length(q), 1e-30f));
+  c = fmax(fabs(c), 1e-3f);
+  float t = fmin(sqrt(fmax(1.0f - c * c, 0.0f)) / c, MP_SHADOW_MAX_SLOPE);
+  return MP_SHADOW_BIAS_TEXELS + MP_SHADOW_SLOPE_BIAS_TEXELS * t;
+}
+
+/* Level a receiver at q reads for hard shadows, from its pixel footprint. */
+MP_INLINE int mp_shadow_base_level(const MP_GLOBAL DeviceShadow* sh, float3 q, float footprint) {
+  int l;
+  if (sh->kind == MP_SHADOW_SUN) {
+    l = mp_sun_level_for(footprint) + sh->level_bias - sh->level0;
+  } else {
+    float3 a = MP_F3(fabs(q.x), fabs(q.y), fabs(q.z));
+    l = mp_cube_mip_for(footprint, fmax(a.x, fmax(a.y, a.z))) + sh->level_bias;
+  }
+  return clamp(l, 0, mp_shadow_level_count(sh) - 1);
+}
+
+/* Point q + offset * scale of a kernel over the light's shape: local lights
+ * scale their shape by (receiver - occluder) / occluder along the ray, the
+ * sun its angle's tangent by the occluder's height above the receiver. */
+MP_INLINE float3 mp_kernel_point(float3 q, float3 offset, float scale) { return q + offset * scale; }
+
+/* Visibility of the light from a receiver at light-space q with geometric
+ * normal n, footprint in scene units: 1 lit, 0 in shadow. */
+MP_INLINE float mp_shadow_visibility_light(const MpShadowMaps* in, const MP_GLOBAL DeviceShadow* sh, float3 q, float3 n,
+                                           float footprint) {
+  int count = mp_shadow_level_count(sh);
+  int base = mp_shadow_base_level(sh, q, footprint);
+  float bias = mp_shadow_bias_texels(sh, q, n);
+  int sun = sh->kind == MP_SHADOW_SUN;
+  float radius = mp_light_shape_radius(sh);
+  if (sh->shape == MP_SHADOW_SHAPE_POINT || !(radius > 0.0f)) {
+    for (int l = base; l < count; ++l) {
+      MpShadowMap m = mp_shadow_map_at(in, sh, q, l);
+      float3 r = mp_shadow_project(&m, q);
+      int missing = 0;
+      float lit = mp_shadow_bilinear(in, &m, r.x, r.y, q, n, r.z, bias * mp_shadow_texel_size(&m, r.z),
+                                     &missing);
+      if (!missing) return lit;
+    }
+    return 1.0f;
+  }
+  /* Blocker search: occluders between the receiver and (local lights) a
+   * fraction of the way to the light, or (sun) the top of the scene. A tap
+   * at the shape's offset O scaled by s finds an occluder whose own scale
+   * (distance ratio, mp_kernel_point) is r: it stands between the receiver
+   * and the light only if the light point O s / r lies on the light, i.e.
+   * r >= s * reach; others are not counted (they would only widen the
+   * penumbra estimate, the classic fault of percentage-closer soft shadows). */
+  float search_scale = sun ? fmax(sh->z_top - q.z, 0.0f) : MP_SHADOW_SEARCH_SCALE;
+  float search_radius = radius * search_scale;
+  int ls = mp_shadow_level_for_size(sh, q, search_radius, MP_SHADOW_SEARCH_TEXELS, base);
+  float3 toward = q;
+  float found = 0.0f, sum = 0.0f;
+  for (; ls < count; ++ls) {
+    int missing = 0;
+    found = sum = 0.0f;
+    for (int k = 0; k < MP_SHADOW_TAPS && !missing; ++k) {
+      float reach;
+      float3 o = mp_search_tap(sh, k, MP_SHADOW_TAPS, toward, &reach);
+      float3 x = mp_kernel_point(q, o, search_scale);
+      MpShadowMap m = mp_shadow_map_at(in, sh, x, ls);
+      float3 r = mp_shadow_project(&m, x);
+      float b = bias * mp_shadow_texel_size(&m, r.z) + MP_SHADOW_SOFT_BIAS * length(o) * search_scale;
+      mp_shadow_blockers(in, &m, r.x, r.y, q, n, r.z, b, sun, search_scale * reach, &found, &sum, &missing);
+    }
+    if (!missing) break;
+  }
+  if (ls >= count || !(found > 0.0f)) return 1.0f;
+  if (found >= (float)MP_SHADOW_TAPS - 1e-3f) return 0.0f;
+  /* The penumbra kernel: the light's shape scaled by the mean occluder's
+   * distance, filtered where it spans a few texels, blended between the two
+   * levels around that size so that the filter does not jump from one to
+   * the next across a penumbra. */
+  float scale = sum / found;
+  float size = radius * scale / MP_SHADOW_FILTER_TEXELS;
+  float level;
+  if (sun) {
+    level = log2(fmax(size, 1e-30f)) - (float)sh->level0;
+  } else {
+    float3 a = MP_F3(fabs(q.x), fabs(q.y), fabs(q.z));
+    level = log2(fmax(size * (float)(MP_MAP_TEXELS / 2) / fmax(fmax(a.x, fmax(a.y, a.z)), 1e-30f), 1e-30f));
+  }
+  level = clamp(level, (float)base, (float)(count - 1));
+  int l0 = (int)floor(level);
+  float blend = level - (float)l0;
+  float result = 0.0f, weight = 0.0f;
+  for (int pass = 0; pass < 2; ++pass) {
+    float w = pass == 0 ? 1.0f - blend : blend;
+    if (w <= 0.0f) continue;
+    for (int lp = l0 + pass; lp < count; ++lp) {
+      int missing = 0;
+      float lit = 0.0f;
+      for (int k = 0; k < MP_SHADOW_TAPS && !missing; ++k) {
+        float3 o = mp_light_shape_tap(sh, k, MP_SHADOW_TAPS, toward);
+        float3 x = mp_kernel_point(q, o, scale);
+        MpShadowMap m = mp_shadow_map_at(in, sh, x, lp);
+        float3 r = mp_shadow_project(&m, x);
+        float b = bias * mp_shadow_texel_size(&m, r.z) + MP_SHADOW_SOFT_BIAS * length(o) * scale;
+        lit += mp_shadow_bilinear(in, &m, r.x, r.y, q, n, r.z, b, &missing);
+      }
+      if (!missing) {
+        result += w * lit / (float)MP_SHADOW_TAPS;
+        weight += w;
+        break;
+      }
+    }
+  }
+  return weight > 0.0f ? result / weight : 1.0f;
+}
+
+/* Visibility of light `light` at camera-space point p with geometric normal n. */
+MP_INLINE float mp_shadow_visibility(const MpShadowMaps* in, uint light, float3 p, float3 n, float footprint) {
+  const MP_GLOBAL DeviceShadow* sh = in->shadows + light;
+  if (sh->kind == MP_SHADOW_NONE) return 1.0f;
+  float3 q = mp_xform_point(sh->to_light, p);
+  float3 nq = mp_xform_dir(sh->to_light, n);
+  return mp_shadow_visibility_light(in, sh, q, nq, footprint * mp_shadow_grazing(sh, q, nq));
+}
+
+#endif

@@ -1,0 +1,297 @@
+#include "pipeline/shadow_maps.h"
+
+#include <algorithm>
+#include <numeric>
+#include <string>
+#include <unordered_set>
+
+#include "micropoly/error.h"
+#include "mp_shadow.h"
+#include "pipeline/scene_fingerprint.h"
+
+namespace mp {
+namespace {
+
+constexpr size_t kPageBytes = size_t(MP_PAGE_TEXELS) * sizeof(cl_uint);
+// The marking pass dices the camera's view this many times coarser (in
+// micropolygon edge) than the frame: its vertices mark the pages around
+// them, and need to be close only next to a page.
+constexpr float kMarkCoarsening = 8.0f;
+
+void grow(DeviceSession& s, cl::Buffer& buffer, size_t& capacity, size_t bytes, const char* what) {
+  if (bytes <= capacity && capacity > 0) return;
+  buffer = cl::Buffer();
+  buffer = s.allocate(bytes, what);
+  capacity = std::max<size_t>(bytes, 16);
+}
+
+}  // namespace
+
+ShadowMaps::ShadowMaps(DeviceSession& session)
+    : session_(session),
+      mark_(session.program(), "mark_shadow_pages"),
+      clear_(session.program(), "clear_shadow_pages"),
+      sample_(session.program(), "shadow_sample") {}
+
+void ShadowMaps::upload_records(const ShadowLayout& layout) {
+  cl::CommandQueue& q = session_.queue();
+  grow(session_, inputs_.shadows, records_capacity_, layout.shadows.size() * sizeof(DeviceShadow), "shadow records");
+  grow(session_, inputs_.levels, levels_capacity_, layout.levels.size() * sizeof(DeviceShadowLevel),
+       "shadow level records");
+  q.enqueueWriteBuffer(inputs_.shadows, CL_FALSE, 0, layout.shadows.size() * sizeof(DeviceShadow),
+                       layout.shadows.data());
+  if (!layout.levels.empty())
+    q.enqueueWriteBuffer(inputs_.levels, CL_FALSE, 0, layout.levels.size() * sizeof(DeviceShadowLevel),
+                         layout.levels.data());
+}
+
+bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, const SceneBuffers& buffers,
+                      const ShadowPassStages& stages, const BoundSplitRunner& run, StageTimer& timer,
+                      std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries) {
+  cl::CommandQueue& q = session_.queue();
+  const size_t n = layout.table_entries;
+  grow(session_, requests_, requests_capacity_, n, "shadow page requests");
+  q.enqueueFillBuffer(requests_, cl_uchar(0), 0, n);
+  FrameParams coarse = frame.params;
+  coarse.micropoly_edge *= kMarkCoarsening;
+  const cl_uint light_count = cl_uint(layout.shadows.size());
+  // Each vertex's box reaches its neighbours: one coarse micropolygon edge.
+  const cl_float reach = coarse.micropoly_edge;
+  GridBuffers& grids = stages.grids;
+  DiceSink sink = [&](const cl::Buffer& diceable, cl_uint count) {
+    stages.layout.run(diceable, count, coarse, grids, timer);
+    stages.dice.run(diceable, count, buffers, coarse, grids, timer);
+    stages.programs.displace(diceable, count, buffers, coarse, grids, timer);
+    mark_.setArg(0, diceable);
+    mark_.setArg(1, count);
+    mark_.setArg(2, grids.vertex_offsets);
+    mark_.setArg(3, coarse);
+    mark_.setArg(4, grids.p);
+    mark_.setArg(5, grids.n);
+    mark_.setArg(6, inputs_.shadows);
+    mark_.setArg(7, inputs_.levels);
+    mark_.setArg(8, light_count);
+    mark_.setArg(9, requests_);
+    mark_.setArg(10, reach);
+    cl::Event e;
+    q.enqueueNDRangeKernel(mark_, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64), nullptr, &e);
+    timer.add(Stage::ShadowMark, e);
+  };
+  if (run(coarse, PassViews{}, sink).cancelled) return false;
+  std::vector<uint8_t> requested(n);
+  q.enqueueReadBuffer(requests_, CL_TRUE, 0, n, requested.data());
+  // Coarser maps first: a budget too short for everything keeps them.
+  std::vector<size_t> order(layout.maps.size());
+  std::iota(order.begin(), order.end(), size_t(0));
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return layout.maps[a].coarseness > layout.maps[b].coarseness; });
+  keys.clear();
+  entries.clear();
+  for (size_t i : order) {
+    const ShadowMapInfo& m = layout.maps[i];
+    for (int sy = 0; sy < m.side; ++sy)
+      for (int sx = 0; sx < m.side; ++sx) {
+        const uint32_t e = m.table + uint32_t(sy * m.side + sx);
+        if (!requested[e]) continue;
+        ShadowPageKey k;
+        k.light = layout.light_keys[size_t(m.light)];
+        k.map = m.map_id;
+        layout.page_position(m, sx, sy, &k.x, &k.y);
+        keys.push_back(k);
+        entries.push_back(e);
+      }
+  }
+  return true;
+}
+
+void ShadowMaps::ensure_pool(uint32_t pages) {
+  if (pages <= pool_pages_) return;
+  const uint32_t grown = std::max(pages, std::min<uint32_t>(pool_pages_ + pool_pages_ / 2, uint32_t(pool_.capacity())));
+  cl::Buffer bigger = session_.allocate(size_t(grown) * kPageBytes, "shadow map page pool");
+  // Pages kept from earlier frames move along.
+  if (pool_pages_ > 0)
+    session_.queue().enqueueCopyBuffer(inputs_.pool, bigger, 0, 0, size_t(pool_pages_) * kPageBytes);
+  inputs_.pool = bigger;
+  pool_pages_ = grown;
+}
+
+bool ShadowMaps::render_views(const std::vector<FrameParams>& views, const std::vector<uint8_t>& masks,
+                              const FrameSetup& frame, const SceneBuffers& buffers, const ShadowPassStages& stages,
+                              const BoundSplitRunner& run, StageTimer& timer) {
+  cl::CommandQueue& q = session_.queue();
+  grow(session_, masks_, masks_capacity_, masks.size(), "shadow page masks");
+  if (!masks.empty()) q.enqueueWriteBuffer(masks_, CL_FALSE, 0, masks.size(), masks.data());
+  const FrameParams& f = frame.params;
+  GridBuffers& grids = stages.grids;
+  DiceSink sink = [&](const cl::Buffer& diceable, cl_uint count) {
+    stages.layout.run(diceable, count, f, grids, timer);
+    stages.dice.run(diceable, count, buffers, f, grids, timer);
+    stages.programs.displace(diceable, count, buffers, f, grids, timer, false);
+    stages.programs.alpha(diceable, count, buffers, f, grids, timer);
+    const cl_uint base = grids.micropolygon_offsets_host[0];
+    const cl_uint total = grids.micropolygon_offsets_host[count] - base;
+    if (total == 0) return;
+    sample_.setArg(0, diceable);
+    sample_.setArg(1, cl_uint(0));
+    sample_.setArg(2, count);
+    sample_.setArg(3, grids.micropolygon_offsets);
+    sample_.setArg(4, base);
+    sample_.setArg(5, total);
+    sample_.setArg(6, buffers.patch_info);
+    sample_.setArg(7, buffers.materials);
+    sample_.setArg(8, f);
+    sample_.setArg(9, views_);
+    sample_.setArg(10, grids.p);
+    sample_.setArg(11, grids.c);
+    sample_.setArg(12, inputs_.pages);
+    sample_.setArg(13, inputs_.pool);
+    cl::Event e;
+    q.enqueueNDRangeKernel(sample_, cl::NullRange, round_up_range(total), cl::NDRange(64), nullptr, &e);
+    timer.add(Stage::Sample, e);
+  };
+  for (size_t first = 0; first < views.size(); first += MP_MAX_PASS_VIEWS) {
+    const size_t count = std::min<size_t>(MP_MAX_PASS_VIEWS, views.size() - first);
+    grow(session_, views_, views_capacity_, MP_MAX_PASS_VIEWS * sizeof(FrameParams), "shadow views");
+    q.enqueueWriteBuffer(views_, CL_FALSE, 0, count * sizeof(FrameParams), views.data() + first);
+    PassViews pass;
+    pass.views = views_;
+    pass.count = cl_uint(count);
+    pass.page_masks = masks_;
+    if (run(f, pass, sink).cancelled) return false;
+  }
+  return true;
+}
+
+bool ShadowMaps::render(const Scene& scene, const FrameSetup& frame, const SceneBuffers& buffers,
+                        const ShadowPassStages& stages, const BoundSplitRunner& run, StageTimer& timer,
+                        ShadowStats& stats) {
+  stats = ShadowStats{};
+  const RenderSettings& settings = scene.settings;
+  stats.budget_bytes = size_t(double(settings.shadow_memory_mib) * 1048576.0);
+  inputs_.enabled = false;
+  if (!settings.shadows || buffers.patch_count == 0) return true;
+  ShadowLayout layout = make_shadow_layout(scene, frame, world_bounds(scene), geometry_fingerprint(scene));
+  if (layout.shadowed_lights == 0) {
+    pool_.clear();
+    return true;
+  }
+  stats.lights = layout.shadowed_lights;
+
+  // The budget holds the page tables, the requests, the page masks (at most
+  // a third of the tables) and the views first; pages take the rest.
+  const size_t fixed = size_t(layout.table_entries) * (sizeof(cl_uint) + 1) + size_t(layout.table_entries) * 4 / 3 +
+                       MP_MAX_PASS_VIEWS * sizeof(FrameParams) + layout.shadows.size() * sizeof(DeviceShadow) +
+                       layout.levels.size() * sizeof(DeviceShadowLevel);
+  if (stats.budget_bytes < fixed + 16 * kPageBytes)
+    throw Error("the shadow map memory budget of " + std::to_string(settings.shadow_memory_mib) + " MiB is too small for " +
+                std::to_string(layout.shadowed_lights) + " shadowed lights: it needs at least " +
+                std::to_string((fixed + 16 * kPageBytes + 1048575) >> 20) + " MiB");
+  const size_t capacity = (stats.budget_bytes - fixed) / kPageBytes;
+  if (pool_.capacity() != capacity) {
+    pool_.set_capacity(capacity);
+    if (pool_.resident() == 0) pool_pages_ = std::min<uint32_t>(pool_pages_, uint32_t(capacity));
+  }
+  std::unordered_set<uint64_t> present;
+  for (uint64_t k : layout.light_keys)
+    if (k) present.insert(k);
+  pool_.keep_only(present);
+
+  std::vector<ShadowPageKey> keys;
+  std::vector<uint32_t> entries;
+  {
+    StageTimer::Redirect to(timer, Stage::ShadowMark);
+    for (int bias = 0;; ++bias) {
+      set_shadow_level_bias(layout, bias);
+      upload_records(layout);
+      if (!mark(layout, frame, buffers, stages, run, timer, keys, entries)) return false;
+      stats.level_bias = bias;
+      if (keys.size() <= capacity || bias >= kMaxShadowLevelBias) break;
+    }
+  }
+  std::vector<ShadowPagePool::Grant> grants;
+  pool_.grant(keys, grants);
+
+  // Page tables: the granted pages, marked for rendering where new.
+  std::vector<uint32_t> table(layout.table_entries, 0u);
+  std::vector<uint32_t> fresh;
+  std::vector<size_t> light_pages(scene.lights.size(), 0);
+  for (size_t i = 0; i < keys.size(); ++i) {
+    const ShadowPagePool::Grant& g = grants[i];
+    if (g.physical == ShadowPagePool::kNone) {
+      ++stats.pages_missing;
+      continue;
+    }
+    table[entries[i]] = g.physical | MP_PAGE_RESIDENT | (g.render ? MP_PAGE_RENDER : 0u);
+    if (g.render) fresh.push_back(g.physical);
+  }
+  stats.pages_requested = keys.size();
+  stats.pages_rendered = fresh.size();
+
+  // The views of maps with pages to render, and their page masks.
+  std::vector<FrameParams> views;
+  std::vector<uint8_t> masks;
+  for (const ShadowMapInfo& m : layout.maps) {
+    const int n = m.side;
+    size_t any = 0;
+    std::vector<uint8_t> level(size_t(n) * size_t(n), 0);
+    for (int ry = 0; ry < n; ++ry)
+      for (int rx = 0; rx < n; ++rx) {
+        const int sx = (rx + m.origin_x) & (n - 1), sy = (ry + m.origin_y) & (n - 1);
+        const uint32_t e = table[m.table + uint32_t(sy * n + sx)];
+        if (e & MP_PAGE_RESIDENT) ++light_pages[size_t(m.light)];
+        if (e & MP_PAGE_RENDER) level[size_t(ry) * n + rx] = 1, ++any;
+      }
+    if (!any) continue;
+    FrameParams v = m.view;
+    v.page_mask = uint32_t(masks.size());
+    masks.insert(masks.end(), level.begin(), level.end());
+    for (int s = n; s > 1; s >>= 1) {
+      const int h = s / 2;
+      std::vector<uint8_t> up(size_t(h) * size_t(h), 0);
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < h; ++x)
+          up[size_t(y) * h + x] = level[size_t(2 * y) * s + 2 * x] | level[size_t(2 * y) * s + 2 * x + 1] |
+                                  level[size_t(2 * y + 1) * s + 2 * x] | level[size_t(2 * y + 1) * s + 2 * x + 1];
+      masks.insert(masks.end(), up.begin(), up.end());
+      level.swap(up);
+    }
+    views.push_back(v);
+  }
+  stats.views = views.size();
+
+  cl::CommandQueue& q = session_.queue();
+  ensure_pool(pool_.extent());
+  grow(session_, inputs_.pages, pages_capacity_, table.size() * sizeof(cl_uint), "shadow page tables");
+  q.enqueueWriteBuffer(inputs_.pages, CL_FALSE, 0, table.size() * sizeof(cl_uint), table.data());
+  if (!fresh.empty()) {
+    grow(session_, clear_list_, clear_capacity_, fresh.size() * sizeof(cl_uint), "shadow page list");
+    q.enqueueWriteBuffer(clear_list_, CL_FALSE, 0, fresh.size() * sizeof(cl_uint), fresh.data());
+    const cl_uint texels = cl_uint(fresh.size() * MP_PAGE_TEXELS);
+    clear_.setArg(0, clear_list_);
+    clear_.setArg(1, texels);
+    clear_.setArg(2, inputs_.pool);
+    cl::Event e;
+    q.enqueueNDRangeKernel(clear_, cl::NullRange, round_up_range(texels, 256), cl::NDRange(256), nullptr, &e);
+    timer.add(Stage::Shadow, e);
+  }
+  if (!views.empty()) {
+    StageTimer::Redirect to(timer, Stage::Shadow);
+    stages.layout.begin_frame();
+    if (!render_views(views, masks, frame, buffers, stages, run, timer)) return false;
+    stats.micropolygons = stages.layout.micropolygons();
+  }
+  inputs_.enabled = true;
+
+  for (size_t l = 0; l < scene.lights.size(); ++l) {
+    if (layout.shadows[l].kind == MP_SHADOW_NONE) continue;
+    const uint32_t entries_of_light = layout.shadows[l].kind == MP_SHADOW_SUN
+                                          ? layout.shadows[l].levels * uint32_t(MP_MAP_PAGES * MP_MAP_PAGES)
+                                          : 6u * MP_CUBE_FACE_ENTRIES;
+    stats.per_light.push_back({int(l), light_pages[l], light_pages[l] * kPageBytes + entries_of_light * sizeof(cl_uint)});
+  }
+  stats.peak_bytes = size_t(pool_pages_) * kPageBytes + pages_capacity_ + requests_capacity_ + masks_capacity_ +
+                     views_capacity_ + records_capacity_ + levels_capacity_ + clear_capacity_;
+  return true;
+}
+
+}  // namespace mp

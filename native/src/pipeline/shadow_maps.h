@@ -1,0 +1,76 @@
+// Shadow maps on the device (kernels/mp_shadow.h, kernels/shadow.cl). Each
+// frame, before the camera's view:
+//  1. the lights' layout (shadow_layout.h) and records go to the device;
+//  2. a coarse pass over the camera's view (bound & split, dicing and
+//     displacement) marks the pages its vertices need, at the levels their
+//     pixel footprints ask for;
+//  3. the requests come back and get physical pages within the budget
+//     (shadow_page_pool.h); pages kept from earlier frames whose light and
+//     geometry did not change are not rendered again;
+//  4. the lights' views go through bound & split, dicing and displacement
+//     as the camera's do, several views per pass, and their micropolygons
+//     are rasterised into the new pages (depth only).
+// Shading then reads the maps through inputs().
+#pragma once
+
+#include <functional>
+#include <vector>
+
+#include "cl/device_session.h"
+#include "micropoly/renderer.h"
+#include "pipeline/bound_split.h"
+#include "pipeline/frame_params.h"
+#include "pipeline/material_programs.h"
+#include "pipeline/micropolygon_stages.h"
+#include "pipeline/scene_buffers.h"
+#include "pipeline/shadow_layout.h"
+#include "pipeline/shadow_page_pool.h"
+#include "pipeline/stage_timer.h"
+
+namespace mp {
+
+// Runs bound & split over the scene in `frame` (its own view, or `views`),
+// handing the batches of diceable sub-patches to `sink`.
+using BoundSplitRunner =
+    std::function<BoundSplitResult(const FrameParams& frame, const PassViews& views, const DiceSink& sink)>;
+
+// The stages a shadow pass shares with the camera's.
+struct ShadowPassStages {
+  GridLayoutStage& layout;
+  DiceStage& dice;
+  MaterialPrograms& programs;
+  GridBuffers& grids;
+};
+
+class ShadowMaps {
+ public:
+  explicit ShadowMaps(DeviceSession& session);
+  // Makes the frame's shadow maps (none when no light casts shadows);
+  // returns false when the runner was cancelled.
+  bool render(const Scene& scene, const FrameSetup& frame, const SceneBuffers& buffers, const ShadowPassStages& stages,
+              const BoundSplitRunner& run, StageTimer& timer, ShadowStats& stats);
+  const ShadowInputs& inputs() const { return inputs_; }
+
+ private:
+  // Marks the pages the camera's receivers need; returns them, coarser maps
+  // first, with the map each belongs to.
+  bool mark(const ShadowLayout& layout, const FrameSetup& frame, const SceneBuffers& buffers,
+            const ShadowPassStages& stages, const BoundSplitRunner& run, StageTimer& timer,
+            std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries);
+  void upload_records(const ShadowLayout& layout);
+  bool render_views(const std::vector<FrameParams>& views, const std::vector<uint8_t>& masks, const FrameSetup& frame,
+                    const SceneBuffers& buffers, const ShadowPassStages& stages, const BoundSplitRunner& run,
+                    StageTimer& timer);
+  void ensure_pool(uint32_t pages);
+
+  DeviceSession& session_;
+  cl::Kernel mark_, clear_, sample_;
+  ShadowPagePool pool_;
+  ShadowInputs inputs_;
+  cl::Buffer requests_, views_, masks_, clear_list_;
+  size_t requests_capacity_ = 0, pages_capacity_ = 0, views_capacity_ = 0, masks_capacity_ = 0, clear_capacity_ = 0, records_capacity_ = 0,
+         levels_capacity_ = 0;
+  uint32_t pool_pages_ = 0;  // pages the pool buffer holds
+};
+
+}  // namespace mp
