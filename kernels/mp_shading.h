@@ -122,8 +122,9 @@ MP_INLINE float mp_spot_mask(MP_GLOBAL const DeviceLight* lt, float3 p) {
   float3 a = fabs(w.x) < 0.9f ? MP_F3(1.0f, 0.0f, 0.0f) : MP_F3(0.0f, 1.0f, 0.0f);
   float3 u = normalize(cross(w, a)), v = cross(w, u);
   float sum = 0.0f;
-  for (int k = 0; k < taps; ++k) {
-    float2 d = taps > 1 ? mp_disk_tap(k, taps) : MP_F2(0.0f, 0.0f);
+  float2 turn = MP_F2(1.0f, 0.0f);
+  for (int k = 0; k < taps; ++k, turn = mp_golden_step(turn)) {
+    float2 d = taps > 1 ? sqrt(((float)k + 0.5f) / (float)taps) * turn : MP_F2(0.0f, 0.0f);
     float cosangle = dot(normalize(p - (c + r * (d.x * u + d.y * v))), axis);
     float m = cosangle > 0.0f ? MP_POWR(cosangle, lt->cone[2]) : 0.0f;
     sum += m * mp_smoothstep(lt->cone[0], lt->cone[1], cosangle);

@@ -206,93 +206,138 @@ MP_INLINE float mp_shadow_texel_size(const MpShadowMap* m, float d) {
   return m->face < 0 ? 1.0f / m->scale : d / m->scale;
 }
 
-/* View depth where the ray of raster point (x, y) meets the plane through q
- * with normal n (light space); `fallback` where it runs along the plane. */
-MP_INLINE float mp_shadow_plane_depth(const MpShadowMap* m, float x, float y, float3 q, float3 n, float fallback) {
+/* The receiver's tangent plane (through q, normal n, light space) as one
+ * map sees it: the view depth where the ray of raster point (x, y) meets it
+ * is a + b x + c y for a sun's level (orthographic), and its reciprocal is
+ * for a cube face (a plane's points have 1 / depth linear in the
+ * projection). Where the rays run along the plane (or miss it), the depth
+ * is the receiver's own. */
+typedef struct {
+  float a, b, c;
+  int reciprocal;
+} MpReceiverPlane;
+
+MP_INLINE MpReceiverPlane mp_receiver_plane(const MpShadowMap* m, float3 q, float3 n, float qdepth) {
+  MpReceiverPlane p;
+  p.reciprocal = 0;
+  p.a = qdepth;
+  p.b = p.c = 0.0f;
   if (m->face < 0) {
-    if (!(fabs(n.z) > 1e-6f)) return fallback;
-    float lx = x / m->scale - m->off_x, ly = y / m->scale - m->off_y;
-    float z = q.z - (n.x * (lx - q.x) + n.y * (ly - q.y)) / n.z;
-    return m->z_top - z;
+    if (!(fabs(n.z) > 1e-6f)) return p;
+    float k = 1.0f / (n.z * m->scale);
+    p.b = n.x * k;
+    p.c = n.y * k;
+    p.a = m->z_top - q.z - (n.x * (m->off_x + q.x) + n.y * (m->off_y + q.y)) / n.z;
+    return p;
   }
-  float3 dir = mp_cube_face_unview(m->face, MP_F3(x / m->scale - 1.0f, y / m->scale - 1.0f, -1.0f));
-  float nd = dot(n, dir);
-  if (!(fabs(nd) > 1e-6f)) return fallback;
-  float t = dot(n, q) / nd;
-  return t > 0.0f ? t : fallback;
+  float nq = dot(n, q);
+  if (!(fabs(nq) > 1e-12f)) return p;
+  /* the ray direction at (x, y), unview(x / scale - 1, y / scale - 1, -1), is linear in x and y */
+  float d0 = dot(n, mp_cube_face_unview(m->face, MP_F3(-1.0f, -1.0f, -1.0f)));
+  float dx = dot(n, mp_cube_face_unview(m->face, MP_F3(1.0f, 0.0f, 0.0f))) / m->scale;
+  float dy = dot(n, mp_cube_face_unview(m->face, MP_F3(0.0f, 1.0f, 0.0f))) / m->scale;
+  p.reciprocal = 1;
+  p.a = d0 / nq;
+  p.b = dx / nq;
+  p.c = dy / nq;
+  return p;
 }
 
-/* Depth stored at texel (ix, iy) of the map; 0 when its page is not
+MP_INLINE float mp_plane_depth(const MpReceiverPlane* p, float x, float y, float fallback) {
+  float v = p->a + p->b * x + p->c * y;
+  if (!p->reciprocal) return v;
+  return v > 0.0f ? 1.0f / v : fallback;
+}
+
+/* The physical page holding texel (ix, iy) of the map, or -1 when it is not
  * resident. A cube face's filters that reach past its edge read its edge
  * texels (the neighbouring face's first ones see nearly the same); outside
  * a clipmap level's window there is nothing (a coarser level covers it). */
-MP_INLINE int mp_shadow_texel(const MpShadowMaps* in, const MpShadowMap* m, int ix, int iy, float* depth) {
+MP_INLINE long mp_shadow_page(const MpShadowMaps* in, const MpShadowMap* m, int* ix, int* iy) {
   int texels = m->side * MP_PAGE_SIZE;
   if (m->face >= 0) {
-    ix = clamp(ix, 0, texels - 1);
-    iy = clamp(iy, 0, texels - 1);
+    *ix = clamp(*ix, 0, texels - 1);
+    *iy = clamp(*iy, 0, texels - 1);
   }
-  if (ix < 0 || iy < 0 || ix >= texels || iy >= texels) return 0;
-  int sx = ((ix >> 7) + m->origin_x) & (m->side - 1), sy = ((iy >> 7) + m->origin_y) & (m->side - 1);
+  if (*ix < 0 || *iy < 0 || *ix >= texels || *iy >= texels) return -1;
+  int sx = ((*ix >> 7) + m->origin_x) & (m->side - 1), sy = ((*iy >> 7) + m->origin_y) & (m->side - 1);
   uint e = in->pages[m->table + (uint)(sy * m->side + sx)];
-  if (!(e & MP_PAGE_RESIDENT)) return 0;
-  uint bits = in->pool[(ulong)MP_PAGE_PHYSICAL(e) * MP_PAGE_TEXELS + (ulong)((iy & 127) * MP_PAGE_SIZE + (ix & 127))];
-  *depth = as_float(bits);
+  return (e & MP_PAGE_RESIDENT) ? (long)MP_PAGE_PHYSICAL(e) : -1;
+}
+
+/* Depth stored at texel (ix, iy) of the map; 0 when its page is not resident. */
+MP_INLINE int mp_shadow_texel(const MpShadowMaps* in, const MpShadowMap* m, int ix, int iy, float* depth) {
+  long page = mp_shadow_page(in, m, &ix, &iy);
+  if (page < 0) return 0;
+  *depth = as_float(in->pool[(ulong)page * MP_PAGE_TEXELS + (ulong)((iy & 127) * MP_PAGE_SIZE + (ix & 127))]);
+  return 1;
+}
+
+/* The 2 x 2 texels around raster point (x, y): their depths, their centres'
+ * receiver-plane depths and their bilinear weights; 0 when a page is not
+ * resident. */
+MP_INLINE int mp_shadow_quad(const MpShadowMaps* in, const MpShadowMap* m, const MpReceiverPlane* plane, float x,
+                             float y, float fallback, float* d, float* r, float* w) {
+  float fx = x - 0.5f, fy = y - 0.5f;
+  float bx = floor(fx), by = floor(fy);
+  int ix = (int)bx, iy = (int)by;
+  float wx = fx - bx, wy = fy - by;
+  /* One page lookup when the four texels share a page (most do). */
+  int jx = ix, jy = iy;
+  long page = -1;
+  int same = ix >= 0 && iy >= 0 && (ix & 127) != 127 && (iy & 127) != 127;
+  if (same) {
+    page = mp_shadow_page(in, m, &jx, &jy);
+    same = jx == ix && jy == iy;
+  }
+  for (int k = 0; k < 4; ++k) {
+    int tx = ix + (k & 1), ty = iy + (k >> 1);
+    if (same) {
+      if (page < 0) return 0;
+      d[k] = as_float(in->pool[(ulong)page * MP_PAGE_TEXELS + (ulong)((ty & 127) * MP_PAGE_SIZE + (tx & 127))]);
+    } else if (!mp_shadow_texel(in, m, tx, ty, &d[k])) {
+      return 0;
+    }
+    r[k] = mp_plane_depth(plane, (float)tx + 0.5f, (float)ty + 0.5f, fallback);
+    w[k] = ((k & 1) ? wx : 1.0f - wx) * ((k >> 1) ? wy : 1.0f - wy);
+  }
   return 1;
 }
 
 /* Fraction of the bilinear footprint around raster point (x, y) that sees
- * the light from the receiver plane (q, n); *missing when a texel's page is
- * not resident. Each texel is compared with the plane's depth on its own ray,
+ * the light from the receiver plane; *missing when a texel's page is not
+ * resident. Each texel is compared with the plane's depth on its own ray,
  * less `bias` (scene units). */
-MP_INLINE float mp_shadow_bilinear(const MpShadowMaps* in, const MpShadowMap* m, float x, float y, float3 q, float3 n,
-                                   float qdepth, float bias, int* missing) {
-  float fx = x - 0.5f, fy = y - 0.5f;
-  float bx = floor(fx), by = floor(fy);
-  int ix = (int)bx, iy = (int)by;
-  float wx = fx - bx, wy = fy - by;
-  float lit = 0.0f;
-  for (int k = 0; k < 4; ++k) {
-    int dx = k & 1, dy = k >> 1;
-    float w = (dx ? wx : 1.0f - wx) * (dy ? wy : 1.0f - wy);
-    float d;
-    if (!mp_shadow_texel(in, m, ix + dx, iy + dy, &d)) {
-      *missing = 1;
-      return 1.0f;
-    }
-    float r = mp_shadow_plane_depth(m, (float)(ix + dx) + 0.5f, (float)(iy + dy) + 0.5f, q, n, qdepth);
-    if (r - bias <= d) lit += w;
+MP_INLINE float mp_shadow_bilinear(const MpShadowMaps* in, const MpShadowMap* m, const MpReceiverPlane* plane, float x,
+                                   float y, float fallback, float bias, int* missing) {
+  float d[4], r[4], w[4];
+  if (!mp_shadow_quad(in, m, plane, x, y, fallback, d, r, w)) {
+    *missing = 1;
+    return 1.0f;
   }
+  float lit = 0.0f;
+  for (int k = 0; k < 4; ++k)
+    if (r[k] - bias <= d[k]) lit += w[k];
   return lit;
 }
 
-/* Occluders around raster point (x, y), bilinearly: each of the four
- * texels whose depth lies in front of the receiver plane by more than
- * `bias`, with an occluder-to-receiver ratio (mp_kernel_point: the depth
- * difference for suns, over the occluder's depth for local lights) of at
- * least min_ratio, adds its weight to *weight and weight x ratio to *sum. */
-MP_INLINE void mp_shadow_blockers(const MpShadowMaps* in, const MpShadowMap* m, float x, float y, float3 q, float3 n,
-                                  float qdepth, float bias, int sun, float min_ratio, float* weight, float* sum,
-                                  int* missing) {
-  float fx = x - 0.5f, fy = y - 0.5f;
-  float bx = floor(fx), by = floor(fy);
-  int ix = (int)bx, iy = (int)by;
-  float wx = fx - bx, wy = fy - by;
-  for (int k = 0; k < 4; ++k) {
-    int dx = k & 1, dy = k >> 1;
-    float d;
-    if (!mp_shadow_texel(in, m, ix + dx, iy + dy, &d)) {
-      *missing = 1;
-      return;
-    }
-    float r = mp_shadow_plane_depth(m, (float)(ix + dx) + 0.5f, (float)(iy + dy) + 0.5f, q, n, qdepth);
-    if (!(r - bias > d)) continue;
-    float ratio = sun ? r - d : (r - d) / fmax(d, 1e-20f);
-    if (ratio < min_ratio) continue;
-    float w = (dx ? wx : 1.0f - wx) * (dy ? wy : 1.0f - wy);
-    *weight += w;
-    *sum += w * ratio;
+/* The texel nearest raster point (x, y): whether it holds an occluder in
+ * front of the receiver plane by more than `bias` whose occluder-to-receiver
+ * ratio (mp_kernel_point: the depth difference for suns, over the occluder's
+ * depth for local lights) is at least min_ratio; the ratio in *ratio. */
+MP_INLINE int mp_shadow_blocker(const MpShadowMaps* in, const MpShadowMap* m, const MpReceiverPlane* plane, float x,
+                                float y, float fallback, float bias, int sun, float min_ratio, float* ratio,
+                                int* missing) {
+  int ix = (int)floor(x), iy = (int)floor(y);
+  float d;
+  if (!mp_shadow_texel(in, m, ix, iy, &d)) {
+    *missing = 1;
+    return 0;
   }
+  float r = mp_plane_depth(plane, (float)ix + 0.5f, (float)iy + 0.5f, fallback);
+  if (!(r - bias > d)) return 0;
+  *ratio = sun ? r - d : (r - d) / fmax(d, 1e-20f);
+  return *ratio >= min_ratio;
 }
 
 /* Depth bias in texels of the map at the receiver. The receiver plane takes
@@ -317,47 +362,63 @@ MP_INLINE void mp_shadow_blockers(const MpShadowMaps* in, const MpShadowMap* m, 
 #define MP_SHADOW_SEARCH_TEXELS 8.0f
 #define MP_SHADOW_FILTER_TEXELS 4.0f
 
-/* Tap k of n over the unit disk (Vogel's spiral: even density, no two taps
- * on one ray). */
-MP_INLINE float2 mp_disk_tap(int k, int n) {
-  float r = sqrt(((float)k + 0.5f) / (float)n);
-  float a = 2.39996323f * (float)k;
-  return MP_F2(r * cos(a), r * sin(a));
+/* Taps over the unit disk follow Vogel's spiral (even density, no two taps
+ * on one ray): tap k at radius sqrt((k + 1/2) / n), turned by k golden
+ * angles. Loops step the turn by a fixed rotation (no sine or cosine per
+ * tap). */
+#define MP_GOLDEN_COS -0.73736887f
+#define MP_GOLDEN_SIN 0.67549029f
+MP_INLINE float2 mp_golden_step(float2 turn) {
+  return MP_F2(turn.x * MP_GOLDEN_COS - turn.y * MP_GOLDEN_SIN, turn.x * MP_GOLDEN_SIN + turn.y * MP_GOLDEN_COS);
 }
 
-/* A point of the light's shape, as an offset from its centre in light
- * space (local lights) or in the light's xy plane (the sun, as tangents of
- * the angle): d in the unit disk (or square, for rectangles) scaled to a
- * disk facing the receiver direction `toward` for point and spot lights, to
- * a rectangle or ellipse in the light's plane for area lights. */
-MP_INLINE float3 mp_light_shape_point(const MP_GLOBAL DeviceShadow* sh, float2 d, float3 toward) {
-  if (sh->shape == MP_SHADOW_SHAPE_RECTANGLE || sh->shape == MP_SHADOW_SHAPE_ELLIPSE)
-    return MP_F3(d.x * sh->size[0], d.y * sh->size[1], 0.0f);
-  if (sh->kind == MP_SHADOW_SUN) return MP_F3(d.x * sh->size[0], d.y * sh->size[0], 0.0f);
-  float3 w = normalize(toward);
-  float3 a = fabs(w.x) < 0.9f ? MP_F3(1.0f, 0.0f, 0.0f) : MP_F3(0.0f, 1.0f, 0.0f);
-  float3 u = normalize(cross(w, a)), v = cross(w, u);
-  return sh->size[0] * (d.x * u + d.y * v);
-}
+/* The light's shape as two offset vectors from its centre: a point d of the
+ * unit disk (or square, for rectangles) lies at d.x u + d.y v, in light space
+ * (local lights) or in the light's xy plane as tangents of the angle (suns).
+ * Point and spot lights are disks facing the receiver's direction `toward`;
+ * area lights lie in the light's plane. */
+typedef struct {
+  float3 u, v;
+  int grid; /* a rectangle: filter taps on a 4 x 4 grid */
+} MpLightShape;
 
-/* Filter tap k of n over the light's shape (mp_light_shape_point): even
- * density over a disk (Vogel's spiral) or a 4 x 4 grid over a rectangle. */
-MP_INLINE float3 mp_light_shape_tap(const MP_GLOBAL DeviceShadow* sh, int k, int n, float3 toward) {
-  if (sh->shape == MP_SHADOW_SHAPE_RECTANGLE) {
-    int side = 4, i = k % side, j = (k / side) % side;
-    return mp_light_shape_point(sh, MP_F2(((float)i + 0.5f) / (float)side * 2.0f - 1.0f,
-                                          ((float)j + 0.5f) / (float)side * 2.0f - 1.0f), toward);
+MP_INLINE MpLightShape mp_light_shape(const MP_GLOBAL DeviceShadow* sh, float3 toward) {
+  MpLightShape s;
+  s.grid = sh->shape == MP_SHADOW_SHAPE_RECTANGLE;
+  if (sh->shape == MP_SHADOW_SHAPE_RECTANGLE || sh->shape == MP_SHADOW_SHAPE_ELLIPSE) {
+    s.u = MP_F3(sh->size[0], 0.0f, 0.0f);
+    s.v = MP_F3(0.0f, sh->size[1], 0.0f);
+  } else if (sh->kind == MP_SHADOW_SUN) {
+    s.u = MP_F3(sh->size[0], 0.0f, 0.0f);
+    s.v = MP_F3(0.0f, sh->size[0], 0.0f);
+  } else {
+    float3 w = normalize(toward);
+    float3 a = fabs(w.x) < 0.9f ? MP_F3(1.0f, 0.0f, 0.0f) : MP_F3(0.0f, 1.0f, 0.0f);
+    float3 u = normalize(cross(w, a));
+    s.u = sh->size[0] * u;
+    s.v = sh->size[0] * cross(w, u);
   }
-  return mp_light_shape_point(sh, mp_disk_tap(k, n), toward);
+  return s;
 }
 
-/* Blocker search tap k of n: from the shape's centre (k = 0) out to its
- * edge at even steps of radius, so that the small regions where occluders
- * near the receiver can stand get taps too; *reach is the radius (0..1). */
-MP_INLINE float3 mp_search_tap(const MP_GLOBAL DeviceShadow* sh, int k, int n, float3 toward, float* reach) {
-  float r = (float)k / (float)(n - 1), a = 2.39996323f * (float)k;
+/* Filter tap k of n: even density over the shape (the spiral, or a 4 x 4
+ * grid over a rectangle); `turn` is the spiral's rotation for tap k. */
+MP_INLINE float3 mp_filter_tap(const MpLightShape* s, int k, int n, float2 turn) {
+  if (s->grid) {
+    float x = ((float)(k & 3) + 0.5f) * 0.5f - 1.0f, y = ((float)((k >> 2) & 3) + 0.5f) * 0.5f - 1.0f;
+    return x * s->u + y * s->v;
+  }
+  float r = sqrt(((float)k + 0.5f) / (float)n);
+  return (r * turn.x) * s->u + (r * turn.y) * s->v;
+}
+
+/* Blocker search tap k of n: from the shape's centre (k = 0) out to its edge
+ * at even steps of radius, so that the small regions where occluders near
+ * the receiver can stand get taps too; *reach is the radius (0..1). */
+MP_INLINE float3 mp_search_tap(const MpLightShape* s, int k, int n, float2 turn, float* reach) {
+  float r = (float)k / (float)(n - 1);
   *reach = r;
-  return mp_light_shape_point(sh, MP_F2(r * cos(a), r * sin(a)), toward);
+  return (r * turn.x) * s->u + (r * turn.y) * s->v;
 }
 
 /* Radius of the light's shape (the search and filter kernels' extent). */
@@ -393,18 +454,6 @@ MP_INLINE int mp_shadow_level_for_size(const MP_GLOBAL DeviceShadow* sh, float3 
   return clamp(max(l, finest), 0, count - 1);
 }
 
-/* Where the light grazes a receiver (normal n, light space), a texel
- * stretches across 1 / |cos| of it along the light: the footprint a map
- * must resolve shrinks by |cos|, down to a half (one level finer) so
- * that grazing surfaces do not ask for unbounded detail. */
-#define MP_SHADOW_MIN_GRAZING 1.0f
-MP_INLINE float mp_shadow_grazing(const MP_GLOBAL DeviceShadow* sh, float3 q, float3 n) {
-  float ln = length(n);
-  if (!(ln > 0.0f)) return 1.0f;
-  float c = sh->kind == MP_SHADOW_SUN ? n.z / ln : dot(n, q) / (ln * fmax(length(q), 1e-30f));
-  return clamp(fabs(c), MP_SHADOW_MIN_GRAZING, 1.0f);
-}
-
 /* The bias of a receiver at q with normal n (light space), in texels. */
 MP_INLINE float mp_shadow_bias_texels(const MP_GLOBAL DeviceShadow* sh, float3 q, float3 n) {
   float ln = length(n);
@@ -431,6 +480,15 @@ MP_INLINE int mp_shadow_base_level(const MP_GLOBAL DeviceShadow* sh, float3 q, f
  * sun its angle's tangent by the occluder's height above the receiver. */
 MP_INLINE float3 mp_kernel_point(float3 q, float3 offset, float scale) { return q + offset * scale; }
 
+/* The receiver plane of map m, kept while taps stay on one map (a map is
+ * known by its page table's start). */
+MP_INLINE void mp_plane_for(const MpShadowMap* m, float3 q, float3 n, float qdepth, uint* map, MpReceiverPlane* plane) {
+  if (*map != m->table) {
+    *plane = mp_receiver_plane(m, q, n, qdepth);
+    *map = m->table;
+  }
+}
+
 /* Visibility of the light from a receiver at light-space q with geometric
  * normal n, footprint in scene units: 1 lit, 0 in shadow. */
 MP_INLINE float mp_shadow_visibility_light(const MpShadowMaps* in, const MP_GLOBAL DeviceShadow* sh, float3 q, float3 n,
@@ -444,13 +502,14 @@ MP_INLINE float mp_shadow_visibility_light(const MpShadowMaps* in, const MP_GLOB
     for (int l = base; l < count; ++l) {
       MpShadowMap m = mp_shadow_map_at(in, sh, q, l);
       float3 r = mp_shadow_project(&m, q);
+      MpReceiverPlane plane = mp_receiver_plane(&m, q, n, r.z);
       int missing = 0;
-      float lit = mp_shadow_bilinear(in, &m, r.x, r.y, q, n, r.z, bias * mp_shadow_texel_size(&m, r.z),
-                                     &missing);
+      float lit = mp_shadow_bilinear(in, &m, &plane, r.x, r.y, r.z, bias * mp_shadow_texel_size(&m, r.z), &missing);
       if (!missing) return lit;
     }
     return 1.0f;
   }
+  MpLightShape shape = mp_light_shape(sh, q);
   /* Blocker search: occluders between the receiver and (local lights) a
    * fraction of the way to the light, or (sun) the top of the scene. A tap
    * at the shape's offset O scaled by s finds an occluder whose own scale
@@ -461,19 +520,26 @@ MP_INLINE float mp_shadow_visibility_light(const MpShadowMaps* in, const MP_GLOB
   float search_scale = sun ? fmax(sh->z_top - q.z, 0.0f) : MP_SHADOW_SEARCH_SCALE;
   float search_radius = radius * search_scale;
   int ls = mp_shadow_level_for_size(sh, q, search_radius, MP_SHADOW_SEARCH_TEXELS, base);
-  float3 toward = q;
+  uint plane_key = 0xffffffffu;
+  MpReceiverPlane plane;
   float found = 0.0f, sum = 0.0f;
   for (; ls < count; ++ls) {
     int missing = 0;
     found = sum = 0.0f;
-    for (int k = 0; k < MP_SHADOW_TAPS && !missing; ++k) {
+    float2 turn = MP_F2(1.0f, 0.0f);
+    for (int k = 0; k < MP_SHADOW_TAPS && !missing; ++k, turn = mp_golden_step(turn)) {
       float reach;
-      float3 o = mp_search_tap(sh, k, MP_SHADOW_TAPS, toward, &reach);
+      float3 o = mp_search_tap(&shape, k, MP_SHADOW_TAPS, turn, &reach);
       float3 x = mp_kernel_point(q, o, search_scale);
       MpShadowMap m = mp_shadow_map_at(in, sh, x, ls);
       float3 r = mp_shadow_project(&m, x);
+      mp_plane_for(&m, q, n, r.z, &plane_key, &plane);
       float b = bias * mp_shadow_texel_size(&m, r.z) + MP_SHADOW_SOFT_BIAS * length(o) * search_scale;
-      mp_shadow_blockers(in, &m, r.x, r.y, q, n, r.z, b, sun, search_scale * reach, &found, &sum, &missing);
+      float ratio;
+      if (mp_shadow_blocker(in, &m, &plane, r.x, r.y, r.z, b, sun, search_scale * reach, &ratio, &missing)) {
+        found += 1.0f;
+        sum += ratio;
+      }
     }
     if (!missing) break;
   }
@@ -502,13 +568,15 @@ MP_INLINE float mp_shadow_visibility_light(const MpShadowMaps* in, const MP_GLOB
     for (int lp = l0 + pass; lp < count; ++lp) {
       int missing = 0;
       float lit = 0.0f;
-      for (int k = 0; k < MP_SHADOW_TAPS && !missing; ++k) {
-        float3 o = mp_light_shape_tap(sh, k, MP_SHADOW_TAPS, toward);
+      float2 turn = MP_F2(1.0f, 0.0f);
+      for (int k = 0; k < MP_SHADOW_TAPS && !missing; ++k, turn = mp_golden_step(turn)) {
+        float3 o = mp_filter_tap(&shape, k, MP_SHADOW_TAPS, turn);
         float3 x = mp_kernel_point(q, o, scale);
         MpShadowMap m = mp_shadow_map_at(in, sh, x, lp);
         float3 r = mp_shadow_project(&m, x);
+        mp_plane_for(&m, q, n, r.z, &plane_key, &plane);
         float b = bias * mp_shadow_texel_size(&m, r.z) + MP_SHADOW_SOFT_BIAS * length(o) * scale;
-        lit += mp_shadow_bilinear(in, &m, r.x, r.y, q, n, r.z, b, &missing);
+        lit += mp_shadow_bilinear(in, &m, &plane, r.x, r.y, r.z, b, &missing);
       }
       if (!missing) {
         result += w * lit / (float)MP_SHADOW_TAPS;
@@ -524,9 +592,7 @@ MP_INLINE float mp_shadow_visibility_light(const MpShadowMaps* in, const MP_GLOB
 MP_INLINE float mp_shadow_visibility(const MpShadowMaps* in, uint light, float3 p, float3 n, float footprint) {
   const MP_GLOBAL DeviceShadow* sh = in->shadows + light;
   if (sh->kind == MP_SHADOW_NONE) return 1.0f;
-  float3 q = mp_xform_point(sh->to_light, p);
-  float3 nq = mp_xform_dir(sh->to_light, n);
-  return mp_shadow_visibility_light(in, sh, q, nq, footprint * mp_shadow_grazing(sh, q, nq));
+  return mp_shadow_visibility_light(in, sh, mp_xform_point(sh->to_light, p), mp_xform_dir(sh->to_light, n), footprint);
 }
 
 #endif

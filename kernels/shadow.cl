@@ -14,9 +14,12 @@
 #include "mp_bound.h"
 #include "mp_shadow.h"
 
-/* Texels of margin around a receiver's box when marking: the filters read
- * up to MP_SHADOW_SEARCH_TEXELS from a receiver, plus a bilinear texel. */
-#define MP_MARK_MARGIN (MP_SHADOW_SEARCH_TEXELS + 2.0f)
+/* Texels of margin around a receiver's box when marking: soft shadows'
+ * filters read up to MP_SHADOW_SEARCH_TEXELS from a receiver, hard shadows'
+ * the bilinear texels around it; a texel more for rounding. */
+MP_INLINE float mp_mark_margin(const MP_GLOBAL DeviceShadow* sh) {
+  return sh->shape == MP_SHADOW_SHAPE_POINT ? 2.0f : MP_SHADOW_SEARCH_TEXELS + 2.0f;
+}
 
 inline void mp_mark_rect(__global uchar* requests, uint table, int side, int origin_x, int origin_y, float x0, float y0,
                          float x1, float y1) {
@@ -43,12 +46,13 @@ inline void mp_mark_sun(__global const DeviceShadow* sh, __global const DeviceSh
   }
   int count = (int)sh->levels;
   int i0 = clamp(l0 - sh->level0, 0, count - 1), i1 = clamp(l1 - sh->level0, 0, count - 1);
+  float margin = mp_mark_margin(sh);
   for (int i = i0; i <= i1; ++i) {
     __global const DeviceShadowLevel* lv = levels + sh->level_records + (uint)i;
     float k = 1.0f / lv->texel;
     mp_mark_rect(requests, lv->page_table, MP_MAP_PAGES, lv->origin_x, lv->origin_y,
-                 (lo.x + lv->offset[0]) * k - MP_MARK_MARGIN, (lo.y + lv->offset[1]) * k - MP_MARK_MARGIN,
-                 (hi.x + lv->offset[0]) * k + MP_MARK_MARGIN, (hi.y + lv->offset[1]) * k + MP_MARK_MARGIN);
+                 (lo.x + lv->offset[0]) * k - margin, (lo.y + lv->offset[1]) * k - margin,
+                 (hi.x + lv->offset[0]) * k + margin, (hi.y + lv->offset[1]) * k + margin);
   }
 }
 
@@ -68,7 +72,7 @@ inline void mp_mark_cube(__global const DeviceShadow* sh, float3 lo, float3 hi, 
   for (int m = m0; m <= m1; ++m) {
     float texels = (float)mp_cube_mip_texels(m);
     /* The margin as scene units at the box's far side. */
-    float margin = MP_MARK_MARGIN * rmax * 2.0f / texels;
+    float margin = mp_mark_margin(sh) * rmax * 2.0f / texels;
     float3 e = MP_F3(margin, margin, margin);
     for (int face = 0; face < 6; ++face) {
       float x0, y0, x1, y1;
@@ -82,19 +86,19 @@ inline void mp_mark_cube(__global const DeviceShadow* sh, float3 lo, float3 hi, 
 /* Marks, for every light with shadow maps, the pages the receivers of a
  * coarse camera pass need (one work-item per grid vertex, displaced): at
  * the level (mip) whose texels are no larger than the vertex's pixel
- * footprint, narrowed where the light grazes the surface (mp_shadow.h),
- * under a box around the vertex reaching its neighbours (`reach` pixels).
- * Soft shadows also mark the coarser levels their filters read. */
+ * footprint (mp_shadow.h), under a box around the vertex reaching its
+ * neighbours (`reach` pixels). Soft shadows also mark the coarser levels
+ * their filters read. */
 __kernel void mark_shadow_pages(__global const SubPatch* diceable, uint count, __global const uint* vertex_offsets,
-                                FrameParams f, __global const float4* grid_p, __global const float4* grid_n,
-                                __global const DeviceShadow* shadows, __global const DeviceShadowLevel* levels,
-                                uint light_count, __global uchar* requests, float reach) {
+                                FrameParams f, __global const float4* grid_p, __global const DeviceShadow* shadows,
+                                __global const DeviceShadowLevel* levels, uint light_count,
+                                __global uchar* requests, float reach) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   float2 uv;
   ulong index;
   if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
-  float3 p = grid_p[index].xyz, n = grid_n[index].xyz;
+  float3 p = grid_p[index].xyz;
   float d = -p.z;
   if (!f.ortho && !(d > 0.0f)) return;
   float s = mp_pixel_footprint(d, f);
@@ -103,10 +107,9 @@ __kernel void mark_shadow_pages(__global const SubPatch* diceable, uint count, _
     __global const DeviceShadow* sh = shadows + l;
     if (sh->kind == MP_SHADOW_NONE) continue;
     float3 q = mp_xform_point(sh->to_light, p);
-    float fp = s * mp_shadow_grazing(sh, q, mp_xform_dir(sh->to_light, n));
     float3 lo = q - MP_F3(r, r, r), hi = q + MP_F3(r, r, r);
     if (sh->kind == MP_SHADOW_SUN) {
-      mp_mark_sun(sh, levels, lo, hi, fp, fp, requests);
+      mp_mark_sun(sh, levels, lo, hi, s, s, requests);
       continue;
     }
     /* Receivers the light cannot reach need no pages: behind an area
@@ -121,7 +124,7 @@ __kernel void mark_shadow_pages(__global const SubPatch* diceable, uint count, _
         if (cos_axis < cos_spread && cos_axis * cos_spread + sin_axis * sin_spread < sh->cone_cos) continue;
       }
     }
-    mp_mark_cube(sh, lo, hi, fp, fp, requests);
+    mp_mark_cube(sh, lo, hi, s, s, requests);
   }
 }
 
@@ -196,11 +199,21 @@ void shadow_sample(__global const SubPatch* diceable, uint first, uint count, __
     mp_id = mp_hash_combine(mp_id, m);
   }
   int side = v.page_side;
+  /* Most micropolygons lie within one page: one table lookup for all. */
+  int one_page = (px0 >> 7) == (px1 >> 7) && (py0 >> 7) == (py1 >> 7);
+  uint e = 0u;
+  if (one_page) {
+    int sx = ((px0 >> 7) + v.page_origin_x) & (side - 1), sy = ((py0 >> 7) + v.page_origin_y) & (side - 1);
+    e = page_table[v.page_table + (uint)(sy * side + sx)];
+    if (!(e & MP_PAGE_RENDER)) return;
+  }
   for (int py = py0; py <= py1; ++py)
     for (int px = px0; px <= px1; ++px) {
-      int sx = ((px >> 7) + v.page_origin_x) & (side - 1), sy = ((py >> 7) + v.page_origin_y) & (side - 1);
-      uint e = page_table[v.page_table + (uint)(sy * side + sx)];
-      if (!(e & MP_PAGE_RENDER)) continue;
+      if (!one_page) {
+        int sx = ((px >> 7) + v.page_origin_x) & (side - 1), sy = ((py >> 7) + v.page_origin_y) & (side - 1);
+        e = page_table[v.page_table + (uint)(sy * side + sx)];
+        if (!(e & MP_PAGE_RENDER)) continue;
+      }
       MpFixed2 s;
       s.x = (long)px * MP_SUBPIXEL_ONE + centre;
       s.y = (long)py * MP_SUBPIXEL_ONE + centre;

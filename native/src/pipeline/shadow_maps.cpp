@@ -61,18 +61,17 @@ bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, const
   DiceSink sink = [&](const cl::Buffer& diceable, cl_uint count) {
     stages.layout.run(diceable, count, coarse, grids, timer);
     stages.dice.run(diceable, count, buffers, coarse, grids, timer);
-    stages.programs.displace(diceable, count, buffers, coarse, grids, timer);
+    stages.programs.displace(diceable, count, buffers, coarse, grids, timer, false);
     mark_.setArg(0, diceable);
     mark_.setArg(1, count);
     mark_.setArg(2, grids.vertex_offsets);
     mark_.setArg(3, coarse);
     mark_.setArg(4, grids.p);
-    mark_.setArg(5, grids.n);
-    mark_.setArg(6, inputs_.shadows);
-    mark_.setArg(7, inputs_.levels);
-    mark_.setArg(8, light_count);
-    mark_.setArg(9, requests_);
-    mark_.setArg(10, reach);
+    mark_.setArg(5, inputs_.shadows);
+    mark_.setArg(6, inputs_.levels);
+    mark_.setArg(7, light_count);
+    mark_.setArg(8, requests_);
+    mark_.setArg(9, reach);
     cl::Event e;
     q.enqueueNDRangeKernel(mark_, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64), nullptr, &e);
     timer.add(Stage::ShadowMark, e);
@@ -280,6 +279,7 @@ bool ShadowMaps::render(const Scene& scene, const FrameSetup& frame, const Scene
     if (!render_views(views, masks, frame, buffers, stages, run, timer)) return false;
     stats.micropolygons = stages.layout.micropolygons();
   }
+
   inputs_.enabled = true;
 
   for (size_t l = 0; l < scene.lights.size(); ++l) {

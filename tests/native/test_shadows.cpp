@@ -1,0 +1,521 @@
+// Shadows (kernels/mp_shadow.h): the host-side bookkeeping and map math,
+// and renders measured against geometry: an orthographic camera looks
+// straight down at a floor under an occluder it does not see (visible_camera
+// false), so the floor shows the whole shadow, whose size, place and
+// penumbra follow from similar triangles.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <unordered_set>
+
+#include "micropoly/error.h"
+#include "micropoly/renderer.h"
+#include "micropoly/settings_util.h"
+#include "mp_shadow.h"
+#include "pipeline/shadow_page_pool.h"
+#include "renderer_fixture.h"
+#include "scene_fixtures.h"
+
+namespace mp::test {
+namespace {
+
+// ---- page pool ----------------------------------------------------------------
+
+ShadowPageKey key(uint64_t light, int x, int y = 0, int map = 0) { return ShadowPageKey{light, map, x, y}; }
+
+TEST(ShadowPagePool, KeepsResidentPagesAndRendersOnlyNewOnes) {
+  ShadowPagePool pool(8);
+  std::vector<ShadowPagePool::Grant> g;
+  EXPECT_EQ(pool.grant({key(1, 0), key(1, 1), key(1, 2)}, g), 3u);
+  for (const auto& x : g) EXPECT_TRUE(x.render);
+  std::unordered_set<uint32_t> physical;
+  for (const auto& x : g) physical.insert(x.physical);
+  EXPECT_EQ(physical.size(), 3u);
+  const uint32_t kept = g[1].physical;
+  // The next frame asks for page 1 again and a new page 3: 1 keeps its page.
+  EXPECT_EQ(pool.grant({key(1, 1), key(1, 3)}, g), 2u);
+  EXPECT_FALSE(g[0].render);
+  EXPECT_EQ(g[0].physical, kept);
+  EXPECT_TRUE(g[1].render);
+  EXPECT_EQ(pool.resident(), 4u);  // pages 0 and 2 stay cached until space is needed
+}
+
+TEST(ShadowPagePool, EvictsLeastRecentlyUsedAndNeverExceedsCapacity) {
+  ShadowPagePool pool(3);
+  std::vector<ShadowPagePool::Grant> g;
+  pool.grant({key(1, 0)}, g);
+  pool.grant({key(1, 1)}, g);
+  pool.grant({key(1, 2)}, g);
+  const uint32_t oldest = g.empty() ? 0 : 0;
+  (void)oldest;
+  // A fourth page evicts page 0 (least recently used), not 2.
+  ASSERT_EQ(pool.grant({key(1, 3)}, g), 1u);
+  EXPECT_TRUE(g[0].render);
+  EXPECT_EQ(pool.resident(), 3u);
+  EXPECT_LE(pool.extent(), 3u);
+  std::vector<ShadowPagePool::Grant> again;
+  pool.grant({key(1, 2)}, again);
+  EXPECT_FALSE(again[0].render) << "page 2 was evicted instead of page 0";
+  // More requests than the capacity: the first ones get pages, the rest none.
+  ASSERT_EQ(pool.grant({key(2, 0), key(2, 1), key(2, 2), key(2, 3), key(2, 4)}, g), 3u);
+  EXPECT_NE(g[0].physical, ShadowPagePool::kNone);
+  EXPECT_NE(g[2].physical, ShadowPagePool::kNone);
+  EXPECT_EQ(g[3].physical, ShadowPagePool::kNone);
+  EXPECT_EQ(g[4].physical, ShadowPagePool::kNone);
+  EXPECT_LE(pool.resident(), 3u);
+}
+
+TEST(ShadowPagePool, ForgetsChangedLights) {
+  ShadowPagePool pool(8);
+  std::vector<ShadowPagePool::Grant> g;
+  pool.grant({key(1, 0), key(2, 0), key(2, 1)}, g);
+  pool.keep_only({2});
+  EXPECT_EQ(pool.resident(), 2u);
+  pool.grant({key(1, 0)}, g);
+  EXPECT_TRUE(g[0].render) << "a changed light's page came back from the cache";
+}
+
+// ---- map math -----------------------------------------------------------------
+
+TEST(ShadowMath, CubeFacesAreRotationsThatCoverEveryDirection) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (int face = 0; face < 6; ++face) {
+    glm::vec3 x = mp_cube_face_view(face, {1, 0, 0}), y = mp_cube_face_view(face, {0, 1, 0}),
+              z = mp_cube_face_view(face, {0, 0, 1});
+    EXPECT_NEAR(glm::determinant(glm::mat3(x, y, z)), 1.0f, 1e-6f) << "face " << face;
+  }
+  for (int i = 0; i < 1000; ++i) {
+    glm::vec3 q(u(rng), u(rng), u(rng));
+    int face = mp_cube_face(q);
+    glm::vec3 v = mp_cube_face_view(face, q);
+    EXPECT_GT(-v.z, 0.0f);  // in front of its face
+    EXPECT_LE(std::abs(v.x), -v.z * 1.0001f);
+    EXPECT_LE(std::abs(v.y), -v.z * 1.0001f);
+    glm::vec3 back = mp_cube_face_unview(face, v);
+    EXPECT_NEAR(glm::length(back - q), 0.0f, 1e-6f);
+  }
+}
+
+TEST(ShadowMath, FaceBoxHoldsTheProjectionOfEveryPointOfTheBox) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-3.0f, 3.0f), s(0.01f, 2.0f), t(0.0f, 1.0f);
+  const float texels = 1024.0f;
+  int tested = 0;
+  for (int i = 0; i < 300; ++i) {
+    glm::vec3 c(u(rng), u(rng), u(rng)), h(s(rng), s(rng), s(rng));
+    for (int face = 0; face < 6; ++face) {
+      float x0, y0, x1, y1;
+      int hit = mp_cube_face_box(face, c - h, c + h, texels, &x0, &y0, &x1, &y1);
+      for (int k = 0; k < 50; ++k) {
+        glm::vec3 p = c - h + 2.0f * h * glm::vec3(t(rng), t(rng), t(rng));
+        if (mp_cube_face(p) != face) continue;
+        glm::vec3 v = mp_cube_face_view(face, p);
+        float rx = (v.x / -v.z + 1.0f) * 0.5f * texels, ry = (v.y / -v.z + 1.0f) * 0.5f * texels;
+        ASSERT_TRUE(hit) << "a point of the box falls on face " << face << " but the box was not marked there";
+        EXPECT_GE(rx, x0 - 1e-2f);
+        EXPECT_LE(rx, x1 + 1e-2f);
+        EXPECT_GE(ry, y0 - 1e-2f);
+        EXPECT_LE(ry, y1 + 1e-2f);
+        ++tested;
+      }
+    }
+  }
+  EXPECT_GT(tested, 5000);
+}
+
+// The receiver plane's depth at a texel is where that texel's ray meets it.
+TEST(ShadowMath, ReceiverPlaneDepthIsTheRayPlaneIntersection) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  DeviceShadow sh{};
+  sh.page_table = 0;
+  sh.z_top = 5.0f;
+  DeviceShadowLevel lv{};
+  lv.offset[0] = 3.0f, lv.offset[1] = -2.0f, lv.texel = 0.01f;
+  for (int i = 0; i < 500; ++i) {
+    glm::vec3 q(u(rng), u(rng), -2.0f + u(rng));
+    glm::vec3 n = glm::normalize(glm::vec3(u(rng), u(rng), u(rng)));
+    // A sun's level: rays run along -z.
+    MpShadowMap sun = mp_sun_map(&sh, &lv);
+    float x = 300.0f + 50.0f * u(rng), y = -200.0f + 50.0f * u(rng);
+    if (std::abs(n.z) > 0.05f) {
+      MpReceiverPlane p = mp_receiver_plane(&sun, q, n, 0.0f);
+      glm::vec3 o(x / sun.scale - sun.off_x, y / sun.scale - sun.off_y, 0.0f);
+      float z = q.z - (n.x * (o.x - q.x) + n.y * (o.y - q.y)) / n.z;
+      EXPECT_NEAR(mp_plane_depth(&p, x, y, -1.0f), sh.z_top - z, 1e-3f);
+    }
+    // A cube face: rays from the light's position.
+    int face = i % 6;
+    MpShadowMap cube = mp_cube_map(&sh, face, 3);
+    glm::vec3 qq = mp_cube_face_unview(face, glm::vec3(0.3f * u(rng), 0.3f * u(rng), -3.0f));
+    MpReceiverPlane p = mp_receiver_plane(&cube, qq, n, 0.0f);
+    float cx = cube.scale * (1.0f + 0.5f * u(rng)), cy = cube.scale * (1.0f + 0.5f * u(rng));
+    glm::vec3 dir = mp_cube_face_unview(face, glm::vec3(cx / cube.scale - 1.0f, cy / cube.scale - 1.0f, -1.0f));
+    float t = glm::dot(n, qq) / glm::dot(n, dir);
+    if (t > 0.1f && t < 100.0f) EXPECT_NEAR(mp_plane_depth(&p, cx, cy, -1.0f), t, 1e-3f * t);
+  }
+}
+
+TEST(ShadowMath, ExponentLog2AgreesWithTheLibrary) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> e(-30.0f, 30.0f);
+  for (int i = 0; i < 10000; ++i) {
+    float x = std::exp2(e(rng));
+    EXPECT_EQ(mp_floor_log2(x), int(std::floor(std::log2(double(x))))) << x;
+    EXPECT_EQ(mp_ceil_log2(x), int(std::ceil(std::log2(double(x))))) << x;
+  }
+  EXPECT_EQ(mp_floor_log2(1.0f), 0);
+  EXPECT_EQ(mp_ceil_log2(1.0f), 0);
+  EXPECT_EQ(mp_floor_log2(0.75f), -1);
+  EXPECT_EQ(mp_ceil_log2(0.75f), 0);
+}
+
+// ---- renders ------------------------------------------------------------------
+
+class ShadowRenderTest : public SharedRendererTest {};
+
+constexpr int kW = 320, kH = 240;
+constexpr float kHalfW = 4.0f, kHalfH = 3.0f;  // the camera's view of the floor, scene units
+
+// A white floor seen straight from above by an orthographic camera, lit by
+// `light` alone; the occluders are added by the test.
+Scene floor_scene(const Light& light) {
+  Scene s;
+  s.settings.width = kW;
+  s.settings.height = kH;
+  set_samples_per_pixel(s.settings, 16);
+  s.settings.filter = PixelFilter::Box;
+  s.settings.filter_width = 1.0f;
+  s.settings.depth_and_normal_passes = false;
+  s.camera.projection = Camera::Projection::Orthographic;
+  s.camera.world_to_camera = glm::lookAt(glm::vec3(0, 0, 30), glm::vec3(0, 0, 0), glm::vec3(0, 1, 0));
+  s.camera.screen_left = -kHalfW, s.camera.screen_right = kHalfW;
+  s.camera.screen_bottom = -kHalfH, s.camera.screen_top = kHalfH;
+  s.camera.clip_near = 0.1f, s.camera.clip_far = 100.0f;
+  Material m;
+  m.model = Material::Model::Matte;
+  m.color = glm::vec3(1.0f);
+  m.kd = 1.0f;
+  s.materials.push_back(m);
+  s.lights.push_back(light);
+  Mesh floor = polygon({{-20, -20, 0}, {20, -20, 0}, {20, 20, 0}, {-20, 20, 0}});
+  floor.name = "floor";
+  s.meshes.push_back(floor);
+  return s;
+}
+
+// A horizontal rectangle [x0, x1] x [y0, y1] at height z that the camera
+// does not see.
+Mesh occluder(float x0, float y0, float x1, float y1, float z) {
+  Mesh m = polygon({{x0, y0, z}, {x1, y0, z}, {x1, y1, z}, {x0, y1, z}});
+  m.name = "occluder";
+  m.visible_camera = false;
+  return m;
+}
+
+glm::vec2 raster(glm::vec2 world) {
+  return {(world.x + kHalfW) / (2 * kHalfW) * kW, (kHalfH - world.y) / (2 * kHalfH) * kH};
+}
+
+float luminance(const RenderResult& r, int x, int y) {
+  const float* p = &r.rgba[4 * (size_t(y) * kW + x)];
+  return (p[0] + p[1] + p[2]) / 3.0f;
+}
+
+// The fraction of the light each pixel gets: the render over the same
+// render without shadows.
+std::vector<float> visibility(Renderer& renderer, Scene s) {
+  RenderResult lit_r, shadowed_r;
+  s.settings.shadows = false;
+  renderer.render(s, lit_r);
+  s.settings.shadows = true;
+  renderer.render(s, shadowed_r);
+  std::vector<float> v(size_t(kW) * kH);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      float lit = luminance(lit_r, x, y);
+      v[size_t(y) * kW + x] = lit > 1e-6f ? luminance(shadowed_r, x, y) / lit : 1.0f;
+    }
+  return v;
+}
+
+struct ShadowShape {
+  double area_px = 0;  // pixels below half the light
+  glm::dvec2 centroid{0.0};
+};
+
+ShadowShape shadow_shape(const std::vector<float>& v) {
+  ShadowShape s;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x)
+      if (v[size_t(y) * kW + x] < 0.5f) {
+        s.area_px += 1;
+        s.centroid += glm::dvec2(x + 0.5, y + 0.5);
+      }
+  if (s.area_px > 0) s.centroid /= s.area_px;
+  return s;
+}
+
+constexpr double kPx = kW / (2.0 * kHalfW);  // pixels per scene unit
+
+TEST_F(ShadowRenderTest, SunCastsTheOccludersShapeAlongItsDirection) {
+  for (float slant : {0.0f, 0.6f}) {
+    Light sun;
+    sun.type = Light::Type::Distant;
+    sun.intensity = 2.0f;
+    sun.direction = glm::normalize(glm::vec3(slant, 0.0f, -1.0f));
+    Scene s = floor_scene(sun);
+    const float h = 1.5f;
+    s.meshes.push_back(occluder(-1.0f, -0.5f, 0.6f, 0.7f, h));
+    ShadowShape got = shadow_shape(visibility(*renderer_, s));
+    // Straight down: the rectangle itself; slanted: moved by h * slant.
+    const double area = 1.6 * 1.2 * kPx * kPx;
+    glm::vec2 c = raster({-0.2f + h * slant, 0.1f});
+    EXPECT_NEAR(got.area_px / area, 1.0, 0.02) << "slant " << slant;
+    EXPECT_NEAR(got.centroid.x, c.x, 0.5) << "slant " << slant;
+    EXPECT_NEAR(got.centroid.y, c.y, 0.5) << "slant " << slant;
+  }
+}
+
+TEST_F(ShadowRenderTest, PointAndSpotLightsMagnifyTheShadowBySimilarTriangles) {
+  for (Light::Type type : {Light::Type::Point, Light::Type::Spot}) {
+    Light l;
+    l.type = type;
+    l.intensity = 40.0f;
+    l.position = glm::vec3(0.3f, -0.2f, 4.0f);
+    l.direction = glm::vec3(0, 0, -1);
+    l.cone_angle = 1.2f;
+    l.cone_delta_angle = 0.1f;
+    l.beam_distribution = 0.0f;
+    Scene s = floor_scene(l);
+    const float h = 1.6f, k = 4.0f / (4.0f - h);  // shadow / occluder size
+    s.meshes.push_back(occluder(-0.6f, -0.4f, 0.4f, 0.5f, h));
+    ShadowShape got = shadow_shape(visibility(*renderer_, s));
+    const double area = 1.0 * 0.9 * k * k * kPx * kPx;
+    // The shadow's centre: the occluder's centre pushed away from the light.
+    glm::vec2 oc(-0.1f, 0.05f), lp(0.3f, -0.2f);
+    glm::vec2 c = raster(lp + (oc - lp) * k);
+    EXPECT_NEAR(got.area_px / area, 1.0, 0.02) << (type == Light::Type::Point ? "point" : "spot");
+    EXPECT_NEAR(got.centroid.x, c.x, 0.5);
+    EXPECT_NEAR(got.centroid.y, c.y, 0.5);
+  }
+}
+
+// Across the edge of an occluder that covers x < 0, the light a floor point
+// sees grows over a penumbra; the distances between its 10% and 90% points
+// are the references (similar triangles and the light's shape).
+double ramp_width(const std::vector<float>& v, int row) {
+  auto crossing = [&](float level) {
+    for (int x = 1; x < kW; ++x) {
+      float a = v[size_t(row) * kW + x - 1], b = v[size_t(row) * kW + x];
+      if (a < level && b >= level) return x - 0.5 + (level - a) / (b - a);
+    }
+    return -1.0;
+  };
+  double lo = crossing(0.1f), hi = crossing(0.9f);
+  return lo < 0 || hi < 0 ? -1.0 : hi - lo;
+}
+
+// 10%-90% width of the fraction of a unit-diameter disk on one side of a
+// line as the line sweeps across it.
+double disk_ramp_width() {
+  auto fraction = [](double t) {  // t in [-0.5, 0.5]: the line's offset from the centre
+    const double r = 0.5, d = std::clamp(t, -r, r);
+    return (r * r * std::acos(-d / r) + d * std::sqrt(r * r - d * d)) / (3.14159265358979 * r * r);
+  };
+  auto solve = [&](double f) {
+    double a = -0.5, b = 0.5;
+    for (int i = 0; i < 60; ++i) (fraction(0.5 * (a + b)) < f ? a : b) = 0.5 * (a + b);
+    return 0.5 * (a + b);
+  };
+  return solve(0.9) - solve(0.1);
+}
+
+TEST_F(ShadowRenderTest, PenumbraWidensWithTheLightsSizeAsSimilarTrianglesSay) {
+  const float h = 1.0f, H = 5.0f;
+  struct Case {
+    const char* what;
+    Light light;
+    double expected_px;
+  };
+  std::vector<Case> cases;
+  {
+    Light a;  // a square area light of side w: a linear ramp over w h / (H - h)
+    a.type = Light::Type::Area;
+    a.intensity = 3.0f;
+    a.position = glm::vec3(0, 0, H);
+    a.direction = glm::vec3(0, 0, -1);
+    a.axis_u = glm::vec3(1, 0, 0);
+    a.size_u = a.size_v = 2.0f;
+    cases.push_back({"area light", a, 0.8 * 2.0 * h / (H - h) * kPx});
+  }
+  {
+    Light p;  // a point light of radius r: a disk of diameter 2r
+    p.type = Light::Type::Point;
+    p.intensity = 30.0f;
+    p.position = glm::vec3(0, 0, H);
+    p.radius = 1.0f;
+    cases.push_back({"point light with radius", p, disk_ramp_width() * 2.0 * h / (H - h) * kPx});
+  }
+  {
+    Light sun;  // a sun of angular diameter a: a disk of diameter 2 h tan(a / 2)
+    sun.type = Light::Type::Distant;
+    sun.direction = glm::vec3(0, 0, -1);
+    sun.angle = 0.5f;
+    cases.push_back({"sun with an angle", sun, disk_ramp_width() * 2.0 * h * std::tan(0.25) * kPx});
+  }
+  for (const Case& c : cases) {
+    Scene s = floor_scene(c.light);
+    s.meshes.push_back(occluder(-20.0f, -20.0f, 0.0f, 20.0f, h));
+    std::vector<float> v = visibility(*renderer_, s);
+    double w = ramp_width(v, kH / 2);
+    ASSERT_GT(w, 0.0) << c.what << ": no penumbra crossing on the middle row";
+    EXPECT_NEAR(w / c.expected_px, 1.0, 0.15) << c.what << ": " << w << " px against " << c.expected_px;
+    // No light in the umbra far under the occluder, all of it far outside.
+    EXPECT_LT(v[size_t(kH / 2) * kW + 10], 0.02f) << c.what;
+    EXPECT_GT(v[size_t(kH / 2) * kW + kW - 10], 0.98f) << c.what;
+  }
+}
+
+TEST_F(ShadowRenderTest, ContactShadowsStartAtTheContact) {
+  // A box standing on the floor under a slanted sun: the floor right at the
+  // box's foot on the far side is in shadow (no gap of light).
+  Light sun;
+  sun.type = Light::Type::Distant;
+  sun.direction = glm::normalize(glm::vec3(1.0f, 0.0f, -1.0f));
+  Scene s = floor_scene(sun);
+  Mesh box = cube_mesh(SubdivScheme::None);
+  box.object_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, 0.5f)) * glm::scale(glm::mat4(1.0f), glm::vec3(0.5f));
+  box.visible_camera = false;
+  s.meshes.push_back(box);
+  std::vector<float> v = visibility(*renderer_, s);
+  // The shadow covers x in [0.5, 1.5] (height 1 at 45 degrees) on y = 0.
+  const int row = kH / 2;
+  for (float x : {0.52f, 0.8f, 1.2f, 1.45f})
+    EXPECT_LT(v[size_t(row) * kW + int(raster({x, 0}).x)], 0.05f) << "light at x = " << x;
+  for (float x : {1.6f, 2.5f}) EXPECT_GT(v[size_t(row) * kW + int(raster({x, 0}).x)], 0.95f) << "shadow at x = " << x;
+}
+
+TEST_F(ShadowRenderTest, ControlsTurnShadowsOffWhereAsked) {
+  Light sun;
+  sun.type = Light::Type::Distant;
+  sun.direction = glm::vec3(0, 0, -1);
+  Scene s = floor_scene(sun);
+  s.meshes.push_back(occluder(-1.0f, -1.0f, 1.0f, 1.0f, 1.0f));
+  auto centre = [&](const Scene& scene) { return visibility(*renderer_, scene)[size_t(kH / 2) * kW + kW / 2]; };
+  EXPECT_LT(centre(s), 0.02f);
+  Scene no_light_shadow = s;
+  no_light_shadow.lights[0].cast_shadows = false;
+  EXPECT_GT(centre(no_light_shadow), 0.98f);
+  Scene no_caster = s;
+  no_caster.meshes[1].cast_shadows = false;
+  EXPECT_GT(centre(no_caster), 0.98f);
+  // Half opacity lets half the light through (stochastic per texel: the
+  // average over the shadow).
+  Scene half = s;
+  Material glass = half.materials[0];
+  glass.opacity = glm::vec3(0.5f);
+  half.materials.push_back(glass);
+  half.meshes[1].material = 1;
+  std::vector<float> v = visibility(*renderer_, half);
+  double sum = 0;
+  int n = 0;
+  for (int y = kH / 2 - 15; y < kH / 2 + 15; ++y)
+    for (int x = kW / 2 - 15; x < kW / 2 + 15; ++x) sum += v[size_t(y) * kW + x], ++n;
+  EXPECT_NEAR(sum / n, 0.5, 0.05);
+}
+
+TEST_F(ShadowRenderTest, DisplacementMovesTheShadow) {
+  // A program that lifts the occluder by 1 unit: its shadow under a
+  // slanted sun moves by the sun's slant.
+  Light sun;
+  sun.type = Light::Type::Distant;
+  sun.direction = glm::normalize(glm::vec3(0.5f, 0.0f, -1.0f));
+  Scene s = floor_scene(sun);
+  s.material_programs.push_back(
+      {"lift", "float3 mp_node_displacement(const MpNodeGlobals* g) { return (float3)(0.0f, 0.0f, 1.0f); }\n"
+               "void mp_node_surface(const MpNodeGlobals* g, MpSurfaceInputs* s) {}\n"});
+  Material lifted = s.materials[0];
+  lifted.program = 0;
+  lifted.program_displaces = true;
+  lifted.displacement_bound = 1.0f;
+  s.materials.push_back(lifted);
+  Mesh o = occluder(-0.5f, -0.5f, 0.5f, 0.5f, 1.0f);
+  o.material = 1;
+  s.meshes.push_back(o);
+  ShadowShape got = shadow_shape(visibility(*renderer_, s));
+  // At height 2 the shadow's centre is at x = 2 * 0.5 = 1 (at height 1, 0.5).
+  EXPECT_NEAR(got.centroid.x, raster({1.0f, 0.0f}).x, 0.6);
+  EXPECT_NEAR(got.area_px / (kPx * kPx), 1.0, 0.03);
+}
+
+TEST_F(ShadowRenderTest, PagesAreKeptBetweenFramesWhileLightsAndGeometryStay) {
+  Light sun;
+  sun.type = Light::Type::Distant;
+  sun.direction = glm::normalize(glm::vec3(0.3f, 0.2f, -1.0f));
+  Scene s = floor_scene(sun);
+  s.meshes.push_back(occluder(-1.0f, -1.0f, 1.0f, 1.0f, 1.0f));
+  Renderer fresh;
+  RenderResult first = renderer_->render(s), again = renderer_->render(s);
+  ASSERT_GT(first.stats.shadows.pages_rendered, 0u);
+  EXPECT_EQ(again.stats.shadows.pages_rendered, 0u) << "an unchanged frame rendered its shadow pages again";
+  EXPECT_EQ(again.stats.shadows.pages_requested, first.stats.shadows.pages_requested);
+  EXPECT_EQ(first.rgba, again.rgba);
+  // The light turns: every page of it is new, and the image is what a
+  // renderer that never saw the first light makes.
+  s.lights[0].direction = glm::normalize(glm::vec3(-0.3f, 0.2f, -1.0f));
+  RenderResult turned = renderer_->render(s);
+  EXPECT_EQ(turned.stats.shadows.pages_rendered, turned.stats.shadows.pages_requested);
+  EXPECT_EQ(turned.rgba, fresh.render(s).rgba);
+}
+
+TEST_F(ShadowRenderTest, BoundSplitStrategiesMakeTheSameShadows) {
+  Light spot;
+  spot.type = Light::Type::Spot;
+  spot.intensity = 50.0f;
+  spot.position = glm::vec3(1, -1, 4);
+  spot.direction = glm::normalize(glm::vec3(-1, 1, -4));
+  spot.cone_angle = 0.8f;
+  spot.radius = 0.3f;
+  Scene s = floor_scene(spot);
+  Mesh torus = torus_mesh(12, 8, 0.3f, SubdivScheme::CatmullClark);
+  torus.object_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, 1));
+  s.meshes.push_back(torus);
+  s.settings.bound_split = BoundSplitMethod::Bounded;
+  RenderResult bounded = Renderer().render(s);
+  s.settings.bound_split = BoundSplitMethod::Breadth;
+  RenderResult breadth = Renderer().render(s);
+  ASSERT_GT(bounded.stats.shadows.pages_rendered, 0u);
+  EXPECT_EQ(bounded.rgba, breadth.rgba);
+}
+
+TEST_F(ShadowRenderTest, AShortBudgetCoarsensShadowsAndKeepsToIt) {
+  Light point;
+  point.type = Light::Type::Point;
+  point.intensity = 40.0f;
+  point.position = glm::vec3(0.5f, 0.5f, 3.0f);
+  Scene s = floor_scene(point);
+  s.meshes.push_back(occluder(-1.0f, -1.0f, 1.0f, 1.0f, 1.0f));
+  RenderResult full = renderer_->render(s);
+  ASSERT_EQ(full.stats.shadows.level_bias, 0);
+  s.settings.shadow_memory_mib = 2.5f;
+  RenderResult short_budget = Renderer().render(s);
+  const ShadowStats& st = short_budget.stats.shadows;
+  EXPECT_GT(st.level_bias + int(st.pages_missing), 0) << "the budget was not short";
+  EXPECT_LE(st.peak_bytes, st.budget_bytes);
+  // Still a shadow where the occluder is.
+  EXPECT_LT(luminance(short_budget, kW / 2, kH / 2), 0.2f * luminance(short_budget, 5, 5));
+  s.settings.shadow_memory_mib = 0.25f;
+  try {
+    Renderer().render(s);
+    FAIL() << "a budget too small for the page tables rendered";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("shadow map memory budget"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace mp::test
