@@ -22,16 +22,6 @@
 namespace mp::rib {
 namespace {
 
-// One integer parameter in [lo, hi]; `out` is unchanged when it is absent.
-void get_int(ArgReader& args, const ParamList& params, const char* name, long long lo, long long hi,
-             int* out) {
-  const Param* p = params.find(name);
-  if (!p) return;
-  if (p->decl.is_string() || p->value->numbers.size() != 1 || !to_int(p->value->numbers[0], lo, hi, out))
-    args.fail_at(p->line, std::string("parameter \"") + name + "\" expects one integer in [" +
-                              std::to_string(lo) + ", " + std::to_string(hi) + "]");
-}
-
 void warn_unknown(const ParamList& params, std::initializer_list<const char*> known,
                   const std::function<void(const std::string&)>& warn) {
   for (const Param& p : params.params()) {
@@ -57,13 +47,13 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   if (!(memory > 0.0f)) args.fail("\"boundsplitmemory\" must be a positive number of MiB");
   s.bound_split_memory_mib = memory;
   // Grid size and split depth are clamped by the renderer; any int is kept.
-  get_int(args, params, "maxgridsize", INT_MIN, INT_MAX, &s.max_grid_size);
-  get_int(args, params, "maxsplitdepth", INT_MIN, INT_MAX, &s.max_split_depth);
+  params.get_int("maxgridsize", INT_MIN, INT_MAX, &s.max_grid_size);
+  params.get_int("maxsplitdepth", INT_MIN, INT_MAX, &s.max_split_depth);
   int flag = s.backface_culling ? 1 : 0;
-  get_int(args, params, "backfaceculling", 0, 1, &flag);
+  params.get_int("backfaceculling", 0, 1, &flag);
   s.backface_culling = flag != 0;
   flag = s.depth_and_normal_passes ? 1 : 0;
-  get_int(args, params, "depthandnormal", 0, 1, &flag);
+  params.get_int("depthandnormal", 0, 1, &flag);
   s.depth_and_normal_passes = flag != 0;
   const int line = args.request().line;
   warn_unknown(params,
@@ -95,7 +85,7 @@ void Parser::read_image_option(ArgReader& args, const ParamList& params) {
   // PNGs hold sRGB-encoded values and EXRs linear ones unless "imagesrgb" says otherwise.
   const std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : path;
   int srgb = ext == ".png" || ext == ".PNG" ? 1 : 0;
-  get_int(args, params, "imagesrgb", 0, 1, &srgb);
+  params.get_int("imagesrgb", 0, 1, &srgb);
   image.srgb = srgb != 0;
   result_.scene.images.push_back(std::move(image));
 }
@@ -117,7 +107,7 @@ void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
   // material (0 replaces the default surface) or add the next one.
   const long long count = static_cast<long long>(result_.scene.materials.size());
   int index = 0;
-  get_int(args, params, "material", 0, std::min<long long>(count, INT_MAX), &index);
+  params.get_int("material", 0, std::min<long long>(count, INT_MAX), &index);
   // A material program (node tree as OpenCL C), shared by identical sources.
   MaterialProgramUse use;
   const std::string source = params.get_string("program", "");
@@ -127,14 +117,14 @@ void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
     use.program = static_cast<int>(it - programs.begin());
     if (it == programs.end()) programs.push_back({params.get_string("materialname", "material program"), source});
     int flag = 0;
-    get_int(args, params, "programdisplaces", 0, 1, &flag);
+    params.get_int("programdisplaces", 0, 1, &flag);
     use.displaces = flag != 0;
     flag = 0;
-    get_int(args, params, "programshades", 0, 1, &flag);
+    params.get_int("programshades", 0, 1, &flag);
     use.shades = flag != 0;
     use.displacement_bound = params.get_float("displacementbound", 0.0f);
     flag = 0;
-    get_int(args, params, "displacementworld", 0, 1, &flag);
+    params.get_int("displacementworld", 0, 1, &flag);
     use.displacement_world = flag != 0;
     if (!(use.displacement_bound >= 0.0f)) args.fail("\"displacementbound\" must be a non-negative number");
   }

@@ -188,4 +188,12 @@ std::string ParamList::get_string(const std::string& name, const std::string& fa
   return p->value->strings[0];
 }
 
+void ParamList::get_int(const std::string& name, long long lo, long long hi, int* out) const {
+  const Param* p = find(name);
+  if (!p) return;
+  if (p->decl.is_string() || p->value->numbers.size() != 1 || !to_int(p->value->numbers[0], lo, hi, out))
+    args_.fail_at(p->line, "parameter \"" + name + "\" expects one integer in [" + std::to_string(lo) + ", " +
+                               std::to_string(hi) + "]");
+}
+
 }  // namespace mp::rib
