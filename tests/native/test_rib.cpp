@@ -394,6 +394,61 @@ TEST(RibLights, HandlesAndIlluminate) {
   EXPECT_EQ(count_warnings(r, "bogus"), 1);
 }
 
+TEST(RibLights, ShadowsOnlyWithAShadowName) {
+  // RenderMan's lights cast shadows through a named shadow map: without a
+  // name (or with an empty one) a light casts none, whatever its type.
+  const mp::RibResult r = parse_world(
+      "LightSource \"pointlight\" 1\n"
+      "LightSource \"pointlight\" 2 \"string shadowname\" [\"\"]\n"
+      "LightSource \"pointlight\" 3 \"string shadowname\" [\"raytrace\"]\n"
+      "LightSource \"spotlight\" 4 \"shadowname\" \"spot.shad\"\n"  // any name, declared or not
+      "LightSource \"distantlight\" 5 \"shadowname\" [\"raytrace\"]\n"
+      "LightSource \"micropoly_arealight\" 6 \"string shadowname\" \"raytrace\"\n"
+      "LightSource \"spotlight\" 7\nLightSource \"distantlight\" 8\nLightSource \"micropoly_arealight\" 9\n"
+      "LightSource \"ambientlight\" 10 \"string shadowname\" \"raytrace\"\n"
+      "LightSource \"ambientlight\" 11 \"string shadowname\" \"raytrace\"\n"
+      "Polygon \"P\" [0 0 0 1 0 0 0 1 0]\n");
+  const auto& L = r.scene.lights;
+  ASSERT_EQ(L.size(), 11u);
+  const bool casts[] = {false, false, true, true, true, true, false, false, false, false, false};
+  for (size_t i = 0; i < L.size(); ++i) EXPECT_EQ(L[i].cast_shadows, casts[i]) << "light " << i + 1;
+  // Ambient light has no shadows: its shadowname is ignored with one warning.
+  EXPECT_EQ(count_warnings(r, "\"shadowname\" is ignored"), 1);
+  EXPECT_EQ(r.warnings.size(), 1u);
+}
+
+TEST(RibLights, SizeForSoftShadows) {
+  const mp::RibResult r = parse_world(
+      "LightSource \"pointlight\" 1 \"float micropoly:radius\" [0.25] \"integer micropoly:softfalloff\" [0]\n"
+      "LightSource \"spotlight\" 2 \"float micropoly:radius\" 1.5 \"integer micropoly:softfalloff\" 1\n"
+      "LightSource \"distantlight\" 3 \"float micropoly:angle\" [0.0093]\n"
+      "LightSource \"pointlight\" 4\nLightSource \"spotlight\" 5\nLightSource \"distantlight\" 6\n"
+      // Parameters of another light type are ignored with a warning.
+      "LightSource \"pointlight\" 7 \"float micropoly:angle\" [0.5]\n"
+      "LightSource \"distantlight\" 8 \"float micropoly:radius\" [2]\n"
+      "LightSource \"micropoly_arealight\" 9 \"float micropoly:radius\" [2]\n"
+      "Polygon \"P\" [0 0 0 1 0 0 0 1 0]\n");
+  const auto& L = r.scene.lights;
+  ASSERT_EQ(L.size(), 9u);
+  EXPECT_EQ(L[0].radius, 0.25f);
+  EXPECT_FALSE(L[0].soft_falloff);
+  EXPECT_EQ(L[1].radius, 1.5f);
+  EXPECT_TRUE(L[1].soft_falloff);
+  EXPECT_EQ(L[2].angle, 0.0093f);
+  // Defaults: a point, with soft falloff; a sun of no size.
+  for (size_t i : {3u, 4u}) {
+    EXPECT_EQ(L[i].radius, 0.0f) << i;
+    EXPECT_TRUE(L[i].soft_falloff) << i;
+  }
+  EXPECT_EQ(L[5].angle, 0.0f);
+  EXPECT_EQ(L[6].angle, 0.0f);
+  EXPECT_EQ(L[7].radius, 0.0f);
+  EXPECT_EQ(L[8].radius, 0.0f);
+  EXPECT_EQ(count_warnings(r, "\"micropoly:angle\" is ignored"), 1);
+  EXPECT_EQ(count_warnings(r, "\"micropoly:radius\" is ignored"), 2);  // once per light shader
+  EXPECT_EQ(r.warnings.size(), 3u);
+}
+
 // --- the complete request set ----------------------------------------------------------------
 
 TEST(RibAllRequests, EveryRequestLandsInTheScene) {

@@ -115,12 +115,28 @@ void expect_same_material(const Material& a, const Material& b) {
   }
 }
 
+// Bit for bit (EXPECT_EQ takes -0 for 0).
+void expect_same_bits(float a, float b) {
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(std::signbit(a), std::signbit(b)) << a << " " << b;
+}
+
 void expect_same_light(const Light& a, const Light& b) {
   EXPECT_EQ(a.type, b.type);
   EXPECT_EQ(a.color, b.color);
   EXPECT_EQ(a.intensity, b.intensity);
-  if (a.type == Light::Type::Ambient) return;
+  if (a.type == Light::Type::Ambient) {
+    EXPECT_FALSE(b.cast_shadows);  // ambient light has no shadows to cast
+    return;
+  }
   EXPECT_EQ(a.position, b.position);
+  EXPECT_EQ(a.cast_shadows, b.cast_shadows);
+  // The size for soft shadows, of the types that have one.
+  if (a.type == Light::Type::Point || a.type == Light::Type::Spot) {
+    expect_same_bits(a.radius, b.radius);
+    EXPECT_EQ(a.soft_falloff, b.soft_falloff);
+  }
+  if (a.type == Light::Type::Distant) expect_same_bits(a.angle, b.angle);
   if (a.type == Light::Type::Point) return;
   // Unit-length directions come back exactly, others normalised.
   if (std::fabs(glm::length(a.direction) - 1.0f) < 1e-6f) {
@@ -293,12 +309,15 @@ Scene full_scene() {
   sun.intensity = 0.8f;
   sun.position = {3.0f, 9.0f, 1.0f};
   sun.direction = glm::normalize(glm::vec3(-0.3f, -0.5f, -1.0f));
+  sun.angle = 0.0093f;
   s.lights.push_back(sun);
   Light point;
   point.type = Light::Type::Point;
   point.position = {-2.5f, 3.1f, 2.2f};
   point.intensity = 9.0f;
   point.color = {1.0f, 0.8f, 0.6f};
+  point.radius = 0.3f;
+  point.soft_falloff = false;
   s.lights.push_back(point);
   Light spot;
   spot.type = Light::Type::Spot;
@@ -306,6 +325,7 @@ Scene full_scene() {
   spot.direction = glm::vec3(0.0f, -5.0f, -40.0f);  // not normalised
   spot.intensity = 900.0f;
   spot.cone_angle = 0.2f, spot.cone_delta_angle = 0.05f, spot.beam_distribution = 1.5f;
+  spot.radius = 1.0f / 3.0f;
   s.lights.push_back(spot);
   Light rect;
   rect.type = Light::Type::Area;
@@ -323,6 +343,7 @@ Scene full_scene() {
   disk.direction = {0.2f, 0.0f, -1.0f};
   disk.axis_u = {0.0f, 1.0f, 0.0f};
   disk.size_u = 0.9f, disk.size_v = 1.3f;
+  disk.cast_shadows = false;
   s.lights.push_back(disk);
 
   // Catmull-Clark cube: creases, corners, a hole, edge-only boundary, a
@@ -505,6 +526,38 @@ TEST(RibWriter, EveryFilterAndBoundSplitMethod) {
       s.settings.depth_and_normal_passes = true;
       expect_same_settings(s.settings, round_trip(s).settings);
     }
+}
+
+TEST(RibWriter, ShadowFieldsOfEveryLightType) {
+  // Every light type with and without shadows, with sizes that print
+  // inexactly and a negative zero, which must come back as such.
+  for (Light::Type type : {Light::Type::Ambient, Light::Type::Distant, Light::Type::Point, Light::Type::Spot,
+                           Light::Type::Area})
+    for (bool casts : {true, false})
+      for (float size : {0.1f, -0.0f, 0.0f}) {
+        SCOPED_TRACE("type " + std::to_string(static_cast<int>(type)) + (casts ? " casting" : "") + " size " +
+                     std::to_string(size));
+        Scene s = ortho_scene();
+        Light l;
+        l.type = type;
+        l.position = {0.5f, 2.0f, 1.0f};
+        l.direction = {0.0f, -1.0f, 0.0f};
+        l.cast_shadows = casts;
+        l.radius = size;
+        l.angle = size;
+        l.soft_falloff = size != 0.1f;
+        s.lights = {l};
+        const Scene back = round_trip(s);
+        ASSERT_EQ(back.lights.size(), 1u);
+        expect_same_light(l, back.lights[0]);
+        // Sizes a type does not have come back as the defaults.
+        const Light def;
+        if (type != Light::Type::Point && type != Light::Type::Spot) {
+          EXPECT_EQ(back.lights[0].radius, def.radius);
+          EXPECT_EQ(back.lights[0].soft_falloff, def.soft_falloff);
+        }
+        if (type != Light::Type::Distant) EXPECT_EQ(back.lights[0].angle, def.angle);
+      }
 }
 
 TEST(RibWriter, FloatsReadBackExactly) {

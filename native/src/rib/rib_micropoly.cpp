@@ -7,6 +7,8 @@
 //   "uniform integer micropoly:material"  per-face material numbers
 //   "facevarying float[2] micropoly:uvK"  UV layer K of a mesh
 //   "constant float[3] micropoly:texspacelocation" / "...size"  Generated space
+// The light shaders' extensions (a light's size for soft shadows) are read
+// with the lights, in rib_shading.cpp.
 #include <algorithm>
 #include <climits>
 #include <functional>

@@ -66,6 +66,10 @@ class ParamList {
   // One integer in [lo, hi] (an error at the parameter's line otherwise);
   // `out` is unchanged when the parameter is absent.
   void get_int(const std::string& name, long long lo, long long hi, int* out) const;
+  // One number for which `valid` holds; otherwise an error at the
+  // parameter's line: parameter "name" must be `must_be`.
+  float get_float_checked(const std::string& name, float fallback, bool (*valid)(float),
+                          const std::string& must_be) const;
 
  private:
   ArgReader& args_;

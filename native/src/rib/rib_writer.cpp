@@ -166,6 +166,12 @@ void param(std::string& out, const char* name, std::string_view v) {
   out += ']';
 }
 
+// True when `v` is not `def` bit for bit (-0 differs from 0): extensions
+// are written only when they differ from the reader's default, so that
+// plain scenes stay standard RIB, and a value that differs in any bit is
+// written so that it comes back exactly.
+bool differs(float v, float def) { return v != def || std::signbit(v) != std::signbit(def); }
+
 // --- scene parts --------------------------------------------------------------------
 
 const char* filter_name(PixelFilter f) {
@@ -247,6 +253,22 @@ void write_image_and_camera(std::string& o, const Scene& scene) {
   o += '\n';
 }
 
+// Shadows as RenderMan's lights ask for them, by naming a shadow map: any
+// name will do for the reader, and "raytrace" is what other renderers take
+// as "trace shadow rays". The light's size for soft shadows is an extension,
+// written when it is not the default. Ambient lights cast no shadows and
+// have no size.
+void write_light_shadows(std::string& o, const Light& l) {
+  if (l.type == Light::Type::Ambient) return;
+  if (l.cast_shadows) param(o, "string shadowname", "raytrace");
+  if (l.type == Light::Type::Point || l.type == Light::Type::Spot) {
+    if (differs(l.radius, 0.0f)) param(o, "float micropoly:radius", l.radius);
+    if (!l.soft_falloff) param(o, "integer micropoly:softfalloff", static_cast<long long>(0));
+  } else if (l.type == Light::Type::Distant && differs(l.angle, 0.0f)) {
+    param(o, "float micropoly:angle", l.angle);
+  }
+}
+
 void write_light(std::string& o, const Light& l, int handle) {
   // Lights with a direction are declared at the origin of a translated frame
   // with "to" = the direction: the reader takes the direction as the
@@ -290,6 +312,7 @@ void write_light(std::string& o, const Light& l, int handle) {
     param(o, "float width", l.size_u);
     param(o, "float height", l.size_v);
   }
+  write_light_shadows(o, l);
   o += directed ? "\nTransformEnd\n" : "\n";
 }
 
