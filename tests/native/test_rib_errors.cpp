@@ -193,6 +193,15 @@ TEST(RibErrors, LightShadowParameters) {
                "\"shadowname\" expects one string");
 }
 
+TEST(RibErrors, VisibilityValues) {
+  expect_error("WorldBegin\nAttribute \"visibility\"\n  \"int camera\" [2]\n", 3,
+               "\"camera\" expects one integer in [0, 1]");
+  expect_error("WorldBegin\nAttribute \"visibility\" \"int camera\" [1]\n  \"int transmission\" [-1]\n", 3,
+               "\"transmission\" expects one integer in [0, 1]");
+  expect_error("WorldBegin\nAttribute \"visibility\" \"transmission\" [0.5]\n", 2, "transmission");
+  expect_error("WorldBegin\nAttribute \"visibility\" \"string transmission\" [\"opaque\"]\n", 2, "transmission");
+}
+
 TEST(RibErrors, Archives) {
   expect_error("WorldBegin\nReadArchive \"does_not_exist.rib\"\n", 2, "cannot read");
   expect_error("ReadArchive \"/dev/zero\"\n", 1, "not a regular file");

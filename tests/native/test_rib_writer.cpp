@@ -179,6 +179,8 @@ void expect_same_mesh(const Mesh& a, const Mesh& b) {
   EXPECT_EQ(a.face_materials, b.face_materials);
   EXPECT_EQ(a.object_to_world, b.object_to_world);
   EXPECT_EQ(a.double_sided, b.double_sided);
+  EXPECT_EQ(a.visible_camera, b.visible_camera);
+  EXPECT_EQ(a.cast_shadows, b.cast_shadows);
   EXPECT_EQ(a.uv_layers, b.uv_layers);
   EXPECT_EQ(a.corner_normals, b.corner_normals);
   EXPECT_EQ(a.texspace_location, b.texspace_location);
@@ -228,6 +230,8 @@ void expect_same_scene(const Scene& a, const Scene& b) {
     EXPECT_EQ(p.material, q.material);
     EXPECT_EQ(p.object_to_world, q.object_to_world);
     EXPECT_EQ(p.double_sided, q.double_sided);
+    EXPECT_EQ(p.visible_camera, q.visible_camera);
+    EXPECT_EQ(p.cast_shadows, q.cast_shadows);
   }
 }
 
@@ -376,6 +380,7 @@ Scene full_scene() {
   mirrored.material = 3;
   mirrored.double_sided = false;
   mirrored.object_to_world = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(-1.8f, 0.3f, 0.5f)), glm::vec3(-0.3f, 0.4f, 0.35f));
+  mirrored.cast_shadows = false;
   s.meshes.push_back(mirrored);
 
   // Catmull-Clark with the other boundary modes and a pentagon.
@@ -389,6 +394,7 @@ Scene full_scene() {
   sheet2.name = "corner sheet";
   sheet2.boundary = BoundaryInterpolation::EdgeAndCorner;
   sheet2.object_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(1.6f, -0.5f, 0.4f));
+  sheet2.visible_camera = false;  // hidden from the camera, still casting shadows
   s.meshes.push_back(sheet2);
   Mesh pentagon;
   pentagon.name = "pentagon";
@@ -419,6 +425,8 @@ Scene full_scene() {
   mirrored_patch.control_points = bezier_net(0.0f, 0.6f);
   mirrored_patch.material = 2;
   mirrored_patch.object_to_world = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(0.3f, 1.8f, 0.0f)), glm::vec3(-0.5f, 0.5f, 0.5f));
+  mirrored_patch.visible_camera = false;
+  mirrored_patch.cast_shadows = false;
   s.bezier_patches.push_back(mirrored_patch);
 
   // Texturing: a material program reads two UV layers, two images (one sRGB

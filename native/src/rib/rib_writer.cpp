@@ -370,22 +370,35 @@ void write_material(std::string& o, const Material& m, int index, const char* in
   o += '\n';
 }
 
-// Name, placement, sides and material: what a mesh and a patch set share.
-void write_object_state(std::string& o, const std::string& name, const glm::mat4& object_to_world,
-                        bool double_sided, const std::vector<Material>& materials, int material,
+// Ray visibility as RenderMan's attribute ("transmission" rays are its
+// shadow rays), only for an object that is hidden from one of them.
+void write_visibility(std::string& o, bool visible_camera, bool cast_shadows) {
+  if (visible_camera && cast_shadows) return;
+  o += "  Attribute \"visibility\"";
+  param(o, "int camera", static_cast<long long>(visible_camera ? 1 : 0));
+  param(o, "int transmission", static_cast<long long>(cast_shadows ? 1 : 0));
+  o += '\n';
+}
+
+// Name, placement, sides, visibility and material: what a mesh and a patch
+// set share.
+template <typename Object>
+void write_object_state(std::string& o, const Object& object, const std::vector<Material>& materials,
                         const std::vector<MaterialProgram>& programs) {
   o += "  Attribute \"identifier\"";
-  param(o, "name", name);
+  param(o, "name", object.name);
   o += "\n  Transform ";
-  put_matrix(o, object_to_world);
-  o += double_sided ? "\n  Sides 2\n" : "\n  Sides 1\n";
+  put_matrix(o, object.object_to_world);
+  o += object.double_sided ? "\n  Sides 2\n" : "\n  Sides 1\n";
+  write_visibility(o, object.visible_camera, object.cast_shadows);
+  const int material = object.material;
   write_material(o, materials[static_cast<size_t>(material)], material, "  ", programs);
 }
 
 void write_mesh(std::string& o, const Mesh& m, const std::vector<Material>& materials,
                 const std::vector<MaterialProgram>& programs) {
   o += "AttributeBegin\n";
-  write_object_state(o, m.name, m.object_to_world, m.double_sided, materials, m.material, programs);
+  write_object_state(o, m, materials, programs);
   if (m.scheme == SubdivScheme::CatmullClark) {
     o += "  SubdivisionMesh \"catmull-clark\" ";
     put_ints(o, m.face_vertex_counts);
@@ -467,7 +480,7 @@ void write_patches(std::string& o, const BezierPatches& b, const std::vector<Mat
   // One Patch request per 4x4 net in the default Bezier basis (step 3); the
   // reader joins consecutive patches of one attribute block into one set.
   o += "AttributeBegin\n";
-  write_object_state(o, b.name, b.object_to_world, b.double_sided, materials, b.material, programs);
+  write_object_state(o, b, materials, programs);
   o += "  Basis \"bezier\" 3 \"bezier\" 3\n";
   for (size_t p = 0; p + 16 <= b.control_points.size(); p += 16) {
     o += "  Patch \"bicubic\" \"P\" ";
