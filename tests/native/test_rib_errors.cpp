@@ -202,6 +202,18 @@ TEST(RibErrors, VisibilityValues) {
   expect_error("WorldBegin\nAttribute \"visibility\" \"string transmission\" [\"opaque\"]\n", 2, "transmission");
 }
 
+TEST(RibErrors, ShadowOptionsAndProgramAlpha) {
+  expect_error("Option \"micropoly\" \"integer shadows\" [2]\n", 1, "\"shadows\" expects one integer in [0, 1]");
+  expect_error("Option \"micropoly\" \"integer shadows\" [1]\n  \"float shadowmemory\" [0]\n", 2,
+               "\"shadowmemory\" must be a positive number of MiB");
+  expect_error("Option \"micropoly\" \"float shadowmemory\" [-64]\n", 1, "shadowmemory");
+  expect_error("Option \"micropoly\"\n\"float shadowshadingrate\" [0]\n", 2, "\"shadowshadingrate\" must be");
+  expect_error("Option \"micropoly\" \"float shadowshadingrate\" [-1]\n", 1, "shadowshadingrate");
+  expect_error("WorldBegin\nAttribute \"micropoly\" \"integer material\" [1] \"string program\" [\"x\"]\n"
+               "  \"integer programalpha\" [3]\n",
+               3, "\"programalpha\" expects one integer in [0, 1]");
+}
+
 TEST(RibErrors, Archives) {
   expect_error("WorldBegin\nReadArchive \"does_not_exist.rib\"\n", 2, "cannot read");
   expect_error("ReadArchive \"/dev/zero\"\n", 1, "not a regular file");

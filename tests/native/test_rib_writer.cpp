@@ -62,6 +62,9 @@ void expect_same_settings(const RenderSettings& a, const RenderSettings& b) {
   EXPECT_EQ(a.max_split_depth, b.max_split_depth);
   EXPECT_EQ(a.backface_culling, b.backface_culling);
   EXPECT_EQ(a.depth_and_normal_passes, b.depth_and_normal_passes);
+  EXPECT_EQ(a.shadows, b.shadows);
+  EXPECT_EQ(a.shadow_memory_mib, b.shadow_memory_mib);
+  EXPECT_EQ(a.shadow_shading_rate, b.shadow_shading_rate);
 }
 
 void expect_same_camera(const Camera& a, const Camera& b) {
@@ -110,6 +113,7 @@ void expect_same_material(const Material& a, const Material& b) {
   if (a.program >= 0) {
     EXPECT_EQ(a.program_displaces, b.program_displaces);
     EXPECT_EQ(a.program_shades, b.program_shades);
+    EXPECT_EQ(a.program_alpha, b.program_alpha);
     EXPECT_EQ(a.displacement_bound, b.displacement_bound);
     EXPECT_EQ(a.displacement_bound_world, b.displacement_bound_world);
   }
@@ -273,6 +277,8 @@ Scene full_scene() {
   st.max_split_depth = 22;
   st.backface_culling = true;
   st.depth_and_normal_passes = false;
+  st.shadow_memory_mib = 100.3f;  // shadows stay on, so that the render tests see them
+  st.shadow_shading_rate = 2.7f;
 
   s.camera = look_at({1.3f, 2.1f, 7.7f}, {0.1f, 0.2f, 0.0f}, 47.3f);
   s.camera.screen_left = -1.4f, s.camera.screen_right = 1.3f;
@@ -451,6 +457,7 @@ Scene full_scene() {
   Material textured = material("textured", Material::Model::Principled, glm::vec3(0.5f));
   textured.program = 0;
   textured.program_shades = true;
+  textured.program_alpha = true;
   textured.displacement_bound = 0.25f;
   textured.displacement_bound_world = true;  // written and read back, though this program does not displace
   s.materials.push_back(textured);
@@ -566,6 +573,44 @@ TEST(RibWriter, ShadowFieldsOfEveryLightType) {
         }
         if (type != Light::Type::Distant) EXPECT_EQ(back.lights[0].angle, def.angle);
       }
+}
+
+TEST(RibWriter, ShadowExtensionsOnlyWhereNotDefault) {
+  // A default scene stays standard RIB but for the shadow name, which is
+  // RenderMan's own way to ask for shadows.
+  Scene s;
+  s.lights.push_back(Light{});
+  s.meshes.push_back(polygon({{0, 0, -2}, {1, 0, -2}, {0, 1, -2}}));
+  Material m;
+  m.program = 0;
+  s.materials.push_back(m);
+  s.material_programs.push_back({"p", "void f() {}"});
+  std::string text = to_rib(s);
+  EXPECT_NE(text.find("\"string shadowname\" [\"raytrace\"]"), std::string::npos) << text;
+  for (const char* name : {"micropoly:radius", "micropoly:softfalloff", "micropoly:angle", "visibility",
+                           "integer shadows", "shadowmemory", "shadowshadingrate", "programalpha"})
+    EXPECT_EQ(text.find(name), std::string::npos) << name << "\n" << text;
+  expect_same_scene(s, round_trip(s));
+
+  // Each one written when set, and read back.
+  s.lights[0].cast_shadows = false;
+  s.settings.shadows = false;
+  s.settings.shadow_memory_mib = 0.1f;
+  s.settings.shadow_shading_rate = 16.5f;
+  s.materials[0].program_alpha = true;
+  s.meshes[0].visible_camera = false;
+  text = to_rib(s);
+  EXPECT_EQ(text.find("shadowname"), std::string::npos) << text;
+  for (const char* written : {"\"integer shadows\" [0]", "\"float shadowmemory\" [0.1]",
+                              "\"float shadowshadingrate\" [16.5]", "\"integer programalpha\" [1]",
+                              "Attribute \"visibility\" \"int camera\" [0] \"int transmission\" [1]"})
+    EXPECT_NE(text.find(written), std::string::npos) << written << "\n" << text;
+  expect_same_scene(s, round_trip(s));
+  s.meshes[0].visible_camera = true;
+  s.meshes[0].cast_shadows = false;
+  text = to_rib(s);
+  EXPECT_NE(text.find("Attribute \"visibility\" \"int camera\" [1] \"int transmission\" [0]"), std::string::npos);
+  expect_same_scene(s, round_trip(s));
 }
 
 TEST(RibWriter, FloatsReadBackExactly) {
@@ -729,6 +774,31 @@ TEST(RibWriterExtensions, PngTexturesAreSrgbAndBottomRowFirst) {
   ASSERT_EQ(im.pixels.size(), 2u);
   EXPECT_EQ(im.pixels[0], glm::vec4(0.0f, 0.0f, std::round(linear_to_srgb(0.2f) * 255.0f) / 255.0f, 1.0f));
   EXPECT_EQ(im.pixels[1], glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
+}
+
+TEST(RibWriterExtensions, ShadowOptionsAndProgramAlpha) {
+  const RibResult r = read_rib_string(
+      "Option \"micropoly\" \"integer shadows\" [0] \"float shadowmemory\" [32.5] \"float shadowshadingrate\" [0.5]\n"
+      "WorldBegin\n"
+      "Attribute \"micropoly\" \"integer material\" 1 \"string program\" \"a\" \"integer programalpha\" 1\n"
+      "Attribute \"micropoly\" \"integer material\" 2 \"string program\" \"a\" \"integer programshades\" 1\n"
+      "WorldEnd\n",
+      "ext.rib");
+  EXPECT_TRUE(r.warnings.empty());
+  const Scene& s = r.scene;
+  EXPECT_FALSE(s.settings.shadows);
+  EXPECT_EQ(s.settings.shadow_memory_mib, 32.5f);
+  EXPECT_EQ(s.settings.shadow_shading_rate, 0.5f);
+  ASSERT_EQ(s.materials.size(), 3u);
+  EXPECT_TRUE(s.materials[1].program_alpha);
+  EXPECT_FALSE(s.materials[2].program_alpha);  // the default
+  EXPECT_TRUE(s.materials[2].program_shades);
+  // Without the option the Scene's defaults stay.
+  const RenderSettings def;
+  const Scene plain = parse("").scene;
+  EXPECT_EQ(plain.settings.shadows, def.shadows);
+  EXPECT_EQ(plain.settings.shadow_memory_mib, def.shadow_memory_mib);
+  EXPECT_EQ(plain.settings.shadow_shading_rate, def.shadow_shading_rate);
 }
 
 TEST(RibWriterExtensions, BadValuesAreErrors) {

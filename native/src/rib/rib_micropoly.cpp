@@ -11,6 +11,7 @@
 // with the lights, in rib_shading.cpp.
 #include <algorithm>
 #include <climits>
+#include <cmath>
 #include <functional>
 #include <initializer_list>
 #include <string>
@@ -57,10 +58,19 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   flag = s.depth_and_normal_passes ? 1 : 0;
   params.get_int("depthandnormal", 0, 1, &flag);
   s.depth_and_normal_passes = flag != 0;
+  // Shadow maps: on or off, their device memory and their shading rate.
+  flag = s.shadows ? 1 : 0;
+  params.get_int("shadows", 0, 1, &flag);
+  s.shadows = flag != 0;
+  auto positive = [](float v) { return v > 0.0f && std::isfinite(v); };
+  s.shadow_memory_mib = params.get_float_checked("shadowmemory", s.shadow_memory_mib, positive,
+                                                 "a positive number of MiB");
+  s.shadow_shading_rate = params.get_float_checked("shadowshadingrate", s.shadow_shading_rate, positive,
+                                                   "a positive number");
   const int line = args.request().line;
   warn_unknown(params,
                {"boundsplit", "boundsplitmemory", "maxgridsize", "maxsplitdepth", "backfaceculling",
-                "depthandnormal"},
+                "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate"},
                [&](const std::string& name) {
                  warn_once("option-micropoly:" + name, line,
                            "Option \"micropoly\": parameter \"" + name + "\" is ignored");
@@ -95,7 +105,7 @@ void Parser::read_image_option(ArgReader& args, const ParamList& params) {
 void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
   const int line = args.request().line;
   warn_unknown(params, {"material", "materialname", "program", "programdisplaces", "programshades",
-                        "displacementbound", "displacementworld"}, [&](const std::string& name) {
+                        "programalpha", "displacementbound", "displacementworld"}, [&](const std::string& name) {
     warn_once("attribute-micropoly:" + name, line,
               "Attribute \"micropoly\": parameter \"" + name + "\" is ignored");
   });
@@ -124,6 +134,9 @@ void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
     flag = 0;
     params.get_int("programshades", 0, 1, &flag);
     use.shades = flag != 0;
+    flag = 0;
+    params.get_int("programalpha", 0, 1, &flag);
+    use.alpha = flag != 0;
     use.displacement_bound = params.get_float("displacementbound", 0.0f);
     flag = 0;
     params.get_int("displacementworld", 0, 1, &flag);
@@ -145,6 +158,7 @@ void Parser::define_material(int index, const std::string& name, const MaterialP
   m.program = use.program;
   m.program_displaces = use.displaces;
   m.program_shades = use.shades;
+  m.program_alpha = use.alpha;
   m.displacement_bound = use.displacement_bound;
   m.displacement_bound_world = use.displacement_world;
   std::vector<Material>& materials = result_.scene.materials;

@@ -230,7 +230,7 @@ class Parser {
   // The material program a micropoly material attribute names (Material::program).
   struct MaterialProgramUse {
     int program = -1;
-    bool displaces = false, shades = false;
+    bool displaces = false, shades = false, alpha = false;
     float displacement_bound = 0.0f;
     bool displacement_world = false;
   };

@@ -62,7 +62,7 @@ std::vector<float> Parser::material_key(const Material& m) {
           m.emission.x, m.emission.y, m.emission.z,
           m.metallic, m.specular, static_cast<float>(m.program), m.displacement_bound,
           static_cast<float>(m.program_displaces), static_cast<float>(m.program_shades),
-          static_cast<float>(m.displacement_bound_world)};
+          static_cast<float>(m.displacement_bound_world), static_cast<float>(m.program_alpha)};
 }
 
 int Parser::material_index(const Attributes& attrs) {

@@ -193,6 +193,13 @@ void write_options(std::string& o, const RenderSettings& s) {
   param(o, "integer maxsplitdepth", static_cast<long long>(s.max_split_depth));
   param(o, "integer backfaceculling", static_cast<long long>(s.backface_culling ? 1 : 0));
   param(o, "integer depthandnormal", static_cast<long long>(s.depth_and_normal_passes ? 1 : 0));
+  // Shadow settings, only when they differ from the defaults (the reader's
+  // and the Scene's are the same).
+  const RenderSettings def;
+  if (s.shadows != def.shadows) param(o, "integer shadows", static_cast<long long>(s.shadows ? 1 : 0));
+  if (differs(s.shadow_memory_mib, def.shadow_memory_mib)) param(o, "float shadowmemory", s.shadow_memory_mib);
+  if (differs(s.shadow_shading_rate, def.shadow_shading_rate))
+    param(o, "float shadowshadingrate", s.shadow_shading_rate);
   o += '\n';
 }
 
@@ -364,6 +371,7 @@ void write_material(std::string& o, const Material& m, int index, const char* in
     param(o, "string program", programs[static_cast<size_t>(m.program)].source);
     param(o, "integer programdisplaces", static_cast<long long>(m.program_displaces ? 1 : 0));
     param(o, "integer programshades", static_cast<long long>(m.program_shades ? 1 : 0));
+    if (m.program_alpha) param(o, "integer programalpha", static_cast<long long>(1));
     param(o, "float displacementbound", m.displacement_bound);
     if (m.displacement_bound_world) param(o, "integer displacementworld", static_cast<long long>(1));
   }
