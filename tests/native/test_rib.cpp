@@ -394,6 +394,149 @@ TEST(RibLights, HandlesAndIlluminate) {
   EXPECT_EQ(count_warnings(r, "bogus"), 1);
 }
 
+TEST(RibLights, ShadowsOnlyWithAShadowName) {
+  // RenderMan's lights cast shadows through a named shadow map: without a
+  // name (or with an empty one) a light casts none, whatever its type.
+  const mp::RibResult r = parse_world(
+      "LightSource \"pointlight\" 1\n"
+      "LightSource \"pointlight\" 2 \"string shadowname\" [\"\"]\n"
+      "LightSource \"pointlight\" 3 \"string shadowname\" [\"raytrace\"]\n"
+      "LightSource \"spotlight\" 4 \"shadowname\" \"spot.shad\"\n"  // any name, declared or not
+      "LightSource \"distantlight\" 5 \"shadowname\" [\"raytrace\"]\n"
+      "LightSource \"micropoly_arealight\" 6 \"string shadowname\" \"raytrace\"\n"
+      "LightSource \"spotlight\" 7\nLightSource \"distantlight\" 8\nLightSource \"micropoly_arealight\" 9\n"
+      "LightSource \"ambientlight\" 10 \"string shadowname\" \"raytrace\"\n"
+      "LightSource \"ambientlight\" 11 \"string shadowname\" \"raytrace\"\n"
+      "Polygon \"P\" [0 0 0 1 0 0 0 1 0]\n");
+  const auto& L = r.scene.lights;
+  ASSERT_EQ(L.size(), 11u);
+  const bool casts[] = {false, false, true, true, true, true, false, false, false, false, false};
+  for (size_t i = 0; i < L.size(); ++i) EXPECT_EQ(L[i].cast_shadows, casts[i]) << "light " << i + 1;
+  // Ambient light has no shadows: its shadowname is ignored with one warning.
+  EXPECT_EQ(count_warnings(r, "\"shadowname\" is ignored"), 1);
+  EXPECT_EQ(r.warnings.size(), 1u);
+}
+
+TEST(RibLights, SizeForSoftShadows) {
+  const mp::RibResult r = parse_world(
+      "LightSource \"pointlight\" 1 \"float micropoly:radius\" [0.25] \"integer micropoly:softfalloff\" [0]\n"
+      "LightSource \"spotlight\" 2 \"float micropoly:radius\" 1.5 \"integer micropoly:softfalloff\" 1\n"
+      "LightSource \"distantlight\" 3 \"float micropoly:angle\" [0.0093]\n"
+      "LightSource \"pointlight\" 4\nLightSource \"spotlight\" 5\nLightSource \"distantlight\" 6\n"
+      // Parameters of another light type are ignored with a warning.
+      "LightSource \"pointlight\" 7 \"float micropoly:angle\" [0.5]\n"
+      "LightSource \"distantlight\" 8 \"float micropoly:radius\" [2]\n"
+      "LightSource \"micropoly_arealight\" 9 \"float micropoly:radius\" [2]\n"
+      "Polygon \"P\" [0 0 0 1 0 0 0 1 0]\n");
+  const auto& L = r.scene.lights;
+  ASSERT_EQ(L.size(), 9u);
+  EXPECT_EQ(L[0].radius, 0.25f);
+  EXPECT_FALSE(L[0].soft_falloff);
+  EXPECT_EQ(L[1].radius, 1.5f);
+  EXPECT_TRUE(L[1].soft_falloff);
+  EXPECT_EQ(L[2].angle, 0.0093f);
+  // Defaults: a point, with soft falloff; a sun of no size.
+  for (size_t i : {3u, 4u}) {
+    EXPECT_EQ(L[i].radius, 0.0f) << i;
+    EXPECT_TRUE(L[i].soft_falloff) << i;
+  }
+  EXPECT_EQ(L[5].angle, 0.0f);
+  EXPECT_EQ(L[6].angle, 0.0f);
+  EXPECT_EQ(L[7].radius, 0.0f);
+  EXPECT_EQ(L[8].radius, 0.0f);
+  EXPECT_EQ(count_warnings(r, "\"micropoly:angle\" is ignored"), 1);
+  EXPECT_EQ(count_warnings(r, "\"micropoly:radius\" is ignored"), 2);  // once per light shader
+  EXPECT_EQ(r.warnings.size(), 3u);
+}
+
+// --- ray visibility -------------------------------------------------------------------------------
+
+TEST(RibVisibility, CameraAndTransmissionAreScopedAttributes) {
+  const mp::RibResult r = parse_world(
+      "Attribute \"identifier\" \"name\" \"default\"\nPolygon \"P\" [0 0 0 1 0 0 0 1 0]\n"
+      "AttributeBegin\n"
+      "  Attribute \"identifier\" \"name\" \"hidden\"\n"
+      "  Attribute \"visibility\" \"int camera\" [0]\n  Polygon \"P\" [0 0 0 1 0 0 0 1 0]\n"
+      "  AttributeBegin\n"
+      "    Attribute \"identifier\" \"name\" \"neither\"\n"
+      "    Attribute \"visibility\" \"integer transmission\" [0] \"int diffuse\" [1]\n"
+      "    Polygon \"P\" [0 0 0 1 0 0 0 1 0]\n"
+      "  AttributeEnd\n"
+      "  Attribute \"identifier\" \"name\" \"hidden again\"\n  Polygon \"P\" [0 0 0 1 0 0 0 1 0]\n"
+      "  Attribute \"identifier\" \"name\" \"no shadow\"\n"
+      "  Attribute \"visibility\" \"int camera\" 1 \"int transmission\" 0 \"int diffuse\" 0 \"int specular\" 0\n"
+      "  Polygon \"P\" [0 0 0 1 0 0 0 1 0]\n"
+      "AttributeEnd\n"
+      "Attribute \"identifier\" \"name\" \"restored\"\nPolygon \"P\" [0 0 0 1 0 0 0 1 0]\n");
+  struct Expect {
+    const char* name;
+    bool camera, shadows;
+  };
+  const Expect expected[] = {{"default", true, true},     {"hidden", false, true},   {"neither", false, false},
+                             {"hidden again", false, true}, {"no shadow", true, false}, {"restored", true, true}};
+  for (const Expect& e : expected) {
+    const mp::Mesh* m = find_mesh(r.scene, e.name);
+    ASSERT_NE(m, nullptr) << e.name;
+    EXPECT_EQ(m->visible_camera, e.camera) << e.name;
+    EXPECT_EQ(m->cast_shadows, e.shadows) << e.name;
+  }
+  // Other kinds of rays are ignored, with one warning per parameter name.
+  EXPECT_EQ(count_warnings(r, "\"diffuse\" is ignored"), 1);
+  EXPECT_EQ(count_warnings(r, "\"specular\" is ignored"), 1);
+  EXPECT_EQ(r.warnings.size(), 2u);
+}
+
+TEST(RibVisibility, PolygonAndPatchRunsMergeOnlyWithEqualVisibility) {
+  const std::string patch = "Patch \"bilinear\" \"P\" [0 0 0 1 0 0 0 1 0 1 1 0]\n";
+  const mp::RibResult r = parse_world(
+      "Polygon \"P\" [0 0 0 1 0 0 0 1 0]\nPolygon \"P\" [0 0 1 1 0 1 0 1 1]\n"  // one mesh
+      "Attribute \"visibility\" \"int transmission\" [0]\n"
+      "Polygon \"P\" [0 0 2 1 0 2 0 1 2]\nPolygon \"P\" [0 0 3 1 0 3 0 1 3]\n"  // a second one
+      "Attribute \"visibility\" \"int camera\" [0] \"int transmission\" [1]\n"
+      "Polygon \"P\" [0 0 4 1 0 4 0 1 4]\n"  // a third
+      "Attribute \"visibility\" \"int camera\" [0]\n"  // the same state again: still the third
+      "Polygon \"P\" [0 0 5 1 0 5 0 1 5]\n" +
+      patch + patch + "Attribute \"visibility\" \"int camera\" [1]\n" + patch);
+  const mp::Scene& s = r.scene;
+  ASSERT_EQ(s.meshes.size(), 3u);
+  EXPECT_EQ(s.meshes[0].face_vertex_counts.size(), 2u);
+  EXPECT_TRUE(s.meshes[0].visible_camera && s.meshes[0].cast_shadows);
+  EXPECT_EQ(s.meshes[1].face_vertex_counts.size(), 2u);
+  EXPECT_TRUE(s.meshes[1].visible_camera);
+  EXPECT_FALSE(s.meshes[1].cast_shadows);
+  EXPECT_EQ(s.meshes[2].face_vertex_counts.size(), 2u);
+  EXPECT_FALSE(s.meshes[2].visible_camera);
+  EXPECT_TRUE(s.meshes[2].cast_shadows);
+  ASSERT_EQ(s.bezier_patches.size(), 2u);
+  EXPECT_EQ(s.bezier_patches[0].control_points.size(), 32u);
+  EXPECT_FALSE(s.bezier_patches[0].visible_camera);
+  EXPECT_TRUE(s.bezier_patches[0].cast_shadows);
+  EXPECT_EQ(s.bezier_patches[1].control_points.size(), 16u);
+  EXPECT_TRUE(s.bezier_patches[1].visible_camera);
+  EXPECT_TRUE(r.warnings.empty());
+}
+
+TEST(RibVisibility, InstancesTakeTheVisibilityWhereTheyAreInstanced) {
+  // As Sides and the material: the state at ObjectInstance applies, and a
+  // visibility set inside the definition does not.
+  const mp::RibResult r = parse_world(
+      "ObjectBegin \"thing\"\n"
+      "  Attribute \"visibility\" \"int camera\" [0] \"int transmission\" [0]\n"
+      "  Polygon \"P\" [0 0 0 1 0 0 0 1 0]\n"
+      "ObjectEnd\n"
+      "ObjectInstance \"thing\"\n"
+      "AttributeBegin\nAttribute \"visibility\" \"int transmission\" [0]\nObjectInstance \"thing\"\nAttributeEnd\n"
+      "AttributeBegin\nAttribute \"visibility\" \"int camera\" [0]\nObjectInstance \"thing\"\nAttributeEnd\n");
+  const mp::Scene& s = r.scene;
+  ASSERT_EQ(s.meshes.size(), 3u);
+  EXPECT_TRUE(s.meshes[0].visible_camera);
+  EXPECT_TRUE(s.meshes[0].cast_shadows);
+  EXPECT_TRUE(s.meshes[1].visible_camera);
+  EXPECT_FALSE(s.meshes[1].cast_shadows);
+  EXPECT_FALSE(s.meshes[2].visible_camera);
+  EXPECT_TRUE(s.meshes[2].cast_shadows);
+}
+
 // --- the complete request set ----------------------------------------------------------------
 
 TEST(RibAllRequests, EveryRequestLandsInTheScene) {

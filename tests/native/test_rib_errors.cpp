@@ -169,6 +169,51 @@ TEST(RibErrors, HandlesAndStructure) {
   expect_error("WorldBegin\nLightSource \"pointlight\" 1 \"from\" [1 1]\n", 2, "multiple of 3");
 }
 
+// Each error names the line of the offending parameter, not the request's.
+TEST(RibErrors, LightShadowParameters) {
+  expect_error("WorldBegin\nLightSource \"pointlight\" 1\n  \"float micropoly:radius\" [-0.5]\n", 3,
+               "\"micropoly:radius\" must be a finite number >= 0");
+  expect_error("WorldBegin\nLightSource \"spotlight\" 1 \"intensity\" 2\n\n  \"micropoly:radius\" -1\n", 4,
+               "micropoly:radius");
+  expect_error("WorldBegin\nLightSource \"spotlight\" 1 \"float micropoly:radius\" [1 2]\n", 2,
+               "\"micropoly:radius\" expects 1 number");
+  expect_error("WorldBegin\nLightSource \"distantlight\" 1\n  \"float micropoly:angle\" [3.1416]\n", 3,
+               "\"micropoly:angle\" must be an angle in [0, pi]");
+  expect_error("WorldBegin\nLightSource \"distantlight\" 1 \"float micropoly:angle\" [-0.01]\n", 2,
+               "micropoly:angle");
+  expect_error("WorldBegin\nLightSource \"pointlight\" 1\n\"integer micropoly:softfalloff\" [2]\n", 3,
+               "\"micropoly:softfalloff\" expects one integer in [0, 1]");
+  expect_error("WorldBegin\nLightSource \"spotlight\" 1 \"micropoly:softfalloff\" [0.5]\n", 2,
+               "micropoly:softfalloff");
+  expect_error("WorldBegin\nLightSource \"pointlight\" 1\n  \"shadowname\" [1]\n", 3,
+               "\"shadowname\" expects strings");
+  expect_error("WorldBegin\nLightSource \"distantlight\" 1\n  \"float shadowname\" [1]\n", 3,
+               "\"shadowname\" expects one string");
+  expect_error("WorldBegin\nLightSource \"micropoly_arealight\" 1 \"shadowname\" [\"a\" \"b\"]\n", 2,
+               "\"shadowname\" expects one string");
+}
+
+TEST(RibErrors, VisibilityValues) {
+  expect_error("WorldBegin\nAttribute \"visibility\"\n  \"int camera\" [2]\n", 3,
+               "\"camera\" expects one integer in [0, 1]");
+  expect_error("WorldBegin\nAttribute \"visibility\" \"int camera\" [1]\n  \"int transmission\" [-1]\n", 3,
+               "\"transmission\" expects one integer in [0, 1]");
+  expect_error("WorldBegin\nAttribute \"visibility\" \"transmission\" [0.5]\n", 2, "transmission");
+  expect_error("WorldBegin\nAttribute \"visibility\" \"string transmission\" [\"opaque\"]\n", 2, "transmission");
+}
+
+TEST(RibErrors, ShadowOptionsAndProgramAlpha) {
+  expect_error("Option \"micropoly\" \"integer shadows\" [2]\n", 1, "\"shadows\" expects one integer in [0, 1]");
+  expect_error("Option \"micropoly\" \"integer shadows\" [1]\n  \"float shadowmemory\" [0]\n", 2,
+               "\"shadowmemory\" must be a positive number of MiB");
+  expect_error("Option \"micropoly\" \"float shadowmemory\" [-64]\n", 1, "shadowmemory");
+  expect_error("Option \"micropoly\"\n\"float shadowshadingrate\" [0]\n", 2, "\"shadowshadingrate\" must be");
+  expect_error("Option \"micropoly\" \"float shadowshadingrate\" [-1]\n", 1, "shadowshadingrate");
+  expect_error("WorldBegin\nAttribute \"micropoly\" \"integer material\" [1] \"string program\" [\"x\"]\n"
+               "  \"integer programalpha\" [3]\n",
+               3, "\"programalpha\" expects one integer in [0, 1]");
+}
+
 TEST(RibErrors, Archives) {
   expect_error("WorldBegin\nReadArchive \"does_not_exist.rib\"\n", 2, "cannot read");
   expect_error("ReadArchive \"/dev/zero\"\n", 1, "not a regular file");

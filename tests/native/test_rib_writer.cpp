@@ -62,6 +62,9 @@ void expect_same_settings(const RenderSettings& a, const RenderSettings& b) {
   EXPECT_EQ(a.max_split_depth, b.max_split_depth);
   EXPECT_EQ(a.backface_culling, b.backface_culling);
   EXPECT_EQ(a.depth_and_normal_passes, b.depth_and_normal_passes);
+  EXPECT_EQ(a.shadows, b.shadows);
+  EXPECT_EQ(a.shadow_memory_mib, b.shadow_memory_mib);
+  EXPECT_EQ(a.shadow_shading_rate, b.shadow_shading_rate);
 }
 
 void expect_same_camera(const Camera& a, const Camera& b) {
@@ -110,17 +113,34 @@ void expect_same_material(const Material& a, const Material& b) {
   if (a.program >= 0) {
     EXPECT_EQ(a.program_displaces, b.program_displaces);
     EXPECT_EQ(a.program_shades, b.program_shades);
+    EXPECT_EQ(a.program_alpha, b.program_alpha);
     EXPECT_EQ(a.displacement_bound, b.displacement_bound);
     EXPECT_EQ(a.displacement_bound_world, b.displacement_bound_world);
   }
+}
+
+// Bit for bit (EXPECT_EQ takes -0 for 0).
+void expect_same_bits(float a, float b) {
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(std::signbit(a), std::signbit(b)) << a << " " << b;
 }
 
 void expect_same_light(const Light& a, const Light& b) {
   EXPECT_EQ(a.type, b.type);
   EXPECT_EQ(a.color, b.color);
   EXPECT_EQ(a.intensity, b.intensity);
-  if (a.type == Light::Type::Ambient) return;
+  if (a.type == Light::Type::Ambient) {
+    EXPECT_FALSE(b.cast_shadows);  // ambient light has no shadows to cast
+    return;
+  }
   EXPECT_EQ(a.position, b.position);
+  EXPECT_EQ(a.cast_shadows, b.cast_shadows);
+  // The size for soft shadows, of the types that have one.
+  if (a.type == Light::Type::Point || a.type == Light::Type::Spot) {
+    expect_same_bits(a.radius, b.radius);
+    EXPECT_EQ(a.soft_falloff, b.soft_falloff);
+  }
+  if (a.type == Light::Type::Distant) expect_same_bits(a.angle, b.angle);
   if (a.type == Light::Type::Point) return;
   // Unit-length directions come back exactly, others normalised.
   if (std::fabs(glm::length(a.direction) - 1.0f) < 1e-6f) {
@@ -163,6 +183,8 @@ void expect_same_mesh(const Mesh& a, const Mesh& b) {
   EXPECT_EQ(a.face_materials, b.face_materials);
   EXPECT_EQ(a.object_to_world, b.object_to_world);
   EXPECT_EQ(a.double_sided, b.double_sided);
+  EXPECT_EQ(a.visible_camera, b.visible_camera);
+  EXPECT_EQ(a.cast_shadows, b.cast_shadows);
   EXPECT_EQ(a.uv_layers, b.uv_layers);
   EXPECT_EQ(a.corner_normals, b.corner_normals);
   EXPECT_EQ(a.texspace_location, b.texspace_location);
@@ -212,6 +234,8 @@ void expect_same_scene(const Scene& a, const Scene& b) {
     EXPECT_EQ(p.material, q.material);
     EXPECT_EQ(p.object_to_world, q.object_to_world);
     EXPECT_EQ(p.double_sided, q.double_sided);
+    EXPECT_EQ(p.visible_camera, q.visible_camera);
+    EXPECT_EQ(p.cast_shadows, q.cast_shadows);
   }
 }
 
@@ -253,6 +277,8 @@ Scene full_scene() {
   st.max_split_depth = 22;
   st.backface_culling = true;
   st.depth_and_normal_passes = false;
+  st.shadow_memory_mib = 100.3f;  // shadows stay on, so that the render tests see them
+  st.shadow_shading_rate = 2.7f;
 
   s.camera = look_at({1.3f, 2.1f, 7.7f}, {0.1f, 0.2f, 0.0f}, 47.3f);
   s.camera.screen_left = -1.4f, s.camera.screen_right = 1.3f;
@@ -293,12 +319,15 @@ Scene full_scene() {
   sun.intensity = 0.8f;
   sun.position = {3.0f, 9.0f, 1.0f};
   sun.direction = glm::normalize(glm::vec3(-0.3f, -0.5f, -1.0f));
+  sun.angle = 0.0093f;
   s.lights.push_back(sun);
   Light point;
   point.type = Light::Type::Point;
   point.position = {-2.5f, 3.1f, 2.2f};
   point.intensity = 9.0f;
   point.color = {1.0f, 0.8f, 0.6f};
+  point.radius = 0.3f;
+  point.soft_falloff = false;
   s.lights.push_back(point);
   Light spot;
   spot.type = Light::Type::Spot;
@@ -306,6 +335,7 @@ Scene full_scene() {
   spot.direction = glm::vec3(0.0f, -5.0f, -40.0f);  // not normalised
   spot.intensity = 900.0f;
   spot.cone_angle = 0.2f, spot.cone_delta_angle = 0.05f, spot.beam_distribution = 1.5f;
+  spot.radius = 1.0f / 3.0f;
   s.lights.push_back(spot);
   Light rect;
   rect.type = Light::Type::Area;
@@ -323,6 +353,7 @@ Scene full_scene() {
   disk.direction = {0.2f, 0.0f, -1.0f};
   disk.axis_u = {0.0f, 1.0f, 0.0f};
   disk.size_u = 0.9f, disk.size_v = 1.3f;
+  disk.cast_shadows = false;
   s.lights.push_back(disk);
 
   // Catmull-Clark cube: creases, corners, a hole, edge-only boundary, a
@@ -355,6 +386,7 @@ Scene full_scene() {
   mirrored.material = 3;
   mirrored.double_sided = false;
   mirrored.object_to_world = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(-1.8f, 0.3f, 0.5f)), glm::vec3(-0.3f, 0.4f, 0.35f));
+  mirrored.cast_shadows = false;
   s.meshes.push_back(mirrored);
 
   // Catmull-Clark with the other boundary modes and a pentagon.
@@ -368,6 +400,7 @@ Scene full_scene() {
   sheet2.name = "corner sheet";
   sheet2.boundary = BoundaryInterpolation::EdgeAndCorner;
   sheet2.object_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(1.6f, -0.5f, 0.4f));
+  sheet2.visible_camera = false;  // hidden from the camera, still casting shadows
   s.meshes.push_back(sheet2);
   Mesh pentagon;
   pentagon.name = "pentagon";
@@ -398,6 +431,8 @@ Scene full_scene() {
   mirrored_patch.control_points = bezier_net(0.0f, 0.6f);
   mirrored_patch.material = 2;
   mirrored_patch.object_to_world = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(0.3f, 1.8f, 0.0f)), glm::vec3(-0.5f, 0.5f, 0.5f));
+  mirrored_patch.visible_camera = false;
+  mirrored_patch.cast_shadows = false;
   s.bezier_patches.push_back(mirrored_patch);
 
   // Texturing: a material program reads two UV layers, two images (one sRGB
@@ -422,6 +457,7 @@ Scene full_scene() {
   Material textured = material("textured", Material::Model::Principled, glm::vec3(0.5f));
   textured.program = 0;
   textured.program_shades = true;
+  textured.program_alpha = true;
   textured.displacement_bound = 0.25f;
   textured.displacement_bound_world = true;  // written and read back, though this program does not displace
   s.materials.push_back(textured);
@@ -505,6 +541,76 @@ TEST(RibWriter, EveryFilterAndBoundSplitMethod) {
       s.settings.depth_and_normal_passes = true;
       expect_same_settings(s.settings, round_trip(s).settings);
     }
+}
+
+TEST(RibWriter, ShadowFieldsOfEveryLightType) {
+  // Every light type with and without shadows, with sizes that print
+  // inexactly and a negative zero, which must come back as such.
+  for (Light::Type type : {Light::Type::Ambient, Light::Type::Distant, Light::Type::Point, Light::Type::Spot,
+                           Light::Type::Area})
+    for (bool casts : {true, false})
+      for (float size : {0.1f, -0.0f, 0.0f}) {
+        SCOPED_TRACE("type " + std::to_string(static_cast<int>(type)) + (casts ? " casting" : "") + " size " +
+                     std::to_string(size));
+        Scene s = ortho_scene();
+        Light l;
+        l.type = type;
+        l.position = {0.5f, 2.0f, 1.0f};
+        l.direction = {0.0f, -1.0f, 0.0f};
+        l.cast_shadows = casts;
+        l.radius = size;
+        l.angle = size;
+        l.soft_falloff = size != 0.1f;
+        s.lights = {l};
+        const Scene back = round_trip(s);
+        ASSERT_EQ(back.lights.size(), 1u);
+        expect_same_light(l, back.lights[0]);
+        // Sizes a type does not have come back as the defaults.
+        const Light def;
+        if (type != Light::Type::Point && type != Light::Type::Spot) {
+          EXPECT_EQ(back.lights[0].radius, def.radius);
+          EXPECT_EQ(back.lights[0].soft_falloff, def.soft_falloff);
+        }
+        if (type != Light::Type::Distant) EXPECT_EQ(back.lights[0].angle, def.angle);
+      }
+}
+
+TEST(RibWriter, ShadowExtensionsOnlyWhereNotDefault) {
+  // A default scene stays standard RIB but for the shadow name, which is
+  // RenderMan's own way to ask for shadows.
+  Scene s;
+  s.lights.push_back(Light{});
+  s.meshes.push_back(polygon({{0, 0, -2}, {1, 0, -2}, {0, 1, -2}}));
+  Material m;
+  m.program = 0;
+  s.materials.push_back(m);
+  s.material_programs.push_back({"p", "void f() {}"});
+  std::string text = to_rib(s);
+  EXPECT_NE(text.find("\"string shadowname\" [\"raytrace\"]"), std::string::npos) << text;
+  for (const char* name : {"micropoly:radius", "micropoly:softfalloff", "micropoly:angle", "visibility",
+                           "integer shadows", "shadowmemory", "shadowshadingrate", "programalpha"})
+    EXPECT_EQ(text.find(name), std::string::npos) << name << "\n" << text;
+  expect_same_scene(s, round_trip(s));
+
+  // Each one written when set, and read back.
+  s.lights[0].cast_shadows = false;
+  s.settings.shadows = false;
+  s.settings.shadow_memory_mib = 0.1f;
+  s.settings.shadow_shading_rate = 16.5f;
+  s.materials[0].program_alpha = true;
+  s.meshes[0].visible_camera = false;
+  text = to_rib(s);
+  EXPECT_EQ(text.find("shadowname"), std::string::npos) << text;
+  for (const char* written : {"\"integer shadows\" [0]", "\"float shadowmemory\" [0.1]",
+                              "\"float shadowshadingrate\" [16.5]", "\"integer programalpha\" [1]",
+                              "Attribute \"visibility\" \"int camera\" [0] \"int transmission\" [1]"})
+    EXPECT_NE(text.find(written), std::string::npos) << written << "\n" << text;
+  expect_same_scene(s, round_trip(s));
+  s.meshes[0].visible_camera = true;
+  s.meshes[0].cast_shadows = false;
+  text = to_rib(s);
+  EXPECT_NE(text.find("Attribute \"visibility\" \"int camera\" [1] \"int transmission\" [0]"), std::string::npos);
+  expect_same_scene(s, round_trip(s));
 }
 
 TEST(RibWriter, FloatsReadBackExactly) {
@@ -668,6 +774,31 @@ TEST(RibWriterExtensions, PngTexturesAreSrgbAndBottomRowFirst) {
   ASSERT_EQ(im.pixels.size(), 2u);
   EXPECT_EQ(im.pixels[0], glm::vec4(0.0f, 0.0f, std::round(linear_to_srgb(0.2f) * 255.0f) / 255.0f, 1.0f));
   EXPECT_EQ(im.pixels[1], glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
+}
+
+TEST(RibWriterExtensions, ShadowOptionsAndProgramAlpha) {
+  const RibResult r = read_rib_string(
+      "Option \"micropoly\" \"integer shadows\" [0] \"float shadowmemory\" [32.5] \"float shadowshadingrate\" [0.5]\n"
+      "WorldBegin\n"
+      "Attribute \"micropoly\" \"integer material\" 1 \"string program\" \"a\" \"integer programalpha\" 1\n"
+      "Attribute \"micropoly\" \"integer material\" 2 \"string program\" \"a\" \"integer programshades\" 1\n"
+      "WorldEnd\n",
+      "ext.rib");
+  EXPECT_TRUE(r.warnings.empty());
+  const Scene& s = r.scene;
+  EXPECT_FALSE(s.settings.shadows);
+  EXPECT_EQ(s.settings.shadow_memory_mib, 32.5f);
+  EXPECT_EQ(s.settings.shadow_shading_rate, 0.5f);
+  ASSERT_EQ(s.materials.size(), 3u);
+  EXPECT_TRUE(s.materials[1].program_alpha);
+  EXPECT_FALSE(s.materials[2].program_alpha);  // the default
+  EXPECT_TRUE(s.materials[2].program_shades);
+  // Without the option the Scene's defaults stay.
+  const RenderSettings def;
+  const Scene plain = parse("").scene;
+  EXPECT_EQ(plain.settings.shadows, def.shadows);
+  EXPECT_EQ(plain.settings.shadow_memory_mib, def.shadow_memory_mib);
+  EXPECT_EQ(plain.settings.shadow_shading_rate, def.shadow_shading_rate);
 }
 
 TEST(RibWriterExtensions, BadValuesAreErrors) {

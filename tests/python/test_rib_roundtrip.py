@@ -34,6 +34,7 @@ def build_scene():
     st.crop_x0, st.crop_x1, st.crop_y0, st.crop_y1 = 0.1, 0.95, 0.05, 0.9
     st.shading_rate = 0.8
     st.bound_split = _native.BoundSplitMethod.BREADTH
+    st.shadow_memory_mib, st.shadow_shading_rate = 96.0, 2.5
     scene.set_camera(look_at((1.5, 2.0, 7.0), (0.0, 0.3, 0.0)), fov_degrees=42.0, clip_near=0.1, clip_far=100.0,
                      screen_window=[-1.4, 1.3, -1.0, 1.05])
     scene.add_material(name="floor", model="matte", color=[0.6, 0.6, 0.55], ka=0.5, kd=0.9)
@@ -43,10 +44,13 @@ def build_scene():
                        specular_color=[1.0, 0.9, 0.8], opacity=[0.8, 0.8, 0.8])
     scene.add_material(name='lamp "shade"', model="constant", color=[0.2, 0.3, 0.4], emission=[0.5, 0.4, 0.1])
     scene.add_light("ambient", intensity=0.1)
-    scene.add_light("distant", intensity=0.7, direction=[-0.3, -0.6, -1.0])
-    scene.add_light("point", intensity=6.0, position=[-2.0, 3.0, 2.0], color=[1.0, 0.9, 0.7])
+    # Shadows: soft from the sun's angle and the point light's radius (a
+    # sphere), none from the spot light.
+    scene.add_light("distant", intensity=0.7, direction=[-0.3, -0.6, -1.0], angle=0.05)
+    scene.add_light("point", intensity=6.0, position=[-2.0, 3.0, 2.0], color=[1.0, 0.9, 0.7], radius=0.3,
+                    soft_falloff=False)
     scene.add_light("spot", intensity=300.0, position=[0.5, 6.0, 20.0], direction=[-0.5, -6.0, -20.0],
-                    cone_angle=0.25, cone_delta_angle=0.05, beam_distribution=1.5)
+                    cone_angle=0.25, cone_delta_angle=0.05, beam_distribution=1.5, cast_shadows=False)
     # Small, distant and normalised in double precision, as the add-on exports
     # them: the direction must come back bit for bit.
     direction = np.array([-0.35, 0.62, -0.7])
@@ -63,14 +67,16 @@ def build_scene():
                    crease_sharpness=np.array([3.0, 10.0], dtype=np.float32),
                    corner_vertices=np.array([6], dtype=np.int32), corner_sharpness=np.array([2.0], dtype=np.float32),
                    hole_faces=np.array([3], dtype=np.int32), boundary="edge_only")
-    # A single-sided floor of two materials, and a mirrored single-sided box.
+    # A single-sided floor of two materials, and a mirrored single-sided box
+    # that the camera does not see (it still casts shadows).
     floor = np.array([[-3, -0.5, -3], [0, -0.5, -3], [3, -0.5, -3], [-3, -0.5, 3], [0, -0.5, 3], [3, -0.5, 3]],
                      dtype=np.float32)
     scene.add_mesh("floor", floor, np.array([4, 4], dtype=np.int32),
                    np.array([0, 3, 4, 1, 1, 4, 5, 2], dtype=np.int32), material=0,
                    face_materials=np.array([0, 2], dtype=np.int32), double_sided=False)
     scene.add_mesh("mirrored", CUBE_POINTS, np.full(6, 4, dtype=np.int32), CUBE_FACES,
-                   object_to_world=transform((-1.8, 0.0, 0.5), (-0.3, 0.4, 0.35)), material=3, double_sided=False)
+                   object_to_world=transform((-1.8, 0.0, 0.5), (-0.3, 0.4, 0.35)), material=3, double_sided=False,
+                   visible_camera=False)
     scene.validate()
     return scene
 
@@ -86,6 +92,8 @@ def test_written_rib_reads_back_and_renders_the_same(renderer, tmp_path):
     scene.write_rib(str(path))
     back = _native.read_rib(str(path))
     assert (back.mesh_count, back.material_count, back.light_count) == (3, 4, 6)
+    settings = back.settings
+    assert (settings.shadows, settings.shadow_memory_mib, settings.shadow_shading_rate) == (True, 96.0, 2.5)
     a = renderer.render(scene)["rgba"]
     b = renderer.render(back)["rgba"]
     assert a.shape == b.shape == (42, 55, 4)  # the crop window of 64 x 48

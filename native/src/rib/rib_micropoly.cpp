@@ -7,8 +7,11 @@
 //   "uniform integer micropoly:material"  per-face material numbers
 //   "facevarying float[2] micropoly:uvK"  UV layer K of a mesh
 //   "constant float[3] micropoly:texspacelocation" / "...size"  Generated space
+// The light shaders' extensions (a light's size for soft shadows) are read
+// with the lights, in rib_shading.cpp.
 #include <algorithm>
 #include <climits>
+#include <cmath>
 #include <functional>
 #include <initializer_list>
 #include <string>
@@ -21,16 +24,6 @@
 
 namespace mp::rib {
 namespace {
-
-// One integer parameter in [lo, hi]; `out` is unchanged when it is absent.
-void get_int(ArgReader& args, const ParamList& params, const char* name, long long lo, long long hi,
-             int* out) {
-  const Param* p = params.find(name);
-  if (!p) return;
-  if (p->decl.is_string() || p->value->numbers.size() != 1 || !to_int(p->value->numbers[0], lo, hi, out))
-    args.fail_at(p->line, std::string("parameter \"") + name + "\" expects one integer in [" +
-                              std::to_string(lo) + ", " + std::to_string(hi) + "]");
-}
 
 void warn_unknown(const ParamList& params, std::initializer_list<const char*> known,
                   const std::function<void(const std::string&)>& warn) {
@@ -57,18 +50,27 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   if (!(memory > 0.0f)) args.fail("\"boundsplitmemory\" must be a positive number of MiB");
   s.bound_split_memory_mib = memory;
   // Grid size and split depth are clamped by the renderer; any int is kept.
-  get_int(args, params, "maxgridsize", INT_MIN, INT_MAX, &s.max_grid_size);
-  get_int(args, params, "maxsplitdepth", INT_MIN, INT_MAX, &s.max_split_depth);
+  params.get_int("maxgridsize", INT_MIN, INT_MAX, &s.max_grid_size);
+  params.get_int("maxsplitdepth", INT_MIN, INT_MAX, &s.max_split_depth);
   int flag = s.backface_culling ? 1 : 0;
-  get_int(args, params, "backfaceculling", 0, 1, &flag);
+  params.get_int("backfaceculling", 0, 1, &flag);
   s.backface_culling = flag != 0;
   flag = s.depth_and_normal_passes ? 1 : 0;
-  get_int(args, params, "depthandnormal", 0, 1, &flag);
+  params.get_int("depthandnormal", 0, 1, &flag);
   s.depth_and_normal_passes = flag != 0;
+  // Shadow maps: on or off, their device memory and their shading rate.
+  flag = s.shadows ? 1 : 0;
+  params.get_int("shadows", 0, 1, &flag);
+  s.shadows = flag != 0;
+  auto positive = [](float v) { return v > 0.0f && std::isfinite(v); };
+  s.shadow_memory_mib = params.get_float_checked("shadowmemory", s.shadow_memory_mib, positive,
+                                                 "a positive number of MiB");
+  s.shadow_shading_rate = params.get_float_checked("shadowshadingrate", s.shadow_shading_rate, positive,
+                                                   "a positive number");
   const int line = args.request().line;
   warn_unknown(params,
                {"boundsplit", "boundsplitmemory", "maxgridsize", "maxsplitdepth", "backfaceculling",
-                "depthandnormal"},
+                "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate"},
                [&](const std::string& name) {
                  warn_once("option-micropoly:" + name, line,
                            "Option \"micropoly\": parameter \"" + name + "\" is ignored");
@@ -95,7 +97,7 @@ void Parser::read_image_option(ArgReader& args, const ParamList& params) {
   // PNGs hold sRGB-encoded values and EXRs linear ones unless "imagesrgb" says otherwise.
   const std::string ext = path.size() >= 4 ? path.substr(path.size() - 4) : path;
   int srgb = ext == ".png" || ext == ".PNG" ? 1 : 0;
-  get_int(args, params, "imagesrgb", 0, 1, &srgb);
+  params.get_int("imagesrgb", 0, 1, &srgb);
   image.srgb = srgb != 0;
   result_.scene.images.push_back(std::move(image));
 }
@@ -103,7 +105,7 @@ void Parser::read_image_option(ArgReader& args, const ParamList& params) {
 void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
   const int line = args.request().line;
   warn_unknown(params, {"material", "materialname", "program", "programdisplaces", "programshades",
-                        "displacementbound", "displacementworld"}, [&](const std::string& name) {
+                        "programalpha", "displacementbound", "displacementworld"}, [&](const std::string& name) {
     warn_once("attribute-micropoly:" + name, line,
               "Attribute \"micropoly\": parameter \"" + name + "\" is ignored");
   });
@@ -117,7 +119,7 @@ void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
   // material (0 replaces the default surface) or add the next one.
   const long long count = static_cast<long long>(result_.scene.materials.size());
   int index = 0;
-  get_int(args, params, "material", 0, std::min<long long>(count, INT_MAX), &index);
+  params.get_int("material", 0, std::min<long long>(count, INT_MAX), &index);
   // A material program (node tree as OpenCL C), shared by identical sources.
   MaterialProgramUse use;
   const std::string source = params.get_string("program", "");
@@ -127,14 +129,17 @@ void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
     use.program = static_cast<int>(it - programs.begin());
     if (it == programs.end()) programs.push_back({params.get_string("materialname", "material program"), source});
     int flag = 0;
-    get_int(args, params, "programdisplaces", 0, 1, &flag);
+    params.get_int("programdisplaces", 0, 1, &flag);
     use.displaces = flag != 0;
     flag = 0;
-    get_int(args, params, "programshades", 0, 1, &flag);
+    params.get_int("programshades", 0, 1, &flag);
     use.shades = flag != 0;
+    flag = 0;
+    params.get_int("programalpha", 0, 1, &flag);
+    use.alpha = flag != 0;
     use.displacement_bound = params.get_float("displacementbound", 0.0f);
     flag = 0;
-    get_int(args, params, "displacementworld", 0, 1, &flag);
+    params.get_int("displacementworld", 0, 1, &flag);
     use.displacement_world = flag != 0;
     if (!(use.displacement_bound >= 0.0f)) args.fail("\"displacementbound\" must be a non-negative number");
   }
@@ -153,6 +158,7 @@ void Parser::define_material(int index, const std::string& name, const MaterialP
   m.program = use.program;
   m.program_displaces = use.displaces;
   m.program_shades = use.shades;
+  m.program_alpha = use.alpha;
   m.displacement_bound = use.displacement_bound;
   m.displacement_bound_world = use.displacement_world;
   std::vector<Material>& materials = result_.scene.materials;

@@ -135,6 +135,8 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
   const bool merge = prim.mergeable && has_merge_target_ && merge_.kind == prim.kind &&
                      merge_.object_to_world == object_to_world && merge_.material == material &&
                      merge_.double_sided == attrs.double_sided &&
+                     merge_.visible_camera == attrs.visible_camera &&
+                     merge_.cast_shadows == attrs.cast_shadows &&
                      merge_.identifier == attrs.identifier &&
                      merge_.has_identifier == attrs.has_identifier;
   if (prim.kind == Primitive::Kind::Mesh) {
@@ -158,6 +160,8 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
     mesh.object_to_world = object_to_world;
     mesh.material = material;
     mesh.double_sided = attrs.double_sided;
+    mesh.visible_camera = attrs.visible_camera;
+    mesh.cast_shadows = attrs.cast_shadows;
     if (flip) reverse_faces(mesh, 0, 0);
     scene.meshes.push_back(std::move(mesh));
   } else {
@@ -175,6 +179,8 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
     set.object_to_world = object_to_world;
     set.material = material;
     set.double_sided = attrs.double_sided;
+    set.visible_camera = attrs.visible_camera;
+    set.cast_shadows = attrs.cast_shadows;
     if (flip) mirror_patches_u(set.control_points, 0);
     scene.bezier_patches.push_back(std::move(set));
   }
@@ -186,6 +192,8 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
     merge_.object_to_world = object_to_world;
     merge_.material = material;
     merge_.double_sided = attrs.double_sided;
+    merge_.visible_camera = attrs.visible_camera;
+    merge_.cast_shadows = attrs.cast_shadows;
     merge_.identifier = attrs.identifier;
     merge_.has_identifier = attrs.has_identifier;
   }
@@ -229,7 +237,9 @@ void Parser::req_object_instance(ArgReader& args) {
     return;
   }
   if (!in_world_) args.fail("ObjectInstance outside WorldBegin/WorldEnd");
-  // Instances take the attributes (material, sides, orientation) current here.
+  // Instances take the attributes (material, sides, orientation, visibility)
+  // current here, as the RI specification has it; attributes set inside the
+  // definition do not apply to it.
   for (const Primitive& p : prims) add_to_scene(p, attrs_.ctm, attrs_, line);
 }
 

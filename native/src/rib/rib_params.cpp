@@ -109,6 +109,7 @@ DeclarationTable::DeclarationTable() {
     declare(f, decl(VarClass::Uniform, VarType::Float));
   declare("specularcolor", decl(VarClass::Uniform, VarType::Color));
   declare("lightcolor", decl(VarClass::Uniform, VarType::Color));
+  declare("shadowname", decl(VarClass::Uniform, VarType::String));
   declare("from", decl(VarClass::Uniform, VarType::Point));
   declare("to", decl(VarClass::Uniform, VarType::Point));
 }
@@ -186,6 +187,22 @@ std::string ParamList::get_string(const std::string& name, const std::string& fa
   if (!p->decl.is_string() || p->value->strings.size() != 1)
     args_.fail_at(p->line, "parameter \"" + name + "\" expects one string");
   return p->value->strings[0];
+}
+
+void ParamList::get_int(const std::string& name, long long lo, long long hi, int* out) const {
+  const Param* p = find(name);
+  if (!p) return;
+  if (p->decl.is_string() || p->value->numbers.size() != 1 || !to_int(p->value->numbers[0], lo, hi, out))
+    args_.fail_at(p->line, "parameter \"" + name + "\" expects one integer in [" + std::to_string(lo) + ", " +
+                               std::to_string(hi) + "]");
+}
+
+float ParamList::get_float_checked(const std::string& name, float fallback, bool (*valid)(float),
+                                   const std::string& must_be) const {
+  const float v = get_float(name, fallback);
+  const Param* p = find(name);  // absent: the fallback, which callers keep valid
+  if (!valid(v)) args_.fail_at(p ? p->line : args_.request().line, "parameter \"" + name + "\" must be " + must_be);
+  return v;
 }
 
 }  // namespace mp::rib

@@ -63,6 +63,13 @@ class ParamList {
   float get_float(const std::string& name, float fallback) const;
   void get_floats(const std::string& name, float* out, size_t n) const;  // unchanged if absent
   std::string get_string(const std::string& name, const std::string& fallback) const;
+  // One integer in [lo, hi] (an error at the parameter's line otherwise);
+  // `out` is unchanged when the parameter is absent.
+  void get_int(const std::string& name, long long lo, long long hi, int* out) const;
+  // One number for which `valid` holds; otherwise an error at the
+  // parameter's line: parameter "name" must be `must_be`.
+  float get_float_checked(const std::string& name, float fallback, bool (*valid)(float),
+                          const std::string& must_be) const;
 
  private:
   ArgReader& args_;

@@ -469,6 +469,7 @@ void Parser::req_attribute(ArgReader& args) {
     return;
   }
   if (name == "micropoly") return micropoly_attribute(args, params);
+  if (name == "visibility") return visibility_attribute(args, params);
   warn_once("attribute:" + name, args.request().line, "Attribute \"" + name + "\" is ignored");
 }
 

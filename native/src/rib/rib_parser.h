@@ -1,7 +1,8 @@
 // The RIB interpreter: executes requests against a graphics-state stack and
 // fills a Scene. Handlers are split by topic over several files:
 //   rib_parser.cpp    dispatch, blocks, options and camera, archives
-//   rib_transform.cpp transformations and named coordinate systems
+//   rib_transform.cpp transformations, named coordinate systems, orientation,
+//                     sides and visibility
 //   rib_shading.cpp   surfaces, colors, lights, materials
 //   rib_geometry.cpp  polygons, subdivision meshes, patches
 //   rib_objects.cpp   placing primitives in the scene, object instancing
@@ -53,6 +54,10 @@ struct Attributes {
   // flip together under transformations, so only Orientation and
   // ReverseOrientation change this.
   bool inside_out = false;
+  // Attribute "visibility": seen by the camera ("camera"), and casting
+  // shadows ("transmission", RenderMan's shadow rays).
+  bool visible_camera = true;
+  bool cast_shadows = true;
   std::vector<char> lights_on;  // by light index; lights past the end are off
   Basis ubasis, vbasis;
   std::string identifier;       // Attribute "identifier" "name"
@@ -120,6 +125,8 @@ class Parser {
     glm::mat4 object_to_world;
     int material;
     bool double_sided;
+    bool visible_camera;
+    bool cast_shadows;
     std::string identifier;
     bool has_identifier;
   };
@@ -179,6 +186,7 @@ class Parser {
   void req_orientation(ArgReader&);
   void req_reverse_orientation(ArgReader&);
   void req_sides(ArgReader&);
+  void visibility_attribute(ArgReader& args, const ParamList& params);
   glm::mat4 read_matrix(ArgReader& args);
 
   // rib_shading.cpp
@@ -222,7 +230,7 @@ class Parser {
   // The material program a micropoly material attribute names (Material::program).
   struct MaterialProgramUse {
     int program = -1;
-    bool displaces = false, shades = false;
+    bool displaces = false, shades = false, alpha = false;
     float displacement_bound = 0.0f;
     bool displacement_world = false;
   };

@@ -4,7 +4,10 @@
 // Micropoly shader names map to the Scene's own models:
 // "micropoly_principled" (Material::Model::Principled) and
 // "micropoly_arealight" (Light::Type::Area); every surface also takes
-// "color emission". See docs/rib.md.
+// "color emission". Lights cast shadows as RenderMan's shadow-casting lights
+// do: when they name a shadow map ("string shadowname"); their size for soft
+// shadows is a Micropoly extension ("micropoly:radius", "micropoly:angle").
+// See docs/rib.md.
 #include <cfloat>
 #include <cmath>
 #include <functional>
@@ -27,6 +30,26 @@ void warn_unknown_params(const ParamList& params, std::initializer_list<const ch
   }
 }
 
+bool non_negative(float v) { return v >= 0.0f && std::isfinite(v); }
+bool angular_diameter(float v) { return v >= 0.0f && v <= glm::pi<float>(); }
+
+// RenderMan's lights cast shadows through a shadow map named by
+// "shadowname"; Micropoly makes its own maps, so any name turns shadows on
+// (the writer writes "raytrace") and its absence, as on the standard
+// lights, keeps a file rendering without them.
+void read_shadow_name(const ParamList& params, Light& light) {
+  light.cast_shadows = !params.get_string("shadowname", "").empty();
+}
+
+// The size of a point or spot light (Light::radius) and whether it is a disk
+// facing the lit point (soft falloff, the default) or a sphere.
+void read_light_radius(const ParamList& params, Light& light) {
+  light.radius = params.get_float_checked("micropoly:radius", 0.0f, non_negative, "a finite number >= 0");
+  int soft = 1;
+  params.get_int("micropoly:softfalloff", 0, 1, &soft);
+  light.soft_falloff = soft != 0;
+}
+
 }  // namespace
 
 std::vector<float> Parser::material_key(const Material& m) {
@@ -39,7 +62,7 @@ std::vector<float> Parser::material_key(const Material& m) {
           m.emission.x, m.emission.y, m.emission.z,
           m.metallic, m.specular, static_cast<float>(m.program), m.displacement_bound,
           static_cast<float>(m.program_displaces), static_cast<float>(m.program_shades),
-          static_cast<float>(m.displacement_bound_world)};
+          static_cast<float>(m.displacement_bound_world), static_cast<float>(m.program_alpha)};
 }
 
 int Parser::material_index(const Attributes& attrs) {
@@ -177,18 +200,29 @@ void Parser::req_light_source(ArgReader& args) {
     light.color = glm::vec3(1.0f);
     params.get_floats("lightcolor", &light.color.x, 3);
     glm::vec3 from(0.0f), to(0.0f, 0.0f, 1.0f);
+    // Ambient light casts no shadows (it has no "shadowname").
+    light.cast_shadows = false;
+    if (light.type != Light::Type::Ambient) read_shadow_name(params, light);
     switch (light.type) {
       case Light::Type::Ambient:
         warn_unknown_params(params, {"intensity", "lightcolor"}, what, warn_param);
         break;
       case Light::Type::Point:
         params.get_floats("from", &from.x, 3);
-        warn_unknown_params(params, {"intensity", "lightcolor", "from"}, what, warn_param);
+        read_light_radius(params, light);
+        warn_unknown_params(params,
+                            {"intensity", "lightcolor", "from", "shadowname", "micropoly:radius",
+                             "micropoly:softfalloff"},
+                            what, warn_param);
         break;
       case Light::Type::Distant:
         params.get_floats("from", &from.x, 3);
         params.get_floats("to", &to.x, 3);
-        warn_unknown_params(params, {"intensity", "lightcolor", "from", "to"}, what, warn_param);
+        // The sun's angular diameter, in radians.
+        light.angle = params.get_float_checked("micropoly:angle", 0.0f, angular_diameter,
+                                               "an angle in [0, pi] radians");
+        warn_unknown_params(params, {"intensity", "lightcolor", "from", "to", "shadowname", "micropoly:angle"},
+                            what, warn_param);
         break;
       case Light::Type::Spot:
         params.get_floats("from", &from.x, 3);
@@ -198,9 +232,10 @@ void Parser::req_light_source(ArgReader& args) {
         light.cone_angle = params.get_float("coneangle", glm::radians(30.0f));
         light.cone_delta_angle = params.get_float("conedeltaangle", glm::radians(5.0f));
         light.beam_distribution = params.get_float("beamdistribution", 2.0f);
+        read_light_radius(params, light);
         warn_unknown_params(params,
-                            {"intensity", "lightcolor", "from", "to", "coneangle",
-                             "conedeltaangle", "beamdistribution"},
+                            {"intensity", "lightcolor", "from", "to", "coneangle", "conedeltaangle",
+                             "beamdistribution", "shadowname", "micropoly:radius", "micropoly:softfalloff"},
                             what, warn_param);
         break;
       case Light::Type::Area: {
@@ -222,7 +257,8 @@ void Parser::req_light_source(ArgReader& args) {
         light.size_v = params.get_float("height", 1.0f);
         if (!(light.size_u >= 0.0f && light.size_v >= 0.0f)) args.fail("negative area light size");
         warn_unknown_params(params,
-                            {"intensity", "lightcolor", "from", "to", "shape", "axis", "width", "height"},
+                            {"intensity", "lightcolor", "from", "to", "shape", "axis", "width", "height",
+                             "shadowname"},
                             what, warn_param);
         break;
       }

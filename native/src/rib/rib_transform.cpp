@@ -1,4 +1,5 @@
-// Transformations, named coordinate systems, orientation and sides.
+// Transformations, named coordinate systems, orientation, sides and ray
+// visibility.
 //
 // RenderMan transforms row vectors (p' = p M) and concatenates new
 // transformations in front of the current one (CTM' = M CTM), so the last
@@ -122,6 +123,22 @@ void Parser::req_sides(ArgReader& args) {
   const int sides = args.integer(1, 2);
   args.done();
   attrs_.double_sided = sides == 2;
+}
+
+void Parser::visibility_attribute(ArgReader& args, const ParamList& params) {
+  // RenderMan's ray visibility: "camera" (seen by the camera) and
+  // "transmission" (blocks shadow rays, i.e. casts shadows). The other kinds
+  // of rays ("diffuse", "specular", "photon", ...) have no counterpart here.
+  int camera = attrs_.visible_camera ? 1 : 0;
+  params.get_int("camera", 0, 1, &camera);
+  int transmission = attrs_.cast_shadows ? 1 : 0;
+  params.get_int("transmission", 0, 1, &transmission);
+  attrs_.visible_camera = camera != 0;
+  attrs_.cast_shadows = transmission != 0;
+  for (const Param& p : params.params())
+    if (p.name != "camera" && p.name != "transmission")
+      warn_once("attribute-visibility:" + p.name, args.request().line,
+                "Attribute \"visibility\": parameter \"" + p.name + "\" is ignored");
 }
 
 }  // namespace mp::rib

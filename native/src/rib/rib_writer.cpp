@@ -166,6 +166,12 @@ void param(std::string& out, const char* name, std::string_view v) {
   out += ']';
 }
 
+// True when `v` is not `def` bit for bit (-0 differs from 0): extensions
+// are written only when they differ from the reader's default, so that
+// plain scenes stay standard RIB, and a value that differs in any bit is
+// written so that it comes back exactly.
+bool differs(float v, float def) { return v != def || std::signbit(v) != std::signbit(def); }
+
 // --- scene parts --------------------------------------------------------------------
 
 const char* filter_name(PixelFilter f) {
@@ -187,6 +193,13 @@ void write_options(std::string& o, const RenderSettings& s) {
   param(o, "integer maxsplitdepth", static_cast<long long>(s.max_split_depth));
   param(o, "integer backfaceculling", static_cast<long long>(s.backface_culling ? 1 : 0));
   param(o, "integer depthandnormal", static_cast<long long>(s.depth_and_normal_passes ? 1 : 0));
+  // Shadow settings, only when they differ from the defaults (the reader's
+  // and the Scene's are the same).
+  const RenderSettings def;
+  if (s.shadows != def.shadows) param(o, "integer shadows", static_cast<long long>(s.shadows ? 1 : 0));
+  if (differs(s.shadow_memory_mib, def.shadow_memory_mib)) param(o, "float shadowmemory", s.shadow_memory_mib);
+  if (differs(s.shadow_shading_rate, def.shadow_shading_rate))
+    param(o, "float shadowshadingrate", s.shadow_shading_rate);
   o += '\n';
 }
 
@@ -247,6 +260,22 @@ void write_image_and_camera(std::string& o, const Scene& scene) {
   o += '\n';
 }
 
+// Shadows as RenderMan's lights ask for them, by naming a shadow map: any
+// name will do for the reader, and "raytrace" is what other renderers take
+// as "trace shadow rays". The light's size for soft shadows is an extension,
+// written when it is not the default. Ambient lights cast no shadows and
+// have no size.
+void write_light_shadows(std::string& o, const Light& l) {
+  if (l.type == Light::Type::Ambient) return;
+  if (l.cast_shadows) param(o, "string shadowname", "raytrace");
+  if (l.type == Light::Type::Point || l.type == Light::Type::Spot) {
+    if (differs(l.radius, 0.0f)) param(o, "float micropoly:radius", l.radius);
+    if (!l.soft_falloff) param(o, "integer micropoly:softfalloff", static_cast<long long>(0));
+  } else if (l.type == Light::Type::Distant && differs(l.angle, 0.0f)) {
+    param(o, "float micropoly:angle", l.angle);
+  }
+}
+
 void write_light(std::string& o, const Light& l, int handle) {
   // Lights with a direction are declared at the origin of a translated frame
   // with "to" = the direction: the reader takes the direction as the
@@ -290,6 +319,7 @@ void write_light(std::string& o, const Light& l, int handle) {
     param(o, "float width", l.size_u);
     param(o, "float height", l.size_v);
   }
+  write_light_shadows(o, l);
   o += directed ? "\nTransformEnd\n" : "\n";
 }
 
@@ -341,28 +371,42 @@ void write_material(std::string& o, const Material& m, int index, const char* in
     param(o, "string program", programs[static_cast<size_t>(m.program)].source);
     param(o, "integer programdisplaces", static_cast<long long>(m.program_displaces ? 1 : 0));
     param(o, "integer programshades", static_cast<long long>(m.program_shades ? 1 : 0));
+    if (m.program_alpha) param(o, "integer programalpha", static_cast<long long>(1));
     param(o, "float displacementbound", m.displacement_bound);
     if (m.displacement_bound_world) param(o, "integer displacementworld", static_cast<long long>(1));
   }
   o += '\n';
 }
 
-// Name, placement, sides and material: what a mesh and a patch set share.
-void write_object_state(std::string& o, const std::string& name, const glm::mat4& object_to_world,
-                        bool double_sided, const std::vector<Material>& materials, int material,
+// Ray visibility as RenderMan's attribute ("transmission" rays are its
+// shadow rays), only for an object that is hidden from one of them.
+void write_visibility(std::string& o, bool visible_camera, bool cast_shadows) {
+  if (visible_camera && cast_shadows) return;
+  o += "  Attribute \"visibility\"";
+  param(o, "int camera", static_cast<long long>(visible_camera ? 1 : 0));
+  param(o, "int transmission", static_cast<long long>(cast_shadows ? 1 : 0));
+  o += '\n';
+}
+
+// Name, placement, sides, visibility and material: what a mesh and a patch
+// set share.
+template <typename Object>
+void write_object_state(std::string& o, const Object& object, const std::vector<Material>& materials,
                         const std::vector<MaterialProgram>& programs) {
   o += "  Attribute \"identifier\"";
-  param(o, "name", name);
+  param(o, "name", object.name);
   o += "\n  Transform ";
-  put_matrix(o, object_to_world);
-  o += double_sided ? "\n  Sides 2\n" : "\n  Sides 1\n";
+  put_matrix(o, object.object_to_world);
+  o += object.double_sided ? "\n  Sides 2\n" : "\n  Sides 1\n";
+  write_visibility(o, object.visible_camera, object.cast_shadows);
+  const int material = object.material;
   write_material(o, materials[static_cast<size_t>(material)], material, "  ", programs);
 }
 
 void write_mesh(std::string& o, const Mesh& m, const std::vector<Material>& materials,
                 const std::vector<MaterialProgram>& programs) {
   o += "AttributeBegin\n";
-  write_object_state(o, m.name, m.object_to_world, m.double_sided, materials, m.material, programs);
+  write_object_state(o, m, materials, programs);
   if (m.scheme == SubdivScheme::CatmullClark) {
     o += "  SubdivisionMesh \"catmull-clark\" ";
     put_ints(o, m.face_vertex_counts);
@@ -444,7 +488,7 @@ void write_patches(std::string& o, const BezierPatches& b, const std::vector<Mat
   // One Patch request per 4x4 net in the default Bezier basis (step 3); the
   // reader joins consecutive patches of one attribute block into one set.
   o += "AttributeBegin\n";
-  write_object_state(o, b.name, b.object_to_world, b.double_sided, materials, b.material, programs);
+  write_object_state(o, b, materials, programs);
   o += "  Basis \"bezier\" 3 \"bezier\" 3\n";
   for (size_t p = 0; p + 16 <= b.control_points.size(); p += 16) {
     o += "  Patch \"bicubic\" \"P\" ";
