@@ -401,11 +401,15 @@ MP_INLINE MpLightShape mp_light_shape(const MP_GLOBAL DeviceShadow* sh, float3 t
   return s;
 }
 
-/* Filter tap k of n: even density over the shape (the spiral, or a 4 x 4
- * grid over a rectangle); `turn` is the spiral's rotation for tap k. */
+/* Filter tap k of n (n = 16): even density over the shape: the spiral over
+ * a disk; over a rectangle the 16 Hammersley points (x = (k + 1/2) / 16, y
+ * its bit-reversed twin), which, unlike a 4 x 4 grid, take 16 different
+ * values along each side, so a shadow edge along either sweeps through 16
+ * steps rather than 4. `turn` is the spiral's rotation for tap k. */
 MP_INLINE float3 mp_filter_tap(const MpLightShape* s, int k, int n, float2 turn) {
   if (s->grid) {
-    float x = ((float)(k & 3) + 0.5f) * 0.5f - 1.0f, y = ((float)((k >> 2) & 3) + 0.5f) * 0.5f - 1.0f;
+    int rev = ((k & 1) << 3) | ((k & 2) << 1) | ((k & 4) >> 1) | ((k & 8) >> 3);
+    float x = ((float)k + 0.5f) / (float)n * 2.0f - 1.0f, y = ((float)rev + 0.5f) / (float)n * 2.0f - 1.0f;
     return x * s->u + y * s->v;
   }
   float r = sqrt(((float)k + 0.5f) / (float)n);
@@ -510,46 +514,58 @@ MP_INLINE float mp_shadow_visibility_light(const MpShadowMaps* in, const MP_GLOB
     return 1.0f;
   }
   MpLightShape shape = mp_light_shape(sh, q);
-  /* Blocker search: occluders between the receiver and (local lights) a
-   * fraction of the way to the light, or (sun) the top of the scene. A tap
-   * at the shape's offset O scaled by s finds an occluder whose own scale
-   * (distance ratio, mp_kernel_point) is r: it stands between the receiver
-   * and the light only if the light point O s / r lies on the light, i.e.
-   * r >= s * reach; others are not counted (they would only widen the
-   * penumbra estimate, the classic fault of percentage-closer soft shadows). */
+  /* Blocker search, in two rounds. The first looks for occluders between
+   * the receiver and (local lights) halfway to the light, or (suns) the top
+   * of the scene; it tells whether any stands near at all and how far off
+   * they are on average. The second searches again over the region those
+   * can shadow (twice their mean scale), where its taps lie denser, and
+   * counts only occluders that stand between the receiver and the light: a
+   * tap at the shape's offset O scaled by s that finds an occluder of scale
+   * (distance ratio, mp_kernel_point) r blocks the light point O s / r,
+   * which is on the light only if r >= s * reach. Occluders off to the side
+   * would only widen the penumbra estimate (the classic fault of
+   * percentage-closer soft shadows). */
   float search_scale = sun ? fmax(sh->z_top - q.z, 0.0f) : MP_SHADOW_SEARCH_SCALE;
-  float search_radius = radius * search_scale;
-  int ls = mp_shadow_level_for_size(sh, q, search_radius, MP_SHADOW_SEARCH_TEXELS, base);
   uint plane_key = 0xffffffffu;
   MpReceiverPlane plane;
-  float found = 0.0f, sum = 0.0f;
-  for (; ls < count; ++ls) {
-    int missing = 0;
-    found = sum = 0.0f;
-    float2 turn = MP_F2(1.0f, 0.0f);
-    for (int k = 0; k < MP_SHADOW_TAPS && !missing; ++k, turn = mp_golden_step(turn)) {
-      float reach;
-      float3 o = mp_search_tap(&shape, k, MP_SHADOW_TAPS, turn, &reach);
-      float3 x = mp_kernel_point(q, o, search_scale);
-      MpShadowMap m = mp_shadow_map_at(in, sh, x, ls);
-      float3 r = mp_shadow_project(&m, x);
-      mp_plane_for(&m, q, n, r.z, &plane_key, &plane);
-      float b = bias * mp_shadow_texel_size(&m, r.z) + MP_SHADOW_SOFT_BIAS * length(o) * search_scale;
-      float ratio;
-      if (mp_shadow_blocker(in, &m, &plane, r.x, r.y, r.z, b, sun, search_scale * reach, &ratio, &missing)) {
-        found += 1.0f;
-        sum += ratio;
+  float found = 0.0f, sum = 0.0f, first = 0.0f;
+  for (int round = 0; round < 2; ++round) {
+    int ls = mp_shadow_level_for_size(sh, q, radius * search_scale, MP_SHADOW_SEARCH_TEXELS, base);
+    for (; ls < count; ++ls) {
+      int missing = 0;
+      found = sum = 0.0f;
+      float2 turn = MP_F2(1.0f, 0.0f);
+      for (int k = 0; k < MP_SHADOW_TAPS && !missing; ++k, turn = mp_golden_step(turn)) {
+        float reach;
+        float3 o = mp_search_tap(&shape, k, MP_SHADOW_TAPS, turn, &reach);
+        float3 x = mp_kernel_point(q, o, search_scale);
+        MpShadowMap m = mp_shadow_map_at(in, sh, x, ls);
+        float3 r = mp_shadow_project(&m, x);
+        mp_plane_for(&m, q, n, r.z, &plane_key, &plane);
+        float b = bias * mp_shadow_texel_size(&m, r.z) + MP_SHADOW_SOFT_BIAS * length(o) * search_scale;
+        float ratio;
+        if (mp_shadow_blocker(in, &m, &plane, r.x, r.y, r.z, b, sun, round ? search_scale * reach : 0.0f, &ratio,
+                              &missing)) {
+          found += 1.0f;
+          sum += ratio;
+        }
       }
+      if (!missing) break;
     }
-    if (!missing) break;
+    if (round == 0) {
+      if (ls >= count || !(found > 0.0f)) return 1.0f;
+      first = sum / found;
+      search_scale = fmin(search_scale, 2.0f * first);
+    }
   }
-  if (ls >= count || !(found > 0.0f)) return 1.0f;
   if (found >= (float)MP_SHADOW_TAPS - 1e-3f) return 0.0f;
+  /* Where the denser search finds none (the outer penumbra, where occluders
+   * hide a sliver of the light), the first estimate stands. */
+  float scale = found > 0.0f ? sum / found : first;
   /* The penumbra kernel: the light's shape scaled by the mean occluder's
    * distance, filtered where it spans a few texels, blended between the two
    * levels around that size so that the filter does not jump from one to
    * the next across a penumbra. */
-  float scale = sum / found;
   float size = radius * scale / MP_SHADOW_FILTER_TEXELS;
   float level;
   if (sun) {

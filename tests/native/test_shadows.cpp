@@ -372,6 +372,10 @@ TEST_F(ShadowRenderTest, PenumbraWidensWithTheLightsSizeAsSimilarTrianglesSay) {
     s.meshes.push_back(occluder(-20.0f, -20.0f, 0.0f, 20.0f, h));
     std::vector<float> v = visibility(*renderer_, s);
     double w = ramp_width(v, kH / 2);
+    if (getenv("MP_PRINT_RAMP")) {
+      for (int x = kW / 2 - 20; x < kW / 2 + 20; ++x) printf("%.2f ", v[size_t(kH / 2) * kW + x]);
+      printf("\n");
+    }
     ASSERT_GT(w, 0.0) << c.what << ": no penumbra crossing on the middle row";
     EXPECT_NEAR(w / c.expected_px, 1.0, 0.15) << c.what << ": " << w << " px against " << c.expected_px;
     // No light in the umbra far under the occluder, all of it far outside.

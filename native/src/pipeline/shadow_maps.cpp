@@ -10,6 +10,8 @@
 #include "pipeline/scene_fingerprint.h"
 
 namespace mp {
+// Host vectors written to the device here live only for the call, so every
+// write blocks until the device has the data.
 namespace {
 
 constexpr size_t kPageBytes = size_t(MP_PAGE_TEXELS) * sizeof(cl_uint);
@@ -38,10 +40,10 @@ void ShadowMaps::upload_records(const ShadowLayout& layout) {
   grow(session_, inputs_.shadows, records_capacity_, layout.shadows.size() * sizeof(DeviceShadow), "shadow records");
   grow(session_, inputs_.levels, levels_capacity_, layout.levels.size() * sizeof(DeviceShadowLevel),
        "shadow level records");
-  q.enqueueWriteBuffer(inputs_.shadows, CL_FALSE, 0, layout.shadows.size() * sizeof(DeviceShadow),
+  q.enqueueWriteBuffer(inputs_.shadows, CL_TRUE, 0, layout.shadows.size() * sizeof(DeviceShadow),
                        layout.shadows.data());
   if (!layout.levels.empty())
-    q.enqueueWriteBuffer(inputs_.levels, CL_FALSE, 0, layout.levels.size() * sizeof(DeviceShadowLevel),
+    q.enqueueWriteBuffer(inputs_.levels, CL_TRUE, 0, layout.levels.size() * sizeof(DeviceShadowLevel),
                          layout.levels.data());
 }
 
@@ -119,7 +121,7 @@ bool ShadowMaps::render_views(const std::vector<FrameParams>& views, const std::
                               const BoundSplitRunner& run, StageTimer& timer) {
   cl::CommandQueue& q = session_.queue();
   grow(session_, masks_, masks_capacity_, masks.size(), "shadow page masks");
-  if (!masks.empty()) q.enqueueWriteBuffer(masks_, CL_FALSE, 0, masks.size(), masks.data());
+  if (!masks.empty()) q.enqueueWriteBuffer(masks_, CL_TRUE, 0, masks.size(), masks.data());
   const FrameParams& f = frame.params;
   GridBuffers& grids = stages.grids;
   DiceSink sink = [&](const cl::Buffer& diceable, cl_uint count) {
@@ -151,7 +153,7 @@ bool ShadowMaps::render_views(const std::vector<FrameParams>& views, const std::
   for (size_t first = 0; first < views.size(); first += MP_MAX_PASS_VIEWS) {
     const size_t count = std::min<size_t>(MP_MAX_PASS_VIEWS, views.size() - first);
     grow(session_, views_, views_capacity_, MP_MAX_PASS_VIEWS * sizeof(FrameParams), "shadow views");
-    q.enqueueWriteBuffer(views_, CL_FALSE, 0, count * sizeof(FrameParams), views.data() + first);
+    q.enqueueWriteBuffer(views_, CL_TRUE, 0, count * sizeof(FrameParams), views.data() + first);
     PassViews pass;
     pass.views = views_;
     pass.count = cl_uint(count);
@@ -261,10 +263,10 @@ bool ShadowMaps::render(const Scene& scene, const FrameSetup& frame, const Scene
   cl::CommandQueue& q = session_.queue();
   ensure_pool(pool_.extent());
   grow(session_, inputs_.pages, pages_capacity_, table.size() * sizeof(cl_uint), "shadow page tables");
-  q.enqueueWriteBuffer(inputs_.pages, CL_FALSE, 0, table.size() * sizeof(cl_uint), table.data());
+  q.enqueueWriteBuffer(inputs_.pages, CL_TRUE, 0, table.size() * sizeof(cl_uint), table.data());
   if (!fresh.empty()) {
     grow(session_, clear_list_, clear_capacity_, fresh.size() * sizeof(cl_uint), "shadow page list");
-    q.enqueueWriteBuffer(clear_list_, CL_FALSE, 0, fresh.size() * sizeof(cl_uint), fresh.data());
+    q.enqueueWriteBuffer(clear_list_, CL_TRUE, 0, fresh.size() * sizeof(cl_uint), fresh.data());
     const cl_uint texels = cl_uint(fresh.size() * MP_PAGE_TEXELS);
     clear_.setArg(0, clear_list_);
     clear_.setArg(1, texels);
