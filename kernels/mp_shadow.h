@@ -352,7 +352,9 @@ MP_INLINE int mp_shadow_blocker(const MpShadowMaps* in, const MpShadowMap* m, co
 /* Soft shadows' taps lie off the receiver, where its tangent plane leaves
  * a curved surface: their bias grows by this fraction of their distance. */
 #define MP_SHADOW_SOFT_BIAS 0.05f
-/* Taps of the blocker search and of the soft filter. */
+/* Taps of the blocker search's first round (which most receivers, seeing
+ * no occluder, end with), of its second round and of the soft filter. */
+#define MP_SHADOW_PROBE_TAPS 8
 #define MP_SHADOW_TAPS 16
 /* The blocker search reaches occluders up to halfway from the receiver to a
  * local light (the search kernel is the light's shape scaled by f / (1 - f)
@@ -535,9 +537,10 @@ MP_INLINE float mp_shadow_visibility_light(const MpShadowMaps* in, const MP_GLOB
       int missing = 0;
       found = sum = 0.0f;
       float2 turn = MP_F2(1.0f, 0.0f);
-      for (int k = 0; k < MP_SHADOW_TAPS && !missing; ++k, turn = mp_golden_step(turn)) {
+      const int taps = round ? MP_SHADOW_TAPS : MP_SHADOW_PROBE_TAPS;
+      for (int k = 0; k < taps && !missing; ++k, turn = mp_golden_step(turn)) {
         float reach;
-        float3 o = mp_search_tap(&shape, k, MP_SHADOW_TAPS, turn, &reach);
+        float3 o = mp_search_tap(&shape, k, taps, turn, &reach);
         float3 x = mp_kernel_point(q, o, search_scale);
         MpShadowMap m = mp_shadow_map_at(in, sh, x, ls);
         float3 r = mp_shadow_project(&m, x);

@@ -100,8 +100,10 @@ def sun(scene):
 
 
 def render_both(scene, w=W, h=H, samples=16, cycles_samples=16):
-    mp = ru.render_passes(scene, "MICROPOLY", w, h, samples=samples)
+    # Cycles' settings first: they switch the lights' shadows off for both
+    # renderers (this file is about displacement; test_shadows.py about shadows).
     ru.setup_cycles(scene, samples=cycles_samples)
+    mp = ru.render_passes(scene, "MICROPOLY", w, h, samples=samples)
     cy = ru.render_passes(scene, "CYCLES", w, h, samples=cycles_samples)
     return mp, cy
 

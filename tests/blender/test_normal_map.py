@@ -98,8 +98,8 @@ def sun(scene):
 def compare(scene, label, camera, target):
     ru.add_camera(scene, camera, target, lens=45)
     sun(scene)
+    ru.setup_cycles(scene, samples=16)  # shadows off for both renderers: test_shadows.py covers them
     mp = ru.render_passes(scene, "MICROPOLY", W, H, samples=16)
-    ru.setup_cycles(scene, samples=16)
     cy = ru.render_passes(scene, "CYCLES", W, H, samples=16)
     both = (mp["rgba"][..., 3] > 0.99) & (cy["rgba"][..., 3] > 0.99)
     value = ru.psnr(mp["rgba"][..., :3][both], cy["rgba"][..., :3][both])

@@ -194,6 +194,10 @@ struct RenderSettings {
   bool shadows = true;
   float shadow_memory_mib = 256.0f;
   float shadow_shading_rate = 4.0f;
+  // A renderer keeps shadow pages whose light and geometry did not change
+  // for its next frames (the viewport's redraws); off, every frame renders
+  // its shadow maps anew (benchmarks).
+  bool keep_shadow_pages = true;
 };
 
 struct Scene {

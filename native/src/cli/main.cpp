@@ -17,14 +17,16 @@ namespace {
 const char* kUsage =
     "usage: micropoly-render SCENE.rib -o OUT.(png|exr) [--spp N] [--shading-rate R]\n"
     "                        [--device cpu|gpu|INDEX] [--bound-split bounded|breadth]\n"
-    "                        [--bound-split-memory MIB] [--stats FILE.json] [--repeat N]\n"
+    "                        [--bound-split-memory MIB] [--shadows on|off] [--shadow-memory MIB]\n"
+    "                        [--fresh-shadows] [--stats FILE.json] [--repeat N]\n"
     "       micropoly-render --list-devices\n";
 
 struct Options {
-  std::string scene, output, device, stats, bound_split;
+  std::string scene, output, device, stats, bound_split, shadows;
   int spp = 0, repeat = 1;
-  float shading_rate = 0, memory_mib = 0;
+  float shading_rate = 0, memory_mib = 0, shadow_memory_mib = 0;
   bool list_devices = false;
+  bool fresh_shadows = false;  // every --repeat frame renders its shadow maps anew
 };
 
 [[noreturn]] void usage_error(const std::string& why) {
@@ -59,6 +61,11 @@ Options parse(int argc, char** argv) {
       o.bound_split = value();
       if (o.bound_split != "bounded" && o.bound_split != "breadth") usage_error("--bound-split is bounded or breadth");
     } else if (a == "--bound-split-memory") o.memory_mib = static_cast<float>(parse_number(a, value(), 0.01, 1 << 20));
+    else if (a == "--shadows") {
+      o.shadows = value();
+      if (o.shadows != "on" && o.shadows != "off") usage_error("--shadows is on or off");
+    } else if (a == "--shadow-memory") o.shadow_memory_mib = static_cast<float>(parse_number(a, value(), 1, 1 << 20));
+    else if (a == "--fresh-shadows") o.fresh_shadows = true;
     else if (a == "--stats") o.stats = value();
     else if (a == "--repeat") o.repeat = static_cast<int>(parse_number(a, value(), 1, 10000));
     else if (a == "--list-devices") o.list_devices = true;
@@ -98,6 +105,9 @@ int main(int argc, char** argv) {
     if (!o.bound_split.empty())
       scene.settings.bound_split = o.bound_split == "breadth" ? mp::BoundSplitMethod::Breadth : mp::BoundSplitMethod::Bounded;
     if (o.memory_mib > 0) scene.settings.bound_split_memory_mib = o.memory_mib;
+    if (!o.shadows.empty()) scene.settings.shadows = o.shadows == "on";
+    if (o.shadow_memory_mib > 0) scene.settings.shadow_memory_mib = o.shadow_memory_mib;
+    if (o.fresh_shadows) scene.settings.keep_shadow_pages = false;
     // Only EXR files hold the Depth and Normal passes.
     auto dot = output.find_last_of('.');
     std::string ext = dot == std::string::npos ? "" : output.substr(dot + 1);

@@ -88,6 +88,13 @@ bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, const
                    [&](size_t a, size_t b) { return layout.maps[a].coarseness > layout.maps[b].coarseness; });
   keys.clear();
   entries.clear();
+  if (getenv("MP_DEBUG_PAGES")) {
+    for (const ShadowMapInfo& m : layout.maps) {
+      size_t c = 0;
+      for (int k = 0; k < m.side * m.side; ++k) c += requested[m.table + k] ? 1 : 0;
+      if (c) fprintf(stderr, "light %d map %d side %d: %zu pages\n", m.light, m.map_id, m.side, c);
+    }
+  }
   for (size_t i : order) {
     const ShadowMapInfo& m = layout.maps[i];
     for (int sy = 0; sy < m.side; ++sy)
@@ -193,8 +200,9 @@ bool ShadowMaps::render(const Scene& scene, const FrameSetup& frame, const Scene
     if (pool_.resident() == 0) pool_pages_ = std::min<uint32_t>(pool_pages_, uint32_t(capacity));
   }
   std::unordered_set<uint64_t> present;
-  for (uint64_t k : layout.light_keys)
-    if (k) present.insert(k);
+  if (settings.keep_shadow_pages)
+    for (uint64_t k : layout.light_keys)
+      if (k) present.insert(k);
   pool_.keep_only(present);
 
   std::vector<ShadowPageKey> keys;
