@@ -50,7 +50,8 @@ __kernel void bs_init_queue(__global SubPatch* queue, uint n, uint patch_count) 
 __kernel void bs_breadth_classify(__global SubPatch* queue, uint n,
                                   __global const float4* points, __global const uint* patch_info,
                                   __global const uint* edges, __global const float4* curves,
-                                  FrameParams f, __global const FrameParams* views, uint view_count,
+                                  __global const float4* patch_bounds, FrameParams f,
+                                  __global const FrameParams* views, uint view_count,
                                   __global const uchar* page_masks, __global uint* decision,
                                   __global uint* dice_flag, __global uint* split_flag) {
   uint i = get_global_id(0);
@@ -61,7 +62,8 @@ __kernel void bs_breadth_classify(__global SubPatch* queue, uint n,
     return;
   }
   SubPatch sp = queue[i];
-  uint d = mp_classify(points, patch_info, edges, curves, &sp, mp_subpatch_view(&sp, f, views, view_count), page_masks);
+  uint d = mp_classify(points, patch_info, edges, curves, patch_bounds, &sp, mp_subpatch_view(&sp, f, views, view_count),
+                       page_masks);
   uint action = MP_DECISION_ACTION(d);
   queue[i] = sp; /* with the edge rates measured here */
   decision[i] = d;
@@ -103,7 +105,7 @@ __kernel void bs_breadth_scatter(__global const SubPatch* queue, uint n, __globa
 
 __kernel void bs_bounded_step(__global const float4* points, __global const uint* patch_info,
                               __global const uint* edges, __global const float4* curves,
-                              uint patch_count, uint root_count, FrameParams f,
+                              __global const float4* patch_bounds, uint patch_count, uint root_count, FrameParams f,
                               __global const FrameParams* views, uint view_count,
                               __global const uchar* page_masks, __global SubPatch* stacks, __global uint* stack_sizes, uint stack_depth,
                               __global SubPatch* ring, uint ring_capacity,
@@ -129,7 +131,8 @@ __kernel void bs_bounded_step(__global const float4* points, __global const uint
       }
     }
     SubPatch sp = stack[--size];
-    uint d = mp_classify(points, patch_info, edges, curves, &sp, mp_subpatch_view(&sp, f, views, view_count), page_masks);
+    uint d = mp_classify(points, patch_info, edges, curves, patch_bounds, &sp,
+                         mp_subpatch_view(&sp, f, views, view_count), page_masks);
     uint action = MP_DECISION_ACTION(d);
     if (action == MP_DICE) {
       uint slot = atomic_inc(&counters[BS_DICE_COUNT]);

@@ -148,10 +148,10 @@ MP_INLINE void mp_project_range(float xl, float xh, float dl, float dh, float a,
 /* Camera-space boxes [lo[k], hi[k]] as boxes of the view's space: each
  * box's centre moves, its half extents go through |rotation| (exact for
  * boxes that are points, as Bezier nets' are). */
-MP_INLINE void mp_boxes_to_view(float3* lo, float3* hi, FrameParams f) {
+MP_INLINE void mp_boxes_to_view(float3* lo, float3* hi, int count, FrameParams f) {
   if (!f.has_view) return;
   const float* m = f.view;
-  for (int k = 0; k < 16; ++k) {
+  for (int k = 0; k < count; ++k) {
     float3 c = mp_to_view(0.5f * (lo[k] + hi[k]), f), h = 0.5f * (hi[k] - lo[k]);
     float3 e = MP_F3(fabs(m[0]) * h.x + fabs(m[1]) * h.y + fabs(m[2]) * h.z,
                      fabs(m[4]) * h.x + fabs(m[5]) * h.y + fabs(m[6]) * h.z,
@@ -162,18 +162,18 @@ MP_INLINE void mp_boxes_to_view(float3* lo, float3* hi, FrameParams f) {
 }
 
 /* Raster/depth bound of view-space boxes. Only meaningful when dmin > 0 (or ortho). */
-MP_INLINE MpBound mp_bound_boxes(const float3* lo, const float3* hi, FrameParams f) {
+MP_INLINE MpBound mp_bound_boxes(const float3* lo, const float3* hi, int count, FrameParams f) {
   MpBound b;
   b.dmin = 3.0e38f;
   b.dmax = -3.0e38f;
-  for (int k = 0; k < 16; ++k) {
+  for (int k = 0; k < count; ++k) {
     b.dmin = fmin(b.dmin, -hi[k].z);
     b.dmax = fmax(b.dmax, -lo[k].z);
   }
   b.xmin = b.ymin = 3.0e38f;
   b.xmax = b.ymax = -3.0e38f;
   if (!f.ortho && b.dmin <= f.eye_epsilon) return b;
-  for (int k = 0; k < 16; ++k) {
+  for (int k = 0; k < count; ++k) {
     float dl = -hi[k].z, dh = -lo[k].z, l, h;
     mp_project_range(lo[k].x, hi[k].x, dl, dh, f.ax, f.bx, f.ortho, &l, &h);
     b.xmin = fmin(b.xmin, l);
@@ -379,6 +379,45 @@ MP_INLINE int mp_page_mask_overlaps(const MP_GLOBAL uchar* mask, int side, float
   return 0;
 }
 
+/* Largest a * x + c * d over view-space boxes (d = -z), for a side plane
+ * of a perspective view's frustum through the eye. */
+MP_INLINE float mp_boxes_plane_max(const float3* lo, const float3* hi, int count, float a, float c) {
+  float m = -3.0e38f;
+  for (int k = 0; k < count; ++k)
+    m = fmax(m, fmax(a * lo[k].x, a * hi[k].x) + fmax(-c * hi[k].z, -c * lo[k].z));
+  return m;
+}
+
+/* Whether view-space boxes lie wholly outside one side of a perspective
+ * view's frustum (plus the ribbon): the side planes pass through the eye, so
+ * the test holds for boxes that reach behind it too, which the raster bound
+ * cannot judge. rx >= -r is ax x + (bx + r) d >= 0, rx <= w + r is
+ * (w + r - bx) d - ax x >= 0, and likewise in y. */
+MP_INLINE int mp_boxes_beside_frustum(const float3* lo, const float3* hi, int count, FrameParams f) {
+  float r = f.ribbon;
+  return mp_boxes_plane_max(lo, hi, count, f.ax, f.bx + r) < 0.0f ||
+         mp_boxes_plane_max(lo, hi, count, -f.ax, (float)f.width + r - f.bx) < 0.0f ||
+         mp_boxes_plane_max(lo, hi, count, f.ay, f.by + r) < 0.0f ||
+         mp_boxes_plane_max(lo, hi, count, -f.ay, (float)f.height + r - f.by) < 0.0f;
+}
+
+/* Whether view-space boxes with bound b lie outside the view: beyond its
+ * clipping planes, beside its frustum, outside its frame (plus the ribbon),
+ * or (shadow views) outside every page it renders; boxes that reach the eye
+ * plane inside the frustum are kept while they can still be split. */
+MP_INLINE int mp_bound_culled(MpBound b, const float3* lo, const float3* hi, int count, FrameParams f,
+                              const MP_GLOBAL uchar* page_masks, int can_split) {
+  if (b.dmax < f.clip_near || b.dmin > f.clip_far) return 1;
+  int straddles = !f.ortho && b.dmin <= f.eye_epsilon;
+  if (straddles) return !can_split || mp_boxes_beside_frustum(lo, hi, count, f);
+  if (b.xmax < -f.ribbon || b.ymax < -f.ribbon || b.xmin > (float)f.width + f.ribbon ||
+      b.ymin > (float)f.height + f.ribbon)
+    return 1;
+  return f.view_kind == MP_VIEW_SHADOW && page_masks &&
+         !mp_page_mask_overlaps(page_masks + f.page_mask, f.page_side, b.xmin - f.ribbon, b.ymin - f.ribbon,
+                                b.xmax + f.ribbon, b.ymax + f.ribbon);
+}
+
 /* The bound & split decision for one sub-patch: cull, dice (with grid size)
  * or split across edges 0 and 2 (MP_SPLIT_U) or 1 and 3 (MP_SPLIT_V). Rates of
  * edges measured here are stored into *sp for its children or its dicing. A
@@ -386,31 +425,32 @@ MP_INLINE int mp_page_mask_overlaps(const MP_GLOBAL uchar* mask, int side, float
  * same diced set. The view is f's (the camera or a shadow map); shadow views
  * also cull what lies under none of their rendered pages (page_masks). */
 MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint* patch_info,
-                           const MP_GLOBAL uint* edges, const MP_GLOBAL float4* curves, SubPatch* sp,
-                           FrameParams f, const MP_GLOBAL uchar* page_masks) {
+                           const MP_GLOBAL uint* edges, const MP_GLOBAL float4* curves,
+                           const MP_GLOBAL float4* patch_bounds, SubPatch* sp, FrameParams f,
+                           const MP_GLOBAL uchar* page_masks) {
   const MP_GLOBAL float4* cp = points + (ulong)sp->patch * MP_PATCH_POINTS;
   uint type = patch_info[4 * (ulong)sp->patch];
   /* Ray visibility: objects hidden from the camera still cast shadows, and
    * objects that cast none stay out of the lights' views. */
   uint flags = patch_info[4 * (ulong)sp->patch + 2];
   if (flags & (f.view_kind == MP_VIEW_SHADOW ? MP_PATCH_NO_SHADOW : MP_PATCH_NO_CAMERA)) return MP_CULL;
-  float3 lo[16], hi[16];
-  mp_subpatch_hull(cp, type, sp, lo, hi);
-  mp_boxes_to_view(lo, hi, f);
-  MpBound b = mp_bound_boxes(lo, hi, f);
   uint depth = MP_INFO_DEPTH(sp->info);
   int can_split = (int)depth < f.max_depth;
-
-  if (b.dmax < f.clip_near || b.dmin > f.clip_far) return MP_CULL;
+  /* Whole patches meet the view through their box first: a pass over many
+   * views (shadow maps) sees most patches outside most views, and a box is
+   * far cheaper to bound than the net. */
+  if (depth == 0u && patch_bounds) {
+    float3 blo = MP_XYZ(patch_bounds[2 * (ulong)sp->patch]), bhi = MP_XYZ(patch_bounds[2 * (ulong)sp->patch + 1]);
+    mp_boxes_to_view(&blo, &bhi, 1, f);
+    MpBound bb = mp_bound_boxes(&blo, &bhi, 1, f);
+    if (mp_bound_culled(bb, &blo, &bhi, 1, f, page_masks, can_split)) return MP_CULL;
+  }
+  float3 lo[16], hi[16];
+  mp_subpatch_hull(cp, type, sp, lo, hi);
+  mp_boxes_to_view(lo, hi, 16, f);
+  MpBound b = mp_bound_boxes(lo, hi, 16, f);
+  if (mp_bound_culled(b, lo, hi, 16, f, page_masks, can_split)) return MP_CULL;
   int straddles = !f.ortho && b.dmin <= f.eye_epsilon;
-  if (straddles && !can_split) return MP_CULL;
-  if (!straddles && (b.xmax < -f.ribbon || b.ymax < -f.ribbon || b.xmin > (float)f.width + f.ribbon ||
-                     b.ymin > (float)f.height + f.ribbon))
-    return MP_CULL;
-  if (!straddles && f.view_kind == MP_VIEW_SHADOW && page_masks &&
-      !mp_page_mask_overlaps(page_masks + f.page_mask, f.page_side, b.xmin - f.ribbon, b.ymin - f.ribbon,
-                             b.xmax + f.ribbon, b.ymax + f.ribbon))
-    return MP_CULL;
 
   /* Rate every edge that has none yet; score = length in target edges. */
   uint codes[4];

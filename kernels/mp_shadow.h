@@ -495,6 +495,64 @@ MP_INLINE void mp_plane_for(const MpShadowMap* m, float3 q, float3 n, float qdep
   }
 }
 
+/* The blocker search runs in two rounds. The first looks for occluders
+ * between the receiver and (local lights) halfway to the light, or (suns)
+ * the top of the scene; it tells whether any stands near at all and how far
+ * off they are on average. The second searches again over the region those
+ * can shadow (twice their mean scale), where its taps lie denser, and
+ * counts only occluders that stand between the receiver and the light: a
+ * tap at the shape's offset O scaled by s that finds an occluder of scale
+ * (distance ratio, mp_kernel_point) r blocks the light point O s / r,
+ * which is on the light only if r >= s * reach. Occluders off to the side
+ * would only widen the penumbra estimate (the classic fault of
+ * percentage-closer soft shadows). */
+MP_INLINE float mp_first_search_scale(const MP_GLOBAL DeviceShadow* sh, float3 q) {
+  return sh->kind == MP_SHADOW_SUN ? fmax(sh->z_top - q.z, 0.0f) : MP_SHADOW_SEARCH_SCALE;
+}
+
+/* One round (0 or 1) of the search at kernel scale s: the occluders found
+ * (*found, their ratios' *sum and the *nearest ratio); returns the level it
+ * read, or the level count when no level had its pages. */
+MP_INLINE int mp_blocker_round(const MpShadowMaps* in, const MP_GLOBAL DeviceShadow* sh, const MpLightShape* shape,
+                               float3 q, float3 n, float bias, int base, int round, float s, uint* plane_key,
+                               MpReceiverPlane* plane, float* found, float* sum, float* nearest) {
+  int count = mp_shadow_level_count(sh), sun = sh->kind == MP_SHADOW_SUN;
+  int ls = mp_shadow_level_for_size(sh, q, mp_light_shape_radius(sh) * s, MP_SHADOW_SEARCH_TEXELS, base);
+  for (; ls < count; ++ls) {
+    int missing = 0;
+    *found = *sum = 0.0f;
+    *nearest = 3.0e38f;
+    float2 turn = MP_F2(1.0f, 0.0f);
+    const int taps = round ? MP_SHADOW_TAPS : MP_SHADOW_PROBE_TAPS;
+    for (int k = 0; k < taps && !missing; ++k, turn = mp_golden_step(turn)) {
+      float reach;
+      float3 o = mp_search_tap(shape, k, taps, turn, &reach);
+      float3 x = mp_kernel_point(q, o, s);
+      MpShadowMap m = mp_shadow_map_at(in, sh, x, ls);
+      float3 r = mp_shadow_project(&m, x);
+      mp_plane_for(&m, q, n, r.z, plane_key, plane);
+      float b = bias * mp_shadow_texel_size(&m, r.z) + MP_SHADOW_SOFT_BIAS * length(o) * s;
+      float ratio;
+      if (mp_shadow_blocker(in, &m, plane, r.x, r.y, r.z, b, sun, round ? s * reach : 0.0f, &ratio, &missing)) {
+        *found += 1.0f;
+        *sum += ratio;
+        *nearest = fmin(*nearest, ratio);
+      }
+    }
+    if (!missing) return ls;
+  }
+  return count;
+}
+
+/* The (fractional) level at which a filter kernel of radius `size` (scene
+ * units at q) spans MP_SHADOW_FILTER_TEXELS texels. */
+MP_INLINE float mp_filter_level(const MP_GLOBAL DeviceShadow* sh, float3 q, float size) {
+  size = fmax(size / MP_SHADOW_FILTER_TEXELS, 1e-30f);
+  if (sh->kind == MP_SHADOW_SUN) return log2(size) - (float)sh->level0;
+  float3 a = MP_F3(fabs(q.x), fabs(q.y), fabs(q.z));
+  return log2(fmax(size * (float)(MP_MAP_TEXELS / 2) / fmax(fmax(a.x, fmax(a.y, a.z)), 1e-30f), 1e-30f));
+}
+
 /* Visibility of the light from a receiver at light-space q with geometric
  * normal n, footprint in scene units: 1 lit, 0 in shadow. */
 MP_INLINE float mp_shadow_visibility_light(const MpShadowMaps* in, const MP_GLOBAL DeviceShadow* sh, float3 q, float3 n,
@@ -502,7 +560,6 @@ MP_INLINE float mp_shadow_visibility_light(const MpShadowMaps* in, const MP_GLOB
   int count = mp_shadow_level_count(sh);
   int base = mp_shadow_base_level(sh, q, footprint);
   float bias = mp_shadow_bias_texels(sh, q, n);
-  int sun = sh->kind == MP_SHADOW_SUN;
   float radius = mp_light_shape_radius(sh);
   if (sh->shape == MP_SHADOW_SHAPE_POINT || !(radius > 0.0f)) {
     for (int l = base; l < count; ++l) {
@@ -516,51 +573,16 @@ MP_INLINE float mp_shadow_visibility_light(const MpShadowMaps* in, const MP_GLOB
     return 1.0f;
   }
   MpLightShape shape = mp_light_shape(sh, q);
-  /* Blocker search, in two rounds. The first looks for occluders between
-   * the receiver and (local lights) halfway to the light, or (suns) the top
-   * of the scene; it tells whether any stands near at all and how far off
-   * they are on average. The second searches again over the region those
-   * can shadow (twice their mean scale), where its taps lie denser, and
-   * counts only occluders that stand between the receiver and the light: a
-   * tap at the shape's offset O scaled by s that finds an occluder of scale
-   * (distance ratio, mp_kernel_point) r blocks the light point O s / r,
-   * which is on the light only if r >= s * reach. Occluders off to the side
-   * would only widen the penumbra estimate (the classic fault of
-   * percentage-closer soft shadows). */
-  float search_scale = sun ? fmax(sh->z_top - q.z, 0.0f) : MP_SHADOW_SEARCH_SCALE;
   uint plane_key = 0xffffffffu;
   MpReceiverPlane plane;
-  float found = 0.0f, sum = 0.0f, first = 0.0f;
-  for (int round = 0; round < 2; ++round) {
-    int ls = mp_shadow_level_for_size(sh, q, radius * search_scale, MP_SHADOW_SEARCH_TEXELS, base);
-    for (; ls < count; ++ls) {
-      int missing = 0;
-      found = sum = 0.0f;
-      float2 turn = MP_F2(1.0f, 0.0f);
-      const int taps = round ? MP_SHADOW_TAPS : MP_SHADOW_PROBE_TAPS;
-      for (int k = 0; k < taps && !missing; ++k, turn = mp_golden_step(turn)) {
-        float reach;
-        float3 o = mp_search_tap(&shape, k, taps, turn, &reach);
-        float3 x = mp_kernel_point(q, o, search_scale);
-        MpShadowMap m = mp_shadow_map_at(in, sh, x, ls);
-        float3 r = mp_shadow_project(&m, x);
-        mp_plane_for(&m, q, n, r.z, &plane_key, &plane);
-        float b = bias * mp_shadow_texel_size(&m, r.z) + MP_SHADOW_SOFT_BIAS * length(o) * search_scale;
-        float ratio;
-        if (mp_shadow_blocker(in, &m, &plane, r.x, r.y, r.z, b, sun, round ? search_scale * reach : 0.0f, &ratio,
-                              &missing)) {
-          found += 1.0f;
-          sum += ratio;
-        }
-      }
-      if (!missing) break;
-    }
-    if (round == 0) {
-      if (ls >= count || !(found > 0.0f)) return 1.0f;
-      first = sum / found;
-      search_scale = fmin(search_scale, 2.0f * first);
-    }
-  }
+  float search_scale = mp_first_search_scale(sh, q), found, sum, nearest;
+  if (mp_blocker_round(in, sh, &shape, q, n, bias, base, 0, search_scale, &plane_key, &plane, &found, &sum, &nearest) >=
+          count ||
+      !(found > 0.0f))
+    return 1.0f;
+  float first = sum / found;
+  search_scale = fmin(search_scale, 2.0f * first);
+  mp_blocker_round(in, sh, &shape, q, n, bias, base, 1, search_scale, &plane_key, &plane, &found, &sum, &nearest);
   if (found >= (float)MP_SHADOW_TAPS - 1e-3f) return 0.0f;
   /* Where the denser search finds none (the outer penumbra, where occluders
    * hide a sliver of the light), the first estimate stands. */
@@ -569,15 +591,7 @@ MP_INLINE float mp_shadow_visibility_light(const MpShadowMaps* in, const MP_GLOB
    * distance, filtered where it spans a few texels, blended between the two
    * levels around that size so that the filter does not jump from one to
    * the next across a penumbra. */
-  float size = radius * scale / MP_SHADOW_FILTER_TEXELS;
-  float level;
-  if (sun) {
-    level = log2(fmax(size, 1e-30f)) - (float)sh->level0;
-  } else {
-    float3 a = MP_F3(fabs(q.x), fabs(q.y), fabs(q.z));
-    level = log2(fmax(size * (float)(MP_MAP_TEXELS / 2) / fmax(fmax(a.x, fmax(a.y, a.z)), 1e-30f), 1e-30f));
-  }
-  level = clamp(level, (float)base, (float)(count - 1));
+  float level = clamp(mp_filter_level(sh, q, radius * scale), (float)base, (float)(count - 1));
   int l0 = (int)floor(level);
   float blend = level - (float)l0;
   float result = 0.0f, weight = 0.0f;

@@ -34,46 +34,71 @@ inline void mp_mark_rect(__global uchar* requests, uint table, int side, int ori
     }
 }
 
-/* A sun's pages under the light-space box [lo, hi] of receivers whose
- * pixel footprints lie in [s0, s1]. */
-inline void mp_mark_sun(__global const DeviceShadow* sh, __global const DeviceShadowLevel* levels, float3 lo, float3 hi,
-                        float s0, float s1, __global uchar* requests) {
-  int l0 = mp_sun_level_for(s0) + sh->level_bias, l1 = mp_sun_level_for(s1) + sh->level_bias;
-  if (sh->shape != MP_SHADOW_SHAPE_POINT && sh->size[0] > 0.0f) {
-    /* Soft shadows read coarser levels, up to the blocker search's. */
-    float search = sh->size[0] * fmax(sh->z_top - lo.z, 0.0f);
-    l1 = max(l1, mp_ceil_log2(fmax(search / MP_SHADOW_SEARCH_TEXELS, 1e-30f)));
-  }
-  int count = (int)sh->levels;
-  int i0 = clamp(l0 - sh->level0, 0, count - 1), i1 = clamp(l1 - sh->level0, 0, count - 1);
-  float margin = mp_mark_margin(sh);
-  for (int i = i0; i <= i1; ++i) {
-    __global const DeviceShadowLevel* lv = levels + sh->level_records + (uint)i;
-    float k = 1.0f / lv->texel;
-    mp_mark_rect(requests, lv->page_table, MP_MAP_PAGES, lv->origin_x, lv->origin_y,
-                 (lo.x + lv->offset[0]) * k - margin, (lo.y + lv->offset[1]) * k - margin,
-                 (hi.x + lv->offset[0]) * k + margin, (hi.y + lv->offset[1]) * k + margin);
-  }
+/* The nearest and farthest face depth a light-space box can have (a face
+ * depth is at least a point's distance over sqrt(3)). */
+inline void mp_box_depths(float3 lo, float3 hi, float* near_depth, float* far_depth) {
+  *far_depth = length(fmax(fabs(lo), fabs(hi)));
+  *near_depth = fmax(length(fmax(fmax(lo, -hi), MP_F3(0.0f, 0.0f, 0.0f))) * 0.57735027f, 1e-20f);
 }
 
-/* A local light's cube pages under the light-space box [lo, hi]. */
-inline void mp_mark_cube(__global const DeviceShadow* sh, float3 lo, float3 hi, float s0, float s1,
-                         __global uchar* requests) {
-  float rmax = length(fmax(fabs(lo), fabs(hi)));
-  /* per axis, the box's distance from the light; a face depth is at least r / sqrt(3) */
-  float rmin = fmax(length(fmax(fmax(lo, -hi), MP_F3(0.0f, 0.0f, 0.0f))) * 0.57735027f, 1e-20f);
-  int m0 = mp_cube_mip_for(s0, rmax) + sh->level_bias, m1 = mp_cube_mip_for(s1, rmin) + sh->level_bias;
-  if (sh->shape != MP_SHADOW_SHAPE_POINT) {
-    float search = mp_light_shape_radius(sh) * MP_SHADOW_SEARCH_SCALE;
-    m1 = max(m1, mp_ceil_log2(fmax(search / MP_SHADOW_SEARCH_TEXELS * (float)(MP_MAP_TEXELS / 2) / rmin, 1e-30f)));
+/* The levels (sun: indices from level0; cube: mips) that receivers in the
+ * light-space box [lo, hi] with pixel footprint s read for hard shadows. */
+inline void mp_base_levels(__global const DeviceShadow* sh, float3 lo, float3 hi, float s, int* first, int* last) {
+  if (sh->kind == MP_SHADOW_SUN) {
+    *first = *last = mp_sun_level_for(s) + sh->level_bias - sh->level0;
+    return;
   }
-  m0 = clamp(m0, 0, MP_CUBE_MIPS - 1);
-  m1 = clamp(m1, 0, MP_CUBE_MIPS - 1);
-  for (int m = m0; m <= m1; ++m) {
+  float dn, df;
+  mp_box_depths(lo, hi, &dn, &df);
+  *first = mp_cube_mip_for(s, df) + sh->level_bias;
+  *last = mp_cube_mip_for(s, dn) + sh->level_bias;
+}
+
+/* The levels the first round of a soft light's blocker search reads there
+ * (mp_blocker_round), no finer than the base levels. */
+inline void mp_probe_levels(__global const DeviceShadow* sh, float3 lo, float3 hi, int base_first, int base_last,
+                            int* first, int* last) {
+  float radius = mp_light_shape_radius(sh);
+  int a, b;
+  if (sh->kind == MP_SHADOW_SUN) {
+    float s_near = fmax(sh->z_top - hi.z, 0.0f), s_far = fmax(sh->z_top - lo.z, 0.0f);
+    a = mp_ceil_log2(fmax(radius * s_near / MP_SHADOW_SEARCH_TEXELS, 1e-30f)) - sh->level0;
+    b = mp_ceil_log2(fmax(radius * s_far / MP_SHADOW_SEARCH_TEXELS, 1e-30f)) - sh->level0;
+  } else {
+    float dn, df, texels = radius * MP_SHADOW_SEARCH_SCALE / MP_SHADOW_SEARCH_TEXELS * (float)(MP_MAP_TEXELS / 2);
+    mp_box_depths(lo, hi, &dn, &df);
+    a = mp_ceil_log2(fmax(texels / df, 1e-30f));
+    b = mp_ceil_log2(fmax(texels / dn, 1e-30f));
+  }
+  *first = max(a, base_first);
+  *last = max(b, base_last);
+}
+
+/* Marks the pages of levels [first, last] under the light-space box [lo,
+ * hi], grown by the margin the light's filters need. */
+inline void mp_mark_levels(__global const DeviceShadow* sh, __global const DeviceShadowLevel* levels, float3 lo, float3 hi,
+                           int first, int last, __global uchar* requests) {
+  int count = mp_shadow_level_count(sh);
+  first = clamp(first, 0, count - 1);
+  last = clamp(last, 0, count - 1);
+  float margin = mp_mark_margin(sh);
+  if (sh->kind == MP_SHADOW_SUN) {
+    for (int i = first; i <= last; ++i) {
+      __global const DeviceShadowLevel* lv = levels + sh->level_records + (uint)i;
+      float k = 1.0f / lv->texel;
+      mp_mark_rect(requests, lv->page_table, MP_MAP_PAGES, lv->origin_x, lv->origin_y,
+                   (lo.x + lv->offset[0]) * k - margin, (lo.y + lv->offset[1]) * k - margin,
+                   (hi.x + lv->offset[0]) * k + margin, (hi.y + lv->offset[1]) * k + margin);
+    }
+    return;
+  }
+  float dn, df;
+  mp_box_depths(lo, hi, &dn, &df);
+  for (int m = first; m <= last; ++m) {
     float texels = (float)mp_cube_mip_texels(m);
     /* The margin as scene units at the box's far side. */
-    float margin = mp_mark_margin(sh) * rmax * 2.0f / texels;
-    float3 e = MP_F3(margin, margin, margin);
+    float grow = margin * df * 2.0f / texels;
+    float3 e = MP_F3(grow, grow, grow);
     for (int face = 0; face < 6; ++face) {
       float x0, y0, x1, y1;
       if (!mp_cube_face_box(face, lo - e, hi + e, texels, &x0, &y0, &x1, &y1)) continue;
@@ -83,12 +108,45 @@ inline void mp_mark_cube(__global const DeviceShadow* sh, float3 lo, float3 hi, 
   }
 }
 
-/* Marks, for every light with shadow maps, the pages the receivers of a
- * coarse camera pass need (one work-item per grid vertex, displaced): at
- * the level (mip) whose texels are no larger than the vertex's pixel
- * footprint (mp_shadow.h), under a box around the vertex reaching its
- * neighbours (`reach` pixels). Soft shadows also mark the coarser levels
- * their filters read. */
+/* Whether receivers in the light-space box [lo, hi] can get light at all:
+ * not behind an area light, nor (by the box's bounding sphere: its angle
+ * from the axis, less its angular radius, exceeds the cone's) outside a
+ * spot's cone. */
+inline int mp_box_lit(__global const DeviceShadow* sh, float3 lo, float3 hi) {
+  if (sh->one_sided && lo.z >= 0.0f) return 0;
+  if (sh->cone_cos > -1.5f) {
+    float3 c = 0.5f * (lo + hi);
+    float dist = length(c), rad = 0.5f * length(hi - lo);
+    if (dist > rad) {
+      float cos_axis = -c.z / dist, sin_axis = sqrt(fmax(1.0f - cos_axis * cos_axis, 0.0f));
+      float sin_spread = rad / dist, cos_spread = sqrt(fmax(1.0f - sin_spread * sin_spread, 0.0f));
+      if (cos_axis < cos_spread && cos_axis * cos_spread + sin_axis * sin_spread < sh->cone_cos) return 0;
+    }
+  }
+  return 1;
+}
+
+/* The grid vertex a marking work-item handles, its light-space box (reach
+ * pixels wide around it) for light sh and its pixel footprint; 0 for a
+ * vertex behind the camera or one the light cannot reach. */
+inline int mp_marking_box(__global const DeviceShadow* sh, float3 p, FrameParams f, float reach, float3* q, float3* lo,
+                          float3* hi, float* s) {
+  float d = -p.z;
+  if (!f.ortho && !(d > 0.0f)) return 0;
+  *s = mp_pixel_footprint(d, f);
+  float r = reach * *s;
+  *q = mp_xform_point(sh->to_light, p);
+  *lo = *q - MP_F3(r, r, r);
+  *hi = *q + MP_F3(r, r, r);
+  return sh->kind == MP_SHADOW_SUN || mp_box_lit(sh, *lo, *hi);
+}
+
+/* First marking, for every light with shadow maps (one work-item per grid
+ * vertex of a coarse camera pass, displaced): the pages of the level (mip)
+ * whose texels are no larger than the vertex's pixel footprint (mp_shadow.h)
+ * for hard shadows, and of the first blocker search round's levels for soft
+ * ones, under a box around the vertex reaching its neighbours (`reach`
+ * pixels). */
 __kernel void mark_shadow_pages(__global const SubPatch* diceable, uint count, __global const uint* vertex_offsets,
                                 FrameParams f, __global const float4* grid_p, __global const DeviceShadow* shadows,
                                 __global const DeviceShadowLevel* levels, uint light_count,
@@ -99,32 +157,60 @@ __kernel void mark_shadow_pages(__global const SubPatch* diceable, uint count, _
   ulong index;
   if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
   float3 p = grid_p[index].xyz;
-  float d = -p.z;
-  if (!f.ortho && !(d > 0.0f)) return;
-  float s = mp_pixel_footprint(d, f);
-  float r = reach * s;
   for (uint l = 0; l < light_count; ++l) {
     __global const DeviceShadow* sh = shadows + l;
     if (sh->kind == MP_SHADOW_NONE) continue;
-    float3 q = mp_xform_point(sh->to_light, p);
-    float3 lo = q - MP_F3(r, r, r), hi = q + MP_F3(r, r, r);
-    if (sh->kind == MP_SHADOW_SUN) {
-      mp_mark_sun(sh, levels, lo, hi, s, s, requests);
+    float3 q, lo, hi;
+    float s;
+    if (!mp_marking_box(sh, p, f, reach, &q, &lo, &hi, &s)) continue;
+    int first, last;
+    mp_base_levels(sh, lo, hi, s, &first, &last);
+    if (sh->shape != MP_SHADOW_SHAPE_POINT) mp_probe_levels(sh, lo, hi, first, last, &first, &last);
+    mp_mark_levels(sh, levels, lo, hi, first, last, requests);
+  }
+}
+
+/* Second marking, for soft shadows, on the maps the first rendered: where
+ * a vertex's first search round finds occluders, the levels the second
+ * round and the penumbra filter can read there, from the nearest
+ * occluder's (the narrowest penumbra, the finest level) to the coarsest;
+ * receivers that see no occluder read nothing more. */
+__kernel void mark_soft_shadow_pages(__global const SubPatch* diceable, uint count, __global const uint* vertex_offsets,
+                                     FrameParams f, __global const float4* grid_p, __global const float4* grid_n,
+                                     __global const DeviceShadow* shadows, __global const DeviceShadowLevel* levels,
+                                     uint light_count, __global const uint* pages, __global const uint* pool,
+                                     __global uchar* requests, float reach) {
+  uint gid = get_global_id(0), i, j;
+  SubPatch sp;
+  float2 uv;
+  ulong index;
+  if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
+  float3 p = grid_p[index].xyz, n = grid_n[index].xyz;
+  MpShadowMaps maps = {shadows, levels, pages, pool};
+  for (uint l = 0; l < light_count; ++l) {
+    __global const DeviceShadow* sh = shadows + l;
+    if (sh->kind == MP_SHADOW_NONE || sh->shape == MP_SHADOW_SHAPE_POINT) continue;
+    float3 q, lo, hi;
+    float s;
+    if (!mp_marking_box(sh, p, f, reach, &q, &lo, &hi, &s)) continue;
+    float3 nq = mp_xform_dir(sh->to_light, n);
+    int base = mp_shadow_base_level(sh, q, s);
+    MpLightShape shape = mp_light_shape(sh, q);
+    uint plane_key = 0xffffffffu;
+    MpReceiverPlane plane;
+    float s1 = mp_first_search_scale(sh, q), found, sum, nearest;
+    int count_levels = mp_shadow_level_count(sh);
+    if (mp_blocker_round(&maps, sh, &shape, q, nq, mp_shadow_bias_texels(sh, q, nq), base, 0, s1, &plane_key, &plane,
+                         &found, &sum, &nearest) >= count_levels ||
+        !(found > 0.0f))
       continue;
-    }
-    /* Receivers the light cannot reach need no pages: behind an area
-     * light, or outside a spot's cone (by the box's bounding sphere: its
-     * angle from the axis, less its angular radius, exceeds the cone's). */
-    if (sh->one_sided && lo.z >= 0.0f) continue;
-    if (sh->cone_cos > -1.5f) {
-      float dist = length(q), rad = 1.7320508f * r;
-      if (dist > rad) {
-        float cos_axis = -q.z / dist, sin_axis = sqrt(fmax(1.0f - cos_axis * cos_axis, 0.0f));
-        float sin_spread = rad / dist, cos_spread = sqrt(fmax(1.0f - sin_spread * sin_spread, 0.0f));
-        if (cos_axis < cos_spread && cos_axis * cos_spread + sin_axis * sin_spread < sh->cone_cos) continue;
-      }
-    }
-    mp_mark_cube(sh, lo, hi, s, s, requests);
+    float radius = mp_light_shape_radius(sh);
+    float s2 = fmin(s1, 2.0f * sum / found);
+    int second = mp_shadow_level_for_size(sh, q, radius * s2, MP_SHADOW_SEARCH_TEXELS, base);
+    int finest = (int)floor(mp_filter_level(sh, q, radius * nearest));
+    int first, last;
+    mp_base_levels(sh, lo, hi, s, &first, &last);
+    mp_mark_levels(sh, levels, lo, hi, max(first, min(finest, second)), count_levels - 1, requests);
   }
 }
 

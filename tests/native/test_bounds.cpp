@@ -32,7 +32,7 @@ Checked check_scene(const Scene& scene) {
     float v0 = std::min({sp.corner[1], sp.corner[3], sp.corner[5], sp.corner[7]});
     float v1 = std::max({sp.corner[1], sp.corner[3], sp.corner[5], sp.corner[7]});
     mp_subpatch_net_boxes(cp, type, u0, v0, u1, v1, lo, hi);
-    MpBound bound = mp_bound_boxes(lo, hi, f);
+    MpBound bound = mp_bound_boxes(lo, hi, 16, f);
     glm::vec3 box_lo(3e38f), box_hi(-3e38f);
     for (int k = 0; k < 16; ++k) box_lo = glm::min(box_lo, lo[k]), box_hi = glm::max(box_hi, hi[k]);
     for (size_t k = 0; k < g.p.size(); ++k) {

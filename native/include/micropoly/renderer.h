@@ -27,11 +27,12 @@ std::vector<DeviceInfo> list_devices();
 // building and transfer), `readback` (wall time of resolve plus the copy of
 // the image to the host) and `total` (wall time of the whole render call).
 // shadow_mark: marking the shadow pages the camera needs; shadow: rendering
-// the lights' views (their bound & split, dicing and sampling); shadows_wall:
-// wall time of both with the host's allocation between them.
+// the lights' views, the sum of its bound & split, dicing (with displacement
+// and alpha) and sampling; shadows_wall: wall time of marking and rendering
+// with the host's page allocation between them.
 struct StageTimings {
   double upload = 0, bound_split = 0, dice = 0, shade = 0, sample = 0, resolve = 0, readback = 0, total = 0;
-  double shadow_mark = 0, shadow = 0, shadows_wall = 0;
+  double shadow_mark = 0, shadow = 0, shadow_bound_split = 0, shadow_dice = 0, shadow_sample = 0, shadows_wall = 0;
 };
 
 // Shadow maps of one light (kernels/mp_shadow.h).

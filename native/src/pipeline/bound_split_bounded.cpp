@@ -69,21 +69,25 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
     step.setArg(2, ctx.scene.patch_edges);
     step.setArg(3, ctx.scene.edge_curves);
     const cl_uint root_count = ctx.root_count();
-    step.setArg(4, ctx.scene.patch_count);
-    step.setArg(5, root_count);
-    step.setArg(6, ctx.frame);
-    step.setArg(7, ctx.views.views);
-    step.setArg(8, ctx.views.count);
-    step.setArg(9, ctx.views.page_masks);
-    step.setArg(10, ws.stacks);
-    step.setArg(11, ws.sizes);
-    step.setArg(12, stack_depth);
-    step.setArg(13, ws.ring);
-    step.setArg(14, ring_capacity);
-    step.setArg(18, ws.diceable);
-    step.setArg(19, dice_capacity);
-    step.setArg(20, ws.counters);
-    step.setArg(21, kStepsPerLaunch);
+    cl_uint arg = 4;
+    step.setArg(arg++, ctx.scene.patch_bounds);
+    step.setArg(arg++, ctx.scene.patch_count);
+    step.setArg(arg++, root_count);
+    step.setArg(arg++, ctx.frame);
+    step.setArg(arg++, ctx.views.views);
+    step.setArg(arg++, ctx.views.count);
+    step.setArg(arg++, ctx.views.page_masks);
+    step.setArg(arg++, ws.stacks);
+    step.setArg(arg++, ws.sizes);
+    step.setArg(arg++, stack_depth);
+    step.setArg(arg++, ws.ring);
+    step.setArg(arg++, ring_capacity);
+    const cl_uint kHeadArg = arg;  // head, tail and the donation limit change per launch
+    arg += 3;
+    step.setArg(arg++, ws.diceable);
+    step.setArg(arg++, dice_capacity);
+    step.setArg(arg++, ws.counters);
+    step.setArg(arg++, kStepsPerLaunch);
 
     auto whole_groups = [&](size_t n) { return std::min(workers, std::max<size_t>(64, (n + 63) / 64 * 64)); };
     // More workers than a few dice batches' worth would mostly hold work they
@@ -94,10 +98,10 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
     for (;;) {
       cl_uint c[kCounters] = {head, tail, next_root, dice_count, 0, 0, 0, 0};
       queue.enqueueWriteBuffer(ws.counters, CL_FALSE, 0, sizeof c, c);
-      step.setArg(15, head);
-      step.setArg(16, tail);
+      step.setArg(kHeadArg, head);
+      step.setArg(kHeadArg + 1, tail);
       // Hand out at most as many children as there will be idle workers.
-      step.setArg(17, hungry);
+      step.setArg(kHeadArg + 2, hungry);
       cl::Event e;
       queue.enqueueNDRangeKernel(step, cl::NullRange, cl::NDRange(launch), cl::NDRange(64), nullptr, &e);
       ctx.timer.add(Stage::BoundSplit, e);

@@ -64,6 +64,8 @@ std::string RenderStats::to_json() const {
        ", \"dice\": " + num(timings_ms.dice) + ", \"shade\": " + num(timings_ms.shade) + ", \"sample\": " +
        num(timings_ms.sample) + ", \"resolve\": " + num(timings_ms.resolve) + ", \"readback\": " + num(timings_ms.readback) +
        ", \"shadow_mark\": " + num(timings_ms.shadow_mark) + ", \"shadow\": " + num(timings_ms.shadow) +
+       ", \"shadow_bound_split\": " + num(timings_ms.shadow_bound_split) + ", \"shadow_dice\": " +
+       num(timings_ms.shadow_dice) + ", \"shadow_sample\": " + num(timings_ms.shadow_sample) +
        ", \"shadows_wall\": " + num(timings_ms.shadows_wall) + ", \"total\": " + num(timings_ms.total) + "}\n";
   j += "}\n";
   return j;

@@ -204,7 +204,10 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     st.timings_ms.sample = timer.ms(Stage::Sample);
     st.timings_ms.resolve = timer.ms(Stage::Resolve);
     st.timings_ms.shadow_mark = timer.ms(Stage::ShadowMark);
-    st.timings_ms.shadow = timer.ms(Stage::Shadow);
+    st.timings_ms.shadow_bound_split = timer.ms(Stage::ShadowBoundSplit);
+    st.timings_ms.shadow_dice = timer.ms(Stage::ShadowDice);
+    st.timings_ms.shadow_sample = timer.ms(Stage::ShadowSample);
+    st.timings_ms.shadow = st.timings_ms.shadow_bound_split + st.timings_ms.shadow_dice + st.timings_ms.shadow_sample;
   } catch (const cl::Error& e) {
     throw Error("rendering on '" + s.info().name + "': " + describe_cl_error(e));
   }

@@ -162,6 +162,21 @@ DeviceLight to_device(const Light& l, const glm::mat4& world_to_camera) {
   return d;
 }
 
+// Each patch's box (camera space): its control points' (Gregory partners
+// included, so the surface lies inside), grown by its displacement bound.
+std::vector<glm::vec4> patch_bounds(const PatchBuffer& patches) {
+  std::vector<glm::vec4> out(2 * patches.size());
+  for (size_t p = 0; p < patches.size(); ++p) {
+    const glm::vec4* cp = &patches.points[p * MP_PATCH_POINTS];
+    glm::vec3 lo(cp[0]), hi(cp[0]);
+    for (int k = 1; k < MP_PATCH_POINTS; ++k) lo = glm::min(lo, glm::vec3(cp[k])), hi = glm::max(hi, glm::vec3(cp[k]));
+    const float reach = cp[0].w;  // MP_PATCH_DISPLACEMENT_BOUND
+    out[2 * p] = glm::vec4(lo - glm::vec3(reach), 0.0f);
+    out[2 * p + 1] = glm::vec4(hi + glm::vec3(reach), 0.0f);
+  }
+  return out;
+}
+
 template <typename T>
 cl::Buffer upload(cl::Context& context, cl::CommandQueue& queue, const std::vector<T>& v) {
   size_t bytes = std::max<size_t>(v.size() * sizeof(T), 16);  // zero-sized buffers are invalid
@@ -219,6 +234,8 @@ SceneBuffers upload_scene_data(cl::Context& context, cl::CommandQueue& queue, co
   b.lights = upload(context, queue, data.lights);
   b.patch_uvs = upload(context, queue, data.patches.uvs);
   b.patch_normals = upload(context, queue, data.patches.normals);
+  const std::vector<glm::vec4> bounds = patch_bounds(data.patches);  // lives until the queue finishes below
+  b.patch_bounds = upload(context, queue, bounds);
   b.images = upload(context, queue, data.images);
   b.texels = upload(context, queue, data.texels);
   b.uv_layers = static_cast<cl_uint>(data.patches.uv_layers);

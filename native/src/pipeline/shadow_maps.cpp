@@ -32,6 +32,7 @@ void grow(DeviceSession& s, cl::Buffer& buffer, size_t& capacity, size_t bytes, 
 ShadowMaps::ShadowMaps(DeviceSession& session)
     : session_(session),
       mark_(session.program(), "mark_shadow_pages"),
+      mark_soft_(session.program(), "mark_soft_shadow_pages"),
       clear_(session.program(), "clear_shadow_pages"),
       sample_(session.program(), "shadow_sample") {}
 
@@ -48,34 +49,44 @@ void ShadowMaps::upload_records(const ShadowLayout& layout) {
 }
 
 bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, const SceneBuffers& buffers,
-                      const ShadowPassStages& stages, const BoundSplitRunner& run, StageTimer& timer,
+                      const ShadowPassStages& stages, const BoundSplitRunner& run, StageTimer& timer, bool soft,
                       std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries) {
+  StageTimer::Redirect to(timer, Stage::ShadowMark);
   cl::CommandQueue& q = session_.queue();
   const size_t n = layout.table_entries;
   grow(session_, requests_, requests_capacity_, n, "shadow page requests");
-  q.enqueueFillBuffer(requests_, cl_uchar(0), 0, n);
+  // The soft marking adds to the first's requests.
+  if (!soft) q.enqueueFillBuffer(requests_, cl_uchar(0), 0, n);
   FrameParams coarse = frame.params;
   coarse.micropoly_edge *= kMarkCoarsening;
   const cl_uint light_count = cl_uint(layout.shadows.size());
   // Each vertex's box reaches its neighbours: one coarse micropolygon edge.
   const cl_float reach = coarse.micropoly_edge;
   GridBuffers& grids = stages.grids;
+  cl::Kernel& kernel = soft ? mark_soft_ : mark_;
   DiceSink sink = [&](const cl::Buffer& diceable, cl_uint count) {
     stages.layout.run(diceable, count, coarse, grids, timer);
     stages.dice.run(diceable, count, buffers, coarse, grids, timer);
-    stages.programs.displace(diceable, count, buffers, coarse, grids, timer, false);
-    mark_.setArg(0, diceable);
-    mark_.setArg(1, count);
-    mark_.setArg(2, grids.vertex_offsets);
-    mark_.setArg(3, coarse);
-    mark_.setArg(4, grids.p);
-    mark_.setArg(5, inputs_.shadows);
-    mark_.setArg(6, inputs_.levels);
-    mark_.setArg(7, light_count);
-    mark_.setArg(8, requests_);
-    mark_.setArg(9, reach);
+    // The soft marking's search compares with the displaced surface's tangent plane.
+    stages.programs.displace(diceable, count, buffers, coarse, grids, timer, soft);
+    cl_uint arg = 0;
+    kernel.setArg(arg++, diceable);
+    kernel.setArg(arg++, count);
+    kernel.setArg(arg++, grids.vertex_offsets);
+    kernel.setArg(arg++, coarse);
+    kernel.setArg(arg++, grids.p);
+    if (soft) kernel.setArg(arg++, grids.n);
+    kernel.setArg(arg++, inputs_.shadows);
+    kernel.setArg(arg++, inputs_.levels);
+    kernel.setArg(arg++, light_count);
+    if (soft) {
+      kernel.setArg(arg++, inputs_.pages);
+      kernel.setArg(arg++, inputs_.pool);
+    }
+    kernel.setArg(arg++, requests_);
+    kernel.setArg(arg++, reach);
     cl::Event e;
-    q.enqueueNDRangeKernel(mark_, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64), nullptr, &e);
+    q.enqueueNDRangeKernel(kernel, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64), nullptr, &e);
     timer.add(Stage::ShadowMark, e);
   };
   if (run(coarse, PassViews{}, sink).cancelled) return false;
@@ -88,13 +99,6 @@ bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, const
                    [&](size_t a, size_t b) { return layout.maps[a].coarseness > layout.maps[b].coarseness; });
   keys.clear();
   entries.clear();
-  if (getenv("MP_DEBUG_PAGES")) {
-    for (const ShadowMapInfo& m : layout.maps) {
-      size_t c = 0;
-      for (int k = 0; k < m.side * m.side; ++k) c += requested[m.table + k] ? 1 : 0;
-      if (c) fprintf(stderr, "light %d map %d side %d: %zu pages\n", m.light, m.map_id, m.side, c);
-    }
-  }
   for (size_t i : order) {
     const ShadowMapInfo& m = layout.maps[i];
     for (int sy = 0; sy < m.side; ++sy)
@@ -205,25 +209,52 @@ bool ShadowMaps::render(const Scene& scene, const FrameSetup& frame, const Scene
       if (k) present.insert(k);
   pool_.keep_only(present);
 
+  // First: hard shadows' pages and soft shadows' first search round's; a
+  // budget too short for them coarsens every light.
   std::vector<ShadowPageKey> keys;
   std::vector<uint32_t> entries;
-  {
-    StageTimer::Redirect to(timer, Stage::ShadowMark);
-    for (int bias = 0;; ++bias) {
-      set_shadow_level_bias(layout, bias);
-      upload_records(layout);
-      if (!mark(layout, frame, buffers, stages, run, timer, keys, entries)) return false;
-      stats.level_bias = bias;
-      if (keys.size() <= capacity || bias >= kMaxShadowLevelBias) break;
-    }
+  for (int bias = 0;; ++bias) {
+    set_shadow_level_bias(layout, bias);
+    upload_records(layout);
+    if (!mark(layout, frame, buffers, stages, run, timer, false, keys, entries)) return false;
+    stats.level_bias = bias;
+    if (keys.size() <= capacity || bias >= kMaxShadowLevelBias) break;
   }
+  if (!allocate_and_render(layout, keys, entries, frame, buffers, stages, run, timer, stats)) return false;
+  // Then, where those maps show occluders near a receiver, the pages soft
+  // shadows' second round and filters read there.
+  bool soft = false;
+  for (const DeviceShadow& d : layout.shadows) soft = soft || (d.kind != MP_SHADOW_NONE && d.shape != MP_SHADOW_SHAPE_POINT);
+  if (soft) {
+    if (!mark(layout, frame, buffers, stages, run, timer, true, keys, entries)) return false;
+    if (!allocate_and_render(layout, keys, entries, frame, buffers, stages, run, timer, stats)) return false;
+  }
+  inputs_.enabled = true;
+  stats.pages_requested = keys.size();
+  stats.per_light.clear();
+  for (size_t l = 0; l < scene.lights.size(); ++l) {
+    if (layout.shadows[l].kind == MP_SHADOW_NONE) continue;
+    const uint32_t entries_of_light = layout.shadows[l].kind == MP_SHADOW_SUN
+                                          ? layout.shadows[l].levels * uint32_t(MP_MAP_PAGES * MP_MAP_PAGES)
+                                          : 6u * MP_CUBE_FACE_ENTRIES;
+    stats.per_light.push_back({int(l), light_pages_[l], light_pages_[l] * kPageBytes + entries_of_light * sizeof(cl_uint)});
+  }
+  stats.peak_bytes = size_t(pool_pages_) * kPageBytes + pages_capacity_ + requests_capacity_ + masks_capacity_ +
+                     views_capacity_ + records_capacity_ + levels_capacity_ + clear_capacity_;
+  return true;
+}
+
+bool ShadowMaps::allocate_and_render(const ShadowLayout& layout, const std::vector<ShadowPageKey>& keys,
+                                     const std::vector<uint32_t>& entries, const FrameSetup& frame,
+                                     const SceneBuffers& buffers, const ShadowPassStages& stages,
+                                     const BoundSplitRunner& run, StageTimer& timer, ShadowStats& stats) {
   std::vector<ShadowPagePool::Grant> grants;
   pool_.grant(keys, grants);
 
   // Page tables: the granted pages, marked for rendering where new.
   std::vector<uint32_t> table(layout.table_entries, 0u);
   std::vector<uint32_t> fresh;
-  std::vector<size_t> light_pages(scene.lights.size(), 0);
+  stats.pages_missing = 0;
   for (size_t i = 0; i < keys.size(); ++i) {
     const ShadowPagePool::Grant& g = grants[i];
     if (g.physical == ShadowPagePool::kNone) {
@@ -233,10 +264,10 @@ bool ShadowMaps::render(const Scene& scene, const FrameSetup& frame, const Scene
     table[entries[i]] = g.physical | MP_PAGE_RESIDENT | (g.render ? MP_PAGE_RENDER : 0u);
     if (g.render) fresh.push_back(g.physical);
   }
-  stats.pages_requested = keys.size();
-  stats.pages_rendered = fresh.size();
+  stats.pages_rendered += fresh.size();
 
   // The views of maps with pages to render, and their page masks.
+  light_pages_.assign(layout.shadows.size(), 0);
   std::vector<FrameParams> views;
   std::vector<uint8_t> masks;
   for (const ShadowMapInfo& m : layout.maps) {
@@ -247,7 +278,7 @@ bool ShadowMaps::render(const Scene& scene, const FrameSetup& frame, const Scene
       for (int rx = 0; rx < n; ++rx) {
         const int sx = (rx + m.origin_x) & (n - 1), sy = (ry + m.origin_y) & (n - 1);
         const uint32_t e = table[m.table + uint32_t(sy * n + sx)];
-        if (e & MP_PAGE_RESIDENT) ++light_pages[size_t(m.light)];
+        if (e & MP_PAGE_RESIDENT) ++light_pages_[size_t(m.light)];
         if (e & MP_PAGE_RENDER) level[size_t(ry) * n + rx] = 1, ++any;
       }
     if (!any) continue;
@@ -266,41 +297,26 @@ bool ShadowMaps::render(const Scene& scene, const FrameSetup& frame, const Scene
     }
     views.push_back(v);
   }
-  stats.views = views.size();
+  stats.views += views.size();
 
   cl::CommandQueue& q = session_.queue();
   ensure_pool(pool_.extent());
   grow(session_, inputs_.pages, pages_capacity_, table.size() * sizeof(cl_uint), "shadow page tables");
   q.enqueueWriteBuffer(inputs_.pages, CL_TRUE, 0, table.size() * sizeof(cl_uint), table.data());
-  if (!fresh.empty()) {
-    grow(session_, clear_list_, clear_capacity_, fresh.size() * sizeof(cl_uint), "shadow page list");
-    q.enqueueWriteBuffer(clear_list_, CL_TRUE, 0, fresh.size() * sizeof(cl_uint), fresh.data());
-    const cl_uint texels = cl_uint(fresh.size() * MP_PAGE_TEXELS);
-    clear_.setArg(0, clear_list_);
-    clear_.setArg(1, texels);
-    clear_.setArg(2, inputs_.pool);
-    cl::Event e;
-    q.enqueueNDRangeKernel(clear_, cl::NullRange, round_up_range(texels, 256), cl::NDRange(256), nullptr, &e);
-    timer.add(Stage::Shadow, e);
-  }
-  if (!views.empty()) {
-    StageTimer::Redirect to(timer, Stage::Shadow);
-    stages.layout.begin_frame();
-    if (!render_views(views, masks, frame, buffers, stages, run, timer)) return false;
-    stats.micropolygons = stages.layout.micropolygons();
-  }
-
-  inputs_.enabled = true;
-
-  for (size_t l = 0; l < scene.lights.size(); ++l) {
-    if (layout.shadows[l].kind == MP_SHADOW_NONE) continue;
-    const uint32_t entries_of_light = layout.shadows[l].kind == MP_SHADOW_SUN
-                                          ? layout.shadows[l].levels * uint32_t(MP_MAP_PAGES * MP_MAP_PAGES)
-                                          : 6u * MP_CUBE_FACE_ENTRIES;
-    stats.per_light.push_back({int(l), light_pages[l], light_pages[l] * kPageBytes + entries_of_light * sizeof(cl_uint)});
-  }
-  stats.peak_bytes = size_t(pool_pages_) * kPageBytes + pages_capacity_ + requests_capacity_ + masks_capacity_ +
-                     views_capacity_ + records_capacity_ + levels_capacity_ + clear_capacity_;
+  if (fresh.empty()) return true;
+  StageTimer::Redirect to(timer, Stage::ShadowBoundSplit);
+  grow(session_, clear_list_, clear_capacity_, fresh.size() * sizeof(cl_uint), "shadow page list");
+  q.enqueueWriteBuffer(clear_list_, CL_TRUE, 0, fresh.size() * sizeof(cl_uint), fresh.data());
+  const cl_uint texels = cl_uint(fresh.size() * MP_PAGE_TEXELS);
+  clear_.setArg(0, clear_list_);
+  clear_.setArg(1, texels);
+  clear_.setArg(2, inputs_.pool);
+  cl::Event e;
+  q.enqueueNDRangeKernel(clear_, cl::NullRange, round_up_range(texels, 256), cl::NDRange(256), nullptr, &e);
+  timer.add(Stage::ShadowSample, e);
+  stages.layout.begin_frame();
+  if (!render_views(views, masks, frame, buffers, stages, run, timer)) return false;
+  stats.micropolygons += stages.layout.micropolygons();
   return true;
 }
 

@@ -3,13 +3,18 @@
 //  1. the lights' layout (shadow_layout.h) and records go to the device;
 //  2. a coarse pass over the camera's view (bound & split, dicing and
 //     displacement) marks the pages its vertices need, at the levels their
-//     pixel footprints ask for;
+//     pixel footprints ask for (soft shadows: their blocker search's);
 //  3. the requests come back and get physical pages within the budget
 //     (shadow_page_pool.h); pages kept from earlier frames whose light and
 //     geometry did not change are not rendered again;
 //  4. the lights' views go through bound & split, dicing and displacement
 //     as the camera's do, several views per pass, and their micropolygons
-//     are rasterised into the new pages (depth only).
+//     are rasterised into the new pages (depth only);
+//  5. for soft shadows, a second marking runs the first search round on
+//     those maps: where it finds occluders, the finer levels the penumbra
+//     filter reads there are marked, allocated and rendered as in 3 and 4
+//     (a penumbra is wider than the pixels wherever its occluders stand
+//     off the receiver, and needs no finer texels there).
 // Shading then reads the maps through inputs().
 #pragma once
 
@@ -52,11 +57,18 @@ class ShadowMaps {
   const ShadowInputs& inputs() const { return inputs_; }
 
  private:
-  // Marks the pages the camera's receivers need; returns them, coarser maps
-  // first, with the map each belongs to.
+  // Marks the pages the camera's receivers need (the first marking, or the
+  // soft one, which adds to it); returns them all, coarser maps first, with
+  // their page-table entries.
   bool mark(const ShadowLayout& layout, const FrameSetup& frame, const SceneBuffers& buffers,
-            const ShadowPassStages& stages, const BoundSplitRunner& run, StageTimer& timer,
+            const ShadowPassStages& stages, const BoundSplitRunner& run, StageTimer& timer, bool soft,
             std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries);
+  // Gives the requested pages physical ones, writes the page tables and
+  // renders the new pages.
+  bool allocate_and_render(const ShadowLayout& layout, const std::vector<ShadowPageKey>& keys,
+                           const std::vector<uint32_t>& entries, const FrameSetup& frame, const SceneBuffers& buffers,
+                           const ShadowPassStages& stages, const BoundSplitRunner& run, StageTimer& timer,
+                           ShadowStats& stats);
   void upload_records(const ShadowLayout& layout);
   bool render_views(const std::vector<FrameParams>& views, const std::vector<uint8_t>& masks, const FrameSetup& frame,
                     const SceneBuffers& buffers, const ShadowPassStages& stages, const BoundSplitRunner& run,
@@ -64,7 +76,8 @@ class ShadowMaps {
   void ensure_pool(uint32_t pages);
 
   DeviceSession& session_;
-  cl::Kernel mark_, clear_, sample_;
+  cl::Kernel mark_, mark_soft_, clear_, sample_;
+  std::vector<size_t> light_pages_;  // resident pages per light, this frame
   ShadowPagePool pool_;
   ShadowInputs inputs_;
   cl::Buffer requests_, views_, masks_, clear_list_;

@@ -9,15 +9,18 @@
 
 namespace mp {
 
-// ShadowMark and Shadow: the shadow maps' page marking, and their rendering
-// (bound & split, dice and sampling of the lights' views).
-enum class Stage { Upload, BoundSplit, Dice, Shade, Sample, Resolve, ShadowMark, Shadow, Count };
+// ShadowMark: the shadow maps' page marking; Shadow*: their rendering (the
+// bound & split, dicing and sampling of the lights' views).
+enum class Stage {
+  Upload, BoundSplit, Dice, Shade, Sample, Resolve, ShadowMark, ShadowBoundSplit, ShadowDice, ShadowSample, Count
+};
 
 class StageTimer {
  public:
-  void add(Stage stage, const cl::Event& event) { pending_.push_back({redirect_ ? *redirect_ : stage, event}); }
-  // While a Redirect lives, every event counts for its stage (the shadow
-  // pass runs the same stages as the camera's).
+  void add(Stage stage, const cl::Event& event) { pending_.push_back({redirected(stage), event}); }
+  // While a Redirect lives, events count for its stage; one to
+  // ShadowBoundSplit sends the camera stages to their shadow twins (the
+  // lights' views run the same stages as the camera's).
   class Redirect {
    public:
     Redirect(StageTimer& timer, Stage stage) : timer_(timer), previous_(timer.redirect_) { timer.redirect_ = stage; }
@@ -41,6 +44,13 @@ class StageTimer {
   double ms(Stage stage) const { return ms_[static_cast<size_t>(stage)]; }
 
  private:
+  Stage redirected(Stage s) const {
+    if (!redirect_) return s;
+    if (*redirect_ != Stage::ShadowBoundSplit) return *redirect_;
+    return s == Stage::BoundSplit ? Stage::ShadowBoundSplit
+           : s == Stage::Dice || s == Stage::Shade ? Stage::ShadowDice
+                                                  : Stage::ShadowSample;
+  }
   std::vector<std::pair<Stage, cl::Event>> pending_;
   std::optional<Stage> redirect_;
   std::array<double, static_cast<size_t>(Stage::Count)> ms_{};

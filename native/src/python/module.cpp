@@ -99,6 +99,9 @@ py::dict stats_dict(const RenderStats& s) {
   t["readback"] = s.timings_ms.readback;
   t["shadow_mark"] = s.timings_ms.shadow_mark;
   t["shadow"] = s.timings_ms.shadow;
+  t["shadow_bound_split"] = s.timings_ms.shadow_bound_split;
+  t["shadow_dice"] = s.timings_ms.shadow_dice;
+  t["shadow_sample"] = s.timings_ms.shadow_sample;
   t["shadows_wall"] = s.timings_ms.shadows_wall;
   t["total"] = s.timings_ms.total;
   d["timings_ms"] = t;
