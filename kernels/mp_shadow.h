@@ -55,9 +55,8 @@
 /* Texels per side of cube mip m, and the table entries before it in a face. */
 MP_INLINE int mp_cube_mip_texels(int m) { return MP_MAP_TEXELS >> m; }
 MP_INLINE uint mp_cube_mip_entries(int m) {
-  uint n = 0u;
-  for (int k = 0; k < m; ++k) n += (uint)((MP_MAP_PAGES >> k) * (MP_MAP_PAGES >> k));
-  return n;
+  /* sum over k < m of (128 >> k)^2 = 16384 (1 - 4^-m) / (3/4) */
+  return (65536u - (65536u >> (2 * m))) / 3u;
 }
 
 /* The cube face a light-space direction falls on: +X, -X, +Y, -Y, +Z, -Z. */
@@ -373,6 +372,12 @@ MP_INLINE int mp_shadow_blocker(const MpShadowMaps* in, const MpShadowMap* m, co
 MP_INLINE float2 mp_golden_step(float2 turn) {
   return MP_F2(turn.x * MP_GOLDEN_COS - turn.y * MP_GOLDEN_SIN, turn.x * MP_GOLDEN_SIN + turn.y * MP_GOLDEN_COS);
 }
+/* Two golden angles. */
+#define MP_GOLDEN2_COS 0.08742572f
+#define MP_GOLDEN2_SIN -0.99617104f
+MP_INLINE float2 mp_golden_step2(float2 turn) {
+  return MP_F2(turn.x * MP_GOLDEN2_COS - turn.y * MP_GOLDEN2_SIN, turn.x * MP_GOLDEN2_SIN + turn.y * MP_GOLDEN2_COS);
+}
 
 /* The light's shape as two offset vectors from its centre: a point d of the
  * unit disk (or square, for rectangles) lies at d.x u + d.y v, in light space
@@ -403,19 +408,35 @@ MP_INLINE MpLightShape mp_light_shape(const MP_GLOBAL DeviceShadow* sh, float3 t
   return s;
 }
 
-/* Filter tap k of n (n = 16): even density over the shape: the spiral over
- * a disk; over a rectangle the 16 Hammersley points (x = (k + 1/2) / 16, y
- * its bit-reversed twin), which, unlike a 4 x 4 grid, take 16 different
- * values along each side, so a shadow edge along either sweeps through 16
- * steps rather than 4. `turn` is the spiral's rotation for tap k. */
-MP_INLINE float3 mp_filter_tap(const MpLightShape* s, int k, int n, float2 turn) {
+/* Filter tap i of MP_SHADOW_TAPS (16), even density over the shape, in an
+ * order whose first half is itself spread evenly (the filter stops there
+ * where all its taps agree). Over a disk Vogel's spiral, tap k at radius
+ * sqrt((k + 1/2) / 16), taken even k first, then odd (`turn` is tap k's
+ * rotation, k golden angles); over a rectangle the 16 Hammersley points (x =
+ * (k + 1/2) / 16, y its bit-reversed twin), which, unlike a 4 x 4 grid, take
+ * 16 different values along each side, so a shadow edge along either sweeps
+ * through 16 steps rather than 4, taken those with an even number of set
+ * bits first (which alone are a (0, 3, 2)-net: one in each eighth of either
+ * side, two in each quarter of the square). */
+MP_INLINE float3 mp_filter_tap(const MpLightShape* s, int i, float2 turn) {
+  int h = i & 7, odd = i >> 3;
   if (s->grid) {
+    int parity = (h ^ (h >> 1) ^ (h >> 2)) & 1;
+    int k = 2 * h + (parity ^ odd);
     int rev = ((k & 1) << 3) | ((k & 2) << 1) | ((k & 4) >> 1) | ((k & 8) >> 3);
-    float x = ((float)k + 0.5f) / (float)n * 2.0f - 1.0f, y = ((float)rev + 0.5f) / (float)n * 2.0f - 1.0f;
+    float x = ((float)k + 0.5f) * (2.0f / 16.0f) - 1.0f, y = ((float)rev + 0.5f) * (2.0f / 16.0f) - 1.0f;
     return x * s->u + y * s->v;
   }
-  float r = sqrt(((float)k + 0.5f) / (float)n);
+  float r = sqrt(((float)(2 * h + odd) + 0.5f) * (1.0f / 16.0f));
   return (r * turn.x) * s->u + (r * turn.y) * s->v;
+}
+
+/* Which of the two filter levels tap i reads: the coarser where this falls
+ * below the kernel's fraction of the way to it (the golden ratio's
+ * multiples, spread evenly over the taps in any run of them). */
+MP_INLINE float mp_tap_dither(int i) {
+  float t = ((float)i + 0.5f) * 0.61803399f;
+  return t - floor(t);
 }
 
 /* Blocker search tap k of n: from the shape's centre (k = 0) out to its edge
@@ -438,6 +459,19 @@ MP_INLINE float mp_light_shape_radius(const MP_GLOBAL DeviceShadow* sh) {
 MP_INLINE MpShadowMap mp_shadow_map_at(const MpShadowMaps* in, const MP_GLOBAL DeviceShadow* sh, float3 q, int level) {
   if (sh->kind == MP_SHADOW_SUN) return mp_sun_map(sh, in->levels + sh->level_records + (uint)level);
   return mp_cube_map(sh, mp_cube_face(q), level);
+}
+
+/* The same for a loop's taps, all at one level: a sun's level is the same
+ * map for all, a cube's map changes only where a tap crosses to another
+ * face (`m` holds the last tap's). */
+MP_INLINE void mp_shadow_map_for(const MpShadowMaps* in, const MP_GLOBAL DeviceShadow* sh, float3 q, int level,
+                                 int first, MpShadowMap* m) {
+  if (sh->kind == MP_SHADOW_SUN) {
+    if (first) *m = mp_sun_map(sh, in->levels + sh->level_records + (uint)level);
+    return;
+  }
+  int face = mp_cube_face(q);
+  if (first || face != m->face) *m = mp_cube_map(sh, face, level);
 }
 
 MP_INLINE int mp_shadow_level_count(const MP_GLOBAL DeviceShadow* sh) {
@@ -524,11 +558,12 @@ MP_INLINE int mp_blocker_round(const MpShadowMaps* in, const MP_GLOBAL DeviceSha
     *nearest = 3.0e38f;
     float2 turn = MP_F2(1.0f, 0.0f);
     const int taps = round ? MP_SHADOW_TAPS : MP_SHADOW_PROBE_TAPS;
+    MpShadowMap m;
     for (int k = 0; k < taps && !missing; ++k, turn = mp_golden_step(turn)) {
       float reach;
       float3 o = mp_search_tap(shape, k, taps, turn, &reach);
       float3 x = mp_kernel_point(q, o, s);
-      MpShadowMap m = mp_shadow_map_at(in, sh, x, ls);
+      mp_shadow_map_for(in, sh, x, ls, k == 0, &m);
       float3 r = mp_shadow_project(&m, x);
       mp_plane_for(&m, q, n, r.z, plane_key, plane);
       float b = bias * mp_shadow_texel_size(&m, r.z) + MP_SHADOW_SOFT_BIAS * length(o) * s;
@@ -588,37 +623,47 @@ MP_INLINE float mp_shadow_visibility_light(const MpShadowMaps* in, const MP_GLOB
    * hide a sliver of the light), the first estimate stands. */
   float scale = found > 0.0f ? sum / found : first;
   /* The penumbra kernel: the light's shape scaled by the mean occluder's
-   * distance, filtered where it spans a few texels, blended between the two
-   * levels around that size so that the filter does not jump from one to
-   * the next across a penumbra. */
+   * distance, filtered where it spans a few texels. Its taps are spread
+   * between the two levels around that size in proportion to where it lies
+   * between them, so that the filter does not jump from one level to the
+   * next across a penumbra. */
   float level = clamp(mp_filter_level(sh, q, radius * scale), (float)base, (float)(count - 1));
   int l0 = (int)floor(level);
   float blend = level - (float)l0;
-  float result = 0.0f, weight = 0.0f;
-  for (int pass = 0; pass < 2; ++pass) {
-    float w = pass == 0 ? 1.0f - blend : blend;
-    if (w <= 0.0f) continue;
-    for (int lp = l0 + pass; lp < count; ++lp) {
-      int missing = 0;
-      float lit = 0.0f;
-      float2 turn = MP_F2(1.0f, 0.0f);
-      for (int k = 0; k < MP_SHADOW_TAPS && !missing; ++k, turn = mp_golden_step(turn)) {
-        float3 o = mp_filter_tap(&shape, k, MP_SHADOW_TAPS, turn);
-        float3 x = mp_kernel_point(q, o, scale);
-        MpShadowMap m = mp_shadow_map_at(in, sh, x, lp);
-        float3 r = mp_shadow_project(&m, x);
-        mp_plane_for(&m, q, n, r.z, &plane_key, &plane);
-        float b = bias * mp_shadow_texel_size(&m, r.z) + MP_SHADOW_SOFT_BIAS * length(o) * scale;
-        lit += mp_shadow_bilinear(in, &m, &plane, r.x, r.y, r.z, b, &missing);
-      }
+  float lit = 0.0f;
+  float2 turn = MP_F2(1.0f, 0.0f);
+  MpShadowMap m[2];
+  int levels[2] = {-1, -1};
+  uint keys[2] = {0xffffffffu, 0xffffffffu};
+  MpReceiverPlane planes[2];
+  for (int i = 0; i < MP_SHADOW_TAPS; ++i) {
+    if (i == MP_SHADOW_TAPS / 2) {
+      /* Half the taps seen: where all agree (umbra, or lit beside the
+       * occluders), the other half would too. */
+      if (lit == 0.0f || lit == (float)i) return lit / (float)i;
+      turn = MP_F2(MP_GOLDEN_COS, MP_GOLDEN_SIN);
+    }
+    float3 o = mp_filter_tap(&shape, i, turn);
+    turn = mp_golden_step2(turn);
+    float3 x = mp_kernel_point(q, o, scale);
+    int which = mp_tap_dither(i) < blend;
+    float b0 = MP_SHADOW_SOFT_BIAS * length(o) * scale;
+    for (int lp = l0 + which; lp < count; ++lp) {
+      int slot = lp == l0 ? 0 : 1, missing = 0;
+      mp_shadow_map_for(in, sh, x, lp, levels[slot] != lp, &m[slot]);
+      levels[slot] = lp;
+      float3 r = mp_shadow_project(&m[slot], x);
+      mp_plane_for(&m[slot], q, n, r.z, &keys[slot], &planes[slot]);
+      float t = mp_shadow_bilinear(in, &m[slot], &planes[slot], r.x, r.y, r.z,
+                                   bias * mp_shadow_texel_size(&m[slot], r.z) + b0, &missing);
       if (!missing) {
-        result += w * lit / (float)MP_SHADOW_TAPS;
-        weight += w;
+        lit += t;
         break;
       }
+      if (lp + 1 == count) lit += 1.0f;
     }
   }
-  return weight > 0.0f ? result / weight : 1.0f;
+  return lit / (float)MP_SHADOW_TAPS;
 }
 
 /* Visibility of light `light` at camera-space point p with geometric normal n. */
