@@ -1,13 +1,22 @@
 """Micropoly, Cycles and EEVEE rendering one scene side by side, plus the
 export time of a 1M-face mesh. Run with Blender (or a Python with bpy):
 
-  MICROPOLY_ADDON_DIR=build/addons blender -b --factory-startup --python bench/blender_bench.py -- [--repeat 3] [--quick] [--displaced]
+  MICROPOLY_ADDON_DIR=build/addons blender -b --factory-startup --python bench/blender_bench.py -- [--repeat 3] [--quick] [--displaced] [--shadows]
 
 Scene: six subdivided Suzannes (Subdivision Surface, rendered by Micropoly as
 limit surfaces and by Cycles with adaptive subdivision at 1 px) on a floor,
 sun + point + area light, 1920x1080, 16 samples for every engine. Cycles uses
 its default light paths with denoising off; EEVEE its defaults with 16 samples.
-Prints the wall time of each F12 render (median of --repeat) and the ratios."""
+The lights have Blender's default sizes (sun angle 0.526 degrees, point radius
+and area size 0.25 m) and cast shadows in every engine.
+Prints the wall time of each F12 render (median of --repeat) and the ratios.
+
+--shadows: the shadow benchmark instead, its renders interleaved round by
+round so that the machine's noise falls on all alike: Micropoly with shadows,
+Micropoly without, Cycles with shadows and direct light only (the light
+Micropoly computes) and Cycles with its default light paths; with the shadow
+maps' page counts and memory per light. --rib-only with --shadows writes the
+scene as RIB for the CLI (bench/out/shadow_suzannes.rib)."""
 
 import json
 import math
@@ -28,6 +37,7 @@ QUICK = "--quick" in args
 # --displaced: every Suzanne's material is displaced by a Noise texture
 # (Displacement Only), the issue-5 benchmark scene.
 DISPLACED = "--displaced" in args
+SHADOWS = "--shadows" in args
 W, H = (480, 270) if QUICK else (1920, 1080)
 SAMPLES = 16
 
@@ -75,7 +85,7 @@ def time_engine(scene, engine):
     if engine == "MICROPOLY":
         scene.micropoly.samples = SAMPLES
     elif engine == "CYCLES":
-        ru.setup_cycles(scene, samples=SAMPLES)
+        ru.setup_cycles(scene, samples=SAMPLES, shadows=True)
         c = scene.cycles
         c.max_bounces, c.diffuse_bounces, c.glossy_bounces = 12, 4, 4  # Cycles' defaults
         scene.render.engine = "CYCLES"
@@ -106,23 +116,86 @@ def export_time():
     return faces, times
 
 
-def export_displaced_rib():
-    """The displaced scene as RIB (material programs included), for the CLI's
-    per-stage timings on PoCL and on a GPU: bench/out/displaced_suzannes.rib."""
+def export_rib(name):
+    """The scene as RIB (material programs included), for the CLI's
+    per-stage timings on PoCL and on a GPU: bench/out/<name>.rib."""
     scene = build_scene()  # enables the add-on
     from micropoly import operators
 
     scene.render.engine = "MICROPOLY"
     scene.micropoly.samples = SAMPLES
-    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out", "displaced_suzannes.rib")
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out", name + ".rib")
     os.makedirs(os.path.dirname(path), exist_ok=True)
     operators.export_rib(bpy.context.evaluated_depsgraph_get(), path)
     print(f"wrote {path}")
 
 
+def shadow_variants():
+    """(label, set-up) of the shadow benchmark's renders."""
+    def micropoly(shadows):
+        def setup(scene):
+            scene.render.engine = "MICROPOLY"
+            scene.micropoly.samples = SAMPLES
+            scene.micropoly.use_shadows = shadows
+        return setup
+
+    def cycles(direct_only):
+        def setup(scene):
+            ru.setup_cycles(scene, samples=SAMPLES, shadows=True)
+            if not direct_only:
+                c = scene.cycles
+                c.max_bounces, c.diffuse_bounces, c.glossy_bounces = 12, 4, 4  # Cycles' defaults
+        return setup
+
+    return (("Micropoly, shadows", micropoly(True)), ("Micropoly, no shadows", micropoly(False)),
+            ("Cycles, shadows, direct light", cycles(True)), ("Cycles, shadows, default light paths", cycles(False)))
+
+
+def shadow_bench():
+    variants = shadow_variants()
+    times = {label: [] for label, _ in variants}
+    stats = None
+    for _ in range(REPEAT):
+        for label, setup in variants:
+            scene = build_scene()
+            setup(scene)
+            started = time.perf_counter()
+            bpy.ops.render.render()
+            times[label].append(time.perf_counter() - started)
+            if label == "Micropoly, shadows" and stats is None:
+                stats = shadow_stats(scene)
+    base = statistics.median(times["Micropoly, no shadows"])
+    print(f"\nBlender {bpy.app.version_string}, {W}x{H}, {SAMPLES} samples, F12, rounds interleaved, median of {REPEAT}")
+    print("| render | F12 s (median) | runs | time / Micropoly without shadows |")
+    print("|---|---|---|---|")
+    for label, runs in times.items():
+        med = statistics.median(runs)
+        print(f"| {label} | {med:.2f} | {', '.join(f'{t:.2f}' for t in runs)} | {med / base:.2f}x |")
+    if stats:
+        print(f"\nshadow maps: {stats['pages_requested']} pages, {stats['micropolygons']:,} micropolygons, "
+              f"peak {stats['peak_bytes'] / 2**20:.1f} MiB of a {stats['budget_bytes'] / 2**20:.0f} MiB budget")
+        for light in stats["per_light"]:
+            print(f"  light {light['light']}: {light['pages']} pages, {light['bytes'] / 2**20:.1f} MiB")
+    print(json.dumps({"version": bpy.app.version_string, "width": W, "height": H, "renders": times,
+                      "shadow_stats": stats}))
+
+
+def shadow_stats(scene):
+    """The shadow statistics of one render of the scene through the native
+    module (F12 reports them only in its status line)."""
+    from micropoly import _native, export, preferences
+
+    exported = export.export_scene(bpy.context.evaluated_depsgraph_get())
+    renderer = _native.Renderer(preferences.device_selector(bpy.context))
+    return renderer.render(exported.scene)["stats"]["shadows"]
+
+
 def main():
-    if DISPLACED and "--rib-only" in args:
-        export_displaced_rib()
+    if "--rib-only" in args:
+        export_rib("shadow_suzannes" if SHADOWS else "displaced_suzannes" if DISPLACED else "suzannes")
+        return
+    if SHADOWS:
+        shadow_bench()
         return
     engines = ("MICROPOLY", "CYCLES", "BLENDER_EEVEE_NEXT" if bpy.app.version >= (4, 2, 0) else "BLENDER_EEVEE")
     results = {}

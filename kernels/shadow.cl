@@ -146,16 +146,24 @@ inline int mp_marking_box(__global const DeviceShadow* sh, float3 p, FrameParams
  * whose texels are no larger than the vertex's pixel footprint (mp_shadow.h)
  * for hard shadows, and of the first blocker search round's levels for soft
  * ones, under a box around the vertex reaching its neighbours (`reach`
- * pixels). */
+ * pixels). Where soft shadows follow (`keep`), the vertex and its normal
+ * are kept at keep_base + its index for their marking (w = 0: no vertex). */
 __kernel void mark_shadow_pages(__global const SubPatch* diceable, uint count, __global const uint* vertex_offsets,
-                                FrameParams f, __global const float4* grid_p, __global const DeviceShadow* shadows,
+                                uint vertex_total, FrameParams f, __global const float4* grid_p,
+                                __global const float4* grid_n, __global const DeviceShadow* shadows,
                                 __global const DeviceShadowLevel* levels, uint light_count,
-                                __global uchar* requests, float reach) {
+                                __global uchar* requests, float reach, uint keep, uint keep_base,
+                                __global float4* kept_p, __global float4* kept_n) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   float2 uv;
   ulong index;
-  if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
+  int valid = mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index);
+  if (keep && gid < vertex_total) {
+    kept_p[keep_base + gid] = valid ? (float4)(grid_p[index].xyz, 1.0f) : (float4)(0.0f);
+    kept_n[keep_base + gid] = valid ? grid_n[index] : (float4)(0.0f);
+  }
+  if (!valid) return;
   float3 p = grid_p[index].xyz;
   for (uint l = 0; l < light_count; ++l) {
     __global const DeviceShadow* sh = shadows + l;
@@ -170,22 +178,20 @@ __kernel void mark_shadow_pages(__global const SubPatch* diceable, uint count, _
   }
 }
 
-/* Second marking, for soft shadows, on the maps the first rendered: where
- * a vertex's first search round finds occluders, the levels the second
- * round and the penumbra filter can read there, from the nearest
- * occluder's (the narrowest penumbra, the finest level) to the coarsest;
- * receivers that see no occluder read nothing more. */
-__kernel void mark_soft_shadow_pages(__global const SubPatch* diceable, uint count, __global const uint* vertex_offsets,
-                                     FrameParams f, __global const float4* grid_p, __global const float4* grid_n,
-                                     __global const DeviceShadow* shadows, __global const DeviceShadowLevel* levels,
-                                     uint light_count, __global const uint* pages, __global const uint* pool,
+/* Second marking, for soft shadows, on the maps the first rendered (one
+ * work-item per vertex the first kept): where a vertex's first search round
+ * finds occluders, the levels the second round and the penumbra filter can
+ * read there, from the nearest occluder's (the narrowest penumbra, the
+ * finest level) to the coarsest; receivers that see no occluder read
+ * nothing more. */
+__kernel void mark_soft_shadow_pages(__global const float4* kept_p, __global const float4* kept_n, uint kept,
+                                     FrameParams f, __global const DeviceShadow* shadows,
+                                     __global const DeviceShadowLevel* levels, uint light_count,
+                                     __global const uint* pages, __global const uint* pool,
                                      __global uchar* requests, float reach) {
-  uint gid = get_global_id(0), i, j;
-  SubPatch sp;
-  float2 uv;
-  ulong index;
-  if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
-  float3 p = grid_p[index].xyz, n = grid_n[index].xyz;
+  uint gid = get_global_id(0);
+  if (gid >= kept || kept_p[gid].w == 0.0f) return;
+  float3 p = kept_p[gid].xyz, n = kept_n[gid].xyz;
   MpShadowMaps maps = {shadows, levels, pages, pool};
   for (uint l = 0; l < light_count; ++l) {
     __global const DeviceShadow* sh = shadows + l;
@@ -212,6 +218,13 @@ __kernel void mark_soft_shadow_pages(__global const SubPatch* diceable, uint cou
     mp_base_levels(sh, lo, hi, s, &first, &last);
     mp_mark_levels(sh, levels, lo, hi, max(first, min(finest, second)), count_levels - 1, requests);
   }
+}
+
+/* Writes the frame's page-table entries (index, value) into a table filled
+ * with zeros: a few thousand entries rather than the whole table. */
+__kernel void set_page_entries(__global const uint2* writes, uint count, __global uint* table) {
+  uint i = get_global_id(0);
+  if (i < count) table[writes[i].x] = writes[i].y;
 }
 
 /* Sets every texel of the listed physical pages to "nothing here". */

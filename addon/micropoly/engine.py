@@ -165,8 +165,11 @@ class MicropolyRenderEngine(bpy.types.RenderEngine):
             return
         self._write_result(scene, view_layer, exported, result)
         mib = stats["bound_split_peak_bytes"] / 2**20
+        shadows = stats["shadows"]
+        shadow_note = (f"shadow maps {shadows['pages_requested']:,} pages, {shadows['peak_bytes'] / 2**20:.0f} of "
+                       f"{shadows['budget_bytes'] / 2**20:.0f} MiB | " if shadows["lights"] else "")
         self.update_stats("", f"Micropoly | {stats['device']} | {stats['micropolygons']:,} micropolygons | "
-                              f"bound & split {mib:.1f} MiB | {time.perf_counter() - started:.2f} s")
+                              f"bound & split {mib:.1f} MiB | {shadow_note}{time.perf_counter() - started:.2f} s")
 
     def should_cancel(self):
         """Esc in Blender; a seam the tests use to cancel in background mode."""

@@ -20,6 +20,9 @@ constexpr size_t kPageBytes = size_t(MP_PAGE_TEXELS) * sizeof(cl_uint);
 // them, and need to be close only next to a page.
 constexpr float kMarkCoarsening = 8.0f;
 
+// Each marking vertex's box reaches its neighbours: one coarse micropolygon edge.
+cl_float mark_reach(const FrameParams& coarse) { return coarse.micropoly_edge; }
+
 void grow(DeviceSession& s, cl::Buffer& buffer, size_t& capacity, size_t bytes, const char* what) {
   if (bytes <= capacity && capacity > 0) return;
   buffer = cl::Buffer();
@@ -34,6 +37,7 @@ ShadowMaps::ShadowMaps(DeviceSession& session)
       mark_(session.program(), "mark_shadow_pages"),
       mark_soft_(session.program(), "mark_soft_shadow_pages"),
       clear_(session.program(), "clear_shadow_pages"),
+      set_entries_(session.program(), "set_page_entries"),
       sample_(session.program(), "shadow_sample") {}
 
 void ShadowMaps::upload_records(const ShadowLayout& layout) {
@@ -49,49 +53,98 @@ void ShadowMaps::upload_records(const ShadowLayout& layout) {
 }
 
 bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, const SceneBuffers& buffers,
-                      const ShadowPassStages& stages, const BoundSplitRunner& run, StageTimer& timer, bool soft,
+                      const ShadowPassStages& stages, const BoundSplitRunner& run, StageTimer& timer, bool keep,
                       std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries) {
   StageTimer::Redirect to(timer, Stage::ShadowMark);
   cl::CommandQueue& q = session_.queue();
   const size_t n = layout.table_entries;
   grow(session_, requests_, requests_capacity_, n, "shadow page requests");
-  // The soft marking adds to the first's requests.
-  if (!soft) q.enqueueFillBuffer(requests_, cl_uchar(0), 0, n);
+  q.enqueueFillBuffer(requests_, cl_uchar(0), 0, n);
   FrameParams coarse = frame.params;
   coarse.micropoly_edge *= kMarkCoarsening;
   const cl_uint light_count = cl_uint(layout.shadows.size());
-  // Each vertex's box reaches its neighbours: one coarse micropolygon edge.
-  const cl_float reach = coarse.micropoly_edge;
   GridBuffers& grids = stages.grids;
-  cl::Kernel& kernel = soft ? mark_soft_ : mark_;
+  kept_vertices_ = 0;
   DiceSink sink = [&](const cl::Buffer& diceable, cl_uint count) {
     stages.layout.run(diceable, count, coarse, grids, timer);
     stages.dice.run(diceable, count, buffers, coarse, grids, timer);
     // The soft marking's search compares with the displaced surface's tangent plane.
-    stages.programs.displace(diceable, count, buffers, coarse, grids, timer, soft);
+    stages.programs.displace(diceable, count, buffers, coarse, grids, timer, keep);
+    const cl_uint vertices = grids.vertex_total;
+    if (keep) keep_room(size_t(kept_vertices_) + vertices);
     cl_uint arg = 0;
-    kernel.setArg(arg++, diceable);
-    kernel.setArg(arg++, count);
-    kernel.setArg(arg++, grids.vertex_offsets);
-    kernel.setArg(arg++, coarse);
-    kernel.setArg(arg++, grids.p);
-    if (soft) kernel.setArg(arg++, grids.n);
-    kernel.setArg(arg++, inputs_.shadows);
-    kernel.setArg(arg++, inputs_.levels);
-    kernel.setArg(arg++, light_count);
-    if (soft) {
-      kernel.setArg(arg++, inputs_.pages);
-      kernel.setArg(arg++, inputs_.pool);
-    }
-    kernel.setArg(arg++, requests_);
-    kernel.setArg(arg++, reach);
+    mark_.setArg(arg++, diceable);
+    mark_.setArg(arg++, count);
+    mark_.setArg(arg++, grids.vertex_offsets);
+    mark_.setArg(arg++, vertices);
+    mark_.setArg(arg++, coarse);
+    mark_.setArg(arg++, grids.p);
+    mark_.setArg(arg++, grids.n);
+    mark_.setArg(arg++, inputs_.shadows);
+    mark_.setArg(arg++, inputs_.levels);
+    mark_.setArg(arg++, light_count);
+    mark_.setArg(arg++, requests_);
+    mark_.setArg(arg++, mark_reach(coarse));
+    mark_.setArg(arg++, cl_uint(keep));
+    mark_.setArg(arg++, kept_vertices_);
+    mark_.setArg(arg++, keep ? kept_p_ : grids.p);  // unwritten when not kept
+    mark_.setArg(arg++, keep ? kept_n_ : grids.n);
     cl::Event e;
-    q.enqueueNDRangeKernel(kernel, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64), nullptr, &e);
+    q.enqueueNDRangeKernel(mark_, cl::NullRange, round_up_range(vertices), cl::NDRange(64), nullptr, &e);
     timer.add(Stage::ShadowMark, e);
+    if (keep) kept_vertices_ += vertices;
   };
   if (run(coarse, PassViews{}, sink).cancelled) return false;
+  collect_requests(layout, keys, entries);
+  return true;
+}
+
+void ShadowMaps::mark_soft(const ShadowLayout& layout, const FrameSetup& frame, StageTimer& timer,
+                           std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries) {
+  StageTimer::Redirect to(timer, Stage::ShadowMark);
+  cl::CommandQueue& q = session_.queue();
+  // The soft marking adds to the first's requests.
+  if (kept_vertices_ > 0) {
+    FrameParams coarse = frame.params;
+    coarse.micropoly_edge *= kMarkCoarsening;
+    cl_uint arg = 0;
+    mark_soft_.setArg(arg++, kept_p_);
+    mark_soft_.setArg(arg++, kept_n_);
+    mark_soft_.setArg(arg++, kept_vertices_);
+    mark_soft_.setArg(arg++, coarse);
+    mark_soft_.setArg(arg++, inputs_.shadows);
+    mark_soft_.setArg(arg++, inputs_.levels);
+    mark_soft_.setArg(arg++, cl_uint(layout.shadows.size()));
+    mark_soft_.setArg(arg++, inputs_.pages);
+    mark_soft_.setArg(arg++, inputs_.pool);
+    mark_soft_.setArg(arg++, requests_);
+    mark_soft_.setArg(arg++, mark_reach(coarse));
+    cl::Event e;
+    q.enqueueNDRangeKernel(mark_soft_, cl::NullRange, round_up_range(kept_vertices_), cl::NDRange(64), nullptr, &e);
+    timer.add(Stage::ShadowMark, e);
+  }
+  collect_requests(layout, keys, entries);
+}
+
+void ShadowMaps::keep_room(size_t vertices) {
+  if (vertices <= kept_capacity_) return;
+  const size_t grown = std::max(vertices, kept_capacity_ + kept_capacity_ / 2);
+  cl::Buffer p = session_.allocate(grown * sizeof(cl_float4), "shadow marking vertices");
+  cl::Buffer nrm = session_.allocate(grown * sizeof(cl_float4), "shadow marking normals");
+  if (kept_vertices_ > 0) {
+    session_.queue().enqueueCopyBuffer(kept_p_, p, 0, 0, size_t(kept_vertices_) * sizeof(cl_float4));
+    session_.queue().enqueueCopyBuffer(kept_n_, nrm, 0, 0, size_t(kept_vertices_) * sizeof(cl_float4));
+  }
+  kept_p_ = p;
+  kept_n_ = nrm;
+  kept_capacity_ = grown;
+}
+
+void ShadowMaps::collect_requests(const ShadowLayout& layout, std::vector<ShadowPageKey>& keys,
+                                  std::vector<uint32_t>& entries) {
+  const size_t n = layout.table_entries;
   std::vector<uint8_t> requested(n);
-  q.enqueueReadBuffer(requests_, CL_TRUE, 0, n, requested.data());
+  session_.queue().enqueueReadBuffer(requests_, CL_TRUE, 0, n, requested.data());
   // Coarser maps first: a budget too short for everything keeps them.
   std::vector<size_t> order(layout.maps.size());
   std::iota(order.begin(), order.end(), size_t(0));
@@ -113,7 +166,19 @@ bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, const
         entries.push_back(e);
       }
   }
-  return true;
+}
+
+void ShadowMaps::write_table(size_t entries, const std::vector<cl_uint2>& writes) {
+  cl::CommandQueue& q = session_.queue();
+  grow(session_, inputs_.pages, pages_capacity_, entries * sizeof(cl_uint), "shadow page tables");
+  q.enqueueFillBuffer(inputs_.pages, cl_uint(0), 0, entries * sizeof(cl_uint));
+  if (writes.empty()) return;
+  grow(session_, writes_, writes_capacity_, writes.size() * sizeof(cl_uint2), "shadow page-table writes");
+  q.enqueueWriteBuffer(writes_, CL_TRUE, 0, writes.size() * sizeof(cl_uint2), writes.data());
+  set_entries_.setArg(0, writes_);
+  set_entries_.setArg(1, cl_uint(writes.size()));
+  set_entries_.setArg(2, inputs_.pages);
+  q.enqueueNDRangeKernel(set_entries_, cl::NullRange, round_up_range(cl_uint(writes.size())), cl::NDRange(64));
 }
 
 void ShadowMaps::ensure_pool(uint32_t pages) {
@@ -213,20 +278,20 @@ bool ShadowMaps::render(const Scene& scene, const FrameSetup& frame, const Scene
   // budget too short for them coarsens every light.
   std::vector<ShadowPageKey> keys;
   std::vector<uint32_t> entries;
+  bool soft = false;
+  for (const DeviceShadow& d : layout.shadows) soft = soft || (d.kind != MP_SHADOW_NONE && d.shape != MP_SHADOW_SHAPE_POINT);
   for (int bias = 0;; ++bias) {
     set_shadow_level_bias(layout, bias);
     upload_records(layout);
-    if (!mark(layout, frame, buffers, stages, run, timer, false, keys, entries)) return false;
+    if (!mark(layout, frame, buffers, stages, run, timer, soft, keys, entries)) return false;
     stats.level_bias = bias;
     if (keys.size() <= capacity || bias >= kMaxShadowLevelBias) break;
   }
   if (!allocate_and_render(layout, keys, entries, frame, buffers, stages, run, timer, stats)) return false;
   // Then, where those maps show occluders near a receiver, the pages soft
   // shadows' second round and filters read there.
-  bool soft = false;
-  for (const DeviceShadow& d : layout.shadows) soft = soft || (d.kind != MP_SHADOW_NONE && d.shape != MP_SHADOW_SHAPE_POINT);
   if (soft) {
-    if (!mark(layout, frame, buffers, stages, run, timer, true, keys, entries)) return false;
+    mark_soft(layout, frame, timer, keys, entries);
     if (!allocate_and_render(layout, keys, entries, frame, buffers, stages, run, timer, stats)) return false;
   }
   inputs_.enabled = true;
@@ -240,7 +305,8 @@ bool ShadowMaps::render(const Scene& scene, const FrameSetup& frame, const Scene
     stats.per_light.push_back({int(l), light_pages_[l], light_pages_[l] * kPageBytes + entries_of_light * sizeof(cl_uint)});
   }
   stats.peak_bytes = size_t(pool_pages_) * kPageBytes + pages_capacity_ + requests_capacity_ + masks_capacity_ +
-                     views_capacity_ + records_capacity_ + levels_capacity_ + clear_capacity_;
+                     views_capacity_ + records_capacity_ + levels_capacity_ + clear_capacity_ + writes_capacity_ +
+                     2 * kept_capacity_ * sizeof(cl_float4);
   return true;
 }
 
@@ -254,6 +320,8 @@ bool ShadowMaps::allocate_and_render(const ShadowLayout& layout, const std::vect
   // Page tables: the granted pages, marked for rendering where new.
   std::vector<uint32_t> table(layout.table_entries, 0u);
   std::vector<uint32_t> fresh;
+  std::vector<cl_uint2> writes;
+  writes.reserve(keys.size());
   stats.pages_missing = 0;
   for (size_t i = 0; i < keys.size(); ++i) {
     const ShadowPagePool::Grant& g = grants[i];
@@ -262,6 +330,7 @@ bool ShadowMaps::allocate_and_render(const ShadowLayout& layout, const std::vect
       continue;
     }
     table[entries[i]] = g.physical | MP_PAGE_RESIDENT | (g.render ? MP_PAGE_RENDER : 0u);
+    writes.push_back({{entries[i], table[entries[i]]}});
     if (g.render) fresh.push_back(g.physical);
   }
   stats.pages_rendered += fresh.size();
@@ -301,8 +370,7 @@ bool ShadowMaps::allocate_and_render(const ShadowLayout& layout, const std::vect
 
   cl::CommandQueue& q = session_.queue();
   ensure_pool(pool_.extent());
-  grow(session_, inputs_.pages, pages_capacity_, table.size() * sizeof(cl_uint), "shadow page tables");
-  q.enqueueWriteBuffer(inputs_.pages, CL_TRUE, 0, table.size() * sizeof(cl_uint), table.data());
+  write_table(table.size(), writes);
   if (fresh.empty()) return true;
   StageTimer::Redirect to(timer, Stage::ShadowBoundSplit);
   grow(session_, clear_list_, clear_capacity_, fresh.size() * sizeof(cl_uint), "shadow page list");

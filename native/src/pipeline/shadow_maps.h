@@ -11,7 +11,8 @@
 //     as the camera's do, several views per pass, and their micropolygons
 //     are rasterised into the new pages (depth only);
 //  5. for soft shadows, a second marking runs the first search round on
-//     those maps: where it finds occluders, the finer levels the penumbra
+//     those maps, from the vertices the first marking kept (no second pass
+//     over the scene): where it finds occluders, the finer levels the penumbra
 //     filter reads there are marked, allocated and rendered as in 3 and 4
 //     (a penumbra is wider than the pixels wherever its occluders stand
 //     off the receiver, and needs no finer texels there).
@@ -57,12 +58,19 @@ class ShadowMaps {
   const ShadowInputs& inputs() const { return inputs_; }
 
  private:
-  // Marks the pages the camera's receivers need (the first marking, or the
-  // soft one, which adds to it); returns them all, coarser maps first, with
-  // their page-table entries.
+  // Marks the pages the camera's receivers need (the first marking), its
+  // vertices kept for the soft marking where `keep`; returns them all,
+  // coarser maps first, with their page-table entries.
   bool mark(const ShadowLayout& layout, const FrameSetup& frame, const SceneBuffers& buffers,
-            const ShadowPassStages& stages, const BoundSplitRunner& run, StageTimer& timer, bool soft,
+            const ShadowPassStages& stages, const BoundSplitRunner& run, StageTimer& timer, bool keep,
             std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries);
+  // The soft marking, over the first's kept vertices; adds to its requests.
+  void mark_soft(const ShadowLayout& layout, const FrameSetup& frame, StageTimer& timer,
+                 std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries);
+  void collect_requests(const ShadowLayout& layout, std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries);
+  void keep_room(size_t vertices);
+  // Zeroes the page tables (`entries` of them) and writes the given entries.
+  void write_table(size_t entries, const std::vector<cl_uint2>& writes);
   // Gives the requested pages physical ones, writes the page tables and
   // renders the new pages.
   bool allocate_and_render(const ShadowLayout& layout, const std::vector<ShadowPageKey>& keys,
@@ -76,11 +84,14 @@ class ShadowMaps {
   void ensure_pool(uint32_t pages);
 
   DeviceSession& session_;
-  cl::Kernel mark_, mark_soft_, clear_, sample_;
+  cl::Kernel mark_, mark_soft_, clear_, set_entries_, sample_;
   std::vector<size_t> light_pages_;  // resident pages per light, this frame
   ShadowPagePool pool_;
   ShadowInputs inputs_;
-  cl::Buffer requests_, views_, masks_, clear_list_;
+  cl::Buffer requests_, views_, masks_, clear_list_, writes_;
+  cl::Buffer kept_p_, kept_n_;  // the first marking's vertices and normals, for the soft one
+  size_t kept_capacity_ = 0, writes_capacity_ = 0;
+  cl_uint kept_vertices_ = 0;
   size_t requests_capacity_ = 0, pages_capacity_ = 0, views_capacity_ = 0, masks_capacity_ = 0, clear_capacity_ = 0, records_capacity_ = 0,
          levels_capacity_ = 0;
   uint32_t pool_pages_ = 0;  // pages the pool buffer holds

@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# The shadow benchmark on a GPU machine, from a bundle made by
+# bench/make_device_bundle.sh (run in its folder, .device/): the GPU tests,
+# then the six-Suzanne scene (bench/out/shadow_suzannes.rib, written by
+# bench/blender_bench.py --shadows --rib-only) at 1920x1080, 16 spp, its
+# three lights casting soft shadows, in interleaved rounds of 30 frames:
+# shadows on with fresh maps every frame, on with pages kept between frames
+# (a still scene, as the viewport redraws it), and off. Prints the medians of
+# each round's per-frame median and writes everything under $OUT.
+set -u
+cd "$(dirname "$0")"
+OUT=${OUT:-/tmp/shadow_bench}
+mkdir -p "$OUT" /tmp/icd
+echo /usr/lib/libnvidia-opencl.so > /tmp/icd/nvidia.icd
+export OCL_ICD_VENDORS=/tmp/icd LD_LIBRARY_PATH=$PWD/lib MICROPOLY_CACHE_DIR=/tmp/mpcache
+nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | tee "$OUT/device.txt"
+./micropoly-render --list-devices | tee -a "$OUT/device.txt"
+if [ -z "${SKIP_TESTS:-}" ]; then
+  MICROPOLY_DEVICE=gpu ./micropoly_tests --gtest_filter="${TESTS:-*Shadow*:RenderTest.*:Watertight*:MaterialProgram*}" \
+    > "$OUT/gpu_tests.txt" 2>&1
+  tail -3 "$OUT/gpu_tests.txt"
+  grep -E "FAILED|Failure" "$OUT/gpu_tests.txt" | head
+fi
+scene=${SCENE:-shadow_suzannes.rib}
+for round in 1 2 3; do
+  ./micropoly-render "$scene" -o "$OUT/on.png" --device gpu --fresh-shadows --repeat 30 --stats "$OUT/on_$round.json" >/dev/null
+  ./micropoly-render "$scene" -o "$OUT/kept.png" --device gpu --repeat 30 --stats "$OUT/kept_$round.json" >/dev/null
+  ./micropoly-render "$scene" -o "$OUT/off.png" --device gpu --shadows off --repeat 30 --stats "$OUT/off_$round.json" >/dev/null
+done
+python3 - "$OUT" <<'PY'
+import json, statistics, sys
+out = sys.argv[1]
+keys = ("total", "shadow_mark", "shadow", "shadow_bound_split", "shadow_dice", "shadow_sample", "shadows_wall",
+        "bound_split", "dice", "shade", "sample", "resolve", "readback")
+for mode in ("on", "kept", "off"):
+    meds = {}
+    for r in (1, 2, 3):
+        frames = json.load(open(f"{out}/{mode}_{r}.json"))[1:]  # the first frame builds programs and buffers
+        for k in keys:
+            meds.setdefault(k, []).append(statistics.median(f["timings_ms"].get(k, 0.0) for f in frames))
+    last = json.load(open(f"{out}/{mode}_1.json"))[-1]
+    sh = last["shadows"]
+    print(mode, json.dumps({k: round(statistics.median(v), 3) for k, v in meds.items()}))
+    print("   ", "pages", sh["pages_requested"], "rendered", sh["pages_rendered"], "shadow micropolygons",
+          sh["micropolygons"], "peak MiB", round(sh["peak_bytes"] / 2**20, 1), "per light MiB",
+          [round(l["bytes"] / 2**20, 1) for l in sh["per_light"]])
+PY
