@@ -27,21 +27,30 @@ for round in 1 2 3; do
   ./micropoly-render "$scene" -o "$OUT/kept.png" --device gpu --repeat 30 --stats "$OUT/kept_$round.json" >/dev/null
   ./micropoly-render "$scene" -o "$OUT/off.png" --device gpu --shadows off --repeat 30 --stats "$OUT/off_$round.json" >/dev/null
 done
+# The breadth-first bound & split, once each.
+./micropoly-render "$scene" -o "$OUT/on_breadth.png" --device gpu --fresh-shadows --bound-split breadth --repeat 30 \
+  --stats "$OUT/breadth_on_1.json" >/dev/null
+./micropoly-render "$scene" -o "$OUT/off_breadth.png" --device gpu --shadows off --bound-split breadth --repeat 30 \
+  --stats "$OUT/breadth_off_1.json" >/dev/null
 python3 - "$OUT" <<'PY'
-import json, statistics, sys
+import json, os, statistics, sys
 out = sys.argv[1]
 keys = ("total", "shadow_mark", "shadow", "shadow_bound_split", "shadow_dice", "shadow_sample", "shadows_wall",
         "bound_split", "dice", "shade", "sample", "resolve", "readback")
-for mode in ("on", "kept", "off"):
+for mode in ("on", "kept", "off", "breadth_on", "breadth_off"):
+    rounds = (1,) if mode.startswith("breadth") else (1, 2, 3)
     meds = {}
-    for r in (1, 2, 3):
+    for r in rounds:
         frames = json.load(open(f"{out}/{mode}_{r}.json"))[1:]  # the first frame builds programs and buffers
         for k in keys:
             meds.setdefault(k, []).append(statistics.median(f["timings_ms"].get(k, 0.0) for f in frames))
     last = json.load(open(f"{out}/{mode}_1.json"))[-1]
     sh = last["shadows"]
     print(mode, json.dumps({k: round(statistics.median(v), 3) for k, v in meds.items()}))
-    print("   ", "pages", sh["pages_requested"], "rendered", sh["pages_rendered"], "shadow micropolygons",
-          sh["micropolygons"], "peak MiB", round(sh["peak_bytes"] / 2**20, 1), "per light MiB",
+    print("   ", "launches", last["bound_split_launches"], "pages", sh["pages_requested"], "rendered", sh["pages_rendered"], "shadow micropolygons",
+          sh["micropolygons"], "batches", sh["batches"], "mark wall ms", round(sh["mark_wall_ms"], 2),
+          "render wall ms", round(sh["render_wall_ms"], 2), "peak MiB", round(sh["peak_bytes"] / 2**20, 1), "per light MiB",
           [round(l["bytes"] / 2**20, 1) for l in sh["per_light"]])
+    for r in rounds[1:]:
+        os.remove(f"{out}/{mode}_{r}.json")  # the medians above keep them
 PY

@@ -53,6 +53,9 @@ struct ShadowStats {
   size_t micropolygons = 0;       // diced for the lights' views
   size_t budget_bytes = 0;        // RenderSettings::shadow_memory_mib
   size_t peak_bytes = 0;          // shadow map device memory held: pages, page tables, requests, masks, views
+  size_t batches = 0;             // dice batches of the markings and the lights' views
+  double mark_wall_ms = 0;        // wall time of the markings, requests read back included
+  double render_wall_ms = 0;      // wall time of allocating, writing the page tables and rendering pages
   std::vector<ShadowLightStats> per_light;
 };
 

@@ -55,7 +55,8 @@ std::string RenderStats::to_json() const {
        ", \"pages_rendered\": " + std::to_string(sh.pages_rendered) + ", \"pages_missing\": " +
        std::to_string(sh.pages_missing) + ", \"micropolygons\": " + std::to_string(sh.micropolygons) +
        ", \"budget_bytes\": " + std::to_string(sh.budget_bytes) + ", \"peak_bytes\": " + std::to_string(sh.peak_bytes) +
-       ", \"per_light\": [";
+       ", \"batches\": " + std::to_string(sh.batches) + ", \"mark_wall_ms\": " + num(sh.mark_wall_ms) +
+       ", \"render_wall_ms\": " + num(sh.render_wall_ms) + ", \"per_light\": [";
   for (size_t i = 0; i < sh.per_light.size(); ++i)
     j += std::string(i ? ", " : "") + "{\"light\": " + std::to_string(sh.per_light[i].light) + ", \"pages\": " +
          std::to_string(sh.per_light[i].pages) + ", \"bytes\": " + std::to_string(sh.per_light[i].bytes) + "}";

@@ -23,10 +23,6 @@ constexpr cl_uint kDiceBatch = 8192;
 // Sub-patches sampled per launch when the caller can cancel.
 constexpr cl_uint kSampleChunk = 256;
 
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
 }  // namespace
 
 // Everything that outlives one frame: the device session, the stages' kernels

@@ -54,8 +54,9 @@ void ShadowMaps::upload_records(const ShadowLayout& layout) {
 
 bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, const SceneBuffers& buffers,
                       const ShadowPassStages& stages, const BoundSplitRunner& run, StageTimer& timer, bool keep,
-                      std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries) {
+                      std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries, ShadowStats& stats) {
   StageTimer::Redirect to(timer, Stage::ShadowMark);
+  const auto started = std::chrono::steady_clock::now();
   cl::CommandQueue& q = session_.queue();
   const size_t n = layout.table_entries;
   grow(session_, requests_, requests_capacity_, n, "shadow page requests");
@@ -71,6 +72,7 @@ bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, const
     // The soft marking's search compares with the displaced surface's tangent plane.
     stages.programs.displace(diceable, count, buffers, coarse, grids, timer, keep);
     const cl_uint vertices = grids.vertex_total;
+    ++stats.batches;
     if (keep) keep_room(size_t(kept_vertices_) + vertices);
     cl_uint arg = 0;
     mark_.setArg(arg++, diceable);
@@ -96,12 +98,14 @@ bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, const
   };
   if (run(coarse, PassViews{}, sink).cancelled) return false;
   collect_requests(layout, keys, entries);
+  stats.mark_wall_ms += ms_since(started);
   return true;
 }
 
 void ShadowMaps::mark_soft(const ShadowLayout& layout, const FrameSetup& frame, StageTimer& timer,
-                           std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries) {
+                           std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries, ShadowStats& stats) {
   StageTimer::Redirect to(timer, Stage::ShadowMark);
+  const auto started = std::chrono::steady_clock::now();
   cl::CommandQueue& q = session_.queue();
   // The soft marking adds to the first's requests.
   if (kept_vertices_ > 0) {
@@ -124,6 +128,7 @@ void ShadowMaps::mark_soft(const ShadowLayout& layout, const FrameSetup& frame, 
     timer.add(Stage::ShadowMark, e);
   }
   collect_requests(layout, keys, entries);
+  stats.mark_wall_ms += ms_since(started);
 }
 
 void ShadowMaps::keep_room(size_t vertices) {
@@ -194,13 +199,14 @@ void ShadowMaps::ensure_pool(uint32_t pages) {
 
 bool ShadowMaps::render_views(const std::vector<FrameParams>& views, const std::vector<uint8_t>& masks,
                               const FrameSetup& frame, const SceneBuffers& buffers, const ShadowPassStages& stages,
-                              const BoundSplitRunner& run, StageTimer& timer) {
+                              const BoundSplitRunner& run, StageTimer& timer, ShadowStats& stats) {
   cl::CommandQueue& q = session_.queue();
   grow(session_, masks_, masks_capacity_, masks.size(), "shadow page masks");
   if (!masks.empty()) q.enqueueWriteBuffer(masks_, CL_TRUE, 0, masks.size(), masks.data());
   const FrameParams& f = frame.params;
   GridBuffers& grids = stages.grids;
   DiceSink sink = [&](const cl::Buffer& diceable, cl_uint count) {
+    ++stats.batches;
     stages.layout.run(diceable, count, f, grids, timer);
     stages.dice.run(diceable, count, buffers, f, grids, timer);
     stages.programs.displace(diceable, count, buffers, f, grids, timer, false);
@@ -283,7 +289,7 @@ bool ShadowMaps::render(const Scene& scene, const FrameSetup& frame, const Scene
   for (int bias = 0;; ++bias) {
     set_shadow_level_bias(layout, bias);
     upload_records(layout);
-    if (!mark(layout, frame, buffers, stages, run, timer, soft, keys, entries)) return false;
+    if (!mark(layout, frame, buffers, stages, run, timer, soft, keys, entries, stats)) return false;
     stats.level_bias = bias;
     if (keys.size() <= capacity || bias >= kMaxShadowLevelBias) break;
   }
@@ -291,7 +297,7 @@ bool ShadowMaps::render(const Scene& scene, const FrameSetup& frame, const Scene
   // Then, where those maps show occluders near a receiver, the pages soft
   // shadows' second round and filters read there.
   if (soft) {
-    mark_soft(layout, frame, timer, keys, entries);
+    mark_soft(layout, frame, timer, keys, entries, stats);
     if (!allocate_and_render(layout, keys, entries, frame, buffers, stages, run, timer, stats)) return false;
   }
   inputs_.enabled = true;
@@ -314,6 +320,12 @@ bool ShadowMaps::allocate_and_render(const ShadowLayout& layout, const std::vect
                                      const std::vector<uint32_t>& entries, const FrameSetup& frame,
                                      const SceneBuffers& buffers, const ShadowPassStages& stages,
                                      const BoundSplitRunner& run, StageTimer& timer, ShadowStats& stats) {
+  const auto started = std::chrono::steady_clock::now();
+  struct AddWall {
+    double& to;
+    std::chrono::steady_clock::time_point from;
+    ~AddWall() { to += ms_since(from); }
+  } add_wall{stats.render_wall_ms, started};
   std::vector<ShadowPagePool::Grant> grants;
   pool_.grant(keys, grants);
 
@@ -335,8 +347,21 @@ bool ShadowMaps::allocate_and_render(const ShadowLayout& layout, const std::vect
   }
   stats.pages_rendered += fresh.size();
 
-  // The views of maps with pages to render, and their page masks.
+  // Resident pages per light: a light's page-table entries follow its first.
   light_pages_.assign(layout.shadows.size(), 0);
+  for (const cl_uint2& w : writes)
+    for (size_t l = layout.shadows.size(); l-- > 0;)
+      if (layout.shadows[l].kind != MP_SHADOW_NONE && w.s[0] >= layout.shadows[l].page_table) {
+        ++light_pages_[l];
+        break;
+      }
+
+  cl::CommandQueue& q = session_.queue();
+  ensure_pool(pool_.extent());
+  write_table(table.size(), writes);
+  if (fresh.empty()) return true;
+
+  // The views of maps with pages to render, and their page masks.
   std::vector<FrameParams> views;
   std::vector<uint8_t> masks;
   for (const ShadowMapInfo& m : layout.maps) {
@@ -346,9 +371,7 @@ bool ShadowMaps::allocate_and_render(const ShadowLayout& layout, const std::vect
     for (int ry = 0; ry < n; ++ry)
       for (int rx = 0; rx < n; ++rx) {
         const int sx = (rx + m.origin_x) & (n - 1), sy = (ry + m.origin_y) & (n - 1);
-        const uint32_t e = table[m.table + uint32_t(sy * n + sx)];
-        if (e & MP_PAGE_RESIDENT) ++light_pages_[size_t(m.light)];
-        if (e & MP_PAGE_RENDER) level[size_t(ry) * n + rx] = 1, ++any;
+        if (table[m.table + uint32_t(sy * n + sx)] & MP_PAGE_RENDER) level[size_t(ry) * n + rx] = 1, ++any;
       }
     if (!any) continue;
     FrameParams v = m.view;
@@ -368,10 +391,6 @@ bool ShadowMaps::allocate_and_render(const ShadowLayout& layout, const std::vect
   }
   stats.views += views.size();
 
-  cl::CommandQueue& q = session_.queue();
-  ensure_pool(pool_.extent());
-  write_table(table.size(), writes);
-  if (fresh.empty()) return true;
   StageTimer::Redirect to(timer, Stage::ShadowBoundSplit);
   grow(session_, clear_list_, clear_capacity_, fresh.size() * sizeof(cl_uint), "shadow page list");
   q.enqueueWriteBuffer(clear_list_, CL_TRUE, 0, fresh.size() * sizeof(cl_uint), fresh.data());
@@ -383,7 +402,7 @@ bool ShadowMaps::allocate_and_render(const ShadowLayout& layout, const std::vect
   q.enqueueNDRangeKernel(clear_, cl::NullRange, round_up_range(texels, 256), cl::NDRange(256), nullptr, &e);
   timer.add(Stage::ShadowSample, e);
   stages.layout.begin_frame();
-  if (!render_views(views, masks, frame, buffers, stages, run, timer)) return false;
+  if (!render_views(views, masks, frame, buffers, stages, run, timer, stats)) return false;
   stats.micropolygons += stages.layout.micropolygons();
   return true;
 }

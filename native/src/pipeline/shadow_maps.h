@@ -63,10 +63,10 @@ class ShadowMaps {
   // coarser maps first, with their page-table entries.
   bool mark(const ShadowLayout& layout, const FrameSetup& frame, const SceneBuffers& buffers,
             const ShadowPassStages& stages, const BoundSplitRunner& run, StageTimer& timer, bool keep,
-            std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries);
+            std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries, ShadowStats& stats);
   // The soft marking, over the first's kept vertices; adds to its requests.
   void mark_soft(const ShadowLayout& layout, const FrameSetup& frame, StageTimer& timer,
-                 std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries);
+                 std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries, ShadowStats& stats);
   void collect_requests(const ShadowLayout& layout, std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries);
   void keep_room(size_t vertices);
   // Zeroes the page tables (`entries` of them) and writes the given entries.
@@ -80,7 +80,7 @@ class ShadowMaps {
   void upload_records(const ShadowLayout& layout);
   bool render_views(const std::vector<FrameParams>& views, const std::vector<uint8_t>& masks, const FrameSetup& frame,
                     const SceneBuffers& buffers, const ShadowPassStages& stages, const BoundSplitRunner& run,
-                    StageTimer& timer);
+                    StageTimer& timer, ShadowStats& stats);
   void ensure_pool(uint32_t pages);
 
   DeviceSession& session_;

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <chrono>
 #include <optional>
 #include <vector>
 
@@ -57,6 +58,11 @@ class StageTimer {
 };
 
 // Rounds a 1D launch up to a multiple of the work-group size used for it.
+// Milliseconds of wall time since t0.
+inline double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
 inline cl::NDRange round_up_range(size_t n, size_t group = 64) { return cl::NDRange(((n + group - 1) / group) * group); }
 
 }  // namespace mp

@@ -80,6 +80,9 @@ py::dict stats_dict(const RenderStats& s) {
   sh["micropolygons"] = s.shadows.micropolygons;
   sh["budget_bytes"] = s.shadows.budget_bytes;
   sh["peak_bytes"] = s.shadows.peak_bytes;
+  sh["batches"] = s.shadows.batches;
+  sh["mark_wall_ms"] = s.shadows.mark_wall_ms;
+  sh["render_wall_ms"] = s.shadows.render_wall_ms;
   py::list per_light;
   for (const ShadowLightStats& l : s.shadows.per_light) {
     py::dict e;
