@@ -11,7 +11,7 @@ for bin in "$build/micropoly-render" "$build/micropoly_tests"; do
   ldd "$bin" | awk '/=> \//{print $3}' | grep -vE '/(libc|libm|libpthread|libdl|librt)\.so' | xargs -r cp -L -t "$out/lib/"
 done
 cp -r tests/scenes "$out/scenes"
-cp bench/gpu_shadow_bench.sh "$out/"
+cp bench/shadow_bench.sh "$out/"
 # The benchmark scenes bench/blender_bench.py writes as RIB (--rib-only).
 [ -d bench/out ] && cp bench/out/*.rib "$out/" 2>/dev/null || true
 du -sh "$out"

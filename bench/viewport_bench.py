@@ -2,7 +2,7 @@
 refinement arrive after the view opens, after an edit and after an orbit.
 Run with Blender (or a Python with bpy):
 
-  MICROPOLY_ADDON_DIR=build/addons blender -b --factory-startup --python bench/viewport_bench.py -- [--repeat 5] [--rate 1.0]
+  MICROPOLY_ADDON_DIR=build/addons blender -b --factory-startup --python bench/viewport_bench.py -- [--repeat 5] [--rate 1.0] [--no-shadows]
 
 Scene: bench/blender_bench.py's six subdivided Suzannes on a floor, seen
 from its camera at 1280x720 through the viewport session
@@ -11,7 +11,9 @@ drawing: view_update's export (with the mesh cache kept between updates)
 and the worker thread's passes: a quarter-resolution image at 1 spp, then
 the full view at 16 spp. Times run from just before the export
 (the edit) or the view change to the image's arrival. Prints medians and a
-JSON line.
+JSON line. The lights cast shadows unless --no-shadows; the session keeps
+the shadow map pages between requests, so an orbit renders only the pages
+the turned view newly needs and an edit (geometry changed) renders all.
 
 --rib PATH writes the same view at 1920x1080, 4 spp as RIB instead, for
 the CLI's frames per second on a GPU:
@@ -33,6 +35,7 @@ import blender_bench  # noqa: E402
 args = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 REPEAT = int(args[args.index("--repeat") + 1]) if "--repeat" in args else 5
 RATE = float(args[args.index("--rate") + 1]) if "--rate" in args else 1.0
+SHADOWS = "--no-shadows" not in args
 WIDTH, HEIGHT, SAMPLES = 1280, 720, 16
 
 
@@ -74,11 +77,13 @@ def main():
     scene.render.engine = "MICROPOLY"
     scene.micropoly.viewport_samples = SAMPLES
     scene.micropoly.viewport_shading_rate = RATE
+    scene.micropoly.use_shadows = SHADOWS
     depsgraph = bpy.context.evaluated_depsgraph_get()
     view = viewport.view_from_camera(scene, depsgraph, WIDTH, HEIGHT)
     meshes = export_mesh.MeshCache()
     session = viewport.ViewportSession("")
     results = {"open": [], "edit": [], "orbit": []}
+    pages = {"edit": [], "orbit": []}  # shadow map pages rendered for the final pass, of those requested
     try:
         for run in range(REPEAT + 1):
             # Open (or re-open after an edit): export, then render.
@@ -88,6 +93,7 @@ def main():
             generation = session.request(exported, view, SAMPLES, RATE)
             first, final, image = wait(session, generation, started)
             results["open" if run == 0 else "edit"].append((first, final, export_s))
+            pages["edit"].append((image.stats["shadows"]["pages_rendered"], image.stats["shadows"]["pages_requested"]))
             # Orbit: the same scene from a camera turned by 2 degrees.
             cam = scene.camera
             cam.rotation_euler.z += math.radians(2.0) * (1 if run % 2 == 0 else -1)
@@ -97,6 +103,7 @@ def main():
             generation = session.restart_view(orbit)
             first, final, image = wait(session, generation, started)
             results["orbit"].append((first, final, 0.0))
+            pages["orbit"].append((image.stats["shadows"]["pages_rendered"], image.stats["shadows"]["pages_requested"]))
             view = orbit
             # The edit for the next round: one Suzanne moves.
             obj = next(o for o in scene.objects if o.type == "MESH" and o.modifiers)
@@ -106,7 +113,12 @@ def main():
     finally:
         session.close()
     print(f"\nBlender {bpy.app.version_string}, viewport {WIDTH}x{HEIGHT}, {SAMPLES} spp, shading rate {RATE}, "
-          f"device {session.device}; final pass: {stats['micropolygons']:,} micropolygons")
+          f"shadows {'on' if SHADOWS else 'off'}, device {session.device}; final pass: "
+          f"{stats['micropolygons']:,} micropolygons")
+    if SHADOWS:
+        for name, rows in pages.items():
+            print(f"shadow pages rendered / requested in the final pass, {name}: "
+                  + ", ".join(f"{r}/{q}" for r, q in rows))
     print("| event | runs | first image s (median) | full refinement s (median) | export s (median) |")
     print("|---|---|---|---|---|")
     for name, rows in results.items():
@@ -115,7 +127,7 @@ def main():
         med = [statistics.median(r[i] for r in rows) for i in range(3)]
         print(f"| {name} | {len(rows)} | {med[0]:.3f} | {med[1]:.3f} | {med[2]:.3f} |")
     print(json.dumps({"version": bpy.app.version_string, "width": WIDTH, "height": HEIGHT, "samples": SAMPLES,
-                      "shading_rate": RATE, "device": session.device, "micropolygons": stats["micropolygons"],
+                      "shading_rate": RATE, "shadows": SHADOWS, "shadow_pages": pages, "device": session.device, "micropolygons": stats["micropolygons"],
                       "runs": results}))
 
 

@@ -40,10 +40,13 @@ torus.data.materials.append(material("Teal", (0.1, 0.5, 0.55)))
 bpy.ops.mesh.primitive_plane_add(size=12.0)
 bpy.context.object.data.materials.append(material("Floor", (0.6, 0.6, 0.6)))
 
+# Both lights cast shadows (Blender's default); their sizes soften them.
 bpy.ops.object.light_add(type="SUN", rotation=(math.radians(40), math.radians(15), math.radians(30)))
 bpy.context.object.data.energy = 3.0
+bpy.context.object.data.angle = math.radians(3.0)
 bpy.ops.object.light_add(type="POINT", location=(-3.0, -3.0, 4.0))
 bpy.context.object.data.energy = 800.0
+bpy.context.object.data.shadow_soft_size = 0.3
 
 bpy.ops.object.camera_add(location=(5.5, -6.5, 4.0))
 cam = bpy.context.object

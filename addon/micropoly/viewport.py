@@ -302,25 +302,33 @@ class ViewportSession:
     def _refine(self, renderer, generation, exported, view, samples, shading_rate, requested):
         native = exported.scene
         passes = refinement_passes(samples, shading_rate)
-        for k, (divisor, spp, rate) in enumerate(passes):
-            if not self._current(generation):
-                return
-            w, h = max(1, math.ceil(view.width / divisor)), max(1, math.ceil(view.height / divisor))
-            replace(view, width=w, height=h).apply(native)
-            native.settings.samples = spp
-            native.settings.shading_rate = rate
-            native.settings.depth_and_normal_passes = False  # the viewport draws colour only
-            result = renderer.render(native, lambda p: self._current(generation))
-            if result["stats"]["cancelled"] or not self._current(generation):
-                return
-            rgba = result["rgba"]
-            if not exported.transparent:
-                alpha = rgba[..., 3:4]
-                rgba = np.concatenate([rgba[..., :3] + (1.0 - alpha) * exported.background, np.ones_like(alpha)],
-                                      axis=-1)
-            image = ViewportImage(np.ascontiguousarray(rgba[::-1], dtype=np.float32), w, h, view.crop, spp,
-                                  k == len(passes) - 1, generation, time.perf_counter() - requested,
-                                  result["stats"])
-            with self._cond:
-                if self._generation == generation:
-                    self._image = image
+        try:
+            for k, (divisor, spp, rate) in enumerate(passes):
+                if not self._current(generation):
+                    return
+                w, h = max(1, math.ceil(view.width / divisor)), max(1, math.ceil(view.height / divisor))
+                replace(view, width=w, height=h).apply(native)
+                native.settings.samples = spp
+                native.settings.shading_rate = rate
+                native.settings.depth_and_normal_passes = False  # the viewport draws colour only
+                # The preview's penumbrae read the pages the first marking makes
+                # (coarser near contact); the final pass adds the finer ones. Its
+                # shadow maps keep the final pass's dicing, so that the pages of
+                # both stay in the renderer for the next request.
+                native.settings.soft_shadow_pages = k == len(passes) - 1
+                result = renderer.render(native, lambda p: self._current(generation))
+                if result["stats"]["cancelled"] or not self._current(generation):
+                    return
+                rgba = result["rgba"]
+                if not exported.transparent:
+                    alpha = rgba[..., 3:4]
+                    rgba = np.concatenate([rgba[..., :3] + (1.0 - alpha) * exported.background, np.ones_like(alpha)],
+                                          axis=-1)
+                image = ViewportImage(np.ascontiguousarray(rgba[::-1], dtype=np.float32), w, h, view.crop, spp,
+                                      k == len(passes) - 1, generation, time.perf_counter() - requested,
+                                      result["stats"])
+                with self._cond:
+                    if self._generation == generation:
+                        self._image = image
+        finally:
+            native.settings.soft_shadow_pages = True  # a view change renders this scene again

@@ -2,7 +2,8 @@
 
 Run as `blender -b --factory-startup --python tests/blender/test_viewport.py`:
 this background part builds the scene (a subdivided Suzanne with a diffuse
-material, a sun, a camera, Micropoly as the engine), saves it, and starts
+material over a floor, a sun casting her shadow on it, a camera, Micropoly
+as the engine), saves it, and starts
 Blender with a window under xvfb-run on that file and this script with
 `-- --gui RESULTS.json`. The window part:
 
@@ -12,7 +13,8 @@ Blender with a window under xvfb-run on that file and this script with
    F12 render of the scene at the frame's size (both colour-managed the same
    way, 8-bit sRGB): mean |difference| <= 2/255 and at most 1% of the pixels
    more than 24/255 apart (silhouette pixels land a fraction of a pixel
-   differently in the two images);
+   differently in the two images); and an F12 render without shadows must
+   not match it (the viewport shows the shadows);
 2. renders F12 references of an edited scene (Suzanne moved, its material
    changed from orange to blue), then applies that edit from Python and
    screenshots the viewport until it matches the edited reference by the
@@ -54,6 +56,8 @@ def build_scene(path):
     suzanne.modifiers.new("Subdivision", "SUBSURF").render_levels = 2
     bpy.ops.object.shade_smooth()
     suzanne.data.materials.append(ru.diffuse_material("Paint", ORANGE))
+    bpy.ops.mesh.primitive_plane_add(size=8.0, location=(0.0, 0.0, -1.0))
+    bpy.context.object.data.materials.append(ru.diffuse_material("Floor", (0.6, 0.6, 0.6)))
     sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
     sun.data.energy = 3.0
     sun.rotation_euler = (0.6, 0.2, 0.3)
@@ -219,6 +223,13 @@ class WindowTest:
         self.results["viewport_vs_f12"] = stats
         if not self.matches(stats):
             self.fail(f"viewport differs from F12: mean {stats[0] * 255:.2f}/255, {stats[1]:.1%} outliers")
+        self.scene.micropoly.use_shadows = False
+        unshadowed = self.f12("no_shadows.png", x1 - x0, y1 - y0)
+        self.scene.micropoly.use_shadows = True
+        stats = self.compare(shot, unshadowed)
+        self.results["viewport_vs_f12_without_shadows"] = stats
+        if self.matches(stats):
+            self.fail("the viewport matches F12 without shadows: it shows none")
         # Orange Suzanne in the viewport must not already look like the
         # edited one, or the next step proves nothing.
         self.edit(0.7, BLUE)

@@ -496,6 +496,34 @@ TEST_F(ShadowRenderTest, BoundSplitStrategiesMakeTheSameShadows) {
   EXPECT_EQ(bounded.rgba, breadth.rgba);
 }
 
+TEST_F(ShadowRenderTest, PreviewPenumbraeWithoutTheirFinerPagesKeepTheirWidth) {
+  // The viewport's preview skips soft shadows' second marking: no more pages
+  // (here, where the first marking's levels already hold the penumbra, no
+  // fewer either), and a penumbra still about as wide as similar triangles
+  // say.
+  const float h = 1.0f, H = 5.0f;
+  Light a;
+  a.type = Light::Type::Area;
+  a.intensity = 3.0f;
+  a.position = glm::vec3(0, 0, H);
+  a.direction = glm::vec3(0, 0, -1);
+  a.axis_u = glm::vec3(1, 0, 0);
+  a.size_u = a.size_v = 2.0f;
+  Scene s = floor_scene(a);
+  s.meshes.push_back(occluder(-20.0f, -20.0f, 0.0f, 20.0f, h));
+  const RenderResult full = Renderer().render(s);
+  s.settings.soft_shadow_pages = false;
+  const RenderResult preview = Renderer().render(s);
+  EXPECT_LE(preview.stats.shadows.pages_requested, full.stats.shadows.pages_requested);
+  EXPECT_EQ(preview.stats.shadows.pages_missing, 0u);
+  std::vector<float> v = visibility(*renderer_, s);
+  const double w = ramp_width(v, kH / 2), expected = 0.8 * 2.0 * h / (H - h) * kPx;
+  ASSERT_GT(w, 0.0);
+  EXPECT_NEAR(w / expected, 1.0, 0.25) << w << " px against " << expected;
+  EXPECT_LT(v[size_t(kH / 2) * kW + 10], 0.02f);
+  EXPECT_GT(v[size_t(kH / 2) * kW + kW - 10], 0.98f);
+}
+
 TEST_F(ShadowRenderTest, AShortBudgetCoarsensShadowsAndKeepsToIt) {
   Light point;
   point.type = Light::Type::Point;

@@ -198,6 +198,10 @@ struct RenderSettings {
   // for its next frames (the viewport's redraws); off, every frame renders
   // its shadow maps anew (benchmarks).
   bool keep_shadow_pages = true;
+  // Soft shadows' finer pages, where their first search finds occluders (a
+  // second marking and pass); off, penumbrae read the levels the first
+  // marking made, coarser near contact (the viewport's preview pass).
+  bool soft_shadow_pages = true;
 };
 
 struct Scene {

@@ -285,7 +285,8 @@ bool ShadowMaps::render(const Scene& scene, const FrameSetup& frame, const Scene
   std::vector<ShadowPageKey> keys;
   std::vector<uint32_t> entries;
   bool soft = false;
-  for (const DeviceShadow& d : layout.shadows) soft = soft || (d.kind != MP_SHADOW_NONE && d.shape != MP_SHADOW_SHAPE_POINT);
+  if (settings.soft_shadow_pages)
+    for (const DeviceShadow& d : layout.shadows) soft = soft || (d.kind != MP_SHADOW_NONE && d.shape != MP_SHADOW_SHAPE_POINT);
   for (int bias = 0;; ++bias) {
     set_shadow_level_bias(layout, bias);
     upload_records(layout);

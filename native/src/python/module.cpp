@@ -163,7 +163,8 @@ PYBIND11_MODULE(_native, m) {
       .def_readwrite("shadows", &RenderSettings::shadows)
       .def_readwrite("shadow_memory_mib", &RenderSettings::shadow_memory_mib)
       .def_readwrite("shadow_shading_rate", &RenderSettings::shadow_shading_rate)
-      .def_readwrite("keep_shadow_pages", &RenderSettings::keep_shadow_pages);
+      .def_readwrite("keep_shadow_pages", &RenderSettings::keep_shadow_pages)
+      .def_readwrite("soft_shadow_pages", &RenderSettings::soft_shadow_pages);
 
   py::class_<Scene>(m, "Scene")
       .def(py::init<>())

@@ -1,19 +1,26 @@
 #!/usr/bin/env bash
-# The shadow benchmark on a GPU machine, from a bundle made by
-# bench/make_device_bundle.sh (run in its folder, .device/): the GPU tests,
-# then the six-Suzanne scene (bench/out/shadow_suzannes.rib, written by
-# bench/blender_bench.py --shadows --rib-only) at 1920x1080, 16 spp, its
-# three lights casting soft shadows, in interleaved rounds of 30 frames:
-# shadows on with fresh maps every frame, on with pages kept between frames
-# (a still scene, as the viewport redraws it), and off. Prints the medians of
-# each round's per-frame median and writes everything under $OUT.
+# The shadow benchmark through the CLI, from a bundle made by
+# bench/make_device_bundle.sh (run in its folder, .device/): on a GPU machine
+# the GPU tests first, then the six-Suzanne scene
+# (bench/out/shadow_suzannes.rib, written by bench/blender_bench.py --shadows
+# --rib-only) at 1920x1080, 16 spp, its three lights casting soft shadows, in
+# interleaved rounds of REPEAT frames (30): shadows on with fresh maps every
+# frame, on with pages kept between frames (a still scene, as the viewport
+# redraws it), and off; then once each with the breadth-first bound & split.
+# Prints the medians of each round's per-frame median and writes everything
+# under $OUT. DEVICE=cpu runs it on PoCL (no tests: SKIP_TESTS=1).
 set -u
 cd "$(dirname "$0")"
 OUT=${OUT:-/tmp/shadow_bench}
-mkdir -p "$OUT" /tmp/icd
-echo /usr/lib/libnvidia-opencl.so > /tmp/icd/nvidia.icd
-export OCL_ICD_VENDORS=/tmp/icd LD_LIBRARY_PATH=$PWD/lib MICROPOLY_CACHE_DIR=/tmp/mpcache
-nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | tee "$OUT/device.txt"
+DEVICE=${DEVICE:-gpu}
+REPEAT=${REPEAT:-30}
+mkdir -p "$OUT"
+export LD_LIBRARY_PATH=$PWD/lib
+if [ "$DEVICE" = gpu ]; then
+  mkdir -p /tmp/icd && echo /usr/lib/libnvidia-opencl.so > /tmp/icd/nvidia.icd
+  export OCL_ICD_VENDORS=/tmp/icd MICROPOLY_CACHE_DIR=/tmp/mpcache
+  nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | tee "$OUT/device.txt"
+fi
 ./micropoly-render --list-devices | tee -a "$OUT/device.txt"
 if [ -z "${SKIP_TESTS:-}" ]; then
   MICROPOLY_DEVICE=gpu ./micropoly_tests --gtest_filter="${TESTS:-*Shadow*:RenderTest.*:Watertight*:MaterialProgram*}" \
@@ -23,14 +30,14 @@ if [ -z "${SKIP_TESTS:-}" ]; then
 fi
 scene=${SCENE:-shadow_suzannes.rib}
 for round in 1 2 3; do
-  ./micropoly-render "$scene" -o "$OUT/on.png" --device gpu --fresh-shadows --repeat 30 --stats "$OUT/on_$round.json" >/dev/null
-  ./micropoly-render "$scene" -o "$OUT/kept.png" --device gpu --repeat 30 --stats "$OUT/kept_$round.json" >/dev/null
-  ./micropoly-render "$scene" -o "$OUT/off.png" --device gpu --shadows off --repeat 30 --stats "$OUT/off_$round.json" >/dev/null
+  ./micropoly-render "$scene" -o "$OUT/on.png" --device "$DEVICE" --fresh-shadows --repeat "$REPEAT" --stats "$OUT/on_$round.json" >/dev/null
+  ./micropoly-render "$scene" -o "$OUT/kept.png" --device "$DEVICE" --repeat "$REPEAT" --stats "$OUT/kept_$round.json" >/dev/null
+  ./micropoly-render "$scene" -o "$OUT/off.png" --device "$DEVICE" --shadows off --repeat "$REPEAT" --stats "$OUT/off_$round.json" >/dev/null
 done
 # The breadth-first bound & split, once each.
-./micropoly-render "$scene" -o "$OUT/on_breadth.png" --device gpu --fresh-shadows --bound-split breadth --repeat 30 \
+./micropoly-render "$scene" -o "$OUT/on_breadth.png" --device "$DEVICE" --fresh-shadows --bound-split breadth --repeat "$REPEAT" \
   --stats "$OUT/breadth_on_1.json" >/dev/null
-./micropoly-render "$scene" -o "$OUT/off_breadth.png" --device gpu --shadows off --bound-split breadth --repeat 30 \
+./micropoly-render "$scene" -o "$OUT/off_breadth.png" --device "$DEVICE" --shadows off --bound-split breadth --repeat "$REPEAT" \
   --stats "$OUT/breadth_off_1.json" >/dev/null
 python3 - "$OUT" <<'PY'
 import json, os, statistics, sys
