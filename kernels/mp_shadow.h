@@ -34,6 +34,7 @@
 #define MP_SHADOW_H
 
 #include "mp_compat.h"
+#include "mp_hash.h"
 #include "mp_types.h"
 
 #define MP_PAGE_SIZE 128          /* texels per page side */
@@ -418,17 +419,33 @@ MP_INLINE MpLightShape mp_light_shape(const MP_GLOBAL DeviceShadow* sh, float3 t
  * through 16 steps rather than 4, taken those with an even number of set
  * bits first (which alone are a (0, 3, 2)-net: one in each eighth of either
  * side, two in each quarter of the square). */
-MP_INLINE float3 mp_filter_tap(const MpLightShape* s, int i, float2 turn) {
+MP_INLINE float3 mp_filter_tap(const MpLightShape* s, int i, float2 turn, float2 shift) {
   int h = i & 7, odd = i >> 3;
   if (s->grid) {
     int parity = (h ^ (h >> 1) ^ (h >> 2)) & 1;
     int k = 2 * h + (parity ^ odd);
     int rev = ((k & 1) << 3) | ((k & 2) << 1) | ((k & 4) >> 1) | ((k & 8) >> 3);
-    float x = ((float)k + 0.5f) * (2.0f / 16.0f) - 1.0f, y = ((float)rev + 0.5f) * (2.0f / 16.0f) - 1.0f;
+    float x = ((float)k + 0.5f) * (1.0f / 16.0f) + shift.x, y = ((float)rev + 0.5f) * (1.0f / 16.0f) + shift.y;
+    x = 2.0f * (x - floor(x)) - 1.0f;
+    y = 2.0f * (y - floor(y)) - 1.0f;
     return x * s->u + y * s->v;
   }
   float r = sqrt(((float)(2 * h + odd) + 0.5f) * (1.0f / 16.0f));
   return (r * turn.x) * s->u + (r * turn.y) * s->v;
+}
+
+/* Each receiver turns the filter's spiral by its own angle (and shifts its
+ * Hammersley points, wrapping around the square), from a hash of its
+ * position: neighbouring receivers then make uncorrelated errors, fine
+ * noise that the pixel samples average, rather than the same error over a
+ * region (blotches). The blocker search keeps one pattern for all: turned
+ * per receiver, it found a receiver's own curved surface at some points
+ * and not at their neighbours (speckles on curved lit surfaces). */
+MP_INLINE float2 mp_filter_spin(float3 q, float2* shift) {
+  uint h = mp_hash_combine(mp_hash_combine(mp_hash32(as_uint(q.x)), as_uint(q.y)), as_uint(q.z));
+  float a = 6.28318531f * mp_hash_unit(h);
+  *shift = MP_F2(mp_hash_unit(mp_hash32(h)), mp_hash_unit(mp_hash32(h ^ 0x5bd1e995u)));
+  return MP_F2(cos(a), sin(a));
 }
 
 /* Which of the two filter levels tap i reads: the coarser where this falls
@@ -610,14 +627,17 @@ MP_INLINE float mp_shadow_visibility_light(const MpShadowMaps* in, const MP_GLOB
   MpLightShape shape = mp_light_shape(sh, q);
   uint plane_key = 0xffffffffu;
   MpReceiverPlane plane;
+  float2 shift;
+  const float2 spin = mp_filter_spin(q, &shift);
   float search_scale = mp_first_search_scale(sh, q), found, sum, nearest;
-  if (mp_blocker_round(in, sh, &shape, q, n, bias, base, 0, search_scale, &plane_key, &plane, &found, &sum, &nearest) >=
-          count ||
+  if (mp_blocker_round(in, sh, &shape, q, n, bias, base, 0, search_scale, &plane_key, &plane, &found, &sum,
+                       &nearest) >= count ||
       !(found > 0.0f))
     return 1.0f;
   float first = sum / found;
   search_scale = fmin(search_scale, 2.0f * first);
-  mp_blocker_round(in, sh, &shape, q, n, bias, base, 1, search_scale, &plane_key, &plane, &found, &sum, &nearest);
+  mp_blocker_round(in, sh, &shape, q, n, bias, base, 1, search_scale, &plane_key, &plane, &found, &sum,
+                   &nearest);
   if (found >= (float)MP_SHADOW_TAPS - 1e-3f) return 0.0f;
   /* Where the denser search finds none (the outer penumbra, where occluders
    * hide a sliver of the light), the first estimate stands. */
@@ -631,19 +651,22 @@ MP_INLINE float mp_shadow_visibility_light(const MpShadowMaps* in, const MP_GLOB
   int l0 = (int)floor(level);
   float blend = level - (float)l0;
   float lit = 0.0f;
-  float2 turn = MP_F2(1.0f, 0.0f);
+  float2 turn = spin;
   MpShadowMap m[2];
   int levels[2] = {-1, -1};
   uint keys[2] = {0xffffffffu, 0xffffffffu};
   MpReceiverPlane planes[2];
   for (int i = 0; i < MP_SHADOW_TAPS; ++i) {
     if (i == MP_SHADOW_TAPS / 2) {
-      /* Half the taps seen: where all agree (umbra, or lit beside the
-       * occluders), the other half would too. */
-      if (lit == 0.0f || lit == (float)i) return lit / (float)i;
-      turn = MP_F2(MP_GOLDEN_COS, MP_GOLDEN_SIN);
+      /* Half the taps seen: where all see the light (lit beside the
+       * occluders), the other half do too. (Stopping where all eight are in
+       * shadow left dark streaks in penumbrae, where thin gaps let the
+       * light through between the first half's taps; umbrae end in the
+       * blocker search instead.) */
+      if (lit == (float)i) return 1.0f;
+      turn = mp_golden_step(spin);
     }
-    float3 o = mp_filter_tap(&shape, i, turn);
+    float3 o = mp_filter_tap(&shape, i, turn, shift);
     turn = mp_golden_step2(turn);
     float3 x = mp_kernel_point(q, o, scale);
     int which = mp_tap_dither(i) < blend;
