@@ -126,3 +126,49 @@ def write_all(folder, teapot_source):
             f.write(rib)
         paths[name] = path
     return paths
+
+
+def _cube_shell(n):
+    """A cube of half size 1 with n x n quads per side, as (points, counts,
+    indices) with shared vertices: a closed Catmull-Clark shell."""
+    index, pts, faces = {}, [], []
+
+    def vertex(p):
+        key = tuple(round(c * 2 * n) for c in p)
+        if key not in index:
+            index[key] = len(pts)
+            pts.append(p)
+        return index[key]
+
+    for axis in range(3):
+        for sign in (-1.0, 1.0):
+            u_axis, v_axis = (axis + 1) % 3, (axis + 2) % 3
+            for j in range(n):
+                for i in range(n):
+                    quad = []
+                    for di, dj in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                        p = [0.0, 0.0, 0.0]
+                        p[axis] = sign
+                        p[u_axis] = -1.0 + 2.0 * (i + di) / n
+                        p[v_axis] = -1.0 + 2.0 * (j + dj) / n
+                        quad.append(vertex(p))
+                    faces.append(quad if sign > 0 else quad[::-1])
+    return pts, [4] * len(faces), [v for f in faces for v in f]
+
+
+def nested_shells(shells, w=1920, h=1080, spp=4, rate=1.0, n=6):
+    """The camera inside `shells` closed, nested Catmull-Clark shells (cubes
+    of n x n faces per side, rounded by subdivision into blobs), the
+    innermost of half size 2, each next 0.1 larger: only the innermost is
+    seen. Depth complexity grows with the number of shells."""
+    pts, counts, indices = _cube_shell(n)
+    out = [_header(w, h, spp, rate, 70), "Rotate -20 0 1 0\nRotate 10 1 0 0\nWorldBegin\n", LIGHTS]
+    for k in range(shells):
+        s = 2.0 + 0.1 * k
+        g = 0.3 + 0.6 * k / max(shells - 1, 1)
+        out.append(f"AttributeBegin\nScale {s:.3f} {0.8 * s:.3f} {1.2 * s:.3f}\nColor [{g:.3f} 0.5 {1 - g:.3f}]\n"
+                   'Surface "matte"\n'
+                   f'SubdivisionMesh "catmull-clark" {_array(counts)} {_array(indices)} [] [] [] [] '
+                   f'"P" {_array([c for p in pts for c in p])}\nAttributeEnd\n')
+    out.append("WorldEnd\n")
+    return "".join(out)

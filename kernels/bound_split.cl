@@ -17,9 +17,11 @@
 #include "mp_bound.h"
 
 /* Root r of a pass over patch_count patches in one or more views: the whole
- * domain of patch r % patch_count in view r / patch_count, no edge rated yet. */
-inline SubPatch mp_root_subpatch(uint r, uint patch_count) {
-  uint p = r % patch_count;
+ * domain of patch r % patch_count in view r / patch_count, no edge rated yet;
+ * with an order (the camera's view, for occlusion culling), the patches are
+ * taken in it (near to far). */
+inline SubPatch mp_root_subpatch(uint r, uint patch_count, __global const uint* order) {
+  uint p = order ? order[r % patch_count] : r % patch_count;
   SubPatch sp;
   sp.corner[0] = 0.0f; sp.corner[1] = 0.0f;
   sp.corner[2] = 1.0f; sp.corner[3] = 0.0f;
@@ -41,10 +43,10 @@ inline FrameParams mp_subpatch_view(const SubPatch* sp, FrameParams f, __global 
 /* ---- breadth-first ------------------------------------------------------ */
 
 /* Initial queue: one whole-domain sub-patch per patch and view. */
-__kernel void bs_init_queue(__global SubPatch* queue, uint n, uint patch_count) {
+__kernel void bs_init_queue(__global SubPatch* queue, uint n, uint patch_count, __global const uint* order) {
   uint i = get_global_id(0);
   if (i >= n) return;
-  queue[i] = mp_root_subpatch(i, patch_count);
+  queue[i] = mp_root_subpatch(i, patch_count, order);
 }
 
 __kernel void bs_breadth_classify(__global SubPatch* queue, uint n,
@@ -52,7 +54,8 @@ __kernel void bs_breadth_classify(__global SubPatch* queue, uint n,
                                   __global const uint* edges, __global const float4* curves,
                                   __global const float4* patch_bounds, FrameParams f,
                                   __global const FrameParams* views, uint view_count,
-                                  __global const uchar* page_masks, __global uint* decision,
+                                  __global const uchar* page_masks, __global const uint* occlusion,
+                                  OcclusionParams occ, volatile __global uint* occluded, __global uint* decision,
                                   __global uint* dice_flag, __global uint* split_flag) {
   uint i = get_global_id(0);
   if (i > n) return;
@@ -63,8 +66,9 @@ __kernel void bs_breadth_classify(__global SubPatch* queue, uint n,
   }
   SubPatch sp = queue[i];
   uint d = mp_classify(points, patch_info, edges, curves, patch_bounds, &sp, mp_subpatch_view(&sp, f, views, view_count),
-                       page_masks);
+                       page_masks, occlusion, occ);
   uint action = MP_DECISION_ACTION(d);
+  if (d == MP_CULL_OCCLUDED) atomic_inc(occluded);
   queue[i] = sp; /* with the edge rates measured here */
   decision[i] = d;
   dice_flag[i] = action == MP_DICE ? 1u : 0u;
@@ -101,13 +105,16 @@ __kernel void bs_breadth_scatter(__global const SubPatch* queue, uint n, __globa
 #define BS_BUSY 4        /* workers left with work after this launch */
 #define BS_IDLE 5        /* workers that ran out of work in this launch */
 #define BS_MAX_BUSY 6    /* 1 + highest index of a worker left with work */
+#define BS_OCCLUDED 7    /* sub-patches culled by occlusion */
 #define BS_COUNTERS 8
 
 __kernel void bs_bounded_step(__global const float4* points, __global const uint* patch_info,
                               __global const uint* edges, __global const float4* curves,
-                              __global const float4* patch_bounds, uint patch_count, uint root_count, FrameParams f,
-                              __global const FrameParams* views, uint view_count,
-                              __global const uchar* page_masks, __global SubPatch* stacks, __global uint* stack_sizes, uint stack_depth,
+                              __global const float4* patch_bounds, uint patch_count, uint root_limit,
+                              __global const uint* root_order, FrameParams f,
+                              __global const FrameParams* views, uint view_count, __global const uchar* page_masks,
+                              __global const uint* occlusion, OcclusionParams occ,
+                              __global SubPatch* stacks, __global uint* stack_sizes, uint stack_depth,
                               __global SubPatch* ring, uint ring_capacity,
                               uint ring_head0, uint ring_tail0, uint donate_limit,
                               __global SubPatch* diceable, uint dice_capacity,
@@ -126,14 +133,15 @@ __kernel void bs_bounded_step(__global const float4* points, __global const uint
         stack[size++] = ring[r % ring_capacity];
       } else {
         uint r = atomic_inc(&counters[BS_NEXT_ROOT]);
-        if (r >= root_count) break;
-        stack[size++] = mp_root_subpatch(r, patch_count);
+        if (r >= root_limit) break; /* the roots taken so far (occlusion culling takes them in waves) */
+        stack[size++] = mp_root_subpatch(r, patch_count, root_order);
       }
     }
     SubPatch sp = stack[--size];
     uint d = mp_classify(points, patch_info, edges, curves, patch_bounds, &sp,
-                         mp_subpatch_view(&sp, f, views, view_count), page_masks);
+                         mp_subpatch_view(&sp, f, views, view_count), page_masks, occlusion, occ);
     uint action = MP_DECISION_ACTION(d);
+    if (d == MP_CULL_OCCLUDED) atomic_inc(&counters[BS_OCCLUDED]);
     if (action == MP_DICE) {
       uint slot = atomic_inc(&counters[BS_DICE_COUNT]);
       if (slot >= dice_capacity) {

@@ -17,14 +17,18 @@
 #include "mp_types.h"
 #include "mp_patch_eval.h"
 #include "mp_surface.h"
+#include "mp_grid.h" /* mp_corner */
+#include "mp_occlusion.h"
 
 #define MP_CULL 0u
 #define MP_DICE 1u
 #define MP_SPLIT_U 2u
 #define MP_SPLIT_V 3u
 
-/* Decision word: action in bits 0-7, grid size nu, nv in bits 8-15, 16-23. */
+/* Decision word: action in bits 0-7, grid size nu, nv in bits 8-15, 16-23;
+ * a cull for occlusion has bit 8 set (counted apart). */
 #define MP_DECISION_ACTION(d) ((d) & 0xffu)
+#define MP_CULL_OCCLUDED (MP_CULL | 0x100u)
 
 typedef struct {
   float xmin, ymin, xmax, ymax; /* raster space */
@@ -422,12 +426,14 @@ MP_INLINE int mp_bound_culled(MpBound b, const float3* lo, const float3* hi, int
  * or split across edges 0 and 2 (MP_SPLIT_U) or 1 and 3 (MP_SPLIT_V). Rates of
  * edges measured here are stored into *sp for its children or its dicing. A
  * pure function of its inputs, so every bound & split strategy reaches the
- * same diced set. The view is f's (the camera or a shadow map); shadow views
- * also cull what lies under none of their rendered pages (page_masks). */
+ * same diced set, less what the occlusion pyramid (occ.levels > 0; the
+ * camera's view) shows hidden by what is already sampled (MP_CULL_OCCLUDED).
+ * The view is f's (the camera or a shadow map); shadow views also cull what
+ * lies under none of their rendered pages (page_masks). */
 MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint* patch_info,
                            const MP_GLOBAL uint* edges, const MP_GLOBAL float4* curves,
                            const MP_GLOBAL float4* patch_bounds, SubPatch* sp, FrameParams f,
-                           const MP_GLOBAL uchar* page_masks) {
+                           const MP_GLOBAL uchar* page_masks, const MP_GLOBAL uint* occlusion, OcclusionParams occ) {
   const MP_GLOBAL float4* cp = points + (ulong)sp->patch * MP_PATCH_POINTS;
   uint type = patch_info[4 * (ulong)sp->patch];
   /* Ray visibility: objects hidden from the camera still cast shadows, and
@@ -444,6 +450,7 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
     mp_boxes_to_view(&blo, &bhi, 1, f);
     MpBound bb = mp_bound_boxes(&blo, &bhi, 1, f);
     if (mp_bound_culled(bb, &blo, &bhi, 1, f, page_masks, can_split)) return MP_CULL;
+    if (mp_occluded(occlusion, occ, f, bb.xmin, bb.ymin, bb.xmax, bb.ymax, bb.dmin)) return MP_CULL_OCCLUDED;
   }
   float3 lo[16], hi[16];
   mp_subpatch_hull(cp, type, sp, lo, hi);
@@ -451,6 +458,7 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
   MpBound b = mp_bound_boxes(lo, hi, 16, f);
   if (mp_bound_culled(b, lo, hi, 16, f, page_masks, can_split)) return MP_CULL;
   int straddles = !f.ortho && b.dmin <= f.eye_epsilon;
+  if (!straddles && mp_occluded(occlusion, occ, f, b.xmin, b.ymin, b.xmax, b.ymax, b.dmin)) return MP_CULL_OCCLUDED;
 
   /* Rate every edge that has none yet; score = length in target edges. */
   uint codes[4];

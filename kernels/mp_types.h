@@ -79,6 +79,17 @@ typedef struct {
   uint page_mask;
 } FrameParams;
 
+/* The camera view's occlusion pyramid (mp_occlusion.h): level 0 has a cell
+ * per 2^cell_shift x 2^cell_shift pixels holding the farthest depth of the
+ * cell's samples (the float's bits; ~0u where a sample is empty), each next
+ * level the farthest of 2 x 2 cells of the last. levels == 0: no culling. */
+typedef struct {
+  int levels;
+  int cell_shift;
+  int base_w, base_h; /* cells of level 0 */
+} OcclusionParams;
+#define MP_OCCLUSION_MAX_LEVELS 16
+
 /* Materials (see scene.h): color.w = model. */
 #define MP_MODEL_CONSTANT 0
 #define MP_MODEL_MATTE 1

@@ -14,6 +14,7 @@
 #include "mp_hash.h"
 #include "mp_raster.h"
 #include "mp_grid.h"
+#include "mp_occlusion.h"
 
 #define MP_PASS_DEPTH 0u
 #define MP_PASS_ATTRIBUTES 1u
@@ -123,6 +124,20 @@ inline void mp_count_sampled(uint l, long area2, uint pass, volatile __global ul
   }
 }
 
+/* Marks the occlusion pyramid's level-0 cells under the micropolygon's
+ * raster bound as changed (occlusion.cl rebuilds only those). */
+inline void mp_mark_occlusion_cells(__global uchar* dirty, OcclusionParams o, FrameParams f, MpFixed2 a, MpFixed2 b,
+                                    MpFixed2 c, MpFixed2 d) {
+  long xmin = min(min(a.x, b.x), min(c.x, d.x)), xmax = max(max(a.x, b.x), max(c.x, d.x));
+  long ymin = min(min(a.y, b.y), min(c.y, d.y)), ymax = max(max(a.y, b.y), max(c.y, d.y));
+  int x0 = (int)clamp(xmin >> MP_SUBPIXEL_BITS, (long)0, (long)f.width - 1) >> o.cell_shift;
+  int x1 = (int)clamp(xmax >> MP_SUBPIXEL_BITS, (long)0, (long)f.width - 1) >> o.cell_shift;
+  int y0 = (int)clamp(ymin >> MP_SUBPIXEL_BITS, (long)0, (long)f.height - 1) >> o.cell_shift;
+  int y1 = (int)clamp(ymax >> MP_SUBPIXEL_BITS, (long)0, (long)f.height - 1) >> o.cell_shift;
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) dirty[y * o.base_w + x] = (uchar)1;
+}
+
 /* One work-item per micropolygon of grids [first, first + count): `offsets`
  * holds each grid of the batch's first micropolygon (from the batch's
  * layout, GridLayoutStage), `base` is the first of these grids' and `total`
@@ -134,7 +149,8 @@ void sample_micropolygons(__global const SubPatch* diceable, uint first, uint co
                                    FrameParams f, __global const float4* grid_p, __global const float4* grid_c,
                                    __global const float4* grid_n, __global const ushort* sample_offsets, uint pass,
                                    volatile __global ulong* keys,
-                                   __global float* colors, __global uint* normals, volatile __global ulong* totals) {
+                                   __global float* colors, __global uint* normals, volatile __global ulong* totals,
+                                   __global uchar* occlusion_dirty, OcclusionParams occ) {
   __local ulong area_sum[64];
   __local uint count_sum[64];
   uint stride = (uint)f.max_grid + 1u;
@@ -183,5 +199,6 @@ void sample_micropolygons(__global const SubPatch* diceable, uint first, uint co
   for (int k = 0; k < 8; ++k) grid_id = mp_hash_combine(grid_id, as_uint(sp.corner[k]));
   uint mp_id = mp_hash_combine(grid_id, m);
   float opacity = grid_c[grid_base + q[0]].w;
+  if (pass == MP_PASS_DEPTH && occlusion_dirty) mp_mark_occlusion_cells(occlusion_dirty, occ, f, v[0].p, v[1].p, v[2].p, v[3].p);
   mp_raster_quad(v[0], v[1], v[2], v[3], keep, mp_id, opacity, f, sample_offsets, pass, keys, colors, normals);
 }

@@ -43,7 +43,8 @@ inline void host_dice(const Scene& scene,
   while (!stack.empty()) {
     SubPatch sp = stack.back();
     stack.pop_back();
-    const uint d = mp_classify(pb.points.data(), info, pb.edges.data(), pb.curves.data(), nullptr, &sp, f, nullptr);
+    const uint d = mp_classify(pb.points.data(), info, pb.edges.data(), pb.curves.data(), nullptr, &sp, f, nullptr, nullptr,
+                               OcclusionParams{});
     const uint action = MP_DECISION_ACTION(d);
     if (action >= MP_SPLIT_U) {
       SubPatch a, b;

@@ -33,6 +33,7 @@ std::vector<DeviceInfo> list_devices();
 struct StageTimings {
   double upload = 0, bound_split = 0, dice = 0, shade = 0, sample = 0, resolve = 0, readback = 0, total = 0;
   double shadow_mark = 0, shadow = 0, shadow_bound_split = 0, shadow_dice = 0, shadow_sample = 0, shadows_wall = 0;
+  double occlusion = 0;  // building the occlusion pyramid (and counting covered pixels)
 };
 
 // Shadow maps of one light (kernels/mp_shadow.h).
@@ -70,6 +71,12 @@ struct RenderStats {
   // pixel of surface, i.e. per covered pixel per depth layer.
   size_t micropolygons_sampled = 0;
   double sampled_area_px = 0;
+  // Occlusion culling (RenderSettings::occlusion_culling): sub-patches bound
+  // & split dropped as hidden behind what was already sampled; pixels with a
+  // surface in any sample. sampled_area_px / covered_pixels is the depth
+  // complexity (surface layers rasterised per covered pixel).
+  size_t subpatches_occluded = 0;
+  size_t covered_pixels = 0;
   size_t bound_split_peak_bytes = 0;
   size_t batches = 0;
   size_t bound_split_launches = 0;

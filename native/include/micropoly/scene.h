@@ -202,6 +202,9 @@ struct RenderSettings {
   // second marking and pass); off, penumbrae read the levels the first
   // marking made, coarser near contact (the viewport's preview pass).
   bool soft_shadow_pages = true;
+  // Bound & split drops sub-patches hidden behind what earlier dice batches
+  // sampled (kernels/mp_occlusion.h); the image is the same either way.
+  bool occlusion_culling = true;
 };
 
 struct Scene {

@@ -18,11 +18,12 @@ const char* kUsage =
     "usage: micropoly-render SCENE.rib -o OUT.(png|exr) [--spp N] [--shading-rate R]\n"
     "                        [--device cpu|gpu|INDEX] [--bound-split bounded|breadth]\n"
     "                        [--bound-split-memory MIB] [--shadows on|off] [--shadow-memory MIB]\n"
-    "                        [--fresh-shadows] [--stats FILE.json] [--repeat N]\n"
+    "                        [--fresh-shadows] [--occlusion-culling on|off] [--stats FILE.json]\n"
+    "                        [--repeat N]\n"
     "       micropoly-render --list-devices\n";
 
 struct Options {
-  std::string scene, output, device, stats, bound_split, shadows;
+  std::string scene, output, device, stats, bound_split, shadows, occlusion;
   int spp = 0, repeat = 1;
   float shading_rate = 0, memory_mib = 0, shadow_memory_mib = 0;
   bool list_devices = false;
@@ -66,6 +67,10 @@ Options parse(int argc, char** argv) {
       if (o.shadows != "on" && o.shadows != "off") usage_error("--shadows is on or off");
     } else if (a == "--shadow-memory") o.shadow_memory_mib = static_cast<float>(parse_number(a, value(), 1, 1 << 20));
     else if (a == "--fresh-shadows") o.fresh_shadows = true;
+    else if (a == "--occlusion-culling") {
+      o.occlusion = value();
+      if (o.occlusion != "on" && o.occlusion != "off") usage_error("--occlusion-culling is on or off");
+    }
     else if (a == "--stats") o.stats = value();
     else if (a == "--repeat") o.repeat = static_cast<int>(parse_number(a, value(), 1, 10000));
     else if (a == "--list-devices") o.list_devices = true;
@@ -108,6 +113,7 @@ int main(int argc, char** argv) {
     if (!o.shadows.empty()) scene.settings.shadows = o.shadows == "on";
     if (o.shadow_memory_mib > 0) scene.settings.shadow_memory_mib = o.shadow_memory_mib;
     if (o.fresh_shadows) scene.settings.keep_shadow_pages = false;
+    if (!o.occlusion.empty()) scene.settings.occlusion_culling = o.occlusion == "on";
     // Only EXR files hold the Depth and Normal passes.
     auto dot = output.find_last_of('.');
     std::string ext = dot == std::string::npos ? "" : output.substr(dot + 1);

@@ -21,6 +21,7 @@ using DiceSink = std::function<void(const cl::Buffer& buffer, cl_uint count)>;
 struct BoundSplitResult {
   size_t peak_bytes = 0;  // device memory the strategy held at its peak
   size_t launches = 0;    // bound & split kernel launches
+  size_t occluded = 0;    // sub-patches culled by occlusion
   bool cancelled = false;
 };
 
@@ -76,6 +77,18 @@ struct PassViews {
   cl::Buffer page_masks;  // shadow views' page mask pyramids (mp_bound.h)
 };
 
+// Occlusion culling of a pass over the camera's view (occlusion_culling.h):
+// the roots are taken near to far, in waves while the pyramid is young, and
+// after a batch that more work follows, `refresh` (dice, shade and sample
+// have run) rebuilds the pyramid the later sub-patches are tested against.
+struct PassOcclusion {
+  cl::Buffer pyramid;
+  OcclusionParams params{};  // levels 0: off
+  cl::Buffer root_order;     // patch indices near to far
+  std::function<void()> refresh;
+  bool on() const { return params.levels > 0; }
+};
+
 struct BoundSplitContext {
   DeviceSession& session;
   const SceneBuffers& scene;
@@ -84,6 +97,7 @@ struct BoundSplitContext {
   const DiceSink& sink;
   const ProgressCallback& progress;
   const PassViews& views;
+  const PassOcclusion& occlusion;
   // Roots: every patch in every view.
   cl_uint root_count() const { return scene.patch_count * std::max<cl_uint>(views.count, 1); }
 };

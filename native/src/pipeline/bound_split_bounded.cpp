@@ -21,9 +21,25 @@ namespace mp {
 namespace {
 
 // Counter slots, as BS_* in kernels/bound_split.cl.
-enum Counter { kPoolHead = 0, kPoolTail = 1, kNextRoot = 2, kDiceCount = 3, kBusy = 4, kIdle = 5, kMaxBusy = 6, kCounters = 8 };
+enum Counter {
+  kPoolHead = 0, kPoolTail = 1, kNextRoot = 2, kDiceCount = 3, kBusy = 4, kIdle = 5, kMaxBusy = 6, kOccluded = 7,
+  kCounters = 8
+};
 constexpr cl_uint kStepsPerLaunch = 16;  // sub-patches a worker handles per launch
 constexpr size_t kMaxWorkers = size_t(1) << 20;
+// With occlusion culling, the roots (near to far) are taken in waves: a
+// wave's sub-patches are diced, shaded and sampled and the pyramid rebuilt
+// before the next wave is taken, so the nearest surfaces hide the rest early
+// (taken all at once, a launch's thousands of workers would split roots from
+// every depth before anything is sampled). The first wave is one root, each
+// next a quarter larger than the last (with steps of one half, more of each
+// shell of bench/scenes.py's nested shells was diced beside the part of the
+// one in front that hides it, before that was sampled). Each wave costs a
+// partly filled dice batch, so once the pyramid holds half a batch of
+// sub-patches, a wave that finds less than 1/kWorthwhile of its sub-patches
+// hidden ends the waves and the rest are taken at once: a scene with little
+// depth complexity pays for two or three waves.
+constexpr size_t kWorthwhile = 64;
 
 void ensure(cl::Context& context, cl::Buffer& buffer, size_t& held, size_t bytes) {
   if (held == bytes) return;
@@ -69,14 +85,21 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
     step.setArg(2, ctx.scene.patch_edges);
     step.setArg(3, ctx.scene.edge_curves);
     const cl_uint root_count = ctx.root_count();
+    const PassOcclusion& occ = ctx.occlusion;
+    cl_uint root_limit = occ.on() ? std::min<cl_uint>(root_count, 1) : root_count;
+    size_t diced = 0, wave_roots = root_limit, diced_before_wave = 0, occluded_before_wave = 0;
     cl_uint arg = 4;
     step.setArg(arg++, ctx.scene.patch_bounds);
     step.setArg(arg++, ctx.scene.patch_count);
-    step.setArg(arg++, root_count);
+    const cl_uint kRootLimitArg = arg++;
+    step.setArg(kRootLimitArg, root_limit);
+    step.setArg(arg++, occ.on() ? occ.root_order : cl::Buffer());
     step.setArg(arg++, ctx.frame);
     step.setArg(arg++, ctx.views.views);
     step.setArg(arg++, ctx.views.count);
     step.setArg(arg++, ctx.views.page_masks);
+    step.setArg(arg++, occ.on() ? occ.pyramid : cl::Buffer());
+    step.setArg(arg++, occ.params);
     step.setArg(arg++, ws.stacks);
     step.setArg(arg++, ws.sizes);
     step.setArg(arg++, stack_depth);
@@ -93,7 +116,7 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
     // More workers than a few dice batches' worth would mostly hold work they
     // cannot hand on until the next flush, so growth stops there.
     const size_t useful = 4 * static_cast<size_t>(dice_capacity);
-    size_t launch = whole_groups(std::min<size_t>(root_count, useful));
+    size_t launch = whole_groups(std::min<size_t>(root_limit, useful));
     cl_uint head = 0, tail = 0, next_root = 0, dice_count = 0, hungry = static_cast<cl_uint>(launch);
     for (;;) {
       cl_uint c[kCounters] = {head, tail, next_root, dice_count, 0, 0, 0, 0};
@@ -112,19 +135,37 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
       const cl_uint head0 = head;
       head = std::min(c[kPoolHead], tail);
       tail = std::min({c[kPoolTail], tail + hungry, head0 + ring_capacity});
-      next_root = std::min(c[kNextRoot], root_count);
+      next_root = std::min(c[kNextRoot], root_limit);
       dice_count = std::min(c[kDiceCount], dice_capacity);
+      result.occluded += c[kOccluded];
       const size_t busy = c[kBusy];
-      const size_t pending = (tail - head) + (root_count - next_root);
-      launch = whole_groups(std::max<size_t>(c[kMaxBusy], std::min(2 * busy + pending, useful)));
-      hungry = static_cast<cl_uint>(launch > busy ? launch - busy : 0);
       if (head == tail) head = tail = 0;  // keep ring indices small
-      bool done = busy == 0 && head == tail && next_root >= root_count;
-      if (dice_count == dice_capacity || (done && dice_count > 0)) {
+      const bool wave_done = busy == 0 && head == tail && next_root >= root_limit;
+      const bool done = wave_done && root_limit >= root_count;
+      if (dice_count == dice_capacity || (wave_done && dice_count > 0)) {
         ctx.sink(ws.diceable, dice_count);
+        diced += dice_count;
         dice_count = 0;
+        if (!done && occ.on()) occ.refresh();
       }
       if (done) break;
+      if (wave_done) {
+        // A quarter more roots than the last wave, or all that are left once a
+        // wave tested against a pyramid of at least half a batch found
+        // fewer than 1/kWorthwhile of its sub-patches hidden.
+        const bool judged = 2 * diced_before_wave >= dice_capacity;
+        const size_t wave_subpatches = (diced - diced_before_wave) + (result.occluded - occluded_before_wave);
+        const bool worthwhile = !judged || (result.occluded - occluded_before_wave) * kWorthwhile >= wave_subpatches;
+        const size_t roots = worthwhile ? wave_roots + (wave_roots + 3) / 4 : root_count;
+        wave_roots = std::min<size_t>(roots, root_count - root_limit);
+        root_limit += static_cast<cl_uint>(wave_roots);
+        diced_before_wave = diced;
+        occluded_before_wave = result.occluded;
+        step.setArg(kRootLimitArg, root_limit);
+      }
+      const size_t pending = (tail - head) + (root_limit - next_root);
+      launch = whole_groups(std::max<size_t>(c[kMaxBusy], std::min(2 * busy + pending, useful)));
+      hungry = static_cast<cl_uint>(launch > busy ? launch - busy : 0);
       if (ctx.progress && !ctx.progress(0.95f * static_cast<float>(next_root) / static_cast<float>(std::max(root_count, 1u)))) {
         result.cancelled = true;
         break;

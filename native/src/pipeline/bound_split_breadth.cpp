@@ -23,12 +23,19 @@ BoundSplitResult bound_split_breadth(BoundSplitContext& ctx, cl_uint dice_capaci
     cl::Kernel init(s.program(), "bs_init_queue"), classify(s.program(), "bs_breadth_classify"),
         scatter(s.program(), "bs_breadth_scatter");
 
+    // Occlusion culling tests each level's sub-patches against what the
+    // levels before it sampled (the roots, all taken at once, against none).
+    const PassOcclusion& occ = ctx.occlusion;
+    TalliedBuffer occluded(tally);
+    occluded.reserve(context, sizeof(cl_uint));
+    queue.enqueueFillBuffer(occluded.get(), cl_uint(0), 0, sizeof(cl_uint));
     cl_uint n = ctx.root_count();
     const size_t rec = sizeof(SubPatch);
     queue_in.reserve(context, n * rec);
     init.setArg(0, queue_in.get());
     init.setArg(1, n);
     init.setArg(2, ctx.scene.patch_count);
+    init.setArg(3, occ.on() ? occ.root_order : cl::Buffer());
     cl::Event e0;
     queue.enqueueNDRangeKernel(init, cl::NullRange, round_up_range(n), cl::NDRange(64), nullptr, &e0);
     ctx.timer.add(Stage::BoundSplit, e0);
@@ -48,9 +55,12 @@ BoundSplitResult bound_split_breadth(BoundSplitContext& ctx, cl_uint dice_capaci
       classify.setArg(8, ctx.views.views);
       classify.setArg(9, ctx.views.count);
       classify.setArg(10, ctx.views.page_masks);
-      classify.setArg(11, decision.get());
-      classify.setArg(12, dice_flag.get());
-      classify.setArg(13, split_flag.get());
+      classify.setArg(11, occ.on() ? occ.pyramid : cl::Buffer());
+      classify.setArg(12, occ.params);
+      classify.setArg(13, occluded.get());
+      classify.setArg(14, decision.get());
+      classify.setArg(15, dice_flag.get());
+      classify.setArg(16, split_flag.get());
       cl::Event e1;
       queue.enqueueNDRangeKernel(classify, cl::NullRange, round_up_range(n + 1), cl::NDRange(64), nullptr, &e1);
       ctx.timer.add(Stage::BoundSplit, e1);
@@ -85,12 +95,15 @@ BoundSplitResult bound_split_breadth(BoundSplitContext& ctx, cl_uint dice_capaci
       }
       queue_in.swap_with(queue_out);
       n = split_total * 2;
+      if (n > 0 && dice_total > 0 && occ.on()) occ.refresh();
       if (ctx.progress && !ctx.progress(std::min(0.95f, 0.1f * static_cast<float>(depth + 1)))) {
         result.cancelled = true;
         break;
       }
     }
-    queue.finish();
+    cl_uint culled = 0;
+    queue.enqueueReadBuffer(occluded.get(), CL_TRUE, 0, sizeof culled, &culled);
+    result.occluded = culled;
   }
   result.peak_bytes = tally.peak();
   return result;

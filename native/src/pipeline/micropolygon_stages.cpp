@@ -149,7 +149,13 @@ void SampleStage::sampled_totals(size_t& micropolygons, double& area_px) {
   area_px = static_cast<double>(t[1]) / (2.0 * MP_SUBPIXEL_ONE * MP_SUBPIXEL_ONE);
 }
 
+void SampleStage::mark_occlusion_cells(const cl::Buffer& dirty, const OcclusionParams& params) {
+  kernel_.setArg(17, dirty);
+  kernel_.setArg(18, params);
+}
+
 void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer) {
+  mark_occlusion_cells(cl::Buffer(), OcclusionParams{});
   const int spp = f.spp_x * f.spp_y;
   size_t samples = static_cast<size_t>(f.width) * static_cast<size_t>(f.height) * static_cast<size_t>(spp);
   // The buffers only grow: the viewport alternates a small preview with the

@@ -84,6 +84,9 @@ class SampleStage {
   // Samples the grids of diceable sub-patches [first, first + count).
   void run(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
            GridBuffers& grids, StageTimer& timer);
+  // From now until the next begin_frame, the depth pass marks the level-0
+  // cells of the occlusion pyramid (mp_occlusion.h) it writes in `dirty`.
+  void mark_occlusion_cells(const cl::Buffer& dirty, const OcclusionParams& params);
   const cl::Buffer& keys() const { return keys_; }
   const cl::Buffer& colors() const { return colors_; }
   const cl::Buffer& normals() const { return normals_; }

@@ -42,6 +42,11 @@ std::string RenderStats::to_json() const {
   j += "  \"micropolygons\": " + std::to_string(micropolygons) + ",\n";
   j += "  \"micropolygons_sampled\": " + std::to_string(micropolygons_sampled) + ",\n";
   j += "  \"sampled_area_px\": " + num(sampled_area_px) + ",\n";
+  j += "  \"subpatches_occluded\": " + std::to_string(subpatches_occluded) + ",\n";
+  j += "  \"covered_pixels\": " + std::to_string(covered_pixels) + ",\n";
+  j += "  \"depth_complexity\": " + num(covered_pixels ? sampled_area_px / double(covered_pixels) : 0.0) + ",\n";
+  j += "  \"micropolygons_per_covered_pixel\": " +
+       num(covered_pixels ? double(micropolygons_sampled) / double(covered_pixels) : 0.0) + ",\n";
   j += "  \"bound_split_peak_bytes\": " + std::to_string(bound_split_peak_bytes) + ",\n";
   j += "  \"bound_split_launches\": " + std::to_string(bound_split_launches) + ",\n";
   j += "  \"batches\": " + std::to_string(batches) + ",\n";
@@ -67,7 +72,8 @@ std::string RenderStats::to_json() const {
        ", \"shadow_mark\": " + num(timings_ms.shadow_mark) + ", \"shadow\": " + num(timings_ms.shadow) +
        ", \"shadow_bound_split\": " + num(timings_ms.shadow_bound_split) + ", \"shadow_dice\": " +
        num(timings_ms.shadow_dice) + ", \"shadow_sample\": " + num(timings_ms.shadow_sample) +
-       ", \"shadows_wall\": " + num(timings_ms.shadows_wall) + ", \"total\": " + num(timings_ms.total) + "}\n";
+       ", \"shadows_wall\": " + num(timings_ms.shadows_wall) + ", \"occlusion\": " + num(timings_ms.occlusion) +
+       ", \"total\": " + num(timings_ms.total) + "}\n";
   j += "}\n";
   return j;
 }

@@ -11,6 +11,7 @@
 #include "pipeline/frame_params.h"
 #include "pipeline/material_programs.h"
 #include "pipeline/micropolygon_stages.h"
+#include "pipeline/occlusion_culling.h"
 #include "pipeline/scene_buffers.h"
 #include "pipeline/scene_fingerprint.h"
 #include "pipeline/shadow_maps.h"
@@ -36,7 +37,8 @@ struct Renderer::Impl {
         sample(session),
         resolve(session),
         programs(session),
-        shadow_maps(session) {}
+        shadow_maps(session),
+        occlusion(session) {}
   DeviceSession session;
   GridLayoutStage layout;
   DiceStage dice;
@@ -45,6 +47,7 @@ struct Renderer::Impl {
   ResolveStage resolve;
   MaterialPrograms programs;
   ShadowMaps shadow_maps;
+  OcclusionCulling occlusion;
   std::unique_ptr<GridBuffers> grids;
   BoundedWorkspace bounded;
   bool first_render = true;
@@ -133,8 +136,11 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     };
     // Bound & split of the scene in one pass: the camera's view, or the
     // lights' views of the shadow maps.
+    // Occlusion culling applies to the camera's own pass only.
+    const PassOcclusion no_occlusion;
+    const PassOcclusion* pass_occlusion = &no_occlusion;
     BoundSplitRunner run_pass = [&](const FrameParams& pass_frame, const PassViews& views, const DiceSink& pass_sink) {
-      BoundSplitContext ctx{s, buffers, pass_frame, timer, pass_sink, keep_going, views};
+      BoundSplitContext ctx{s, buffers, pass_frame, timer, pass_sink, keep_going, views, *pass_occlusion};
       BoundSplitResult r;
       if (buffers.patch_count == 0 || cancelled) return r;
       if (scene.settings.bound_split == BoundSplitMethod::Bounded) {
@@ -145,6 +151,7 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       }
       st.bound_split_peak_bytes = std::max(st.bound_split_peak_bytes, r.peak_bytes);
       st.bound_split_launches += r.launches;
+      st.subpatches_occluded += r.occluded;
       r.cancelled = r.cancelled || cancelled;
       return r;
     };
@@ -177,6 +184,19 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       s.queue().finish();  // clearing a large sample buffer takes a while: look again
       keep_going(0.0f);
     }
+    PassOcclusion camera_occlusion;
+    if (scene.settings.occlusion_culling) {
+      OcclusionCulling& occ = impl_->occlusion;
+      occ.begin_frame(f, timer);
+      camera_occlusion.pyramid = occ.pyramid();
+      camera_occlusion.params = occ.params();
+      camera_occlusion.root_order = occ.root_order(buffers.host_patch_bounds, impl_->scene_key, f);
+      sample.mark_occlusion_cells(occ.dirty(), occ.params());
+      camera_occlusion.refresh = [&] {
+        if (!cancelled) occ.refresh(sample.keys(), f, timer);
+      };
+      pass_occlusion = &camera_occlusion;
+    }
     BoundSplitResult bs;
     if (shadows_done) bs = run_pass(f, PassViews{}, sink);
     if (!shadows_done || cancelled || bs.cancelled) {
@@ -187,6 +207,7 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       out.rgba.clear(), out.depth.clear(), out.normal.clear();
       return;
     }
+    st.covered_pixels = impl_->occlusion.covered_pixels(sample.keys(), f, timer);
     auto t_resolve = std::chrono::steady_clock::now();
     resolve.run(sample, frame, scene.settings.filter, scene.settings.filter_width, scene.settings.depth_and_normal_passes,
                 out, timer);
@@ -203,6 +224,7 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     st.timings_ms.shadow_bound_split = timer.ms(Stage::ShadowBoundSplit);
     st.timings_ms.shadow_dice = timer.ms(Stage::ShadowDice);
     st.timings_ms.shadow_sample = timer.ms(Stage::ShadowSample);
+    st.timings_ms.occlusion = timer.ms(Stage::Occlusion);
     st.timings_ms.shadow = st.timings_ms.shadow_bound_split + st.timings_ms.shadow_dice + st.timings_ms.shadow_sample;
   } catch (const cl::Error& e) {
     throw Error("rendering on '" + s.info().name + "': " + describe_cl_error(e));

@@ -234,8 +234,8 @@ SceneBuffers upload_scene_data(cl::Context& context, cl::CommandQueue& queue, co
   b.lights = upload(context, queue, data.lights);
   b.patch_uvs = upload(context, queue, data.patches.uvs);
   b.patch_normals = upload(context, queue, data.patches.normals);
-  const std::vector<glm::vec4> bounds = patch_bounds(data.patches);  // lives until the queue finishes below
-  b.patch_bounds = upload(context, queue, bounds);
+  b.host_patch_bounds = patch_bounds(data.patches);  // lives until the queue finishes below
+  b.patch_bounds = upload(context, queue, b.host_patch_bounds);
   b.images = upload(context, queue, data.images);
   b.texels = upload(context, queue, data.texels);
   b.uv_layers = static_cast<cl_uint>(data.patches.uv_layers);

@@ -36,6 +36,7 @@ struct SceneBuffers {
   cl::Buffer patch_uvs;   // 2 float4 per patch and UV layer (kernels/mp_patch.h)
   cl::Buffer patch_normals;  // 4 float4 per patch: smooth shading normals at its corners
   cl::Buffer patch_bounds;   // 2 float4 per patch: camera-space box of its net, displacement included
+  std::vector<glm::vec4> host_patch_bounds;  // the same on the host (occlusion culling's root order)
   cl::Buffer images;      // DeviceImage per image
   cl::Buffer texels;      // float4
   cl_uint patch_count = 0;

@@ -13,7 +13,7 @@ namespace mp {
 // ShadowMark: the shadow maps' page marking; Shadow*: their rendering (the
 // bound & split, dicing and sampling of the lights' views).
 enum class Stage {
-  Upload, BoundSplit, Dice, Shade, Sample, Resolve, ShadowMark, ShadowBoundSplit, ShadowDice, ShadowSample, Count
+  Upload, BoundSplit, Dice, Shade, Sample, Resolve, ShadowMark, ShadowBoundSplit, ShadowDice, ShadowSample, Occlusion, Count
 };
 
 class StageTimer {

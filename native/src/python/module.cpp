@@ -63,6 +63,11 @@ py::dict stats_dict(const RenderStats& s) {
   d["micropolygons"] = s.micropolygons;
   d["micropolygons_sampled"] = s.micropolygons_sampled;
   d["sampled_area_px"] = s.sampled_area_px;
+  d["subpatches_occluded"] = s.subpatches_occluded;
+  d["covered_pixels"] = s.covered_pixels;
+  d["depth_complexity"] = s.covered_pixels ? s.sampled_area_px / double(s.covered_pixels) : 0.0;
+  d["micropolygons_per_covered_pixel"] =
+      s.covered_pixels ? double(s.micropolygons_sampled) / double(s.covered_pixels) : 0.0;
   d["bound_split_peak_bytes"] = s.bound_split_peak_bytes;
   d["bound_split_launches"] = s.bound_split_launches;
   d["batches"] = s.batches;
@@ -106,6 +111,7 @@ py::dict stats_dict(const RenderStats& s) {
   t["shadow_dice"] = s.timings_ms.shadow_dice;
   t["shadow_sample"] = s.timings_ms.shadow_sample;
   t["shadows_wall"] = s.timings_ms.shadows_wall;
+  t["occlusion"] = s.timings_ms.occlusion;
   t["total"] = s.timings_ms.total;
   d["timings_ms"] = t;
   return d;
@@ -164,7 +170,8 @@ PYBIND11_MODULE(_native, m) {
       .def_readwrite("shadow_memory_mib", &RenderSettings::shadow_memory_mib)
       .def_readwrite("shadow_shading_rate", &RenderSettings::shadow_shading_rate)
       .def_readwrite("keep_shadow_pages", &RenderSettings::keep_shadow_pages)
-      .def_readwrite("soft_shadow_pages", &RenderSettings::soft_shadow_pages);
+      .def_readwrite("soft_shadow_pages", &RenderSettings::soft_shadow_pages)
+      .def_readwrite("occlusion_culling", &RenderSettings::occlusion_culling);
 
   py::class_<Scene>(m, "Scene")
       .def(py::init<>())

@@ -62,6 +62,9 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   flag = s.shadows ? 1 : 0;
   params.get_int("shadows", 0, 1, &flag);
   s.shadows = flag != 0;
+  flag = s.occlusion_culling ? 1 : 0;
+  params.get_int("occlusionculling", 0, 1, &flag);
+  s.occlusion_culling = flag != 0;
   auto positive = [](float v) { return v > 0.0f && std::isfinite(v); };
   s.shadow_memory_mib = params.get_float_checked("shadowmemory", s.shadow_memory_mib, positive,
                                                  "a positive number of MiB");
@@ -70,7 +73,7 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   const int line = args.request().line;
   warn_unknown(params,
                {"boundsplit", "boundsplitmemory", "maxgridsize", "maxsplitdepth", "backfaceculling",
-                "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate"},
+                "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate", "occlusionculling"},
                [&](const std::string& name) {
                  warn_once("option-micropoly:" + name, line,
                            "Option \"micropoly\": parameter \"" + name + "\" is ignored");

@@ -200,6 +200,8 @@ void write_options(std::string& o, const RenderSettings& s) {
   if (differs(s.shadow_memory_mib, def.shadow_memory_mib)) param(o, "float shadowmemory", s.shadow_memory_mib);
   if (differs(s.shadow_shading_rate, def.shadow_shading_rate))
     param(o, "float shadowshadingrate", s.shadow_shading_rate);
+  if (s.occlusion_culling != def.occlusion_culling)
+    param(o, "integer occlusionculling", static_cast<long long>(s.occlusion_culling ? 1 : 0));
   o += '\n';
 }
 
