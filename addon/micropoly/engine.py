@@ -168,8 +168,11 @@ class MicropolyRenderEngine(bpy.types.RenderEngine):
         shadows = stats["shadows"]
         shadow_note = (f"shadow maps {shadows['pages_requested']:,} pages, {shadows['peak_bytes'] / 2**20:.0f} of "
                        f"{shadows['budget_bytes'] / 2**20:.0f} MiB | " if shadows["lights"] else "")
+        hidden = (f"{stats['subpatches_occluded']:,} hidden sub-patches culled | "
+                  if stats["subpatches_occluded"] else "")
         self.update_stats("", f"Micropoly | {stats['device']} | {stats['micropolygons']:,} micropolygons | "
-                              f"bound & split {mib:.1f} MiB | {shadow_note}{time.perf_counter() - started:.2f} s")
+                              f"{hidden}bound & split {mib:.1f} MiB | {shadow_note}"
+                              f"{time.perf_counter() - started:.2f} s")
 
     def should_cancel(self):
         """Esc in Blender; a seam the tests use to cancel in background mode."""

@@ -123,6 +123,7 @@ def export_settings(native_scene, scene, width, height):
     settings.filter_width = mp.filter_width
     settings.bound_split = getattr(_native.BoundSplitMethod, mp.bound_split_method)
     settings.bound_split_memory_mib = mp.bound_split_memory
+    settings.occlusion_culling = mp.use_occlusion_culling
     settings.shadows = mp.use_shadows
     settings.shadow_memory_mib = mp.shadow_memory
     settings.shadow_shading_rate = mp.shadow_shading_rate

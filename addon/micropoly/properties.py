@@ -33,6 +33,9 @@ class MicropolySceneSettings(bpy.types.PropertyGroup):
     bound_split_method: EnumProperty(name="Bound & Split", items=BOUND_SPLIT, default="BOUNDED")
     bound_split_memory: FloatProperty(name="Memory Budget", description="Device memory for bound & split, "
                                       "in MiB (bounded method)", default=64.0, min=0.25, max=65536.0)
+    use_occlusion_culling: BoolProperty(name="Occlusion Culling", description="Skip surfaces hidden behind "
+                                        "what is already rendered before dicing them (the image is the same; "
+                                        "off for comparison)", default=True)
     filter_type: EnumProperty(name="Pixel Filter", items=FILTERS, default="BLACKMAN_HARRIS")
     filter_width: FloatProperty(name="Filter Width", description="Pixel filter width in pixels",
                                 default=1.5, min=0.5, max=8.0, subtype="PIXEL")

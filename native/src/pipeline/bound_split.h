@@ -78,7 +78,8 @@ struct PassViews {
 };
 
 // Occlusion culling of a pass over the camera's view (occlusion_culling.h):
-// the roots are taken near to far, in waves while the pyramid is young, and
+// the roots are taken near to far, in waves while the pyramid is young (CPU
+// devices), and
 // after a batch that more work follows, `refresh` (dice, shade and sample
 // have run) rebuilds the pyramid the later sub-patches are tested against.
 struct PassOcclusion {
@@ -86,6 +87,7 @@ struct PassOcclusion {
   OcclusionParams params{};  // levels 0: off
   cl::Buffer root_order;     // patch indices near to far
   std::function<void()> refresh;
+  bool waves = true;  // take the roots in waves (bound_split_bounded.cpp)
   bool on() const { return params.levels > 0; }
 };
 

@@ -33,13 +33,18 @@ constexpr size_t kMaxWorkers = size_t(1) << 20;
 // (taken all at once, a launch's thousands of workers would split roots from
 // every depth before anything is sampled). The first wave is one root, each
 // next a quarter larger than the last (with steps of one half, more of each
-// shell of bench/scenes.py's nested shells was diced beside the part of the
-// one in front that hides it, before that was sampled). Each wave costs a
-// partly filled dice batch, so once the pyramid holds half a batch of
-// sub-patches, a wave that finds less than 1/kWorthwhile of its sub-patches
-// hidden ends the waves and the rest are taken at once: a scene with little
-// depth complexity pays for two or three waves.
+// shell of bench/occlusion_bench.py's nested shells was diced beside the
+// part of the one in front that hides it, before that was sampled), and at
+// least kMinWave sub-patches' worth. Each wave costs a partly filled dice
+// batch, so once the pyramid holds a quarter of the scene's sub-patches (as
+// far as the waves so far tell; at most half a batch), a wave that finds
+// less than 1/kWorthwhile of its sub-patches hidden ends the waves and the
+// rest are taken at once. A partly filled batch costs about a millisecond
+// of launches and host round trips on a GPU, more than rasterising a few
+// hidden layers there, so waves are for CPU devices (PassOcclusion::waves);
+// on a GPU the pyramid is rebuilt at the batches' natural ends only.
 constexpr size_t kWorthwhile = 64;
+constexpr cl_uint kMinWave = 64;
 
 void ensure(cl::Context& context, cl::Buffer& buffer, size_t& held, size_t bytes) {
   if (held == bytes) return;
@@ -86,7 +91,7 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
     step.setArg(3, ctx.scene.edge_curves);
     const cl_uint root_count = ctx.root_count();
     const PassOcclusion& occ = ctx.occlusion;
-    cl_uint root_limit = occ.on() ? std::min<cl_uint>(root_count, 1) : root_count;
+    cl_uint root_limit = occ.on() && occ.waves ? std::min<cl_uint>(root_count, 1) : root_count;
     size_t diced = 0, wave_roots = root_limit, diced_before_wave = 0, occluded_before_wave = 0;
     cl_uint arg = 4;
     step.setArg(arg++, ctx.scene.patch_bounds);
@@ -142,7 +147,9 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
       if (head == tail) head = tail = 0;  // keep ring indices small
       const bool wave_done = busy == 0 && head == tail && next_root >= root_limit;
       const bool done = wave_done && root_limit >= root_count;
-      if (dice_count == dice_capacity || (wave_done && dice_count > 0)) {
+      // A wave ends in a flush once it has kMinWave sub-patches to dice (or
+      // it is the last); smaller ones are carried into the next wave.
+      if (dice_count == dice_capacity || (wave_done && dice_count > 0 && (done || dice_count >= kMinWave))) {
         ctx.sink(ws.diceable, dice_count);
         diced += dice_count;
         dice_count = 0;
@@ -150,13 +157,21 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
       }
       if (done) break;
       if (wave_done) {
-        // A quarter more roots than the last wave, or all that are left once a
-        // wave tested against a pyramid of at least half a batch found
-        // fewer than 1/kWorthwhile of its sub-patches hidden.
-        const bool judged = 2 * diced_before_wave >= dice_capacity;
+        // A quarter more roots than the last wave, and (up to four times the
+        // last) enough for kMinWave sub-patches at the rate per root so far;
+        // or all that are left once a wave tested against a pyramid of a
+        // quarter of the scene's sub-patches (as far as the rate tells; at
+        // most half a batch) found less than 1/kWorthwhile of them hidden.
+        const double per_root = static_cast<double>(diced + result.occluded) / root_limit;
+        const double expected = per_root * root_count;
+        const bool judged = diced_before_wave > 0 &&
+                            static_cast<double>(diced_before_wave) >= std::min(0.5 * dice_capacity, 0.25 * expected);
         const size_t wave_subpatches = (diced - diced_before_wave) + (result.occluded - occluded_before_wave);
         const bool worthwhile = !judged || (result.occluded - occluded_before_wave) * kWorthwhile >= wave_subpatches;
-        const size_t roots = worthwhile ? wave_roots + (wave_roots + 3) / 4 : root_count;
+        size_t roots = wave_roots + (wave_roots + 3) / 4;
+        if (diced + result.occluded >= kMinWave)  // a rate measured on enough sub-patches; at most 4x the last
+          roots = std::max(roots, std::min(4 * wave_roots, static_cast<size_t>(double(kMinWave) / per_root)));
+        if (!worthwhile) roots = root_count;
         wave_roots = std::min<size_t>(roots, root_count - root_limit);
         root_limit += static_cast<cl_uint>(wave_roots);
         diced_before_wave = diced;

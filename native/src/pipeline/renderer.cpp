@@ -191,6 +191,7 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       camera_occlusion.pyramid = occ.pyramid();
       camera_occlusion.params = occ.params();
       camera_occlusion.root_order = occ.root_order(buffers.host_patch_bounds, impl_->scene_key, f);
+      camera_occlusion.waves = s.info().type == "cpu";
       sample.mark_occlusion_cells(occ.dirty(), occ.params());
       camera_occlusion.refresh = [&] {
         if (!cancelled) occ.refresh(sample.keys(), f, timer);
