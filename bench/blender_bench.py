@@ -53,18 +53,7 @@ def build_scene():
         bpy.ops.object.shade_smooth()
         mat = ru.diffuse_material(f"m{i}", (0.2 + 0.12 * i, 0.5, 0.8 - 0.1 * i))
         if DISPLACED:
-            nt = mat.node_tree
-            noise = nt.nodes.new("ShaderNodeTexNoise")
-            noise.inputs["Scale"].default_value = 4.0
-            disp = nt.nodes.new("ShaderNodeDisplacement")
-            disp.inputs["Scale"].default_value = 0.15
-            nt.links.new(noise.outputs["Fac"], disp.inputs["Height"])
-            out = next(n for n in nt.nodes if n.type == "OUTPUT_MATERIAL")
-            nt.links.new(disp.outputs["Displacement"], out.inputs["Displacement"])
-            if hasattr(mat, "displacement_method"):
-                mat.displacement_method = "DISPLACEMENT"
-            else:
-                mat.cycles.displacement_method = "DISPLACEMENT"
+            ru.add_noise_displacement(mat, 4.0, 0.15)
         obj.data.materials.append(mat)
     bpy.ops.mesh.primitive_plane_add(size=30.0, location=(0, 0, -1.0))
     for kind, energy, loc in (("SUN", 3.0, (3, -3, 6)), ("POINT", 1000.0, (-4, -4, 4)), ("AREA", 500.0, (0, -6, 5))):

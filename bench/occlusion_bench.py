@@ -88,20 +88,7 @@ def field_scene(count=2000, seed=7):
     bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=2, radius=1.0)
     rock = bpy.context.object
     rock.modifiers.new("Subdivision", "SUBSURF").render_levels = 2
-    mat = ru.diffuse_material("Rock", (0.5, 0.5, 0.45))
-    nt = mat.node_tree
-    noise = nt.nodes.new("ShaderNodeTexNoise")
-    noise.inputs["Scale"].default_value = 2.0
-    disp = nt.nodes.new("ShaderNodeDisplacement")
-    disp.inputs["Scale"].default_value = 0.4
-    nt.links.new(noise.outputs["Fac"], disp.inputs["Height"])
-    out = next(n for n in nt.nodes if n.type == "OUTPUT_MATERIAL")
-    nt.links.new(disp.outputs["Displacement"], out.inputs["Displacement"])
-    if hasattr(mat, "displacement_method"):
-        mat.displacement_method = "DISPLACEMENT"
-    else:
-        mat.cycles.displacement_method = "DISPLACEMENT"
-    rock.data.materials.append(mat)
+    rock.data.materials.append(ru.add_noise_displacement(ru.diffuse_material("Rock", (0.5, 0.5, 0.45)), 2.0, 0.4))
     rng = random.Random(seed)
     for k in range(count):
         obj = rock if k == 0 else rock.copy()  # instances of one mesh, each placed and sized

@@ -15,13 +15,7 @@ OUT=${OUT:-/tmp/shadow_bench}
 DEVICE=${DEVICE:-gpu}
 REPEAT=${REPEAT:-30}
 mkdir -p "$OUT"
-export LD_LIBRARY_PATH=$PWD/lib
-if [ "$DEVICE" = gpu ]; then
-  mkdir -p /tmp/icd && echo /usr/lib/libnvidia-opencl.so > /tmp/icd/nvidia.icd
-  export OCL_ICD_VENDORS=/tmp/icd MICROPOLY_CACHE_DIR=/tmp/mpcache
-  nvidia-smi --query-gpu=name,driver_version --format=csv,noheader | tee "$OUT/device.txt"
-fi
-./micropoly-render --list-devices | tee -a "$OUT/device.txt"
+. ./device_env.sh
 if [ -z "${SKIP_TESTS:-}" ]; then
   MICROPOLY_DEVICE=gpu ./micropoly_tests --gtest_filter="${TESTS:-*Shadow*:RenderTest.*:Watertight*:MaterialProgram*}" \
     > "$OUT/gpu_tests.txt" 2>&1

@@ -133,6 +133,24 @@ def diffuse_material(name, color):
     return m
 
 
+def add_noise_displacement(mat, scale, strength):
+    """Displaces the node material `mat` by a Noise texture of `scale` through
+    a Displacement node of `strength` (Displacement Only, in every version)."""
+    nt = mat.node_tree
+    noise = nt.nodes.new("ShaderNodeTexNoise")
+    noise.inputs["Scale"].default_value = scale
+    disp = nt.nodes.new("ShaderNodeDisplacement")
+    disp.inputs["Scale"].default_value = strength
+    nt.links.new(noise.outputs["Fac"], disp.inputs["Height"])
+    out = next(n for n in nt.nodes if n.type == "OUTPUT_MATERIAL")
+    nt.links.new(disp.outputs["Displacement"], out.inputs["Displacement"])
+    if hasattr(mat, "displacement_method"):
+        mat.displacement_method = "DISPLACEMENT"
+    else:
+        mat.cycles.displacement_method = "DISPLACEMENT"
+    return mat
+
+
 def png_image(name, rgba, colorspace):
     """Writes rgba ((h, w, 4) in [0, 1], rows bottom to top) as an 8-bit PNG
     in a temporary folder and loads it back, as an artist's image file would

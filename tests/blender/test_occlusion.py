@@ -62,19 +62,7 @@ def hole_scene():
     scene = ru.reset_scene()
     bpy.ops.mesh.primitive_plane_add(size=6.0, location=(0.0, 0.0, 0.0))
     ground = subdivided(bpy.context.object, 3)
-    mat = material("Displaced", (0.8, 0.6, 0.2))
-    nodes, links = mat.node_tree.nodes, mat.node_tree.links
-    wave = nodes.new("ShaderNodeTexNoise")
-    wave.inputs["Scale"].default_value = 3.0
-    disp = nodes.new("ShaderNodeDisplacement")
-    disp.inputs["Scale"].default_value = 0.3
-    links.new(wave.outputs["Fac"], disp.inputs["Height"])
-    out = next(n for n in nodes if n.type == "OUTPUT_MATERIAL")
-    links.new(disp.outputs["Displacement"], out.inputs["Displacement"])
-    if hasattr(mat, "displacement_method"):
-        mat.displacement_method = "DISPLACEMENT"
-    if hasattr(mat, "cycles"):
-        mat.cycles.displacement_method = "DISPLACEMENT"
+    mat = ru.add_noise_displacement(material("Displaced", (0.8, 0.6, 0.2)), 3.0, 0.3)
     ground.data.materials.append(mat)
     # The wall: a 2 x 2 m plane at height 2 with a square hole, as four quads.
     h = 0.05
