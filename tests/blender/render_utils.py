@@ -133,15 +133,15 @@ def diffuse_material(name, color):
     return m
 
 
-def add_noise_displacement(mat, scale, strength):
-    """Displaces the node material `mat` by a Noise texture of `scale` through
-    a Displacement node of `strength` (Displacement Only, in every version)."""
+def add_displacement(mat, height, strength, midlevel=0.5):
+    """Displaces the node material `mat` along its normal by the output
+    socket `height` through a Displacement node of `strength` (Displacement
+    Only, in every version)."""
     nt = mat.node_tree
-    noise = nt.nodes.new("ShaderNodeTexNoise")
-    noise.inputs["Scale"].default_value = scale
     disp = nt.nodes.new("ShaderNodeDisplacement")
     disp.inputs["Scale"].default_value = strength
-    nt.links.new(noise.outputs["Fac"], disp.inputs["Height"])
+    disp.inputs["Midlevel"].default_value = midlevel
+    nt.links.new(height, disp.inputs["Height"])
     out = next(n for n in nt.nodes if n.type == "OUTPUT_MATERIAL")
     nt.links.new(disp.outputs["Displacement"], out.inputs["Displacement"])
     if hasattr(mat, "displacement_method"):
@@ -149,6 +149,33 @@ def add_noise_displacement(mat, scale, strength):
     else:
         mat.cycles.displacement_method = "DISPLACEMENT"
     return mat
+
+
+def add_noise_displacement(mat, scale, strength, detail=None):
+    """Displaces `mat` by a Noise texture of `scale` (add_displacement)."""
+    noise = mat.node_tree.nodes.new("ShaderNodeTexNoise")
+    noise.inputs["Scale"].default_value = scale
+    if detail is not None:
+        noise.inputs["Detail"].default_value = detail
+    return add_displacement(mat, noise.outputs["Fac"], strength)
+
+
+def add_aimed_light(scene, kind, location, target, energy, **props):
+    """A light of `kind` at `location` aimed at `target`, of radius 0 unless
+    `props` (light data attributes) say otherwise."""
+    from mathutils import Vector
+
+    data = bpy.data.lights.new(kind.lower(), kind)
+    data.energy = energy
+    if hasattr(data, "shadow_soft_size"):
+        data.shadow_soft_size = 0.0
+    for k, v in props.items():
+        setattr(data, k, v)
+    obj = bpy.data.objects.new(kind.lower(), data)
+    scene.collection.objects.link(obj)
+    obj.location = location
+    obj.rotation_euler = (Vector(location) - Vector(target)).to_track_quat("Z", "Y").to_euler()
+    return obj
 
 
 def png_image(name, rgba, colorspace):

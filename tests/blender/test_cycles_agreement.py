@@ -40,19 +40,7 @@ def floor(scene, size=8.0, z=-1.0):
 
 
 def light(scene, kind, location=(2.0, -4.0, 3.0), target=(0.0, 0.0, 0.0), energy=500.0, **props):
-    from mathutils import Vector
-
-    data = bpy.data.lights.new(kind.lower(), kind)
-    data.energy = energy
-    if hasattr(data, "shadow_soft_size"):
-        data.shadow_soft_size = 0.0
-    for k, v in props.items():
-        setattr(data, k, v)
-    obj = bpy.data.objects.new(kind.lower(), data)
-    scene.collection.objects.link(obj)
-    obj.location = location
-    obj.rotation_euler = (Vector(location) - Vector(target)).to_track_quat("Z", "Y").to_euler()
-    return obj
+    return ru.add_aimed_light(scene, kind, location, target, energy, **props)
 
 
 def compare(name, scene, checks):

@@ -66,17 +66,7 @@ def floor(scene, size=9.0, z=-0.9):
 
 
 def add_light(scene, kind, location, target=(0.0, 0.0, -0.5), energy=1000.0, **props):
-    data = bpy.data.lights.new(kind.lower(), kind)
-    data.energy = energy
-    if hasattr(data, "shadow_soft_size"):
-        data.shadow_soft_size = 0.0
-    for k, v in props.items():
-        setattr(data, k, v)
-    obj = bpy.data.objects.new(kind.lower(), data)
-    scene.collection.objects.link(obj)
-    obj.location = location
-    obj.rotation_euler = (Vector(location) - Vector(target)).to_track_quat("Z", "Y").to_euler()
-    return obj
+    return ru.add_aimed_light(scene, kind, location, target, energy, **props)
 
 
 def render_both(scene, name, cycles_samples, shadows=True):
@@ -157,22 +147,7 @@ def case_area(soft):
 
 
 def noise_displaced_material(name, scale, strength, color=(0.75, 0.75, 0.7)):
-    mat = ru.diffuse_material(name, color)
-    nt = mat.node_tree
-    out = next(n for n in nt.nodes if n.type == "OUTPUT_MATERIAL")
-    tex = nt.nodes.new("ShaderNodeTexNoise")
-    tex.inputs["Scale"].default_value = scale
-    tex.inputs["Detail"].default_value = 3.0
-    disp = nt.nodes.new("ShaderNodeDisplacement")
-    disp.inputs["Scale"].default_value = strength
-    disp.inputs["Midlevel"].default_value = 0.5
-    nt.links.new(tex.outputs["Fac"], disp.inputs["Height"])
-    nt.links.new(disp.outputs["Displacement"], out.inputs["Displacement"])
-    if hasattr(mat, "displacement_method"):
-        mat.displacement_method = "DISPLACEMENT"
-    else:
-        mat.cycles.displacement_method = "DISPLACEMENT"
-    return mat
+    return ru.add_noise_displacement(ru.diffuse_material(name, color), scale, strength, detail=3.0)
 
 
 def displaced_plane(size=6.0, scale=1.2, strength=0.35):
@@ -187,23 +162,12 @@ def displaced_plane(size=6.0, scale=1.2, strength=0.35):
 def wave_displaced_material(name, scale, strength, color=(0.75, 0.75, 0.7)):
     """Ridges: a Wave texture's bands along x, with a little Noise."""
     mat = ru.diffuse_material(name, color)
-    nt = mat.node_tree
-    out = next(n for n in nt.nodes if n.type == "OUTPUT_MATERIAL")
-    wave = nt.nodes.new("ShaderNodeTexWave")
+    wave = mat.node_tree.nodes.new("ShaderNodeTexWave")
     wave.wave_type = "BANDS"
     wave.bands_direction = "X"
     wave.inputs["Scale"].default_value = scale
     wave.inputs["Distortion"].default_value = 4.0
-    disp = nt.nodes.new("ShaderNodeDisplacement")
-    disp.inputs["Scale"].default_value = strength
-    disp.inputs["Midlevel"].default_value = 0.5
-    nt.links.new(wave.outputs["Fac"], disp.inputs["Height"])
-    nt.links.new(disp.outputs["Displacement"], out.inputs["Displacement"])
-    if hasattr(mat, "displacement_method"):
-        mat.displacement_method = "DISPLACEMENT"
-    else:
-        mat.cycles.displacement_method = "DISPLACEMENT"
-    return mat
+    return ru.add_displacement(mat, wave.outputs["Fac"], strength)
 
 
 def case_displaced_grazing():

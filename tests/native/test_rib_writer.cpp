@@ -824,6 +824,7 @@ TEST(RibWriterExtensions, BadValuesAreErrors) {
                "one material index per face");
   expect_error("Option \"micropoly\" \"string boundsplit\" \"fast\"\n", "boundsplit");
   expect_error("Option \"micropoly\" \"integer backfaceculling\" 2\n", "backfaceculling");
+  expect_error("Option \"micropoly\" \"integer occlusionculling\" 2\n", "occlusionculling");
   expect_error("WorldBegin\nLightSource \"micropoly_arealight\" 1 \"string shape\" \"disc\"\nWorldEnd\n", "shape");
   expect_error("Option \"micropoly\" \"string imagefile\" \"/nonexistent/t.exr\"\n", "/nonexistent/t.exr");
   expect_error("Option \"micropoly\" \"string imagefile\" \"t.tif\"\n", "only .exr and .png");

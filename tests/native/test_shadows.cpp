@@ -180,6 +180,18 @@ class ShadowRenderTest : public SharedRendererTest {};
 constexpr int kW = 320, kH = 240;
 constexpr float kHalfW = 4.0f, kHalfH = 3.0f;  // the camera's view of the floor, scene units
 
+// A square area light of side w at height H over the floor, facing down.
+Light square_area_light(float H, float w) {
+  Light a;
+  a.type = Light::Type::Area;
+  a.intensity = 3.0f;
+  a.position = glm::vec3(0, 0, H);
+  a.direction = glm::vec3(0, 0, -1);
+  a.axis_u = glm::vec3(1, 0, 0);
+  a.size_u = a.size_v = w;
+  return a;
+}
+
 // A white floor seen straight from above by an orthographic camera, lit by
 // `light` alone; the occluders are added by the test.
 Scene floor_scene(const Light& light) {
@@ -343,13 +355,7 @@ TEST_F(ShadowRenderTest, PenumbraWidensWithTheLightsSizeAsSimilarTrianglesSay) {
   };
   std::vector<Case> cases;
   {
-    Light a;  // a square area light of side w: a linear ramp over w h / (H - h)
-    a.type = Light::Type::Area;
-    a.intensity = 3.0f;
-    a.position = glm::vec3(0, 0, H);
-    a.direction = glm::vec3(0, 0, -1);
-    a.axis_u = glm::vec3(1, 0, 0);
-    a.size_u = a.size_v = 2.0f;
+    Light a = square_area_light(H, 2.0f);  // a linear ramp over w h / (H - h)
     cases.push_back({"area light", a, 0.8 * 2.0 * h / (H - h) * kPx});
   }
   {
@@ -502,14 +508,7 @@ TEST_F(ShadowRenderTest, PreviewPenumbraeWithoutTheirFinerPagesKeepTheirWidth) {
   // fewer either), and a penumbra still about as wide as similar triangles
   // say.
   const float h = 1.0f, H = 5.0f;
-  Light a;
-  a.type = Light::Type::Area;
-  a.intensity = 3.0f;
-  a.position = glm::vec3(0, 0, H);
-  a.direction = glm::vec3(0, 0, -1);
-  a.axis_u = glm::vec3(1, 0, 0);
-  a.size_u = a.size_v = 2.0f;
-  Scene s = floor_scene(a);
+  Scene s = floor_scene(square_area_light(H, 2.0f));
   s.meshes.push_back(occluder(-20.0f, -20.0f, 0.0f, 20.0f, h));
   const RenderResult full = Renderer().render(s);
   s.settings.soft_shadow_pages = false;
