@@ -92,9 +92,7 @@ void place_shape(const PatchBuffer& shape, const glm::mat4& to_camera, const Mes
 
   const size_t first = out.size();
   const uint32_t curve_base = uint32_t(out.curves.size() / MP_CURVE_FLOAT4S);
-  out.points.reserve(out.points.size() + shape.points.size());
   for (const glm::vec4& p : shape.points) out.points.push_back(point(p));
-  out.info.reserve(out.info.size() + shape.info.size());
   for (size_t p = 0; p < shape.size(); ++p) {
     glm::uvec4 info = shape.info[p];
     const int material = mesh ? (mesh->face_materials.empty() ? mesh->material : mesh->face_materials[info.w])
@@ -109,9 +107,7 @@ void place_shape(const PatchBuffer& shape, const glm::mat4& to_camera, const Mes
             mat.displacement_bound * (mat.displacement_bound_world ? 1.0f : bound_scale);  // camera = world units
     }
   }
-  out.edges.reserve(out.edges.size() + shape.edges.size());
   for (uint32_t ref : shape.edges) out.edges.push_back(ref == MP_NO_CURVE ? ref : ref + (curve_base << 1));
-  out.curves.reserve(out.curves.size() + shape.curves.size());
   for (size_t c = 0; c < shape.curves.size(); c += MP_CURVE_FLOAT4S) {
     for (int k = 0; k < 4; ++k) out.curves.push_back(point(shape.curves[c + size_t(k)]));
     for (int k = 4; k < MP_CURVE_FLOAT4S; ++k) {
@@ -120,7 +116,6 @@ void place_shape(const PatchBuffer& shape, const glm::mat4& to_camera, const Mes
     }
   }
   out.uvs.insert(out.uvs.end(), shape.uvs.begin(), shape.uvs.end());
-  out.normals.reserve(out.normals.size() + shape.normals.size());
   for (const glm::vec4& n : shape.normals) {
     const glm::dvec3 m = normal_map * glm::dvec3(glm::vec3(n));
     out.normals.emplace_back(float(m.x), float(m.y), float(m.z), 0.0f);
@@ -199,6 +194,17 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
   for (const BezierPatches& set : scene.bezier_patches) surfaces.push_back({nullptr, &set});
   PatchCache local;
   const auto shapes = (cache ? cache : &local)->shapes(surfaces, out.patches.uv_layers);
+  // Reserved once for all surfaces: growing per surface to its exact size
+  // would copy everything placed so far for every object (quadratic in the
+  // object count; thousands of instances took minutes).
+  size_t totals[6] = {};
+  for (const auto& shape : shapes) {
+    totals[0] += shape->points.size(), totals[1] += shape->info.size(), totals[2] += shape->edges.size();
+    totals[3] += shape->curves.size(), totals[4] += shape->uvs.size(), totals[5] += shape->normals.size();
+  }
+  out.patches.points.reserve(totals[0]), out.patches.info.reserve(totals[1]), out.patches.edges.reserve(totals[2]);
+  out.patches.curves.reserve(totals[3]), out.patches.uvs.reserve(totals[4]), out.patches.normals.reserve(totals[5]);
+  out.objects.reserve(surfaces.size());
   for (size_t i = 0; i < surfaces.size(); ++i) {
     const Mesh* mesh = surfaces[i].mesh;
     const BezierPatches* set = surfaces[i].set;
