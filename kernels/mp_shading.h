@@ -23,6 +23,29 @@ MP_INLINE float mp_smoothstep(float e0, float e1, float x) {
 
 MP_INLINE float3 mp_light_f3(const MP_GLOBAL float* v) { return MP_F3(v[0], v[1], v[2]); }
 
+/* The world's irradiance over pi (a radiance, as an ambient light's) on a
+ * surface with camera-space normal n, from an MP_LIGHT_ENVIRONMENT light:
+ * E(n) / pi = sum of c_lm Y_lm(R n), with R camera -> world and the
+ * coefficients already scaled by the cosine lobe's A_l / pi (Ramamoorthi &
+ * Hanrahan 2001, "An efficient representation for irradiance environment
+ * maps"). The two records hold 40 floats past their colour fields:
+ * R's rows, then the coefficients (world_lighting.cpp writes them). */
+MP_INLINE float mp_env_float(MP_GLOBAL const DeviceLight* lt, int i) {
+  MP_GLOBAL const float* f = (MP_GLOBAL const float*)lt;
+  return i < 20 ? f[4 + i] : f[28 + (i - 20)];
+}
+MP_INLINE float3 mp_env_irradiance(MP_GLOBAL const DeviceLight* lt, float3 n) {
+  float x = mp_env_float(lt, 0) * n.x + mp_env_float(lt, 1) * n.y + mp_env_float(lt, 2) * n.z;
+  float y = mp_env_float(lt, 3) * n.x + mp_env_float(lt, 4) * n.y + mp_env_float(lt, 5) * n.z;
+  float z = mp_env_float(lt, 6) * n.x + mp_env_float(lt, 7) * n.y + mp_env_float(lt, 8) * n.z;
+  float basis[9] = {0.282095f, 0.488603f * y, 0.488603f * z, 0.488603f * x, 1.092548f * x * y, 1.092548f * y * z,
+                    0.315392f * (3.0f * z * z - 1.0f), 1.092548f * x * z, 0.546274f * (x * x - y * y)};
+  float3 e = MP_F3(0.0f, 0.0f, 0.0f);
+  for (int k = 0; k < 9; ++k)
+    e += basis[k] * MP_F3(mp_env_float(lt, 9 + 3 * k), mp_env_float(lt, 10 + 3 * k), mp_env_float(lt, 11 + 3 * k));
+  return MP_F3(fmax(e.x, 0.0f), fmax(e.y, 0.0f), fmax(e.z, 0.0f));
+}
+
 /* Irradiance factor of a uniformly emitting polygon seen from a point with
  * normal n (vertices relative to the point): the polygon's projected solid
  * angle, by Lambert's formula, after clipping the polygon to the hemisphere
@@ -249,12 +272,25 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal,
   float alpha = fmax(roughness * roughness, 1e-3f);
   float3 f0 = (1.0f - metallic) * MP_F3(0.08f, 0.08f, 0.08f) * m->principled[1] + metallic * cs;
   float3 ambient = MP_F3(0.0f, 0.0f, 0.0f), diffuse = ambient, specular = ambient;
+  MP_GLOBAL const DeviceLight* world = 0;
+  float probe_lit = 0.0f, probe_total = 0.0f; /* the world's visibility, weighted by its probes' light */
   for (uint k = 0; k < light_count; ++k) {
     MP_GLOBAL const DeviceLight* lt = lights + k;
     float3 cl = mp_light_f3(lt->color);
     int type = (int)lt->color[3];
     if (type == MP_LIGHT_AMBIENT) {
       ambient += cl;
+      continue;
+    }
+    if (type == MP_LIGHT_ENVIRONMENT) world = lt;
+    if (type == MP_LIGHT_ENVIRONMENT || type == MP_LIGHT_ENVIRONMENT_DATA) continue;
+    if (type == MP_LIGHT_DISTANT && lt->axis_u[3] == MP_WORLD_PROBE) {
+      float3 lp = -mp_light_f3(lt->direction);
+      float w = (cl.x + cl.y + cl.z) * fmax(dot(nd, lp), 0.0f);
+      if (w > 0.0f) {
+        probe_total += w;
+        probe_lit += w * (shadow ? mp_shadow_visibility(shadow->maps, k, p, shadow->normal, shadow->footprint) : 1.0f);
+      }
       continue;
     }
     float3 l;
@@ -299,13 +335,22 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal,
     } else
       specular += (e / fmax(dot(nf, l), 1e-6f)) * MP_POWR(fmax(dot(nf, normalize(l + v)), 0.0f), inv_roughness);
   }
+  /* The world's light: its irradiance by the diffuse normal and, for the
+   * glossy lobe, around the mirror direction, darkened by the visibility
+   * its probes' shadow maps give. */
+  float3 world_d = MP_F3(0.0f, 0.0f, 0.0f), world_s = world_d;
+  if (world) {
+    float vis = probe_total > 0.0f ? probe_lit / probe_total : 1.0f;
+    world_d = mp_env_irradiance(world, nd) * (vis * world->color[0]);
+    world_s = mp_env_irradiance(world, 2.0f * dot(nf, v) * nf - v) * (vis * world->color[1]);
+  }
   if (model == MP_MODEL_PRINCIPLED) {
     /* Lambert: albedo / pi per unit irradiance; a uniform ambient radiance A
      * gives irradiance pi A, so the diffuse response to it is albedo * A. */
     float3 albedo = cs * (1.0f - metallic);
-    return albedo * (diffuse * (1.0f / MP_PI) + ambient) + specular + f0 * ambient + emission;
+    return albedo * (diffuse * (1.0f / MP_PI) + ambient + world_d) + specular + f0 * (ambient + world_s) + emission;
   }
-  float3 c = cs * (ka * ambient + kd * diffuse);
+  float3 c = cs * (ka * (ambient + world_d) + kd * diffuse);
   if (model == MP_MODEL_PLASTIC) c += MP_F3(m->specular[0], m->specular[1], m->specular[2]) * (ks * specular);
   return c + emission;
 }

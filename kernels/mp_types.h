@@ -135,6 +135,14 @@ typedef struct {
 #define MP_LIGHT_POINT 2
 #define MP_LIGHT_SPOT 3
 #define MP_LIGHT_AREA 4
+/* The world's light (world_lighting.h): irradiance as 9 spherical-harmonic
+ * coefficients in two consecutive records, the second typed _DATA. */
+#define MP_LIGHT_ENVIRONMENT 5
+#define MP_LIGHT_ENVIRONMENT_DATA 6
+/* A distant light with axis_u[3] == MP_WORLD_PROBE gives no light of its
+ * own: its shadow map tells how much of the world's light reaches a point
+ * from its part of the sky (world_lighting.h). */
+#define MP_WORLD_PROBE 1.0f
 #define MP_AREA_RECTANGLE 0
 #define MP_AREA_ELLIPSE 1
 

@@ -184,7 +184,8 @@ class MicropolyRenderEngine(bpy.types.RenderEngine):
         if not scene.render.film_transparent:
             # An opaque film shows the world color behind objects, as Cycles does.
             alpha = rgba[..., 3:4]
-            rgba = np.concatenate([rgba[..., :3] + (1.0 - alpha) * exported.background,
+            behind = result.get("background", exported.background)  # a baked world's, per pixel
+            rgba = np.concatenate([rgba[..., :3] + (1.0 - alpha) * behind,
                                    np.ones_like(alpha)], axis=-1)
         x0, y0 = exported.crop_origin_bottom_left(width, height)
         render_result = self.begin_result(x0, y0, width, height, layer=view_layer.name)

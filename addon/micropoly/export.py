@@ -148,7 +148,7 @@ def export_scene(depsgraph, view=None, meshes=None):
         view.apply(native_scene)
     materials = export_materials.MaterialTable(native_scene, out.warnings)
     meshes = meshes if meshes is not None else export_mesh.MeshCache()
-    out.background = export_lights.export_world(native_scene, scene.world)
+    out.background = export_lights.export_world(native_scene, scene.world, materials, out.warnings)
     # Materials first: their node programs decide which UV maps meshes export.
     for inst in depsgraph.object_instances:
         if inst.object.type == "MESH":

@@ -16,16 +16,54 @@ import numpy as np
 from mathutils import Vector
 
 
-def export_world(native_scene, world):
-    """The world's color as uniform ambient light; returns the background color."""
+def _world_background_node(world):
+    """The Background node feeding the world's active World Output, or None."""
+    outputs = [n for n in world.node_tree.nodes
+               if n.type == "OUTPUT_WORLD" and getattr(n, "target", "ALL") in ("ALL", "CYCLES")]
+    out = next((n for n in outputs if n.is_active_output), outputs[0] if outputs else None)
+    if out is None or not out.inputs["Surface"].is_linked:
+        return None
+    node = out.inputs["Surface"].links[0].from_node
+    while node is not None and node.type == "REROUTE":
+        node = node.inputs[0].links[0].from_node if node.inputs[0].is_linked else None
+    return node
+
+
+def _ray_visibility(world):
+    """Camera, diffuse and glossy visibility: Object-like ray visibility on
+    the world from Blender 3.0 (world.visible_camera ...), else all on."""
+    vis = getattr(world, "cycles_visibility", None)
+    get = lambda name: bool(getattr(world, f"visible_{name}", getattr(vis, name, True)))
+    return get("camera"), get("diffuse"), get("glossy")
+
+
+def export_world(native_scene, world, materials=None, warnings=None):
+    """The world: a uniform color as ambient light; a Background whose color
+    or strength comes from nodes (an HDRI, a gradient) as a world program
+    baked into an environment map, whose light the scene shadows
+    (native world_lighting.h). Returns the background color (for a uniform
+    world; a baked world's background comes with the render result)."""
     if world is None:
         return np.zeros(3, dtype=np.float32)
     color = np.array(list(world.color)[:3], dtype=np.float32)
     if world.use_nodes and world.node_tree is not None:
-        background = next((n for n in world.node_tree.nodes if n.type == "BACKGROUND"), None)
-        if background is not None and not background.inputs["Color"].is_linked:
+        background = _world_background_node(world)
+        if background is not None and background.type == "BACKGROUND":
+            linked = background.inputs["Color"].is_linked or background.inputs["Strength"].is_linked
+            if linked and materials is not None:
+                from . import node_compiler
+                source = node_compiler.NodeCompiler(world, materials.warnings, resources=materials) \
+                    .compile_world(background)
+                program = native_scene.add_material_program("world " + world.name, source)
+                camera, diffuse, glossy = _ray_visibility(world)
+                native_scene.set_world(program=program, camera=camera, diffuse=float(diffuse),
+                                       glossy=float(glossy))
+                return np.zeros(3, dtype=np.float32)
             color = np.array(list(background.inputs["Color"].default_value)[:3], dtype=np.float32)
             color *= float(background.inputs["Strength"].default_value)
+        elif background is not None and warnings is not None:
+            warnings.append(f"world '{world.name}': a {background.bl_label} node at its output is not supported; "
+                            "its viewport color lights the scene")
     if np.any(color > 0):
         native_scene.add_light("ambient", color=color.tolist(), intensity=1.0)
     return color

@@ -282,6 +282,8 @@ class NodeCompiler:
             return {"UV": (self.uv(node.uv_map), VEC, None)}
         if t == "TEX_IMAGE":
             return self.emit_image(node)
+        if t == "TEX_ENVIRONMENT":
+            return self.emit_environment(node)
         if t == "NEW_GEOMETRY":
             self.warn(node, "only Normal is supported here, in object space")
             return {"Normal": ("g->N", VEC, None)}
@@ -574,6 +576,32 @@ class NodeCompiler:
         color = f"{rgba}.xyz" if straight else f"({rgba}.xyz * {rgba}.w)"
         rng = (0.0, 1.0) if byte_image else None  # 8-bit images hold [0, 1]
         return {"Color": (color, VEC, rng), "Alpha": (f"{rgba}.w", FLOAT, (0.0, 1.0))}
+
+    def emit_environment(self, node):
+        """An Environment Texture: the image at a direction (the world's
+        own by default), equirectangular or mirror ball, wrapping in longitude."""
+        self.headers.add("mp_tex_image.h")
+        index, byte_image = self.resources.image(node.image, lambda what: self.warn(node, what))
+        vec = self.input(node, "Vector", VEC)[0] if node.inputs["Vector"].is_linked else "g->generated"
+        proj = "mirror_ball" if node.projection == "MIRROR_BALL" else "equirect"
+        uv = self.fn.temp("float2", f"mp_env_{proj}_uv({vec})")[0]
+        interp = IMAGE_INTERPOLATION.get(node.interpolation, 0)
+        images = f"g->images, g->image_count, g->texels, {index}"
+        rgba = self.fn.temp("float4", f"mp_tex_image({images}, ({uv}).x, ({uv}).y, {interp}, 0)")[0]
+        rng = (0.0, 1.0) if byte_image else None
+        return {"Color": (f"{rgba}.xyz", VEC, rng)}
+
+    # ---- the world ------------------------------------------------------------
+    def compile_world(self, background):
+        """The world program: its Background's colour times strength as the
+        Surface emission, for each direction (material_program.cl, bake_world)."""
+        disp_src = "float3 mp_node_displacement(const MpNodeGlobals* g) {\n  return (float3)(0.0f);\n}\n"
+        surf_src = self._function(
+            "void mp_node_surface(const MpNodeGlobals* g, MpSurfaceInputs* s)",
+            lambda: f"  s->emission = {self.input(background, 'Color', VEC)[0]} * "
+                    f"{self.input(background, 'Strength', FLOAT)[0]};\n")
+        includes = "".join(f'#include "textures/{h}"\n' for h in sorted(self.headers))
+        return includes + "".join(self.helpers) + disp_src + surf_src
 
     # ---- the material -----------------------------------------------------------
     def _function(self, header, body_fn):

@@ -206,3 +206,39 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
                              use_shadows ? &shadow : 0);
   grid_c[index] = (float4)(c, clamp(s.alpha, 0.0f, 1.0f));
 }
+
+/* The world's radiance over an equirectangular map (scene.h, World): the
+ * world program's Surface emission (a Background node's colour times its
+ * strength) for the direction of each texel's centre. World nodes see that
+ * direction as their position, normal and Generated coordinate, as in
+ * Cycles' world shaders. */
+__kernel void bake_world(uint width, uint height, MP_PROGRAM_INPUT_ARGS, __global float4* out) {
+  uint i = get_global_id(0);
+  if (i >= width * height) return;
+  float u = ((float)(i % width) + 0.5f) / (float)width, v = ((float)(i / width) + 0.5f) / (float)height;
+  float phi = MP_PI * (1.0f - 2.0f * u), elevation = MP_PI * (v - 0.5f);
+  float3 d = (float3)(cos(elevation) * cos(phi), cos(elevation) * sin(phi), sin(elevation));
+  MpProgramInputs in = MP_PROGRAM_INPUTS;
+  MpNodeGlobals g;
+  g.P = d;
+  g.N = d;
+  g.generated = d;
+  for (uint k = 0; k < MP_MAX_UV_LAYERS; ++k) g.uv[k] = (float3)(0.0f);
+  g.object = 0;
+  g.images = in.images;
+  g.image_count = in.image_count;
+  g.texels = in.texels;
+  g.dx = 0;
+  g.dy = 0;
+  MpSurfaceInputs s;
+  s.base_color = (float3)(0.0f);
+  s.metallic = s.specular = s.roughness = 0.0f;
+  s.alpha = 1.0f;
+  s.emission = (float3)(0.0f);
+  s.normal = d;
+  s.has_normal = 0;
+  mp_node_surface(&g, &s);
+  float3 e = s.emission;
+  out[i] = (float4)(isfinite(e.x) ? fmax(e.x, 0.0f) : 0.0f, isfinite(e.y) ? fmax(e.y, 0.0f) : 0.0f,
+                    isfinite(e.z) ? fmax(e.z, 0.0f) : 0.0f, 1.0f);
+}

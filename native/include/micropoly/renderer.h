@@ -98,6 +98,9 @@ struct RenderStats {
 struct RenderResult {
   int width = 0, height = 0;
   std::vector<float> rgba, depth, normal;
+  // What the camera sees of the world behind objects (RGB, rows as rgba),
+  // for an opaque film; empty without a world or when the camera does not see it.
+  std::vector<float> background;
   RenderStats stats;
 };
 

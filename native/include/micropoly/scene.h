@@ -135,7 +135,8 @@ struct Image {
 // light with soft falloff; without soft_falloff (Blender 4.1 and later) a
 // sphere, which lights as the point does while it is above the horizon.
 struct Light {
-  enum class Type { Ambient, Distant, Point, Spot, Area };
+  // Environment: the world's light (World below), made by the renderer.
+  enum class Type { Ambient, Distant, Point, Spot, Area, Environment };
   enum class Shape { Rectangle, Ellipse };
   Type type = Type::Point;
   glm::vec3 color{1.0f};
@@ -152,6 +153,32 @@ struct Light {
   float radius = 0.0f;                     // point and spot lights
   bool soft_falloff = true;
   float angle = 0.0f;                      // distant lights, radians
+  // Lights the renderer derives from the world (world_lighting.h): a
+  // distant probe gives no light of its own, only its shadow map's
+  // visibility; the environment light holds the world's irradiance as
+  // spherical harmonics (9 RGB coefficients, world space, already scaled
+  // by the cosine lobe's A_l / pi) and the world's diffuse and glossy
+  // visibility factors in color.
+  bool world_probe = false;
+  std::vector<float> irradiance_sh;
+};
+
+// The world: light from every direction and what the camera sees behind
+// objects. Its radiance is an equirectangular map in world space (Blender's
+// and Cycles' convention: +Z up; a direction d sits at u = 0.5 -
+// atan2(d.y, d.x) / 2pi, v = 0.5 + asin(d.z) / pi, rows from the bottom),
+// either given (`radiance`, RGBA) or baked on the device from a world
+// program, a node tree the add-on compiled like a material's (its Surface
+// emission is the radiance). Without either, the scene has no world light.
+struct World {
+  int program = -1;                 // index into Scene::material_programs
+  int bake_width = 512;             // the baked map's width; its height is half
+  int width = 0, height = 0;        // of `radiance`
+  std::vector<float> radiance;
+  bool camera = true;               // seen behind objects on an opaque film
+  float diffuse = 1.0f, glossy = 1.0f;  // Ray Visibility: light on diffuse and glossy lobes
+  bool cast_shadows = true;         // the scene shadows its world light
+  bool present() const { return program >= 0 || (width > 0 && height > 0); }
 };
 
 // Camera: right-handed camera space, looking down -Z with +Y up (Blender's
@@ -205,6 +232,9 @@ struct RenderSettings {
   // Bound & split drops sub-patches hidden behind what earlier dice batches
   // sampled (kernels/mp_occlusion.h); the image is the same either way.
   bool occlusion_culling = true;
+  // The world's light is shadowed through this many probe directions
+  // (world_lighting.h), each a soft-shadowed distant light.
+  int world_probes = 8;
 };
 
 struct Scene {
@@ -214,6 +244,7 @@ struct Scene {
   std::vector<MaterialProgram> material_programs;
   std::vector<Image> images;
   std::vector<Light> lights;
+  World world;
   std::vector<Mesh> meshes;
   std::vector<BezierPatches> bezier_patches;
 };

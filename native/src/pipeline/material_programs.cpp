@@ -3,6 +3,8 @@
 #include "cl/program_cache.h"
 #include "micropoly/error.h"
 
+#include <algorithm>
+
 namespace mp {
 
 void MaterialPrograms::prepare(const Scene& scene, RenderStats& stats) {
@@ -17,27 +19,59 @@ void MaterialPrograms::prepare(const Scene& scene, RenderStats& stats) {
   }
   for (size_t i = 0; i < scene.material_programs.size(); ++i) {
     if (!displaces[i] && !shades[i]) continue;
-    const MaterialProgram& mp = scene.material_programs[i];
-    auto it = built_.find(mp.source);
-    if (it == built_.end()) {
-      BuiltProgram b;
-      try {
-        b = build_program_cached(session_.context(), session_.device(), assemble_material_program_source(mp.source),
-                                 "-cl-std=CL1.2");
-      } catch (const Error& e) {
-        throw Error("material '" + mp.name + "': its node tree did not compile: " + e.what());
-      }
-      stats.program_build_ms += b.build_ms;
-      auto built = std::make_unique<Built>();
-      built->program = b.program;
-      built->displace = cl::Kernel(built->program, "displace_grids");
-      built->shade = cl::Kernel(built->program, "shade_program_grids");
-      it = built_.emplace(mp.source, std::move(built)).first;
-    }
-    active_.push_back({it->second.get(), static_cast<cl_int>(i), static_cast<bool>(displaces[i]),
-                       static_cast<bool>(shades[i]), static_cast<bool>(alpha[i])});
+    active_.push_back({build(scene.material_programs[i], "material '", stats), static_cast<cl_int>(i),
+                       static_cast<bool>(displaces[i]), static_cast<bool>(shades[i]), static_cast<bool>(alpha[i])});
     displaces_ = displaces_ || displaces[i];
   }
+  const int w = scene.world.program;
+  world_ = w >= 0 && size_t(w) < scene.material_programs.size()
+               ? build(scene.material_programs[size_t(w)], "world '", stats)
+               : nullptr;
+}
+
+MaterialPrograms::Built* MaterialPrograms::build(const MaterialProgram& mp, const char* owner, RenderStats& stats) {
+  auto it = built_.find(mp.source);
+  if (it != built_.end()) return it->second.get();
+  BuiltProgram b;
+  try {
+    b = build_program_cached(session_.context(), session_.device(), assemble_material_program_source(mp.source),
+                             "-cl-std=CL1.2");
+  } catch (const Error& e) {
+    throw Error(owner + mp.name + "': its node tree did not compile: " + e.what());
+  }
+  stats.program_build_ms += b.build_ms;
+  auto built = std::make_unique<Built>();
+  built->program = b.program;
+  built->displace = cl::Kernel(built->program, "displace_grids");
+  built->shade = cl::Kernel(built->program, "shade_program_grids");
+  built->bake_world = cl::Kernel(built->program, "bake_world");
+  return built_.emplace(mp.source, std::move(built)).first->second.get();
+}
+
+WorldMap MaterialPrograms::bake_world(const Scene& scene, const SceneBuffers& buffers) {
+  WorldMap map;
+  if (!world_) return map;
+  map.width = std::clamp(scene.world.bake_width, 8, 8192);
+  map.height = map.width / 2;
+  const size_t texels = size_t(map.width) * size_t(map.height);
+  cl::Buffer out = session_.allocate(texels * sizeof(cl_float4), "world map");
+  cl::Kernel& k = world_->bake_world;
+  k.setArg(0, cl_uint(map.width));
+  k.setArg(1, cl_uint(map.height));
+  k.setArg(2, buffers.patch_edges);
+  k.setArg(3, buffers.patch_uvs);
+  k.setArg(4, buffers.uv_layers);
+  k.setArg(5, buffers.images);
+  k.setArg(6, buffers.image_count);
+  k.setArg(7, buffers.texels);
+  k.setArg(8, out);
+  cl::CommandQueue& q = session_.queue();
+  q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(cl_uint(texels)), cl::NDRange(64));
+  std::vector<cl_float4> host(texels);
+  q.enqueueReadBuffer(out, CL_TRUE, 0, texels * sizeof(cl_float4), host.data());
+  map.radiance.resize(texels);
+  for (size_t i = 0; i < texels; ++i) map.radiance[i] = glm::vec3(host[i].s[0], host[i].s[1], host[i].s[2]);
+  return map;
 }
 
 namespace {

@@ -16,6 +16,7 @@
 #include "pipeline/micropolygon_stages.h"
 #include "pipeline/scene_buffers.h"
 #include "pipeline/stage_timer.h"
+#include "pipeline/world_lighting.h"
 
 namespace mp {
 
@@ -33,6 +34,9 @@ class MaterialPrograms {
   // Shades the vertices whose materials compute their Principled inputs.
   void shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
              GridBuffers& grids, const ShadowInputs& shadows, StageTimer& timer);
+  // The world program's radiance map (scene.h, World), baked on the device
+  // with the scene's images; empty when the world has no program.
+  WorldMap bake_world(const Scene& scene, const SceneBuffers& buffers);
   // Only the alpha (grid_c's w) of the vertices whose programs compute it:
   // what a shadow view needs.
   void alpha(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
@@ -41,13 +45,14 @@ class MaterialPrograms {
  private:
   struct Built {
     cl::Program program;
-    cl::Kernel displace, shade;
+    cl::Kernel displace, shade, bake_world;
   };
   struct Active {
     Built* built;
     cl_int index;  // the scene's program index, as DeviceMaterial.program[0]
     bool displaces, shades, alpha;
   };
+  Built* build(const MaterialProgram& mp, const char* owner, RenderStats& stats);
   void launch(cl::Kernel& kernel, cl_uint count, GridBuffers& grids, Stage stage, StageTimer& timer);
   void run_shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
                  GridBuffers& grids, const ShadowInputs& shadows, bool alpha_only, StageTimer& timer);
@@ -55,6 +60,7 @@ class MaterialPrograms {
   DeviceSession& session_;
   std::unordered_map<std::string, std::unique_ptr<Built>> built_;  // by source
   std::vector<Active> active_;
+  Built* world_ = nullptr;  // the scene's world program, if any
   bool displaces_ = false;
   cl::Kernel normals_;  // displaced_normals, from the main program
 };

@@ -15,6 +15,7 @@
 #include "pipeline/scene_buffers.h"
 #include "pipeline/scene_fingerprint.h"
 #include "pipeline/shadow_maps.h"
+#include "pipeline/world_lighting.h"
 
 namespace mp {
 namespace {
@@ -56,6 +57,11 @@ struct Renderer::Impl {
   // building and uploading patches.
   std::unique_ptr<SceneBuffers> scene_buffers;
   uint64_t scene_key = 0;
+  // The world's map and the lights derived from it (world-space, so a
+  // moving camera keeps them), kept while the world stays the same.
+  WorldMap world_map;
+  std::vector<Light> world_lights;
+  uint64_t world_key = 0;
   // Object-space patches of the last scenes' shapes: a moved camera or
   // object re-places them instead of rebuilding (patch_cache.h).
   PatchCache patch_cache;
@@ -101,6 +107,24 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       impl_->scene_key = key;
     } else {
       st.scene_reused = true;
+    }
+    // The scene's lights, then its world's (world_lighting.h): baked once
+    // per world, their device records rewritten each frame (camera space).
+    std::vector<Light> lights = scene.lights;
+    if (scene.world.present()) {
+      const uint64_t wkey = world_fingerprint(scene);
+      if (wkey != impl_->world_key || impl_->world_map.radiance.empty()) {
+        impl_->world_map = scene.world.program >= 0 ? impl_->programs.bake_world(scene, *impl_->scene_buffers)
+                                                    : given_world_map(scene.world);
+        impl_->world_lights = world_lights(impl_->world_map, scene.world, scene.settings.world_probes);
+        impl_->world_key = wkey;
+      }
+      lights.insert(lights.end(), impl_->world_lights.begin(), impl_->world_lights.end());
+      SceneBuffers& b = *impl_->scene_buffers;
+      const std::vector<DeviceLight> records = device_lights(lights, scene.camera.world_to_camera);
+      b.lights = s.allocate(records.size() * sizeof(DeviceLight), "lights");
+      s.queue().enqueueWriteBuffer(b.lights, CL_TRUE, 0, records.size() * sizeof(DeviceLight), records.data());
+      b.light_count = cl_uint(records.size());
     }
     const SceneBuffers& buffers = *impl_->scene_buffers;
     st.timings_ms.upload = ms_since(t_upload);
@@ -157,7 +181,7 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     };
     // The shadow maps first: shading the camera's view reads them.
     auto t_shadows = std::chrono::steady_clock::now();
-    const bool shadows_done = impl_->shadow_maps.render(scene, frame, buffers, {impl_->layout, dice, impl_->programs, grids},
+    const bool shadows_done = impl_->shadow_maps.render(scene, lights, frame, buffers, {impl_->layout, dice, impl_->programs, grids},
                                                         run_pass, timer, st.shadows);
     st.timings_ms.shadows_wall = ms_since(t_shadows);
     const ShadowInputs& shadows = impl_->shadow_maps.inputs();
@@ -212,6 +236,10 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     auto t_resolve = std::chrono::steady_clock::now();
     resolve.run(sample, frame, scene.settings.filter, scene.settings.filter_width, scene.settings.depth_and_normal_passes,
                 out, timer);
+    if (scene.world.present() && scene.world.camera)
+      out.background = world_background(impl_->world_map, frame, scene.camera);
+    else
+      out.background.clear();
     st.timings_ms.readback = ms_since(t_resolve);
     timer.collect();
     st.micropolygons = impl_->layout.micropolygons();

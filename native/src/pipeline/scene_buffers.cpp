@@ -122,6 +122,29 @@ void place_shape(const PatchBuffer& shape, const glm::mat4& to_camera, const Mes
   }
 }
 
+// The environment light's two records (kernels/mp_shading.h,
+// mp_env_irradiance): camera -> world rotation rows, then the coefficients.
+void put_environment(const Light& l, const glm::mat4& world_to_camera, std::vector<DeviceLight>& out) {
+  DeviceLight r[2]{};
+  put(r[0].color, l.color, float(MP_LIGHT_ENVIRONMENT));
+  r[1].color[3] = float(MP_LIGHT_ENVIRONMENT_DATA);
+  auto slot = [&](int i) -> float& {
+    static_assert(sizeof(DeviceLight) == 24 * sizeof(float), "DeviceLight is 24 floats");
+    float* f = reinterpret_cast<float*>(r);  // floats 4..23 of each record, past its colour
+    return i < 20 ? f[4 + i] : f[28 + (i - 20)];
+  };
+  // world_to_camera is rigid (scaled at most uniformly): its inverse's
+  // linear part is the normalised transpose.
+  glm::mat3 to_camera(world_to_camera);
+  for (int c = 0; c < 3; ++c) to_camera[c] = glm::normalize(to_camera[c]);
+  const glm::mat3 to_world = glm::transpose(to_camera);
+  for (int row = 0; row < 3; ++row)
+    for (int col = 0; col < 3; ++col) slot(3 * row + col) = to_world[col][row];
+  for (size_t k = 0; k < l.irradiance_sh.size() && k < 27; ++k) slot(9 + int(k)) = l.irradiance_sh[k];
+  out.push_back(r[0]);
+  out.push_back(r[1]);
+}
+
 DeviceLight to_device(const Light& l, const glm::mat4& world_to_camera) {
   DeviceLight d{};
   int type = l.type == Light::Type::Ambient   ? MP_LIGHT_AMBIENT
@@ -154,6 +177,7 @@ DeviceLight to_device(const Light& l, const glm::mat4& world_to_camera) {
     put(d.axis_u, hu, l.shape == Light::Shape::Ellipse ? float(MP_AREA_ELLIPSE) : float(MP_AREA_RECTANGLE));
     put(d.axis_v, hv, 0.0f);
   }
+  if (l.world_probe) d.axis_u[3] = MP_WORLD_PROBE;
   return d;
 }
 
@@ -181,6 +205,17 @@ cl::Buffer upload(cl::Context& context, cl::CommandQueue& queue, const std::vect
 }
 
 }  // namespace
+
+std::vector<DeviceLight> device_lights(const std::vector<Light>& lights, const glm::mat4& world_to_camera) {
+  std::vector<DeviceLight> out;
+  for (const Light& l : lights) {
+    if (l.type == Light::Type::Environment)
+      put_environment(l, world_to_camera, out);
+    else
+      out.push_back(to_device(l, world_to_camera));
+  }
+  return out;
+}
 
 HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
   HostSceneData out;
@@ -217,7 +252,7 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
   }
   if (scene.materials.empty()) out.materials.push_back(to_device(Material{}));
   for (const Material& m : scene.materials) out.materials.push_back(to_device(m));
-  for (const Light& l : scene.lights) out.lights.push_back(to_device(l, w2c));
+  out.lights = device_lights(scene.lights, w2c);
   for (const Image& image : scene.images) {
     // DeviceImage offsets are 32-bit texel indices (64 GiB of float texels).
     if (out.texels.size() + image.pixels.size() > size_t(UINT32_MAX))

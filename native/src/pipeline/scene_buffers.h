@@ -24,6 +24,9 @@ struct HostSceneData {
 // Surfaces' object-space patches come from `cache` when given (kept by the
 // caller between scenes; patch_cache.h), else they are built for this call.
 HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache = nullptr);
+// Lights in their device layout, camera space; an environment light takes
+// two records, so it comes last (shadow records follow the lights' order).
+std::vector<DeviceLight> device_lights(const std::vector<Light>& lights, const glm::mat4& world_to_camera);
 
 struct SceneBuffers {
   cl::Buffer points;      // float4 x MP_PATCH_POINTS per patch

@@ -146,8 +146,27 @@ uint64_t shadow_light_key(const Light& light, uint64_t geometry_key, const Rende
   return h.result();
 }
 
+uint64_t world_fingerprint(const Scene& scene) {
+  Hasher h;
+  const World& w = scene.world;
+  h.value(w.program);
+  if (w.program >= 0 && size_t(w.program) < scene.material_programs.size())
+    h.text(scene.material_programs[size_t(w.program)].source);
+  h.value(w.bake_width), h.value(w.width), h.value(w.height);
+  h.values(w.radiance);
+  h.value(w.camera), h.value(w.diffuse), h.value(w.glossy), h.value(w.cast_shadows);
+  h.value(scene.settings.world_probes);
+  if (w.program >= 0) {  // what its Environment Textures read
+    h.value(scene.images.size());
+    for (const Image& im : scene.images) h.values(im.pixels);
+  }
+  return h.result();
+}
+
 uint64_t scene_fingerprint(const Scene& scene) {
   Hasher h;
+  // Device light records include the world's (world_lighting.h).
+  h.value(scene.world.present() ? world_fingerprint(scene) : uint64_t(0));
   h.value(scene.camera.world_to_camera);
   hash_surfaces(h, scene);
   h.value(scene.lights.size());

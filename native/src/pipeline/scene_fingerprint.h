@@ -13,6 +13,9 @@
 namespace mp {
 
 uint64_t scene_fingerprint(const Scene& scene);
+// The world's light and background (scene.h, World): its program or map,
+// visibility, probe count and, for a program, the images it may read.
+uint64_t world_fingerprint(const Scene& scene);
 
 // What the scene's shadow maps' contents depend on besides each light
 // (kernels/mp_shadow.h): the surfaces in world space, with their materials'

@@ -108,13 +108,13 @@ void ShadowLayout::page_position(const ShadowMapInfo& m, int sx, int sy, int32_t
   *y = m.page_y + ((sy - m.origin_y) & (m.side - 1));
 }
 
-ShadowLayout make_shadow_layout(const Scene& scene, const FrameSetup& frame, const WorldBounds& bounds,
-                                uint64_t geometry_key) {
+ShadowLayout make_shadow_layout(const Scene& scene, const std::vector<Light>& lights, const FrameSetup& frame,
+                                const WorldBounds& bounds, uint64_t geometry_key) {
   ShadowLayout out;
   const RenderSettings& s = scene.settings;
   const FrameParams& f = frame.params;
-  out.shadows.resize(scene.lights.size());
-  out.light_keys.assign(scene.lights.size(), 0);
+  out.shadows.resize(lights.size());
+  out.light_keys.assign(lights.size(), 0);
   for (DeviceShadow& d : out.shadows) d = DeviceShadow{}, d.kind = MP_SHADOW_NONE, d.cone_cos = -2.0f;
   if (!s.shadows || bounds.empty()) return out;
 
@@ -135,8 +135,8 @@ ShadowLayout make_shadow_layout(const Scene& scene, const FrameSetup& frame, con
   const float fp_lo = mp_pixel_footprint(float(dmin), f), fp_hi = mp_pixel_footprint(float(dmax), f);
   const FrameParams base = shadow_view_base(f, s);
 
-  for (size_t i = 0; i < scene.lights.size(); ++i) {
-    const Light& l = scene.lights[i];
+  for (size_t i = 0; i < lights.size(); ++i) {
+    const Light& l = lights[i];
     if (!l.cast_shadows || l.type == Light::Type::Ambient) continue;
     if (l.type == Light::Type::Spot && !(l.cone_angle > 0.0f)) continue;
     DeviceShadow& d = out.shadows[i];

@@ -49,12 +49,13 @@ struct ShadowLayout {
   void page_position(const ShadowMapInfo& m, int sx, int sy, int32_t* x, int32_t* y) const;
 };
 
-// The layout for a scene seen by `frame` (the camera's view). Lights cast
+// The layout for a scene seen by `frame` (the camera's view), for `lights`
+// (the scene's and its world's, world_lighting.h). Lights cast
 // shadows when the settings and the light allow it and the scene has
 // surfaces. `geometry_key` fingerprints what the maps' contents depend on
 // (geometry_fingerprint).
-ShadowLayout make_shadow_layout(const Scene& scene, const FrameSetup& frame, const WorldBounds& bounds,
-                                uint64_t geometry_key);
+ShadowLayout make_shadow_layout(const Scene& scene, const std::vector<Light>& lights, const FrameSetup& frame,
+                                const WorldBounds& bounds, uint64_t geometry_key);
 
 // Sets every shadowed light's level bias (levels coarser than the
 // footprint asks for), in the records the kernels read.

@@ -245,7 +245,7 @@ bool ShadowMaps::render_views(const std::vector<FrameParams>& views, const std::
   return true;
 }
 
-bool ShadowMaps::render(const Scene& scene, const FrameSetup& frame, const SceneBuffers& buffers,
+bool ShadowMaps::render(const Scene& scene, const std::vector<Light>& lights, const FrameSetup& frame, const SceneBuffers& buffers,
                         const ShadowPassStages& stages, const BoundSplitRunner& run, StageTimer& timer,
                         ShadowStats& stats) {
   stats = ShadowStats{};
@@ -253,7 +253,7 @@ bool ShadowMaps::render(const Scene& scene, const FrameSetup& frame, const Scene
   stats.budget_bytes = size_t(double(settings.shadow_memory_mib) * 1048576.0);
   inputs_.enabled = false;
   if (!settings.shadows || buffers.patch_count == 0) return true;
-  ShadowLayout layout = make_shadow_layout(scene, frame, world_bounds(scene), geometry_fingerprint(scene));
+  ShadowLayout layout = make_shadow_layout(scene, lights, frame, world_bounds(scene), geometry_fingerprint(scene));
   if (layout.shadowed_lights == 0) {
     pool_.clear();
     return true;
@@ -304,7 +304,7 @@ bool ShadowMaps::render(const Scene& scene, const FrameSetup& frame, const Scene
   inputs_.enabled = true;
   stats.pages_requested = keys.size();
   stats.per_light.clear();
-  for (size_t l = 0; l < scene.lights.size(); ++l) {
+  for (size_t l = 0; l < lights.size(); ++l) {
     if (layout.shadows[l].kind == MP_SHADOW_NONE) continue;
     const uint32_t entries_of_light = layout.shadows[l].kind == MP_SHADOW_SUN
                                           ? layout.shadows[l].levels * uint32_t(MP_MAP_PAGES * MP_MAP_PAGES)

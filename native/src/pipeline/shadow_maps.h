@@ -53,7 +53,7 @@ class ShadowMaps {
   explicit ShadowMaps(DeviceSession& session);
   // Makes the frame's shadow maps (none when no light casts shadows);
   // returns false when the runner was cancelled.
-  bool render(const Scene& scene, const FrameSetup& frame, const SceneBuffers& buffers, const ShadowPassStages& stages,
+  bool render(const Scene& scene, const std::vector<Light>& lights, const FrameSetup& frame, const SceneBuffers& buffers, const ShadowPassStages& stages,
               const BoundSplitRunner& run, StageTimer& timer, ShadowStats& stats);
   const ShadowInputs& inputs() const { return inputs_; }
 

@@ -123,6 +123,7 @@ py::dict result_dict(RenderResult&& r) {
   d["rgba"] = Array<float>({h, w, py::ssize_t(4)}, r.rgba.data());
   if (!r.depth.empty()) d["depth"] = Array<float>({h, w}, r.depth.data());
   if (!r.normal.empty()) d["normal"] = Array<float>({h, w, py::ssize_t(3)}, r.normal.data());
+  if (!r.background.empty()) d["background"] = Array<float>({h, w, py::ssize_t(3)}, r.background.data());
   d["stats"] = stats_dict(r.stats);
   return d;
 }
@@ -171,7 +172,8 @@ PYBIND11_MODULE(_native, m) {
       .def_readwrite("shadow_shading_rate", &RenderSettings::shadow_shading_rate)
       .def_readwrite("keep_shadow_pages", &RenderSettings::keep_shadow_pages)
       .def_readwrite("soft_shadow_pages", &RenderSettings::soft_shadow_pages)
-      .def_readwrite("occlusion_culling", &RenderSettings::occlusion_culling);
+      .def_readwrite("occlusion_culling", &RenderSettings::occlusion_culling)
+      .def_readwrite("world_probes", &RenderSettings::world_probes);
 
   py::class_<Scene>(m, "Scene")
       .def(py::init<>())
@@ -349,6 +351,27 @@ PYBIND11_MODULE(_native, m) {
           py::arg("name"), py::arg("pixels"), py::arg("srgb") = false,
           "Adds a texture image: (height, width, 4) RGBA, rows bottom to top, scene-linear or (srgb) sRGB-encoded "
           "colour decoded after filtering; returns its index.")
+      .def(
+          "set_world",
+          [](Scene& s, int program, int bake_width, const Array<float>& radiance, bool camera, float diffuse,
+             float glossy, bool cast_shadows) {
+            World w;
+            w.program = program;
+            w.bake_width = bake_width;
+            if (radiance.size() > 0) {
+              if (radiance.ndim() != 3 || radiance.shape(2) != 4)
+                throw Error("world: radiance must be a (height, width, 4) array");
+              w.height = static_cast<int>(radiance.shape(0));
+              w.width = static_cast<int>(radiance.shape(1));
+              w.radiance.assign(radiance.data(), radiance.data() + radiance.size());
+            }
+            w.camera = camera, w.diffuse = diffuse, w.glossy = glossy, w.cast_shadows = cast_shadows;
+            s.world = std::move(w);
+          },
+          py::arg("program") = -1, py::arg("bake_width") = 512, py::arg("radiance") = Array<float>(),
+          py::arg("camera") = true, py::arg("diffuse") = 1.0f, py::arg("glossy") = 1.0f, py::arg("cast_shadows") = true,
+          "Sets the world (scene.h, World): a world program's index (add_material_program) baked to a map "
+          "bake_width wide, or an equirectangular radiance map (height, width, 4), rows bottom to top.")
       .def("validate", [](const Scene& s) { validate_scene(s); })
       .def_property_readonly("mesh_count", [](const Scene& s) { return s.meshes.size(); })
       .def_property_readonly("patch_set_count", [](const Scene& s) { return s.bezier_patches.size(); })

@@ -134,6 +134,19 @@ void validate_scene(const Scene& scene) {
     if (!std::isfinite(m.displacement_bound) || m.displacement_bound < 0)
       fail("material", m.name.empty() ? std::to_string(i) : m.name, "needs a finite, non-negative displacement bound");
   }
+  const World& w = scene.world;
+  if (w.program >= 0 && size_t(w.program) >= scene.material_programs.size())
+    throw Error("world: program " + std::to_string(w.program) + " does not exist");
+  if (w.program >= 0 && (w.bake_width < 8 || w.bake_width > 8192))
+    throw Error("world: the baked map's width must be 8 to 8192 texels, not " + std::to_string(w.bake_width));
+  if (w.width < 0 || w.height < 0 || w.radiance.size() != size_t(w.width) * size_t(w.height) * 4)
+    throw Error("world: the radiance map's size does not match its width and height");
+  for (float v : w.radiance)
+    if (!std::isfinite(v)) throw Error("world: the radiance map holds a NaN or infinite value");
+  if (!std::isfinite(w.diffuse) || !std::isfinite(w.glossy) || w.diffuse < 0.0f || w.glossy < 0.0f)
+    throw Error("world: its diffuse and glossy visibility must be finite and not negative");
+  if (scene.settings.world_probes < 0 || scene.settings.world_probes > 64)
+    throw Error("world: world_probes must be 0 to 64, not " + std::to_string(scene.settings.world_probes));
   for (size_t i = 0; i < scene.lights.size(); ++i) {
     const Light& l = scene.lights[i];
     if (!finite(l.color) || !finite(l.position) || !finite(l.direction) || !std::isfinite(l.intensity) ||

@@ -1,0 +1,83 @@
+// The world's light as lights (pipeline/world_lighting.h), against
+// analytic results: a uniform world's irradiance and a point-like sun's.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "pipeline/world_lighting.h"
+
+namespace mp {
+namespace {
+
+WorldMap uniform_map(int w, const glm::vec3& radiance) {
+  WorldMap m;
+  m.width = w, m.height = w / 2;
+  m.radiance.assign(size_t(m.width) * size_t(m.height), radiance);
+  return m;
+}
+
+TEST(WorldLighting, UniformWorldGivesItsRadianceAsIrradianceOverPi) {
+  // A uniform radiance L gives irradiance pi L on every normal: E / pi = L.
+  const WorldMap m = uniform_map(64, glm::vec3(0.5f, 1.0f, 2.0f));
+  const auto sh = world_irradiance_sh(m);
+  for (const glm::vec3 n : {glm::vec3(0, 0, 1), glm::vec3(1, 0, 0), glm::normalize(glm::vec3(-1, 2, -3))}) {
+    const glm::vec3 e = eval_irradiance_sh(sh, n);
+    EXPECT_NEAR(e.x, 0.5f, 2e-3f);
+    EXPECT_NEAR(e.y, 1.0f, 4e-3f);
+    EXPECT_NEAR(e.z, 2.0f, 8e-3f);
+  }
+}
+
+TEST(WorldLighting, UpperHemisphereLightsUpFacingNormalsOnly) {
+  // Radiance 1 above the horizon, 0 below: E(up) = pi, E(down) = 0,
+  // E(sideways) = pi / 2. Order-2 harmonics are within about 10% of these.
+  WorldMap m = uniform_map(128, glm::vec3(1.0f));
+  for (int y = 0; y < m.height / 2; ++y)
+    for (int x = 0; x < m.width; ++x) m.radiance[size_t(y) * m.width + x] = glm::vec3(0.0f);
+  const auto sh = world_irradiance_sh(m);
+  EXPECT_NEAR(eval_irradiance_sh(sh, glm::vec3(0, 0, 1)).x, 1.0f, 0.1f);
+  EXPECT_NEAR(eval_irradiance_sh(sh, glm::vec3(0, 0, -1)).x, 0.0f, 0.1f);
+  EXPECT_NEAR(eval_irradiance_sh(sh, glm::vec3(1, 0, 0)).x, 0.5f, 0.05f);
+}
+
+TEST(WorldLighting, MapCoordinatesRoundTrip) {
+  for (const glm::vec3 d : {glm::vec3(1, 0, 0), glm::vec3(0, -1, 0), glm::normalize(glm::vec3(0.3f, -0.4f, 0.8f))}) {
+    const glm::vec2 uv = world_map_uv(d);
+    const glm::vec3 back = world_map_direction(1000, 500, uv.x * 1000 - 0.5f, uv.y * 500 - 0.5f);
+    EXPECT_NEAR(glm::dot(back, d), 1.0f, 1e-5f);
+  }
+  // +X faces the map's centre, +Z its top row (Cycles' equirectangular).
+  EXPECT_NEAR(world_map_uv(glm::vec3(1, 0, 0)).x, 0.5f, 1e-6f);
+  EXPECT_NEAR(world_map_uv(glm::vec3(0, 0, 1)).y, 1.0f, 1e-6f);
+}
+
+TEST(WorldLighting, MedianCutFindsTheSunAndKeepsTheLight) {
+  // A dim sky and one bright texel: the cut gives every region an equal
+  // share of the light, so one small region holds the sun, pointing at it.
+  WorldMap m = uniform_map(128, glm::vec3(0.01f));
+  const int sx = 40, sy = 50;
+  m.radiance[size_t(sy) * m.width + sx] = glm::vec3(5000.0f);
+  const glm::vec3 sun = world_map_direction(m.width, m.height, float(sx), float(sy));
+  const auto regions = median_cut(m, 8);
+  ASSERT_EQ(regions.size(), 8u);
+  double total = 0.0, expected = 0.0;
+  for (const WorldRegion& r : regions) total += r.light.x;
+  for (int y = 0; y < m.height; ++y) {
+    const double lo = M_PI * (double(y) / m.height - 0.5), hi = M_PI * (double(y + 1) / m.height - 0.5);
+    const double sa = (std::sin(hi) - std::sin(lo)) * 2.0 * M_PI / m.width;
+    for (int x = 0; x < m.width; ++x) expected += m.radiance[size_t(y) * m.width + x].x * sa;
+  }
+  EXPECT_NEAR(total, expected, 1e-4 * expected);
+  float best = -1.0f;
+  for (const WorldRegion& r : regions) best = std::max(best, glm::dot(r.direction, sun));
+  EXPECT_GT(best, 0.999f);
+  // The probes and the environment light follow.
+  const auto lights = world_lights(m, World{}, 8);
+  ASSERT_FALSE(lights.empty());
+  EXPECT_EQ(lights.back().type, Light::Type::Environment);
+  EXPECT_EQ(lights.back().irradiance_sh.size(), 27u);
+  for (size_t i = 0; i + 1 < lights.size(); ++i) EXPECT_TRUE(lights[i].world_probe);
+}
+
+}  // namespace
+}  // namespace mp
