@@ -10,6 +10,7 @@
 #include "mp_patch.h"
 #include "mp_types.h"
 #include "mp_shadow.h"
+#include "mp_world.h"
 
 #define MP_PI 3.14159265358979f
 #define MP_AREA_MAX_VERTICES 18  /* a 16-gon plus one vertex from horizon clipping, plus slack */
@@ -25,10 +26,9 @@ MP_INLINE float3 mp_light_f3(const MP_GLOBAL float* v) { return MP_F3(v[0], v[1]
 
 /* The world's irradiance over pi (a radiance, as an ambient light's) on a
  * surface with camera-space normal n, from an MP_LIGHT_ENVIRONMENT light:
- * E(n) / pi = sum of c_lm Y_lm(R n), with R camera -> world and the
- * coefficients already scaled by the cosine lobe's A_l / pi (Ramamoorthi &
- * Hanrahan 2001, "An efficient representation for irradiance environment
- * maps"). The two records hold 40 floats past their colour fields:
+ * E(n) / pi = sum of c_lm Y_lm(R n) (mp_world.h), with R camera -> world
+ * and the coefficients already scaled by the cosine lobe's A_l / pi. The
+ * two records hold 40 floats past their colour fields:
  * R's rows, then the coefficients (world_lighting.cpp writes them). */
 MP_INLINE float mp_env_float(MP_GLOBAL const DeviceLight* lt, int i) {
   MP_GLOBAL const float* f = (MP_GLOBAL const float*)lt;
@@ -38,8 +38,8 @@ MP_INLINE float3 mp_env_irradiance(MP_GLOBAL const DeviceLight* lt, float3 n) {
   float x = mp_env_float(lt, 0) * n.x + mp_env_float(lt, 1) * n.y + mp_env_float(lt, 2) * n.z;
   float y = mp_env_float(lt, 3) * n.x + mp_env_float(lt, 4) * n.y + mp_env_float(lt, 5) * n.z;
   float z = mp_env_float(lt, 6) * n.x + mp_env_float(lt, 7) * n.y + mp_env_float(lt, 8) * n.z;
-  float basis[9] = {0.282095f, 0.488603f * y, 0.488603f * z, 0.488603f * x, 1.092548f * x * y, 1.092548f * y * z,
-                    0.315392f * (3.0f * z * z - 1.0f), 1.092548f * x * z, 0.546274f * (x * x - y * y)};
+  float basis[9];
+  mp_sh9_basis(MP_F3(x, y, z), basis);
   float3 e = MP_F3(0.0f, 0.0f, 0.0f);
   for (int k = 0; k < 9; ++k)
     e += basis[k] * MP_F3(mp_env_float(lt, 9 + 3 * k), mp_env_float(lt, 10 + 3 * k), mp_env_float(lt, 11 + 3 * k));

@@ -15,6 +15,8 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
+from . import node_compiler
+
 
 def _world_background_node(world):
     """The Background node feeding the world's active World Output, or None."""
@@ -51,7 +53,6 @@ def export_world(native_scene, world, materials=None, warnings=None):
         if background is not None and background.type == "BACKGROUND":
             linked = background.inputs["Color"].is_linked or background.inputs["Strength"].is_linked
             if linked and materials is not None:
-                from . import node_compiler
                 source = node_compiler.NodeCompiler(world, materials.warnings, resources=materials) \
                     .compile_world(background)
                 program = native_scene.add_material_program("world " + world.name, source)

@@ -322,8 +322,8 @@ class ViewportSession:
                 rgba = result["rgba"]
                 if not exported.transparent:
                     alpha = rgba[..., 3:4]
-                    rgba = np.concatenate([rgba[..., :3] + (1.0 - alpha) * result.get("background", exported.background), np.ones_like(alpha)],
-                                          axis=-1)
+                    behind = result.get("background", exported.background)  # a baked world's, per pixel
+                    rgba = np.concatenate([rgba[..., :3] + (1.0 - alpha) * behind, np.ones_like(alpha)], axis=-1)
                 image = ViewportImage(np.ascontiguousarray(rgba[::-1], dtype=np.float32), w, h, view.crop, spp,
                                       k == len(passes) - 1, generation, time.perf_counter() - requested,
                                       result["stats"])

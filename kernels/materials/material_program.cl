@@ -216,8 +216,7 @@ __kernel void bake_world(uint width, uint height, MP_PROGRAM_INPUT_ARGS, __globa
   uint i = get_global_id(0);
   if (i >= width * height) return;
   float u = ((float)(i % width) + 0.5f) / (float)width, v = ((float)(i / width) + 0.5f) / (float)height;
-  float phi = MP_PI * (1.0f - 2.0f * u), elevation = MP_PI * (v - 0.5f);
-  float3 d = (float3)(cos(elevation) * cos(phi), cos(elevation) * sin(phi), sin(elevation));
+  float3 d = mp_env_equirect_direction(u, v);
   MpProgramInputs in = MP_PROGRAM_INPUTS;
   MpNodeGlobals g;
   g.P = d;

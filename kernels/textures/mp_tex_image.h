@@ -8,6 +8,8 @@
 #ifndef MP_TEX_IMAGE_H
 #define MP_TEX_IMAGE_H
 
+#include "mp_world.h" /* the Environment Texture's projections */
+
 #define MP_IMAGE_LINEAR 0
 #define MP_IMAGE_CLOSEST 1
 #define MP_IMAGE_CUBIC 2
@@ -109,25 +111,6 @@ MP_INLINE float2 mp_image_sphere_uv(float3 co) {
   if (!(len > 0.0f)) return MP_F2(0.0f, 0.0f);
   float u = co.x == 0.0f && co.y == 0.0f ? 0.0f : (1.0f - atan2(co.x, co.y) / MP_IMAGE_PI) * 0.5f;
   return MP_F2(u, 1.0f - acos(clamp(co.z / len, -1.0f, 1.0f)) / MP_IMAGE_PI);
-}
-
-/* Environment Texture projections of a world direction, as Cycles maps
- * them: equirectangular (longitude from -X at u = 0 through +X at u = 0.5,
- * latitude from -Z at v = 0 to +Z at v = 1; scene.h, World) and mirror
- * ball (a ball photographed from -Y). */
-MP_INLINE float2 mp_env_equirect_uv(float3 d) {
-  float len = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-  if (!(len > 0.0f)) return MP_F2(0.0f, 0.0f);
-  return MP_F2(0.5f - atan2(d.y, d.x) / (2.0f * MP_IMAGE_PI), 0.5f + asin(clamp(d.z / len, -1.0f, 1.0f)) / MP_IMAGE_PI);
-}
-MP_INLINE float2 mp_env_mirror_ball_uv(float3 d) {
-  float len = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-  if (!(len > 0.0f)) return MP_F2(0.5f, 0.5f);
-  d = d / len;
-  d.y -= 1.0f;
-  float div = 2.0f * sqrt(fmax(-0.5f * d.y, 0.0f));
-  if (div > 0.0f) d = d / div;
-  return MP_F2(0.5f * (d.x + 1.0f), 0.5f * (d.z + 1.0f));
 }
 
 /* Longitude around z as for Sphere, height along z. */

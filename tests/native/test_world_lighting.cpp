@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "micropoly/error.h"
 #include "pipeline/world_lighting.h"
 
 namespace mp {
@@ -77,6 +78,45 @@ TEST(WorldLighting, MedianCutFindsTheSunAndKeepsTheLight) {
   EXPECT_EQ(lights.back().type, Light::Type::Environment);
   EXPECT_EQ(lights.back().irradiance_sh.size(), 27u);
   for (size_t i = 0; i + 1 < lights.size(); ++i) EXPECT_TRUE(lights[i].world_probe);
+}
+
+}  // namespace
+}  // namespace mp
+
+namespace mp {
+namespace {
+
+// A broken world is refused with a message naming the world, before any
+// device work.
+TEST(WorldLighting, BadWorldsAreRefusedCleanly) {
+  auto refused = [](const Scene& s) {
+    try {
+      validate_scene(s);
+    } catch (const Error& e) {
+      return std::string(e.what()).find("world") != std::string::npos;
+    }
+    return false;
+  };
+  Scene program_missing;
+  program_missing.world.program = 3;
+  EXPECT_TRUE(refused(program_missing));
+  Scene size_mismatch;
+  size_mismatch.world.width = 4, size_mismatch.world.height = 2;
+  size_mismatch.world.radiance.assign(7, 1.0f);
+  EXPECT_TRUE(refused(size_mismatch));
+  Scene nan_texel;
+  nan_texel.world.width = 2, nan_texel.world.height = 1;
+  nan_texel.world.radiance.assign(8, 1.0f);
+  nan_texel.world.radiance[5] = std::nanf("");
+  EXPECT_TRUE(refused(nan_texel));
+  Scene too_many_probes;
+  too_many_probes.world.width = 2, too_many_probes.world.height = 1;
+  too_many_probes.world.radiance.assign(8, 1.0f);
+  too_many_probes.settings.world_probes = 1000;
+  EXPECT_TRUE(refused(too_many_probes));
+  Scene fine = too_many_probes;
+  fine.settings.world_probes = 8;
+  EXPECT_FALSE(refused(fine));
 }
 
 }  // namespace

@@ -100,7 +100,8 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     auto t_upload = std::chrono::steady_clock::now();
     impl_->programs.prepare(scene, st);
     const uint64_t key = scene_fingerprint(scene);
-    if (!impl_->scene_buffers || impl_->scene_key != key) {
+    const bool fresh = !impl_->scene_buffers || impl_->scene_key != key;
+    if (fresh) {
       impl_->scene_buffers.reset();  // free the old scene's device memory first
       HostSceneData host = prepare_scene_data(scene, &impl_->patch_cache);
       impl_->scene_buffers = std::make_unique<SceneBuffers>(upload_scene_data(s.context(), s.queue(), host));
@@ -108,23 +109,23 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     } else {
       st.scene_reused = true;
     }
-    // The scene's lights, then its world's (world_lighting.h): baked once
-    // per world, their device records rewritten each frame (camera space).
+    // The scene's lights, then its world's (world_lighting.h). The world's
+    // map is baked (with the uploaded images) only when the world changed,
+    // and its lights join the device's after the scene's upload: the scene
+    // key covers camera, lights and world, so reused buffers hold them.
     std::vector<Light> lights = scene.lights;
     if (scene.world.present()) {
-      const uint64_t wkey = world_fingerprint(scene);
-      if (wkey != impl_->world_key || impl_->world_map.radiance.empty()) {
-        impl_->world_map = scene.world.program >= 0 ? impl_->programs.bake_world(scene, *impl_->scene_buffers)
-                                                    : given_world_map(scene.world);
-        impl_->world_lights = world_lights(impl_->world_map, scene.world, scene.settings.world_probes);
-        impl_->world_key = wkey;
+      if (fresh) {
+        const uint64_t wkey = world_fingerprint(scene);
+        if (wkey != impl_->world_key) {
+          impl_->world_map = scene.world.program >= 0 ? impl_->programs.bake_world(scene, *impl_->scene_buffers)
+                                                      : given_world_map(scene.world);
+          impl_->world_lights = world_lights(impl_->world_map, scene.world, scene.settings.world_probes);
+          impl_->world_key = wkey;
+        }
       }
       lights.insert(lights.end(), impl_->world_lights.begin(), impl_->world_lights.end());
-      SceneBuffers& b = *impl_->scene_buffers;
-      const std::vector<DeviceLight> records = device_lights(lights, scene.camera.world_to_camera);
-      b.lights = s.allocate(records.size() * sizeof(DeviceLight), "lights");
-      s.queue().enqueueWriteBuffer(b.lights, CL_TRUE, 0, records.size() * sizeof(DeviceLight), records.data());
-      b.light_count = cl_uint(records.size());
+      if (fresh) upload_lights(s.context(), s.queue(), lights, scene.camera.world_to_camera, *impl_->scene_buffers);
     }
     const SceneBuffers& buffers = *impl_->scene_buffers;
     st.timings_ms.upload = ms_since(t_upload);

@@ -264,6 +264,14 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
   return out;
 }
 
+void upload_lights(cl::Context& context, cl::CommandQueue& queue, const std::vector<Light>& lights,
+                   const glm::mat4& world_to_camera, SceneBuffers& buffers) {
+  const std::vector<DeviceLight> records = device_lights(lights, world_to_camera);
+  buffers.lights = upload(context, queue, records);
+  buffers.light_count = static_cast<cl_uint>(records.size());
+  queue.finish();  // `records` lives only for the call
+}
+
 SceneBuffers upload_scene_data(cl::Context& context, cl::CommandQueue& queue, const HostSceneData& data) {
   SceneBuffers b;
   b.points = upload(context, queue, data.patches.points);

@@ -48,5 +48,8 @@ struct SceneBuffers {
   cl_uint image_count = 0;
 };
 SceneBuffers upload_scene_data(cl::Context& context, cl::CommandQueue& queue, const HostSceneData& data);
+// Replaces the buffers' lights (the scene's and its world's, device_lights).
+void upload_lights(cl::Context& context, cl::CommandQueue& queue, const std::vector<Light>& lights,
+                   const glm::mat4& world_to_camera, SceneBuffers& buffers);
 
 }  // namespace mp

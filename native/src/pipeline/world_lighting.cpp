@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mp_world.h"
+
 namespace mp {
 namespace {
 
@@ -17,9 +19,9 @@ double texel_solid_angle(int width, int height, int y) {
 }
 
 std::array<float, 9> sh_basis(const glm::vec3& d) {
-  const float x = d.x, y = d.y, z = d.z;
-  return {0.282095f, 0.488603f * y, 0.488603f * z, 0.488603f * x, 1.092548f * x * y, 1.092548f * y * z,
-          0.315392f * (3.0f * z * z - 1.0f), 1.092548f * x * z, 0.546274f * (x * x - y * y)};
+  std::array<float, 9> b;
+  mp_sh9_basis(d, b.data());
+  return b;
 }
 
 // Energy (luminance times solid angle) per texel, summed over rectangles.
@@ -44,15 +46,10 @@ struct Rect {
 }  // namespace
 
 glm::vec3 world_map_direction(int width, int height, float x, float y) {
-  const double phi = kPi * (1.0 - 2.0 * (x + 0.5) / width), el = kPi * ((y + 0.5) / height - 0.5);
-  return glm::vec3(float(std::cos(el) * std::cos(phi)), float(std::cos(el) * std::sin(phi)), float(std::sin(el)));
+  return mp_env_equirect_direction((x + 0.5f) / float(width), (y + 0.5f) / float(height));
 }
 
-glm::vec2 world_map_uv(const glm::vec3& d) {
-  const glm::vec3 n = glm::normalize(d);
-  return glm::vec2(float(0.5 - std::atan2(double(n.y), double(n.x)) / (2.0 * kPi)),
-                   float(0.5 + std::asin(std::clamp(double(n.z), -1.0, 1.0)) / kPi));
-}
+glm::vec2 world_map_uv(const glm::vec3& d) { return mp_env_equirect_uv(d); }
 
 std::array<glm::vec3, 9> world_irradiance_sh(const WorldMap& map) {
   std::array<glm::dvec3, 9> acc{};
