@@ -34,12 +34,15 @@ MP_INLINE float mp_env_float(MP_GLOBAL const DeviceLight* lt, int i) {
   MP_GLOBAL const float* f = (MP_GLOBAL const float*)lt;
   return i < 20 ? f[4 + i] : f[28 + (i - 20)];
 }
+/* A camera-space direction in world space (R's rows). */
+MP_INLINE float3 mp_env_to_world(MP_GLOBAL const DeviceLight* lt, float3 n) {
+  return MP_F3(mp_env_float(lt, 0) * n.x + mp_env_float(lt, 1) * n.y + mp_env_float(lt, 2) * n.z,
+               mp_env_float(lt, 3) * n.x + mp_env_float(lt, 4) * n.y + mp_env_float(lt, 5) * n.z,
+               mp_env_float(lt, 6) * n.x + mp_env_float(lt, 7) * n.y + mp_env_float(lt, 8) * n.z);
+}
 MP_INLINE float3 mp_env_irradiance(MP_GLOBAL const DeviceLight* lt, float3 n) {
-  float x = mp_env_float(lt, 0) * n.x + mp_env_float(lt, 1) * n.y + mp_env_float(lt, 2) * n.z;
-  float y = mp_env_float(lt, 3) * n.x + mp_env_float(lt, 4) * n.y + mp_env_float(lt, 5) * n.z;
-  float z = mp_env_float(lt, 6) * n.x + mp_env_float(lt, 7) * n.y + mp_env_float(lt, 8) * n.z;
   float basis[9];
-  mp_sh9_basis(MP_F3(x, y, z), basis);
+  mp_sh9_basis(mp_env_to_world(lt, n), basis);
   float3 e = MP_F3(0.0f, 0.0f, 0.0f);
   for (int k = 0; k < 9; ++k)
     e += basis[k] * MP_F3(mp_env_float(lt, 9 + 3 * k), mp_env_float(lt, 10 + 3 * k), mp_env_float(lt, 11 + 3 * k));
@@ -254,7 +257,7 @@ MP_INLINE float mp_bump_shadowing_v4(float3 ns, float3 n, float3 l, int correcti
  * smooth normal turning away near a silhouette is not flipped. */
 MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal, int faced, int ortho,
                                  const DeviceMaterial* m, MP_GLOBAL const DeviceLight* lights, uint light_count,
-                                 const MpShadowQuery* shadow) {
+                                 MP_GLOBAL const float4* world_glossy, const MpShadowQuery* shadow) {
   float3 cs = MP_F3(m->color[0], m->color[1], m->color[2]);
   float3 emission = MP_F3(m->emission[0], m->emission[1], m->emission[2]);
   int model = (int)m->color[3];
@@ -273,7 +276,10 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal,
   float3 f0 = (1.0f - metallic) * MP_F3(0.08f, 0.08f, 0.08f) * m->principled[1] + metallic * cs;
   float3 ambient = MP_F3(0.0f, 0.0f, 0.0f), diffuse = ambient, specular = ambient;
   MP_GLOBAL const DeviceLight* world = 0;
-  float probe_lit = 0.0f, probe_total = 0.0f; /* the world's visibility, weighted by its probes' light */
+  /* The world's visibility, weighted by its probes' light on the diffuse
+   * normal and around the mirror direction. */
+  float probe_lit = 0.0f, probe_total = 0.0f, probe_lit_s = 0.0f, probe_total_s = 0.0f;
+  float3 mirror = 2.0f * dot(nf, v) * nf - v;
   for (uint k = 0; k < light_count; ++k) {
     MP_GLOBAL const DeviceLight* lt = lights + k;
     float3 cl = mp_light_f3(lt->color);
@@ -287,9 +293,11 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal,
     if (type == MP_LIGHT_DISTANT && lt->axis_u[3] == MP_WORLD_PROBE) {
       float3 lp = -mp_light_f3(lt->direction);
       float w = (cl.x + cl.y + cl.z) * fmax(dot(nd, lp), 0.0f);
-      if (w > 0.0f) {
-        probe_total += w;
-        probe_lit += w * (shadow ? mp_shadow_visibility(shadow->maps, k, p, shadow->normal, shadow->footprint) : 1.0f);
+      float ws = (cl.x + cl.y + cl.z) * fmax(dot(mirror, lp), 0.0f);
+      if (w > 0.0f || ws > 0.0f) {
+        float vis = shadow ? mp_shadow_visibility(shadow->maps, k, p, shadow->normal, shadow->footprint) : 1.0f;
+        probe_total += w, probe_lit += w * vis;
+        probe_total_s += ws, probe_lit_s += ws * vis;
       }
       continue;
     }
@@ -336,19 +344,25 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal,
       specular += (e / fmax(dot(nf, l), 1e-6f)) * MP_POWR(fmax(dot(nf, normalize(l + v)), 0.0f), inv_roughness);
   }
   /* The world's light: its irradiance by the diffuse normal and, for the
-   * glossy lobe, around the mirror direction, darkened by the visibility
-   * its probes' shadow maps give. */
+   * glossy lobe, its map prefiltered by the lobe around the mirror direction
+   * (mp_world.h), each darkened by the visibility its probes' shadow maps
+   * give. */
   float3 world_d = MP_F3(0.0f, 0.0f, 0.0f), world_s = world_d;
   if (world) {
     float vis = probe_total > 0.0f ? probe_lit / probe_total : 1.0f;
+    float vis_s = probe_total_s > 0.0f ? probe_lit_s / probe_total_s : vis;
     world_d = mp_env_irradiance(world, nd) * (vis * world->color[0]);
-    world_s = mp_env_irradiance(world, 2.0f * dot(nf, v) * nf - v) * (vis * world->color[1]);
+    world_s = mp_world_glossy(world_glossy, mp_env_to_world(world, mirror), roughness) * (vis_s * world->color[1]);
   }
   if (model == MP_MODEL_PRINCIPLED) {
     /* Lambert: albedo / pi per unit irradiance; a uniform ambient radiance A
      * gives irradiance pi A, so the diffuse response to it is albedo * A. */
     float3 albedo = cs * (1.0f - metallic);
-    return albedo * (diffuse * (1.0f / MP_PI) + ambient + world_d) + specular + f0 * (ambient + world_s) + emission;
+    /* The world's glossy light by the split sum: the prefiltered radiance
+     * times the lobe's directional albedo f0 a + b (mp_env_brdf). */
+    float2 ab = mp_env_brdf(roughness, fmax(dot(nf, v), 1e-4f));
+    return albedo * (diffuse * (1.0f / MP_PI) + ambient + world_d) + specular + f0 * ambient +
+           world_s * (f0 * ab.x + MP_F3(ab.y, ab.y, ab.y)) + emission;
   }
   float3 c = cs * (ka * (ambient + world_d) + kd * diffuse);
   if (model == MP_MODEL_PLASTIC) c += MP_F3(m->specular[0], m->specular[1], m->specular[2]) * (ks * specular);
@@ -357,8 +371,9 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal,
 
 /* Radiance leaving point p with normal n towards the eye. */
 MP_INLINE float3 mp_shade(float3 p, float3 n, int faced, int ortho, const DeviceMaterial* m,
-                          MP_GLOBAL const DeviceLight* lights, uint light_count, const MpShadowQuery* shadow) {
-  return mp_shade_bumped(p, n, n, 0, faced, ortho, m, lights, light_count, shadow);
+                          MP_GLOBAL const DeviceLight* lights, uint light_count, MP_GLOBAL const float4* world_glossy,
+                          const MpShadowQuery* shadow) {
+  return mp_shade_bumped(p, n, n, 0, faced, ortho, m, lights, light_count, world_glossy, shadow);
 }
 
 /* The smooth shading normal of a patch at (u, v) (mp_patch.h,

@@ -48,4 +48,52 @@ MP_INLINE void mp_sh9_basis(float3 d, float* b) {
   b[8] = 0.546274f * (d.x * d.x - d.y * d.y);
 }
 
+/* The world's glossy light: the map prefiltered by the GGX lobe of
+ * roughness k / 8 for level k (level 0 the map itself, a mirror), each
+ * level equirectangular, coarser as its lobe widens (the split-sum
+ * prefiltering of Karis 2013, "Real Shading in Unreal Engine 4").
+ * pipeline/world_lighting.cpp fills them; shading reads them between the
+ * two levels around a surface's roughness. */
+#define MP_WORLD_GLOSSY_LEVELS 9
+MP_INLINE int mp_world_glossy_width(int k) { return k == 0 ? 512 : k <= 2 ? 256 : k == 3 ? 128 : k == 4 ? 64 : 32; }
+MP_INLINE int mp_world_glossy_offset(int k) {
+  int offset = 0;
+  for (int i = 0; i < k; ++i) offset += mp_world_glossy_width(i) * mp_world_glossy_width(i) / 2;
+  return offset;
+}
+
+/* Level k at world direction d, bilinear; longitude wraps. */
+MP_INLINE float3 mp_world_glossy_level(const MP_GLOBAL float4* maps, int k, float3 d) {
+  int w = mp_world_glossy_width(k), h = w / 2, base = mp_world_glossy_offset(k);
+  float2 uv = mp_env_equirect_uv(d);
+  float x = uv.x * (float)w - 0.5f, y = uv.y * (float)h - 0.5f;
+  float fx0 = floor(x), fy0 = floor(y);
+  float fx = x - fx0, fy = y - fy0;
+  int x0 = (int)fx0, y0 = (int)fy0;
+  int xa = ((x0 % w) + w) % w, xb = (xa + 1) % w;
+  int ya = clamp(y0, 0, h - 1), yb = clamp(y0 + 1, 0, h - 1);
+  float4 c = (1.0f - fy) * ((1.0f - fx) * maps[base + ya * w + xa] + fx * maps[base + ya * w + xb]) +
+             fy * ((1.0f - fx) * maps[base + yb * w + xa] + fx * maps[base + yb * w + xb]);
+  return MP_F3(c.x, c.y, c.z);
+}
+
+/* The prefiltered radiance around world direction d for a GGX roughness. */
+MP_INLINE float3 mp_world_glossy(const MP_GLOBAL float4* maps, float3 d, float roughness) {
+  float r = clamp(roughness, 0.0f, 1.0f) * (float)(MP_WORLD_GLOSSY_LEVELS - 1);
+  int k = (int)floor(r);
+  if (k >= MP_WORLD_GLOSSY_LEVELS - 1) return mp_world_glossy_level(maps, MP_WORLD_GLOSSY_LEVELS - 1, d);
+  float t = r - (float)k;
+  return (1.0f - t) * mp_world_glossy_level(maps, k, d) + t * mp_world_glossy_level(maps, k + 1, d);
+}
+
+/* The split sum's second factor, the GGX lobe's directional albedo as
+ * f0 * a + b for a view at cosine nv: the analytic fit of Karis 2014
+ * ("Physically Based Shading on Mobile"). */
+MP_INLINE float2 mp_env_brdf(float roughness, float nv) {
+  float rx = 1.0f - roughness, ry = 0.0425f - 0.0275f * roughness;
+  float rz = 1.04f - 0.572f * roughness, rw = 0.022f * roughness - 0.04f;
+  float a004 = fmin(rx * rx, (float)exp2(-9.28f * nv)) * rx + ry;
+  return MP_F2(rz - 1.04f * a004, rw + 1.04f * a004);
+}
+
 #endif

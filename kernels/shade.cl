@@ -12,7 +12,8 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
                           uint light_count, __global float4* grid_c, __global const uint* vertex_offsets,
                           __global const float4* patch_normals, uint use_shadows,
                           __global const DeviceShadow* shadows, __global const DeviceShadowLevel* shadow_levels,
-                          __global const uint* shadow_pages, __global const uint* shadow_pool) {
+                          __global const uint* shadow_pages, __global const uint* shadow_pool,
+                          __global const float4* world_glossy) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   float2 uv;
@@ -35,6 +36,6 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
     }
   }
   if (m.program[2] > 0.0f) return; /* shaded by its node program (material_program.cl) */
-  float3 c = mp_shade(p, n, faced, f.ortho, &m, lights, light_count, use_shadows ? &shadow : 0);
+  float3 c = mp_shade(p, n, faced, f.ortho, &m, lights, light_count, world_glossy, use_shadows ? &shadow : 0);
   grid_c[index] = (float4)(c, m.opacity[3]);
 }

@@ -127,6 +127,7 @@ def export_settings(native_scene, scene, width, height):
     settings.shadows = mp.use_shadows
     settings.shadow_memory_mib = mp.shadow_memory
     settings.shadow_shading_rate = mp.shadow_shading_rate
+    settings.world_probes = mp.world_shadow_directions
 
 
 def export_scene(depsgraph, view=None, meshes=None):

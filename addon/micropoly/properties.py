@@ -47,6 +47,10 @@ class MicropolySceneSettings(bpy.types.PropertyGroup):
     shadow_shading_rate: FloatProperty(name="Shadow Shading Rate", description="Area of a shadow map's "
                                        "micropolygons in its texels; smaller is finer and slower", default=4.0,
                                        min=0.25, max=64.0)
+    world_shadow_directions: IntProperty(name="World Shadow Directions", description="Directions from which the "
+                                         "scene shadows its world's light, each a soft shadow map placed where the "
+                                         "world is bright; 0 leaves world light unshadowed", default=16, min=0,
+                                         max=64)
 
 
 class MicropolyMaterialSettings(bpy.types.PropertyGroup):

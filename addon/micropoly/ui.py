@@ -88,6 +88,7 @@ class MICROPOLY_PT_shadows(MicropolyPanel, bpy.types.Panel):
         settings = context.scene.micropoly
         layout.active = settings.use_shadows
         layout.prop(settings, "shadow_memory")
+        layout.prop(settings, "world_shadow_directions")
         layout.prop(settings, "shadow_shading_rate")
 
 

@@ -135,7 +135,7 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
                                   __global const uint* vertex_offsets, uint use_shadows,
                                   __global const DeviceShadow* shadows, __global const DeviceShadowLevel* shadow_levels,
                                   __global const uint* shadow_pages, __global const uint* shadow_pool,
-                                  uint alpha_only) {
+                                  uint alpha_only, __global const float4* world_glossy) {
   uint gid = get_global_id(0), material, object, i, j;
   SubPatch sp;
   float2 uv;
@@ -203,30 +203,24 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   MpShadowMaps maps = {shadows, shadow_levels, shadow_pages, shadow_pool};
   MpShadowQuery shadow = {&maps, n, mp_pixel_footprint(-p.z, f)};
   float3 c = mp_shade_bumped(p, n, ns, bsdf_normal, grid_n[index].w > 0.5f, f.ortho, &m, lights, light_count,
-                             use_shadows ? &shadow : 0);
+                             world_glossy, use_shadows ? &shadow : 0);
   grid_c[index] = (float4)(c, clamp(s.alpha, 0.0f, 1.0f));
 }
 
-/* The world's radiance over an equirectangular map (scene.h, World): the
- * world program's Surface emission (a Background node's colour times its
- * strength) for the direction of each texel's centre. World nodes see that
- * direction as their position, normal and Generated coordinate, as in
- * Cycles' world shaders. */
-__kernel void bake_world(uint width, uint height, MP_PROGRAM_INPUT_ARGS, __global float4* out) {
-  uint i = get_global_id(0);
-  if (i >= width * height) return;
-  float u = ((float)(i % width) + 0.5f) / (float)width, v = ((float)(i / width) + 0.5f) / (float)height;
-  float3 d = mp_env_equirect_direction(u, v);
-  MpProgramInputs in = MP_PROGRAM_INPUTS;
+/* The world's radiance towards world direction d: the world program's
+ * Surface emission (a Background node's colour times its strength). World
+ * nodes see that direction as their position, normal and Generated
+ * coordinate, as in Cycles' world shaders. */
+float3 mp_world_radiance(float3 d, const MpProgramInputs* in) {
   MpNodeGlobals g;
   g.P = d;
   g.N = d;
   g.generated = d;
   for (uint k = 0; k < MP_MAX_UV_LAYERS; ++k) g.uv[k] = (float3)(0.0f);
   g.object = 0;
-  g.images = in.images;
-  g.image_count = in.image_count;
-  g.texels = in.texels;
+  g.images = in->images;
+  g.image_count = in->image_count;
+  g.texels = in->texels;
   g.dx = 0;
   g.dy = 0;
   MpSurfaceInputs s;
@@ -238,6 +232,37 @@ __kernel void bake_world(uint width, uint height, MP_PROGRAM_INPUT_ARGS, __globa
   s.has_normal = 0;
   mp_node_surface(&g, &s);
   float3 e = s.emission;
-  out[i] = (float4)(isfinite(e.x) ? fmax(e.x, 0.0f) : 0.0f, isfinite(e.y) ? fmax(e.y, 0.0f) : 0.0f,
-                    isfinite(e.z) ? fmax(e.z, 0.0f) : 0.0f, 1.0f);
+  return (float3)(isfinite(e.x) ? fmax(e.x, 0.0f) : 0.0f, isfinite(e.y) ? fmax(e.y, 0.0f) : 0.0f,
+                  isfinite(e.z) ? fmax(e.z, 0.0f) : 0.0f);
+}
+
+/* The world over an equirectangular map (scene.h, World), at each texel's
+ * centre. */
+__kernel void bake_world(uint width, uint height, MP_PROGRAM_INPUT_ARGS, __global float4* out) {
+  uint i = get_global_id(0);
+  if (i >= width * height) return;
+  float u = ((float)(i % width) + 0.5f) / (float)width, v = ((float)(i / width) + 0.5f) / (float)height;
+  MpProgramInputs in = MP_PROGRAM_INPUTS;
+  out[i] = (float4)(mp_world_radiance(mp_env_equirect_direction(u, v), &in), 1.0f);
+}
+
+/* The world behind each pixel of the frame (its crop): the mean of 4 x 4
+ * stratified rays through the pixel, the raster mapping of FrameParams
+ * inverted, turned into the world by rows r0..r2 (camera to world). */
+__kernel void world_pixels(FrameParams f, float4 r0, float4 r1, float4 r2, MP_PROGRAM_INPUT_ARGS,
+                           __global float* out) {
+  uint i = get_global_id(0);
+  if (i >= (uint)f.width * (uint)f.height) return;
+  float px = (float)(i % (uint)f.width), py = (float)(i / (uint)f.width);
+  MpProgramInputs in = MP_PROGRAM_INPUTS;
+  float3 sum = (float3)(0.0f);
+  for (int s = 0; s < 16; ++s) {
+    float3 d = (float3)(0.0f, 0.0f, -1.0f);
+    if (!f.ortho)
+      d = (float3)((px + ((float)(s % 4) + 0.5f) * 0.25f - f.bx) / f.ax,
+                   (py + ((float)(s / 4) + 0.5f) * 0.25f - f.by) / f.ay, -1.0f);
+    sum += mp_world_radiance((float3)(dot(r0.xyz, d), dot(r1.xyz, d), dot(r2.xyz, d)), &in);
+  }
+  sum *= 1.0f / 16.0f;
+  out[3 * i] = sum.x, out[3 * i + 1] = sum.y, out[3 * i + 2] = sum.z;
 }

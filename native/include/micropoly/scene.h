@@ -234,7 +234,7 @@ struct RenderSettings {
   bool occlusion_culling = true;
   // The world's light is shadowed through this many probe directions
   // (world_lighting.h), each a soft-shadowed distant light.
-  int world_probes = 8;
+  int world_probes = 16;
 };
 
 struct Scene {

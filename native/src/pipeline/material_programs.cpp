@@ -45,6 +45,7 @@ MaterialPrograms::Built* MaterialPrograms::build(const MaterialProgram& mp, cons
   built->displace = cl::Kernel(built->program, "displace_grids");
   built->shade = cl::Kernel(built->program, "shade_program_grids");
   built->bake_world = cl::Kernel(built->program, "bake_world");
+  built->world_pixels = cl::Kernel(built->program, "world_pixels");
   return built_.emplace(mp.source, std::move(built)).first->second.get();
 }
 
@@ -72,6 +73,31 @@ WorldMap MaterialPrograms::bake_world(const Scene& scene, const SceneBuffers& bu
   map.radiance.resize(texels);
   for (size_t i = 0; i < texels; ++i) map.radiance[i] = glm::vec3(host[i].s[0], host[i].s[1], host[i].s[2]);
   return map;
+}
+
+std::vector<float> MaterialPrograms::world_background(const Scene& scene, const SceneBuffers& buffers,
+                                                     const FrameParams& f) {
+  if (!world_) return {};
+  const size_t pixels = size_t(f.width) * size_t(f.height);
+  cl::Buffer out = session_.allocate(pixels * 3 * sizeof(float), "world background");
+  // Camera to world: the inverse of the view's rotation, by rows.
+  const glm::mat3 to_world = glm::inverse(glm::mat3(scene.camera.world_to_camera));
+  cl::Kernel& k = world_->world_pixels;
+  k.setArg(0, f);
+  for (int r = 0; r < 3; ++r)
+    k.setArg(cl_uint(1 + r), cl_float4{{to_world[0][r], to_world[1][r], to_world[2][r], 0.0f}});
+  k.setArg(4, buffers.patch_edges);
+  k.setArg(5, buffers.patch_uvs);
+  k.setArg(6, buffers.uv_layers);
+  k.setArg(7, buffers.images);
+  k.setArg(8, buffers.image_count);
+  k.setArg(9, buffers.texels);
+  k.setArg(10, out);
+  cl::CommandQueue& q = session_.queue();
+  q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(cl_uint(pixels)), cl::NDRange(64));
+  std::vector<float> host(pixels * 3);
+  q.enqueueReadBuffer(out, CL_TRUE, 0, host.size() * sizeof(float), host.data());
+  return host;
 }
 
 namespace {
@@ -152,6 +178,7 @@ void MaterialPrograms::run_shade(const cl::Buffer& diceable, cl_uint count, cons
     k.setArg(18, grids.vertex_offsets);
     shadows.set_args(k, 19);
     k.setArg(24, cl_uint(alpha_only ? 1 : 0));
+    k.setArg(25, scene.world_glossy);
     launch(k, count, grids, Stage::Shade, timer);
   }
 }

@@ -130,6 +130,7 @@ void ShadeStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffe
   kernel_.setArg(10, grids.vertex_offsets);
   kernel_.setArg(11, scene.patch_normals);
   shadows.set_args(kernel_, 12);
+  kernel_.setArg(17, scene.world_glossy);
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64),
                                         nullptr, &e);

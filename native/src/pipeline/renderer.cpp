@@ -61,6 +61,7 @@ struct Renderer::Impl {
   // moving camera keeps them), kept while the world stays the same.
   WorldMap world_map;
   std::vector<Light> world_lights;
+  std::vector<glm::vec4> world_glossy;
   uint64_t world_key = 0;
   // Object-space patches of the last scenes' shapes: a moved camera or
   // object re-places them instead of rebuilding (patch_cache.h).
@@ -121,11 +122,15 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
           impl_->world_map = scene.world.program >= 0 ? impl_->programs.bake_world(scene, *impl_->scene_buffers)
                                                       : given_world_map(scene.world);
           impl_->world_lights = world_lights(impl_->world_map, scene.world, scene.settings.world_probes);
+          impl_->world_glossy = world_glossy_maps(impl_->world_map);
           impl_->world_key = wkey;
         }
       }
       lights.insert(lights.end(), impl_->world_lights.begin(), impl_->world_lights.end());
-      if (fresh) upload_lights(s.context(), s.queue(), lights, scene.camera.world_to_camera, *impl_->scene_buffers);
+      if (fresh) {
+        upload_lights(s.context(), s.queue(), lights, scene.camera.world_to_camera, *impl_->scene_buffers);
+        upload_world_glossy(s.context(), s.queue(), impl_->world_glossy, *impl_->scene_buffers);
+      }
     }
     const SceneBuffers& buffers = *impl_->scene_buffers;
     st.timings_ms.upload = ms_since(t_upload);
@@ -237,8 +242,11 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     auto t_resolve = std::chrono::steady_clock::now();
     resolve.run(sample, frame, scene.settings.filter, scene.settings.filter_width, scene.settings.depth_and_normal_passes,
                 out, timer);
+    // The world behind the frame: its program, evaluated per pixel on the
+    // device (finer than the baked map), or the map a scene gave.
     if (scene.world.present() && scene.world.camera)
-      out.background = world_background(impl_->world_map, frame, scene.camera);
+      out.background = scene.world.program >= 0 ? impl_->programs.world_background(scene, buffers, f)
+                                                : world_background(impl_->world_map, frame, scene.camera);
     else
       out.background.clear();
     st.timings_ms.readback = ms_since(t_resolve);

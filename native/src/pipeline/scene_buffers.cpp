@@ -272,6 +272,12 @@ void upload_lights(cl::Context& context, cl::CommandQueue& queue, const std::vec
   queue.finish();  // `records` lives only for the call
 }
 
+void upload_world_glossy(cl::Context& context, cl::CommandQueue& queue, const std::vector<glm::vec4>& maps,
+                         SceneBuffers& buffers) {
+  buffers.world_glossy = upload(context, queue, maps);
+  queue.finish();  // `maps` is the caller's; the write must end while it lives
+}
+
 SceneBuffers upload_scene_data(cl::Context& context, cl::CommandQueue& queue, const HostSceneData& data) {
   SceneBuffers b;
   b.points = upload(context, queue, data.patches.points);
@@ -287,6 +293,7 @@ SceneBuffers upload_scene_data(cl::Context& context, cl::CommandQueue& queue, co
   b.patch_bounds = upload(context, queue, b.host_patch_bounds);
   b.images = upload(context, queue, data.images);
   b.texels = upload(context, queue, data.texels);
+  b.world_glossy = upload(context, queue, std::vector<glm::vec4>(1, glm::vec4(0.0f)));
   b.uv_layers = static_cast<cl_uint>(data.patches.uv_layers);
   b.image_count = static_cast<cl_uint>(data.images.size());
   b.patch_count = static_cast<cl_uint>(data.patches.size());

@@ -42,12 +42,16 @@ struct SceneBuffers {
   std::vector<glm::vec4> host_patch_bounds;  // the same on the host (occlusion culling's root order)
   cl::Buffer images;      // DeviceImage per image
   cl::Buffer texels;      // float4
+  cl::Buffer world_glossy;  // float4: the world's glossy maps (kernels/mp_world.h), or one zero texel
   cl_uint patch_count = 0;
   cl_uint light_count = 0;
   cl_uint uv_layers = 0;
   cl_uint image_count = 0;
 };
 SceneBuffers upload_scene_data(cl::Context& context, cl::CommandQueue& queue, const HostSceneData& data);
+// Replaces the world's glossy maps (world_lighting.h, world_glossy_maps).
+void upload_world_glossy(cl::Context& context, cl::CommandQueue& queue, const std::vector<glm::vec4>& maps,
+                         SceneBuffers& buffers);
 // Replaces the buffers' lights (the scene's and its world's, device_lights).
 void upload_lights(cl::Context& context, cl::CommandQueue& queue, const std::vector<Light>& lights,
                    const glm::mat4& world_to_camera, SceneBuffers& buffers);

@@ -53,6 +53,14 @@ std::vector<WorldRegion> median_cut(const WorldMap& map, int regions);
 // environment light.
 std::vector<Light> world_lights(const WorldMap& map, const World& world, int probes);
 
+// The world's glossy maps (kernels/mp_world.h, MP_WORLD_GLOSSY_LEVELS):
+// level 0 the map resampled, level k the map convolved with the GGX lobe of
+// roughness k / 8 around each direction (view = normal = the direction, as
+// the split-sum approximation assumes), by filtered importance sampling
+// (Krivanek & Colbert 2008): GGX samples read a mip of the map whose texel
+// is as large as the sample's share of the lobe, weighted by the cosine.
+std::vector<glm::vec4> world_glossy_maps(const WorldMap& map);
+
 // A World's own radiance array as a map.
 WorldMap given_world_map(const World& world);
 
