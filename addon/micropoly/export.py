@@ -149,7 +149,8 @@ def export_scene(depsgraph, view=None, meshes=None):
         view.apply(native_scene)
     materials = export_materials.MaterialTable(native_scene, out.warnings)
     meshes = meshes if meshes is not None else export_mesh.MeshCache()
-    out.background = export_lights.export_world(native_scene, scene.world, materials, out.warnings)
+    out.background = export_lights.export_world(native_scene, scene.world, materials, out.warnings,
+                                                film_transparent=scene.render.film_transparent)
     # Materials first: their node programs decide which UV maps meshes export.
     for inst in depsgraph.object_instances:
         if inst.object.type == "MESH":

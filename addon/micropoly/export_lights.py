@@ -39,7 +39,7 @@ def _ray_visibility(world):
     return get("camera"), get("diffuse"), get("glossy")
 
 
-def export_world(native_scene, world, materials=None, warnings=None):
+def export_world(native_scene, world, materials=None, warnings=None, film_transparent=False):
     """The world: a uniform color as ambient light; a Background whose color
     or strength comes from nodes (an HDRI, a gradient) as a world program
     baked into an environment map, whose light the scene shadows
@@ -57,6 +57,7 @@ def export_world(native_scene, world, materials=None, warnings=None):
                     .compile_world(background)
                 program = native_scene.add_material_program("world " + world.name, source)
                 camera, diffuse, glossy = _ray_visibility(world)
+                camera = camera and not film_transparent  # behind objects only on an opaque film
                 native_scene.set_world(program=program, camera=camera, diffuse=float(diffuse),
                                        glossy=float(glossy))
                 return np.zeros(3, dtype=np.float32)

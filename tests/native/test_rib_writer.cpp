@@ -837,6 +837,44 @@ TEST(RibWriterExtensions, BadValuesAreErrors) {
   expect_error("WorldBegin\nPolygon \"P\" [0 0 0 1 0 0 0 1 0] \"uniform normal N\" [0 0 1]\nWorldEnd\n", "\"N\"");
 }
 
+TEST(RibWriterExtensions, EnvironmentLightRoundTrips) {
+  // A world map given as radiance: written as a texture beside the RIB and
+  // read back texel for texel, with its visibility and shadow settings.
+  Scene s;
+  s.settings.world_probes = 5;
+  World& w = s.world;
+  w.width = 8, w.height = 4;
+  for (int i = 0; i < w.width * w.height; ++i) w.radiance.insert(w.radiance.end(), {0.1f * i, 1.0f, 2.5f, 1.0f});
+  w.camera = false, w.diffuse = 0.5f, w.glossy = 0.25f, w.cast_shadows = false;
+  const Scene back = round_trip(s);
+  EXPECT_EQ(back.settings.world_probes, 5);
+  EXPECT_EQ(back.world.program, -1);
+  EXPECT_EQ(back.world.width, 8);
+  EXPECT_EQ(back.world.height, 4);
+  EXPECT_EQ(back.world.radiance, w.radiance);
+  EXPECT_FALSE(back.world.camera);
+  EXPECT_EQ(back.world.diffuse, 0.5f);
+  EXPECT_EQ(back.world.glossy, 0.25f);
+  EXPECT_FALSE(back.world.cast_shadows);
+  // A world program travels as its source, shared with a material's.
+  Scene p;
+  p.material_programs.push_back({"world", "/* the world's program */\n"});
+  p.world.program = 0, p.world.bake_width = 256;
+  const Scene pb = round_trip(p);
+  ASSERT_EQ(pb.material_programs.size(), 1u);
+  EXPECT_EQ(pb.material_programs[0].source, p.material_programs[0].source);
+  EXPECT_EQ(pb.world.program, 0);
+  EXPECT_EQ(pb.world.bake_width, 256);
+  EXPECT_TRUE(pb.world.camera);
+  EXPECT_TRUE(pb.world.cast_shadows);
+  // Exactly one of "program" and "mapname".
+  EXPECT_THROW(read_rib_string("WorldBegin\nLightSource \"micropoly_environmentlight\" 1\nWorldEnd\n", "e.rib"),
+               RibError);
+  EXPECT_THROW(read_rib_string("WorldBegin\nLightSource \"micropoly_environmentlight\" 1 \"string mapname\" "
+                               "\"/nonexistent/sky.exr\"\nWorldEnd\n", "e.rib"),
+               RibError);
+}
+
 TEST(RibWriterExtensions, AreaLightInCameraSpace) {
   // Declared before WorldBegin: carried to world space like the standard lights.
   const RibResult r = read_rib_string(

@@ -70,10 +70,12 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
                                                  "a positive number of MiB");
   s.shadow_shading_rate = params.get_float_checked("shadowshadingrate", s.shadow_shading_rate, positive,
                                                    "a positive number");
+  params.get_int("worldshadowdirections", 0, 64, &s.world_probes);
   const int line = args.request().line;
   warn_unknown(params,
                {"boundsplit", "boundsplitmemory", "maxgridsize", "maxsplitdepth", "backfaceculling",
-                "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate", "occlusionculling"},
+                "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate", "occlusionculling",
+                "worldshadowdirections"},
                [&](const std::string& name) {
                  warn_once("option-micropoly:" + name, line,
                            "Option \"micropoly\": parameter \"" + name + "\" is ignored");
@@ -103,6 +105,53 @@ void Parser::read_image_option(ArgReader& args, const ParamList& params) {
   params.get_int("imagesrgb", 0, 1, &srgb);
   image.srgb = srgb != 0;
   result_.scene.images.push_back(std::move(image));
+}
+
+void Parser::read_environment_light(ArgReader& args, const ParamList& params) {
+  const int line = args.request().line;
+  const std::string what = "LightSource \"micropoly_environmentlight\"";
+  warn_unknown(params, {"program", "programname", "mapname", "bakewidth", "camera", "diffuse", "glossy",
+                        "shadowname", "intensity"},
+               [&](const std::string& name) {
+                 warn_once("envlight-param:" + name, line, what + ": parameter \"" + name + "\" is ignored");
+               });
+  World& world = result_.scene.world;
+  if (world.present()) warn_once("envlight-twice", line, what + ": a second environment replaces the first");
+  world = World{};
+  const std::string source = params.get_string("program", ""), map = params.get_string("mapname", "");
+  if (source.empty() == map.empty()) args.fail(what + " needs one of \"program\" and \"mapname\"");
+  if (!source.empty()) {
+    // The world's node tree as a material program, shared like materials'.
+    std::vector<MaterialProgram>& programs = result_.scene.material_programs;
+    auto it = std::find_if(programs.begin(), programs.end(), [&](const MaterialProgram& p) { return p.source == source; });
+    world.program = static_cast<int>(it - programs.begin());
+    if (it == programs.end()) programs.push_back({params.get_string("programname", "world"), source});
+    params.get_int("bakewidth", 8, 8192, &world.bake_width);
+  } else {
+    // An equirectangular map in world space (Cycles' convention, Z up).
+    // Its radiance is the texture's times "intensity".
+    Image image;
+    try {
+      image = read_texture_image(resolve_path(*source_->base_dir, map), Limits::kMaxTexels - texels_);
+    } catch (const Error& e) {
+      args.fail(e.what());
+    }
+    texels_ += image.pixels.size();
+    const float intensity = params.get_float("intensity", 1.0f);
+    world.width = image.width, world.height = image.height;
+    world.radiance.resize(image.pixels.size() * 4);
+    for (size_t i = 0; i < image.pixels.size(); ++i)
+      for (int c = 0; c < 4; ++c) world.radiance[4 * i + size_t(c)] = image.pixels[i][c] * (c < 3 ? intensity : 1.0f);
+  }
+  int camera = 1;
+  params.get_int("camera", 0, 1, &camera);
+  world.camera = camera != 0;
+  auto unit = [](float v) { return v >= 0.0f && v <= 1.0f; };
+  world.diffuse = params.get_float_checked("diffuse", 1.0f, unit, "a number in [0, 1]");
+  world.glossy = params.get_float_checked("glossy", 1.0f, unit, "a number in [0, 1]");
+  // As for the other lights: "shadowname" names where shadows come from; an
+  // empty one (or none) leaves the world's light unshadowed.
+  world.cast_shadows = !params.get_string("shadowname", "").empty();
 }
 
 void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {

@@ -247,6 +247,8 @@ class Parser {
                            size_t npoints, Mesh* mesh) const;
   // One texture image named by Option "micropoly" "string imagefile".
   void read_image_option(ArgReader& args, const ParamList& params);
+  // LightSource "micropoly_environmentlight": the Scene's World (docs/rib.md).
+  void read_environment_light(ArgReader& args, const ParamList& params);
 
   // State.
   RibResult result_;

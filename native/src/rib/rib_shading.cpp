@@ -169,6 +169,12 @@ void Parser::req_light_source(ArgReader& args) {
       handle = handle_key(args);
   }
   ParamList params(args, decls_);
+  if (shader == "micropoly_environmentlight") {
+    // The world's light: not a light of the light list (it lights every
+    // primitive, as a World does), so Illuminate does not reach it.
+    read_environment_light(args, params);
+    return;
+  }
   if (static_cast<int>(lights_.size()) >= Limits::kMaxLights)
     args.fail("more than " + std::to_string(Limits::kMaxLights) + " light sources");
 

@@ -202,6 +202,8 @@ void write_options(std::string& o, const RenderSettings& s) {
     param(o, "float shadowshadingrate", s.shadow_shading_rate);
   if (s.occlusion_culling != def.occlusion_culling)
     param(o, "integer occlusionculling", static_cast<long long>(s.occlusion_culling ? 1 : 0));
+  if (s.world_probes != def.world_probes)
+    param(o, "integer worldshadowdirections", static_cast<long long>(s.world_probes));
   o += '\n';
 }
 
@@ -529,6 +531,38 @@ void write_images(std::string& o, const std::vector<Image>& images, const std::s
   }
 }
 
+// The World as LightSource "micropoly_environmentlight" (docs/rib.md): its
+// program, or its map written beside the RIB as a texture.
+void write_world(std::string& o, const Scene& scene, const std::string& folder, const std::string& reference) {
+  const World& w = scene.world;
+  if (!w.present()) return;
+  o += "LightSource \"micropoly_environmentlight\" \"world\"";
+  if (w.program >= 0) {
+    const MaterialProgram& p = scene.material_programs[size_t(w.program)];
+    param(o, "string programname", p.name);
+    param(o, "string program", p.source);
+    param(o, "integer bakewidth", static_cast<long long>(w.bake_width));
+  } else {
+    if (folder.empty()) throw Error("the scene's world map needs a folder to be written to");
+    std::error_code ec;
+    std::filesystem::create_directories(folder, ec);
+    if (ec) throw Error("cannot create texture folder '" + folder + "': " + ec.message());
+    Image map;
+    map.name = "world";
+    map.width = w.width, map.height = w.height;
+    map.pixels.resize(size_t(w.width) * size_t(w.height));
+    for (size_t i = 0; i < map.pixels.size(); ++i)
+      map.pixels[i] = glm::vec4(w.radiance[4 * i], w.radiance[4 * i + 1], w.radiance[4 * i + 2], w.radiance[4 * i + 3]);
+    write_texture_image((std::filesystem::path(folder) / "world.exr").string(), map);
+    param(o, "string mapname", (std::filesystem::path(reference) / "world.exr").generic_string());
+  }
+  param(o, "integer camera", static_cast<long long>(w.camera ? 1 : 0));
+  param(o, "float diffuse", w.diffuse);
+  param(o, "float glossy", w.glossy);
+  if (w.cast_shadows) param(o, "string shadowname", "raytrace");
+  o += '\n';
+}
+
 // write_rib() after validation.
 void write_valid_scene(const Scene& scene, std::ostream& out, const std::string& display_name,
                        const std::string& image_folder, const std::string& image_reference) {
@@ -552,6 +586,7 @@ void write_valid_scene(const Scene& scene, std::ostream& out, const std::string&
   o += "WorldBegin\n";
   // Lights first, at the world's top level: on for every primitive, in order.
   for (size_t i = 0; i < scene.lights.size(); ++i) write_light(o, scene.lights[i], static_cast<int>(i) + 1);
+  write_world(o, scene, image_folder, image_reference);
   // The material table, in index order (index 0 replaces the default surface).
   for (size_t i = 0; i < materials.size(); ++i) {
     o += "AttributeBegin\n";
