@@ -47,7 +47,8 @@ def image_pixels(image, warn):
 
 
 class ImageTable:
-    """One native image per Blender image, exported on first use."""
+    """One native image per Blender image, exported on first use; images
+    computed in memory (a Sky Texture's) under keys of their own."""
 
     def __init__(self, native_scene):
         self.native = native_scene
@@ -63,3 +64,18 @@ class ImageTable:
             pixels, srgb = image_pixels(image, warn)
             self.index[key] = -1 if pixels is None else self.native.add_image(key, pixels, srgb=srgb)
         return self.index[key], not image.is_float
+
+    def array(self, key, pixels):
+        """Native index of a (height, width, 4) float RGBA image held in
+        memory (scene-linear, rows bottom to top), one per `key` (a hashable
+        naming its content). `pixels` is the array or a function making it,
+        called on the key's first use only."""
+        table_key = ("array", key)
+        if table_key not in self.index:
+            rgba = np.asarray(pixels() if callable(pixels) else pixels, dtype=np.float32)
+            if rgba.ndim != 3 or rgba.shape[2] != 4:
+                raise ValueError(f"an in-memory image must be (height, width, 4), not {rgba.shape}")
+            rgba = np.ascontiguousarray(np.nan_to_num(rgba, nan=0.0, posinf=0.0, neginf=0.0))
+            name = key[0] if isinstance(key, tuple) and key else str(key)
+            self.index[table_key] = self.native.add_image(str(name), rgba, srgb=False)
+        return self.index[table_key]

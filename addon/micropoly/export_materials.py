@@ -93,6 +93,9 @@ class MaterialTable:
     def image(self, image, warn):
         return self.images.get(image, warn)
 
+    def array_image(self, key, pixels):
+        return self.images.array(key, pixels)
+
     def get(self, material):
         if material is None:
             return 0

@@ -37,6 +37,13 @@ TEXTURE_HEADERS = {"TEX_NOISE": "mp_tex_noise.h", "TEX_MUSGRAVE": "mp_tex_noise.
                    "TEX_VORONOI": "mp_tex_voronoi.h", "TEX_WAVE": "mp_tex_wave.h"}
 IMAGE_INTERPOLATION = {"Linear": 0, "Closest": 1, "Cubic": 2, "Smart": 2}  # Cycles renders Smart as Cubic
 IMAGE_EXTENSION = {"REPEAT": 0, "EXTEND": 1, "CLIP": 2, "MIRROR": 3}
+# Sky Texture models with a precomputed texture (native nishita_sky_texture).
+SKY_MODELS = ("NISHITA", "SINGLE_SCATTERING", "MULTIPLE_SCATTERING")
+# A world is baked by sampling its map's texel centres (512 texels around by
+# default); the sun's disc, smaller than a texel, has its light spread over
+# 2.5 texels of that map so every bake holds it to within 1%
+# (kernels/textures/mp_tex_sky.h).
+WORLD_SUN_SPREAD = 2.5 * 2.0 * math.pi / 512
 # A texture's Fac stays close to [0, 1]; displacement bounds derived from it
 # take this margin on both sides.
 FAC_RANGE = (-0.25, 1.25)
@@ -106,6 +113,11 @@ class NoResources:
     def image(self, image, warn):
         return -1, False
 
+    def array_image(self, key, pixels):
+        """Index of an in-memory float RGBA image (`pixels`: the array or a
+        function making it), or -1."""
+        return -1
+
 
 class NodeCompiler:
     def __init__(self, material, warnings, user_bound=0.0, resources=None):
@@ -121,6 +133,7 @@ class NodeCompiler:
         self.uses_neighbours = False
         self.displacement_world = False
         self.groups = []           # the Group nodes whose trees are being compiled, outermost first
+        self.world = False         # compiling a world (baked into a map) rather than a material
 
     # ---- helpers ----------------------------------------------------------
     def warn(self, node, what):
@@ -284,6 +297,8 @@ class NodeCompiler:
             return self.emit_image(node)
         if t == "TEX_ENVIRONMENT":
             return self.emit_environment(node)
+        if t == "TEX_SKY":
+            return self.emit_sky(node)
         if t == "NEW_GEOMETRY":
             self.warn(node, "only Normal is supported here, in object space")
             return {"Normal": ("g->N", VEC, None)}
@@ -591,10 +606,48 @@ class NodeCompiler:
         rng = (0.0, 1.0) if byte_image else None
         return {"Color": (f"{rgba}.xyz", VEC, rng)}
 
+    def emit_sky(self, node):
+        """A Sky Texture of a physical model (Nishita before 5.0; Single and
+        Multiple Scattering in 5.0): a texture precomputed by the native
+        module as Cycles does, and the sun's disc (kernels/textures/mp_tex_sky.h)."""
+        sky_type = node.sky_type
+        if sky_type not in SKY_MODELS:
+            # Blender's default world grey stands in for the sky.
+            self.warn(node, f"the {sky_type.replace('_', ' ').title()} sky model is not supported; it gives grey")
+            return {"Color": ("(float3)(0.050876f)", VEC, None)}
+        from . import _native  # the precomputation is native; compiling alone needs no module
+
+        self.headers.add("mp_tex_sky.h")
+        params = dict(model=sky_type, sun_disc=bool(node.sun_disc), sun_size=float(node.sun_size),
+                      sun_intensity=float(node.sun_intensity), sun_elevation=float(node.sun_elevation),
+                      sun_rotation=float(node.sun_rotation), altitude=float(node.altitude),
+                      air=float(node.air_density),
+                      dust=float(getattr(node, "aerosol_density", getattr(node, "dust_density", 1.0))),
+                      ozone=float(node.ozone_density))
+        spread = WORLD_SUN_SPREAD if self.world else 0.0
+        sun = _native.nishita_sky_sun(spread=spread, **params)
+        key = ("sky",) + tuple(sorted(params.items()))
+        index = self.resources.array_image(key, lambda: _native.nishita_sky_texture(**params)[0])
+        # The node's Vector socket is hidden in every version (its lookup by
+        # name fails from 4.0); when it is linked all the same, it is the direction.
+        vector = next((s for s in node.inputs if s.identifier == "Vector"), None)
+        vec = self.input(node, list(node.inputs).index(vector), VEC)[0] if vector is not None and vector.is_linked \
+            else "g->generated"
+        name = f"sky{self.fn.counter}"
+        self.fn.counter += 1
+        fields = [_vec_lit(sun["sun_bottom"]), _vec_lit(sun["sun_top"]), _vec_lit(sun["sun_flux"])]
+        fields += [_lit(sun[k]) for k in ("sun_elevation", "sun_rotation", "sun_diameter", "sun_intensity",
+                                          "earth_angle", "spread")]
+        fields.append(str(int(sun["layout"])))
+        self.fn.lines.append(f"  MpSky {name} = {{{', '.join(fields)}}};")
+        images = f"g->images, g->image_count, g->texels, {index}"
+        return {"Color": self.fn.temp(VEC, f"mp_tex_sky({images}, {vec}, &{name})")}
+
     # ---- the world ------------------------------------------------------------
     def compile_world(self, background):
         """The world program: its Background's colour times strength as the
         Surface emission, for each direction (material_program.cl, bake_world)."""
+        self.world = True
         disp_src = "float3 mp_node_displacement(const MpNodeGlobals* g) {\n  return (float3)(0.0f);\n}\n"
         surf_src = self._function(
             "void mp_node_surface(const MpNodeGlobals* g, MpSurfaceInputs* s)",

@@ -17,6 +17,7 @@ using namespace mp;
 
 // Bindings kept in files of their own (native/src/python/bind_*.cpp).
 void bind_rib(py::module_& m);
+void bind_sky(py::module_& m);
 
 namespace {
 
@@ -379,6 +380,7 @@ PYBIND11_MODULE(_native, m) {
       .def_property_readonly("light_count", [](const Scene& s) { return s.lights.size(); });
 
   bind_rib(m);
+  bind_sky(m);
 
   m.def("list_devices", [] {
     std::vector<DeviceInfo> devices;
