@@ -276,10 +276,15 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal,
   float3 f0 = (1.0f - metallic) * MP_F3(0.08f, 0.08f, 0.08f) * m->principled[1] + metallic * cs;
   float3 ambient = MP_F3(0.0f, 0.0f, 0.0f), diffuse = ambient, specular = ambient;
   MP_GLOBAL const DeviceLight* world = 0;
-  /* The world's visibility, weighted by its probes' light on the diffuse
-   * normal and around the mirror direction. */
-  float probe_lit = 0.0f, probe_total = 0.0f, probe_lit_s = 0.0f, probe_total_s = 0.0f;
+  /* The world's visibility: its probes' shadows, weighted by the light each
+   * gives the diffuse normal and around the mirror direction. Only the
+   * MP_WORLD_PROBE_LOOKUPS probes of most weight are looked up (each lookup
+   * costs as much as a soft-shadowed light's); the others are taken to be
+   * as visible as those are, on average. */
   float3 mirror = 2.0f * dot(nf, v) * nf - v;
+  uint probe_index[MP_WORLD_PROBE_LOOKUPS];
+  float probe_w[MP_WORLD_PROBE_LOOKUPS], probe_ws[MP_WORLD_PROBE_LOOKUPS];
+  int probes = 0;
   for (uint k = 0; k < light_count; ++k) {
     MP_GLOBAL const DeviceLight* lt = lights + k;
     float3 cl = mp_light_f3(lt->color);
@@ -294,11 +299,15 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal,
       float3 lp = -mp_light_f3(lt->direction);
       float w = (cl.x + cl.y + cl.z) * fmax(dot(nd, lp), 0.0f);
       float ws = (cl.x + cl.y + cl.z) * fmax(dot(mirror, lp), 0.0f);
-      if (w > 0.0f || ws > 0.0f) {
-        float vis = shadow ? mp_shadow_visibility(shadow->maps, k, p, shadow->normal, shadow->footprint) : 1.0f;
-        probe_total += w, probe_lit += w * vis;
-        probe_total_s += ws, probe_lit_s += ws * vis;
+      if (!(w + ws > 0.0f)) continue;
+      /* Kept in order of weight: insert, dropping the lightest when full. */
+      int at = probes < MP_WORLD_PROBE_LOOKUPS ? probes++ : MP_WORLD_PROBE_LOOKUPS;
+      while (at > 0 && probe_w[at - 1] + probe_ws[at - 1] < w + ws) {
+        if (at < MP_WORLD_PROBE_LOOKUPS)
+          probe_index[at] = probe_index[at - 1], probe_w[at] = probe_w[at - 1], probe_ws[at] = probe_ws[at - 1];
+        --at;
       }
+      if (at < MP_WORLD_PROBE_LOOKUPS) probe_index[at] = k, probe_w[at] = w, probe_ws[at] = ws;
       continue;
     }
     float3 l;
@@ -348,6 +357,12 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal,
    * (mp_world.h), each darkened by the visibility its probes' shadow maps
    * give. */
   float3 world_d = MP_F3(0.0f, 0.0f, 0.0f), world_s = world_d;
+  float probe_lit = 0.0f, probe_total = 0.0f, probe_lit_s = 0.0f, probe_total_s = 0.0f;
+  for (int i = 0; i < probes; ++i) {
+    float vis = shadow ? mp_shadow_visibility(shadow->maps, probe_index[i], p, shadow->normal, shadow->footprint) : 1.0f;
+    probe_total += probe_w[i], probe_lit += probe_w[i] * vis;
+    probe_total_s += probe_ws[i], probe_lit_s += probe_ws[i] * vis;
+  }
   if (world) {
     float vis = probe_total > 0.0f ? probe_lit / probe_total : 1.0f;
     float vis_s = probe_total_s > 0.0f ? probe_lit_s / probe_total_s : vis;
@@ -358,6 +373,12 @@ MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal,
     /* Lambert: albedo / pi per unit irradiance; a uniform ambient radiance A
      * gives irradiance pi A, so the diffuse response to it is albedo * A. */
     float3 albedo = cs * (1.0f - metallic);
+    /* Blender 4.0's layered Principled: the diffuse base gets what the
+     * dielectric specular layer lets through, 1 - its directional albedo. */
+    if (m->principled[2] > 0.0f) {
+      float2 e = mp_env_brdf(roughness, fmax(dot(nf, v), 1e-4f));
+      albedo *= fmax(1.0f - (0.08f * m->principled[1] * e.x + e.y), 0.0f);
+    }
     /* The world's glossy light by the split sum: the prefiltered radiance
      * times the lobe's directional albedo f0 a + b (mp_env_brdf). */
     float2 ab = mp_env_brdf(roughness, fmax(dot(nf, v), 1e-4f));

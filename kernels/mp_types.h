@@ -101,7 +101,7 @@ typedef struct {
   float coeffs[4];          /* ka, kd, ks, roughness */
   float specular[4];        /* specular color (plastic) */
   float emission[4];
-  float principled[4];      /* metallic, specular, 0, 0 */
+  float principled[4];      /* metallic, specular, layered (Blender 4.0 and later), 0 */
   float program[4];         /* compiled node program index or -1, displaces (1/0), surface program (1/0),
                                program computes the alpha (1/0) */
 } DeviceMaterial;
@@ -139,6 +139,8 @@ typedef struct {
  * coefficients in two consecutive records, the second typed _DATA. */
 #define MP_LIGHT_ENVIRONMENT 5
 #define MP_LIGHT_ENVIRONMENT_DATA 6
+/* Probe shadows a shaded point looks up (kernels/mp_shading.h). */
+#define MP_WORLD_PROBE_LOOKUPS 8
 /* A distant light with axis_u[3] == MP_WORLD_PROBE gives no light of its
  * own: its shadow map tells how much of the world's light reaches a point
  * from its part of the sky (world_lighting.h). */

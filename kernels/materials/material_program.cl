@@ -246,7 +246,7 @@ __kernel void bake_world(uint width, uint height, MP_PROGRAM_INPUT_ARGS, __globa
   out[i] = (float4)(mp_world_radiance(mp_env_equirect_direction(u, v), &in), 1.0f);
 }
 
-/* The world behind each pixel of the frame (its crop): the mean of 4 x 4
+/* The world behind each pixel of the frame (its crop): the mean of 2 x 2
  * stratified rays through the pixel, the raster mapping of FrameParams
  * inverted, turned into the world by rows r0..r2 (camera to world). */
 __kernel void world_pixels(FrameParams f, float4 r0, float4 r1, float4 r2, MP_PROGRAM_INPUT_ARGS,
@@ -256,13 +256,13 @@ __kernel void world_pixels(FrameParams f, float4 r0, float4 r1, float4 r2, MP_PR
   float px = (float)(i % (uint)f.width), py = (float)(i / (uint)f.width);
   MpProgramInputs in = MP_PROGRAM_INPUTS;
   float3 sum = (float3)(0.0f);
-  for (int s = 0; s < 16; ++s) {
+  for (int s = 0; s < 4; ++s) {
     float3 d = (float3)(0.0f, 0.0f, -1.0f);
     if (!f.ortho)
-      d = (float3)((px + ((float)(s % 4) + 0.5f) * 0.25f - f.bx) / f.ax,
-                   (py + ((float)(s / 4) + 0.5f) * 0.25f - f.by) / f.ay, -1.0f);
+      d = (float3)((px + ((float)(s % 2) + 0.5f) * 0.5f - f.bx) / f.ax,
+                   (py + ((float)(s / 2) + 0.5f) * 0.5f - f.by) / f.ay, -1.0f);
     sum += mp_world_radiance((float3)(dot(r0.xyz, d), dot(r1.xyz, d), dot(r2.xyz, d)), &in);
   }
-  sum *= 1.0f / 16.0f;
+  sum *= 0.25f;
   out[3 * i] = sum.x, out[3 * i + 1] = sum.y, out[3 * i + 2] = sum.z;
 }

@@ -108,6 +108,7 @@ void expect_same_material(const Material& a, const Material& b) {
       EXPECT_EQ(a.metallic, b.metallic);
       EXPECT_EQ(a.roughness, b.roughness);
       EXPECT_EQ(a.specular, b.specular);
+      EXPECT_EQ(a.layered, b.layered);
       break;
   }
   EXPECT_EQ(a.program, b.program);
@@ -298,6 +299,7 @@ Scene full_scene() {
   s.materials.push_back(plastic);
   Material principled = material("gold", Material::Model::Principled, {1.0f, 0.766f, 0.336f});
   principled.metallic = 0.9f, principled.roughness = 0.35f, principled.specular = 0.45f;
+  principled.layered = true;
   principled.opacity = glm::vec3(0.75f);
   s.materials.push_back(principled);
   Material glow = material("glow", Material::Model::Constant, {0.2f, 0.3f, 0.4f});

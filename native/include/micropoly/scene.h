@@ -80,6 +80,9 @@ struct Material {
   glm::vec3 specular_color{1.0f};
   float metallic = 0.0f;   // Principled only
   float specular = 0.5f;   // Principled only
+  // Principled only: Blender 4.0's layered Principled BSDF, whose diffuse
+  // base lies under the specular layer and gets the light it lets through.
+  bool layered = false;
   glm::vec3 emission{0.0f};
   // A node tree compiled to a material program (Scene::material_programs),
   // or -1. The program may displace the surface (displacement_bound is then

@@ -115,6 +115,7 @@ ShadowLayout make_shadow_layout(const Scene& scene, const std::vector<Light>& li
   const FrameParams& f = frame.params;
   out.shadows.resize(lights.size());
   out.light_keys.assign(lights.size(), 0);
+  out.own_bias.assign(lights.size(), 0);
   for (DeviceShadow& d : out.shadows) d = DeviceShadow{}, d.kind = MP_SHADOW_NONE, d.cone_cos = -2.0f;
   if (!s.shadows || bounds.empty()) return out;
 
@@ -147,7 +148,11 @@ ShadowLayout make_shadow_layout(const Scene& scene, const std::vector<Light>& li
     const glm::dvec3 t = basis * (camera_position - origin);
     put_rows(d.to_light, r, t);
     d.page_table = out.table_entries;
-    d.level_bias = 0;
+    // A world probe's shadow is as soft as a wide region of the sky: its
+    // penumbrae span many texels of the level the footprint asks for, so
+    // it is rendered two levels (16x fewer texels) coarser.
+    out.own_bias[i] = l.world_probe ? kWorldProbeLevelBias : 0;
+    d.level_bias = out.own_bias[i];
     d.cone_cos = l.type == Light::Type::Spot ? std::cos(std::clamp(l.cone_angle, 0.0f, 3.14159265f)) : -2.0f;
     d.one_sided = l.type == Light::Type::Area ? 1u : 0u;
     if (sun) {
@@ -249,7 +254,7 @@ ShadowLayout make_shadow_layout(const Scene& scene, const std::vector<Light>& li
 }
 
 void set_shadow_level_bias(ShadowLayout& layout, int bias) {
-  for (DeviceShadow& d : layout.shadows) d.level_bias = bias;
+  for (size_t i = 0; i < layout.shadows.size(); ++i) layout.shadows[i].level_bias = layout.own_bias[i] + bias;
 }
 
 }  // namespace mp

@@ -42,6 +42,7 @@ struct ShadowLayout {
   std::vector<DeviceShadow> shadows;        // one per scene light; kind MP_SHADOW_NONE where none
   std::vector<DeviceShadowLevel> levels;    // the suns' clipmap levels
   std::vector<uint64_t> light_keys;         // per scene light: what its pages' contents depend on (0: none)
+  std::vector<int> own_bias;                // per scene light: levels coarser than its footprint asks for
   std::vector<ShadowMapInfo> maps;
   uint32_t table_entries = 0;
   int shadowed_lights = 0;
@@ -59,6 +60,9 @@ ShadowLayout make_shadow_layout(const Scene& scene, const std::vector<Light>& li
 
 // Sets every shadowed light's level bias (levels coarser than the
 // footprint asks for), in the records the kernels read.
+// Every light `bias` levels coarser than its own (a short budget).
 void set_shadow_level_bias(ShadowLayout& layout, int bias);
+// World probes' own coarsening (world_lighting.h): their shadows are soft.
+constexpr int kWorldProbeLevelBias = 2;
 
 }  // namespace mp

@@ -62,7 +62,8 @@ std::vector<float> Parser::material_key(const Material& m) {
           m.emission.x, m.emission.y, m.emission.z,
           m.metallic, m.specular, static_cast<float>(m.program), m.displacement_bound,
           static_cast<float>(m.program_displaces), static_cast<float>(m.program_shades),
-          static_cast<float>(m.displacement_bound_world), static_cast<float>(m.program_alpha)};
+          static_cast<float>(m.displacement_bound_world), static_cast<float>(m.program_alpha),
+          static_cast<float>(m.layered)};
 }
 
 int Parser::material_index(const Attributes& attrs) {
@@ -127,8 +128,11 @@ void Parser::req_surface(ArgReader& args) {
     m.metallic = params.get_float("metallic", m.metallic);
     m.roughness = params.get_float("roughness", m.roughness);
     m.specular = params.get_float("specular", m.specular);
+    int layered = 0;
+    params.get_int("layered", 0, 1, &layered);
+    m.layered = layered != 0;
     read_emission();
-    warn_unknown_params(params, {"metallic", "roughness", "specular", "emission"},
+    warn_unknown_params(params, {"metallic", "roughness", "specular", "layered", "emission"},
                         "Surface \"micropoly_principled\"", warn_param);
   } else {
     // plastic, and the fallback for any other shader with plastic's defaults.

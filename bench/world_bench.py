@@ -1,0 +1,131 @@
+"""The world-lighting benchmark. Run with Blender (or a Python with bpy):
+
+  MICROPOLY_ADDON_DIR=build/addons blender -b --factory-startup --python bench/world_bench.py -- [--rib-only] [--quick]
+
+Scene: Suzanne and a torus with Subdivision Surface on a floor (the scene
+of tests/blender/test_world.py), Principled roughness 0.3, 1920x1080 and
+16 samples, in three lightings:
+  world_hdri    lit only by Blender's forest.exr studio light (its world
+                program baked, 16 shadowed directions: the default);
+  world_lights4 a black world and four lights casting soft shadows (sun,
+                point, spot, area);
+  world_none    a black world and no lights (what both add to).
+
+Default: F12 of world_hdri by Micropoly on its default device and by Cycles
+(direct light only, as in the tests, and its default light paths), 16
+samples each, one run each, wall time printed.
+--rib-only: writes the three scenes as RIB (bench/out/world_*.rib) for the
+CLI's per-stage timings (bench/world_bench.sh)."""
+
+import math
+import os
+import sys
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "blender"))
+
+import bpy  # noqa: E402
+
+import render_utils as ru  # noqa: E402
+
+args = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+W, H = (480, 270) if "--quick" in args else (1920, 1080)
+SAMPLES = 16
+
+
+def principled(name, color):
+    m, _ = ru.empty_material(name)
+    nodes = m.node_tree.nodes
+    bsdf = nodes.new("ShaderNodeBsdfPrincipled")
+    bsdf.inputs["Base Color"].default_value = (*color, 1.0)
+    bsdf.inputs["Roughness"].default_value = 0.3
+    out = next(n for n in nodes if n.type == "OUTPUT_MATERIAL")
+    m.node_tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
+    return m
+
+
+def hdri_world(scene):
+    world = scene.world or bpy.data.worlds.new("World")
+    scene.world = world
+    world.use_nodes = True
+    nodes, links = world.node_tree.nodes, world.node_tree.links
+    env = nodes.new("ShaderNodeTexEnvironment")
+    folder = bpy.utils.system_resource("DATAFILES", path="studiolights/world")
+    env.image = bpy.data.images.load(os.path.join(folder, "forest.exr"), check_existing=True)
+    links.new(env.outputs["Color"], nodes["Background"].inputs["Color"])
+
+
+def build_scene(lighting):
+    scene = ru.reset_scene()
+    bpy.ops.mesh.primitive_plane_add(size=8.0)
+    bpy.context.object.data.materials.append(principled("Floor", (0.6, 0.6, 0.6)))
+    bpy.ops.mesh.primitive_monkey_add(location=(-0.8, 0.0, 0.75), rotation=(0.5, 0.0, 0.3))
+    monkey = bpy.context.object
+    bpy.ops.mesh.primitive_torus_add(location=(1.1, 0.3, 0.35), major_radius=0.6, minor_radius=0.25)
+    torus = bpy.context.object
+    for obj, color in ((monkey, (0.8, 0.5, 0.3)), (torus, (0.3, 0.5, 0.8))):
+        obj.modifiers.new("Subdivision", "SUBSURF").render_levels = 2
+        obj.data.materials.append(principled(obj.name, color))
+        bpy.ops.object.select_all(action="DESELECT")
+        obj.select_set(True)
+        bpy.context.view_layer.objects.active = obj
+        bpy.ops.object.shade_smooth()
+    if lighting == "hdri":
+        hdri_world(scene)
+    else:
+        scene.world.color = (0.0, 0.0, 0.0)
+    if lighting == "lights4":
+        ru.add_sun(scene, (0.6, 0.2, 0.8), energy=3.0)
+        ru.add_aimed_light(scene, "POINT", (2.5, -2.0, 3.0), (0.0, 0.0, 0.5), 800.0, shadow_soft_size=0.25)
+        ru.add_aimed_light(scene, "SPOT", (-3.0, -2.0, 3.5), (0.0, 0.0, 0.5), 1000.0, shadow_soft_size=0.25)
+        ru.add_aimed_light(scene, "AREA", (0.0, 3.0, 3.0), (0.0, 0.0, 0.5), 500.0)
+        for obj in scene.objects:
+            if obj.type == "LIGHT":
+                ru.set_cast_shadow(obj.data, True)
+    ru.add_camera(scene, (0.0, -6.0, 3.2), (0.2, 0.0, 0.4), lens=40.0)
+    r = scene.render
+    r.resolution_x, r.resolution_y, r.resolution_percentage = W, H, 100
+    r.film_transparent = False
+    scene.micropoly.samples = SAMPLES
+    return scene
+
+
+def export_ribs():
+    ru.enable_addon()
+    from micropoly import operators
+    folder = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
+    os.makedirs(folder, exist_ok=True)
+    for lighting in ("hdri", "lights4", "none"):
+        scene = build_scene(lighting)
+        scene.render.engine = "MICROPOLY"
+        path = os.path.join(folder, f"world_{lighting}.rib")
+        operators.export_rib(bpy.context.evaluated_depsgraph_get(), path)
+        print(f"wrote {path}")
+
+
+def f12(scene):
+    started = time.perf_counter()
+    bpy.ops.render.render()
+    return time.perf_counter() - started
+
+
+def side_by_side():
+    ru.enable_addon()
+    print(f"world_hdri, {W}x{H}, {SAMPLES} samples, F12 wall time, one run each")
+    scene = build_scene("hdri")
+    scene.render.engine = "MICROPOLY"
+    print(f"Micropoly: {f12(scene):.2f} s")
+    scene = build_scene("hdri")
+    ru.setup_cycles(scene, samples=SAMPLES)
+    print(f"Cycles, direct light (max bounces 0), adaptive subdivision 1 px: {f12(scene):.2f} s")
+    scene = build_scene("hdri")
+    ru.setup_cycles(scene, samples=SAMPLES)
+    c = scene.cycles
+    c.max_bounces, c.diffuse_bounces, c.glossy_bounces, c.transmission_bounces = 12, 4, 4, 12
+    print(f"Cycles, default light paths, adaptive subdivision 1 px: {f12(scene):.2f} s")
+
+
+if "--rib-only" in args:
+    export_ribs()
+else:
+    side_by_side()
