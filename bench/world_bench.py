@@ -78,7 +78,7 @@ def build_scene(lighting):
         ru.add_sun(scene, (0.6, 0.2, 0.8), energy=3.0)
         ru.add_aimed_light(scene, "POINT", (2.5, -2.0, 3.0), (0.0, 0.0, 0.5), 800.0, shadow_soft_size=0.25)
         ru.add_aimed_light(scene, "SPOT", (-3.0, -2.0, 3.5), (0.0, 0.0, 0.5), 1000.0, shadow_soft_size=0.25)
-        ru.add_aimed_light(scene, "AREA", (0.0, 3.0, 3.0), (0.0, 0.0, 0.5), 500.0)
+        ru.add_aimed_light(scene, "AREA", (0.0, 3.0, 3.0), (0.0, 0.0, 0.5), 500.0, size=0.25)
         for obj in scene.objects:
             if obj.type == "LIGHT":
                 ru.set_cast_shadow(obj.data, True)
