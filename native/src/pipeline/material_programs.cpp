@@ -49,6 +49,20 @@ MaterialPrograms::Built* MaterialPrograms::build(const MaterialProgram& mp, cons
   return built_.emplace(mp.source, std::move(built)).first->second.get();
 }
 
+namespace {
+
+// MP_PROGRAM_INPUT_ARGS (material_program.cl) from argument `first` on.
+void set_program_input_args(cl::Kernel& k, cl_uint first, const SceneBuffers& buffers) {
+  k.setArg(first, buffers.patch_edges);
+  k.setArg(first + 1, buffers.patch_uvs);
+  k.setArg(first + 2, buffers.uv_layers);
+  k.setArg(first + 3, buffers.images);
+  k.setArg(first + 4, buffers.image_count);
+  k.setArg(first + 5, buffers.texels);
+}
+
+}  // namespace
+
 WorldMap MaterialPrograms::bake_world(const Scene& scene, const SceneBuffers& buffers) {
   WorldMap map;
   if (!world_) return map;
@@ -59,12 +73,7 @@ WorldMap MaterialPrograms::bake_world(const Scene& scene, const SceneBuffers& bu
   cl::Kernel& k = world_->bake_world;
   k.setArg(0, cl_uint(map.width));
   k.setArg(1, cl_uint(map.height));
-  k.setArg(2, buffers.patch_edges);
-  k.setArg(3, buffers.patch_uvs);
-  k.setArg(4, buffers.uv_layers);
-  k.setArg(5, buffers.images);
-  k.setArg(6, buffers.image_count);
-  k.setArg(7, buffers.texels);
+  set_program_input_args(k, 2, buffers);
   k.setArg(8, out);
   cl::CommandQueue& q = session_.queue();
   q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(cl_uint(texels)), cl::NDRange(64));
@@ -86,12 +95,7 @@ std::vector<float> MaterialPrograms::world_background(const Scene& scene, const 
   k.setArg(0, f);
   for (int r = 0; r < 3; ++r)
     k.setArg(cl_uint(1 + r), cl_float4{{to_world[0][r], to_world[1][r], to_world[2][r], 0.0f}});
-  k.setArg(4, buffers.patch_edges);
-  k.setArg(5, buffers.patch_uvs);
-  k.setArg(6, buffers.uv_layers);
-  k.setArg(7, buffers.images);
-  k.setArg(8, buffers.image_count);
-  k.setArg(9, buffers.texels);
+  set_program_input_args(k, 4, buffers);
   k.setArg(10, out);
   cl::CommandQueue& q = session_.queue();
   q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(cl_uint(pixels)), cl::NDRange(64));
