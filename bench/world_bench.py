@@ -33,17 +33,6 @@ W, H = (480, 270) if "--quick" in args else (1920, 1080)
 SAMPLES = 16
 
 
-def principled(name, color):
-    m, _ = ru.empty_material(name)
-    nodes = m.node_tree.nodes
-    bsdf = nodes.new("ShaderNodeBsdfPrincipled")
-    bsdf.inputs["Base Color"].default_value = (*color, 1.0)
-    bsdf.inputs["Roughness"].default_value = 0.3
-    out = next(n for n in nodes if n.type == "OUTPUT_MATERIAL")
-    m.node_tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
-    return m
-
-
 def hdri_world(scene):
     world = scene.world or bpy.data.worlds.new("World")
     scene.world = world
@@ -57,19 +46,7 @@ def hdri_world(scene):
 
 def build_scene(lighting):
     scene = ru.reset_scene()
-    bpy.ops.mesh.primitive_plane_add(size=8.0)
-    bpy.context.object.data.materials.append(principled("Floor", (0.6, 0.6, 0.6)))
-    bpy.ops.mesh.primitive_monkey_add(location=(-0.8, 0.0, 0.75), rotation=(0.5, 0.0, 0.3))
-    monkey = bpy.context.object
-    bpy.ops.mesh.primitive_torus_add(location=(1.1, 0.3, 0.35), major_radius=0.6, minor_radius=0.25)
-    torus = bpy.context.object
-    for obj, color in ((monkey, (0.8, 0.5, 0.3)), (torus, (0.3, 0.5, 0.8))):
-        obj.modifiers.new("Subdivision", "SUBSURF").render_levels = 2
-        obj.data.materials.append(principled(obj.name, color))
-        bpy.ops.object.select_all(action="DESELECT")
-        obj.select_set(True)
-        bpy.context.view_layer.objects.active = obj
-        bpy.ops.object.shade_smooth()
+    ru.add_suzanne_torus_floor(lambda name, color: ru.principled_material(name, color, 0.3))
     if lighting == "hdri":
         hdri_world(scene)
     else:

@@ -133,6 +133,40 @@ def diffuse_material(name, color):
     return m
 
 
+def principled_material(name, color, roughness):
+    m, _ = empty_material(name)
+    nodes = m.node_tree.nodes
+    bsdf = nodes.new("ShaderNodeBsdfPrincipled")
+    bsdf.inputs["Base Color"].default_value = (*color, 1.0)
+    bsdf.inputs["Roughness"].default_value = roughness
+    out = next(n for n in nodes if n.type == "OUTPUT_MATERIAL")
+    m.node_tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
+    return m
+
+
+def shade_smooth(obj):
+    bpy.ops.object.select_all(action="DESELECT")
+    obj.select_set(True)
+    bpy.context.view_layer.objects.active = obj
+    bpy.ops.object.shade_smooth()
+
+
+def add_suzanne_torus_floor(material):
+    """The world-lighting scene (tests/blender/test_world.py, bench/world_bench.py):
+    a floor, Suzanne and a torus with Subdivision Surface, smooth shaded;
+    material(name, color) makes each one's material."""
+    bpy.ops.mesh.primitive_plane_add(size=8.0)
+    bpy.context.object.data.materials.append(material("Floor", (0.6, 0.6, 0.6)))
+    bpy.ops.mesh.primitive_monkey_add(location=(-0.8, 0.0, 0.75), rotation=(0.5, 0.0, 0.3))
+    monkey = bpy.context.object
+    bpy.ops.mesh.primitive_torus_add(location=(1.1, 0.3, 0.35), major_radius=0.6, minor_radius=0.25)
+    torus = bpy.context.object
+    for obj, color in ((monkey, (0.8, 0.5, 0.3)), (torus, (0.3, 0.5, 0.8))):
+        obj.modifiers.new("Subdivision", "SUBSURF").render_levels = 2
+        obj.data.materials.append(material(obj.name, color))
+        shade_smooth(obj)
+
+
 def add_displacement(mat, height, strength, midlevel=0.5):
     """Displaces the node material `mat` along its normal by the output
     socket `height` through a Displacement node of `strength` (Displacement

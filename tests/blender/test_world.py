@@ -27,19 +27,8 @@ MIN_DIFFUSE_DB = float(os.environ.get("MP_WORLD_MIN_DB", "30"))
 MIN_GLOSSY_DB = float(os.environ.get("MP_WORLD_MIN_GLOSSY_DB", "28"))
 
 
-def principled_material(name, color, roughness):
-    m, _ = ru.empty_material(name)
-    nodes = m.node_tree.nodes
-    bsdf = nodes.new("ShaderNodeBsdfPrincipled")
-    bsdf.inputs["Base Color"].default_value = (*color, 1.0)
-    bsdf.inputs["Roughness"].default_value = roughness
-    out = next(n for n in nodes if n.type == "OUTPUT_MATERIAL")
-    m.node_tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
-    return m
-
-
 def material(name, color, glossy):
-    return principled_material(name, color, 0.3) if glossy else ru.diffuse_material(name, color)
+    return ru.principled_material(name, color, 0.3) if glossy else ru.diffuse_material(name, color)
 
 
 def hdri_path(name):
@@ -66,26 +55,9 @@ def set_world(scene, hdri, rotation_z):
     background.inputs["Strength"].default_value = 1.0
 
 
-def smooth(obj):
-    bpy.ops.object.select_all(action="DESELECT")
-    obj.select_set(True)
-    bpy.context.view_layer.objects.active = obj
-    bpy.ops.object.shade_smooth()
-
-
 def build_scene(hdri, rotation_z=0.0, glossy=False):
     scene = ru.reset_scene()
-    bpy.ops.mesh.primitive_plane_add(size=8.0)
-    floor = bpy.context.object
-    floor.data.materials.append(material("Floor", (0.6, 0.6, 0.6), glossy))
-    bpy.ops.mesh.primitive_monkey_add(location=(-0.8, 0.0, 0.75), rotation=(0.5, 0.0, 0.3))
-    monkey = bpy.context.object
-    bpy.ops.mesh.primitive_torus_add(location=(1.1, 0.3, 0.35), major_radius=0.6, minor_radius=0.25)
-    torus = bpy.context.object
-    for obj, color in ((monkey, (0.8, 0.5, 0.3)), (torus, (0.3, 0.5, 0.8))):
-        obj.modifiers.new("Subdivision", "SUBSURF").render_levels = 2
-        obj.data.materials.append(material(obj.name, color, glossy))
-        smooth(obj)
+    ru.add_suzanne_torus_floor(lambda name, color: material(name, color, glossy))
     set_world(scene, hdri, rotation_z)
     ru.add_camera(scene, (0.0, -6.0, 3.2), (0.2, 0.0, 0.4), lens=40.0)
     return scene
@@ -149,7 +121,7 @@ def occlusion_scene(directions=None):
     bpy.ops.mesh.primitive_uv_sphere_add(radius=0.6, location=(0.0, 0.0, 0.6), segments=48, ring_count=24)
     ball = bpy.context.object
     ball.data.materials.append(ru.diffuse_material("Ball", (0.6, 0.6, 0.6)))
-    smooth(ball)
+    ru.shade_smooth(ball)
     set_world(scene, "forest.exr", 0.0)
     ru.add_camera(scene, (0.0, -5.0, 4.0), (0.0, 0.0, 0.3), lens=35.0)
     if directions is not None:

@@ -70,20 +70,7 @@ def sky_scene(model, rotation):
 
 def lit_scene(model):
     scene = ru.reset_scene()
-    bpy.ops.mesh.primitive_plane_add(size=8.0)
-    floor = bpy.context.object
-    floor.data.materials.append(ru.diffuse_material("Floor", (0.6, 0.6, 0.6)))
-    bpy.ops.mesh.primitive_monkey_add(location=(-0.8, 0.0, 0.75), rotation=(0.5, 0.0, 0.3))
-    monkey = bpy.context.object
-    bpy.ops.mesh.primitive_torus_add(location=(1.1, 0.3, 0.35), major_radius=0.6, minor_radius=0.25)
-    torus = bpy.context.object
-    for obj, color in ((monkey, (0.8, 0.5, 0.3)), (torus, (0.3, 0.5, 0.8))):
-        obj.modifiers.new("Subdivision", "SUBSURF").render_levels = 2
-        obj.data.materials.append(ru.diffuse_material(obj.name, color))
-        bpy.ops.object.select_all(action="DESELECT")
-        obj.select_set(True)
-        bpy.context.view_layer.objects.active = obj
-        bpy.ops.object.shade_smooth()
+    ru.add_suzanne_torus_floor(ru.diffuse_material)
     # The sun in front, to the left: shadows fall towards the camera's right.
     sky_world(scene, model, math.radians(35.0), math.radians(150.0), LIT_STRENGTH)
     ru.add_camera(scene, (0.0, -6.0, 3.2), (0.2, 0.0, 0.4), lens=40.0)
