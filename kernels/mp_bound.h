@@ -19,6 +19,7 @@
 #include "mp_surface.h"
 #include "mp_grid.h" /* mp_corner */
 #include "mp_occlusion.h"
+#include "mp_lens.h"
 
 #define MP_CULL 0u
 #define MP_DICE 1u
@@ -247,6 +248,14 @@ MP_INLINE float mp_polyline_screen_length(float3* p, int count, FrameParams f) {
     float2 d = mp_project_view(p[k + 1], f) - mp_project_view(p[k], f);
     len += sqrt(d.x * d.x + d.y * d.y);
   }
+  /* Out of focus, the target edge grows with the circle of confusion of the
+   * line's sharpest point (RenderMan's focus factor): a function of the
+   * line alone, so both sides of a shared edge still agree. */
+  if (mp_lens_on(f)) {
+    float coc = 3.0e38f;
+    for (int k = 0; k < count; ++k) coc = fmin(coc, mp_coc_diameter(f, -p[k].z));
+    len *= f.micropoly_edge / fmax(f.micropoly_edge, f.dof_dice_factor * coc);
+  }
   return len;
 }
 
@@ -399,10 +408,18 @@ MP_INLINE float mp_boxes_plane_max(const float3* lo, const float3* hi, int count
  * (w + r - bx) d - ax x >= 0, and likewise in y. */
 MP_INLINE int mp_boxes_beside_frustum(const float3* lo, const float3* hi, int count, FrameParams f) {
   float r = f.ribbon;
-  return mp_boxes_plane_max(lo, hi, count, f.ax, f.bx + r) < 0.0f ||
-         mp_boxes_plane_max(lo, hi, count, -f.ax, (float)f.width + r - f.bx) < 0.0f ||
-         mp_boxes_plane_max(lo, hi, count, f.ay, f.by + r) < 0.0f ||
-         mp_boxes_plane_max(lo, hi, count, -f.ay, (float)f.height + r - f.by) < 0.0f;
+  /* A lens widens the frustum into the union of those of its points. */
+  float sx = 0.0f, sy = 0.0f;
+  if (mp_lens_on(f)) {
+    float dmin = 3.0e38f, dmax = -3.0e38f;
+    for (int k = 0; k < count; ++k) dmin = fmin(dmin, -hi[k].z), dmax = fmax(dmax, -lo[k].z);
+    sx = mp_lens_plane_slack(f, f.ax, f.lens_radius * f.lens_x_scale, dmin, dmax);
+    sy = mp_lens_plane_slack(f, f.ay, f.lens_radius, dmin, dmax);
+  }
+  return mp_boxes_plane_max(lo, hi, count, f.ax, f.bx + r) + sx < 0.0f ||
+         mp_boxes_plane_max(lo, hi, count, -f.ax, (float)f.width + r - f.bx) + sx < 0.0f ||
+         mp_boxes_plane_max(lo, hi, count, f.ay, f.by + r) + sy < 0.0f ||
+         mp_boxes_plane_max(lo, hi, count, -f.ay, (float)f.height + r - f.by) + sy < 0.0f;
 }
 
 /* Whether view-space boxes with bound b lie outside the view: beyond its
@@ -414,9 +431,9 @@ MP_INLINE int mp_bound_culled(MpBound b, const float3* lo, const float3* hi, int
   if (b.dmax < f.clip_near || b.dmin > f.clip_far) return 1;
   int straddles = !f.ortho && b.dmin <= f.eye_epsilon;
   if (straddles) return !can_split || mp_boxes_beside_frustum(lo, hi, count, f);
-  if (b.xmax < -f.ribbon || b.ymax < -f.ribbon || b.xmin > (float)f.width + f.ribbon ||
-      b.ymin > (float)f.height + f.ribbon)
-    return 1;
+  /* Seen through a lens, a point may land anywhere in its circle of confusion. */
+  float rx = f.ribbon + mp_lens_slack_x(f, b.dmin, b.dmax), ry = f.ribbon + mp_lens_slack_y(f, b.dmin, b.dmax);
+  if (b.xmax < -rx || b.ymax < -ry || b.xmin > (float)f.width + rx || b.ymin > (float)f.height + ry) return 1;
   return f.view_kind == MP_VIEW_SHADOW && page_masks &&
          !mp_page_mask_overlaps(page_masks + f.page_mask, f.page_side, b.xmin - f.ribbon, b.ymin - f.ribbon,
                                 b.xmax + f.ribbon, b.ymax + f.ribbon);

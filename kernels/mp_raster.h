@@ -8,6 +8,7 @@
 
 #include "mp_compat.h"
 #include "mp_hash.h"
+#include "mp_lens.h"
 #include "mp_types.h"
 
 #define MP_SUBPIXEL_BITS 8
@@ -29,7 +30,12 @@ MP_INLINE long mp_to_fixed(float r) { return (long)floor(r * (float)MP_SUBPIXEL_
 #define MP_SAMPLE_TILE 32
 
 MP_INLINE uint mp_sample_offset_packed(int tx, int ty, int s, FrameParams f) {
-  int sx = s % f.spp_x, sy = s / f.spp_x;
+  /* With a lens, slot s is lens stratum s (mp_sample_lens); its position
+   * stratum is shuffled per pixel so the two do not follow each other. */
+  int p = mp_lens_on(f) ? (int)mp_permute((uint)s, (uint)(f.spp_x * f.spp_y),
+                                          mp_hash_combine(mp_hash32((uint)tx ^ f.seed), (uint)ty))
+                        : s;
+  int sx = p % f.spp_x, sy = p / f.spp_x;
   uint h = mp_hash_combine(mp_hash_combine(mp_hash32((uint)tx ^ f.seed), (uint)ty), (uint)s);
   float jx = mp_hash_unit(h), jy = mp_hash_unit(mp_hash32(h));
   uint ox = (uint)(((float)sx + jx) / (float)f.spp_x * (float)MP_SUBPIXEL_ONE);

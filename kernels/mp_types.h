@@ -77,6 +77,19 @@ typedef struct {
   int page_side;
   int page_origin_x, page_origin_y;
   uint page_mask;
+  /* Depth of field (the camera's view only; mp_lens.h): a thin lens of
+   * radius lens_radius (scene units, y; x is lens_radius * lens_x_scale, the
+   * anamorphic ratio) focused on the plane at depth focus_distance, with
+   * aperture_blades sides (0: round) turned by aperture_rotation radians.
+   * Sub-patches are diced by their blurred size: the target edge grows to
+   * dof_dice_factor times the circle of confusion's diameter where that is
+   * larger. lens_radius == 0: a pinhole. */
+  float lens_radius;
+  float lens_x_scale;
+  float focus_distance;
+  int aperture_blades;
+  float aperture_rotation;
+  float dof_dice_factor;
 } FrameParams;
 
 /* The camera view's occlusion pyramid (mp_occlusion.h): level 0 has a cell

@@ -103,6 +103,85 @@ inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVerte
       }
 }
 
+/* The quad as samples that carry lens positions see it (mp_lens.h): each
+ * sample slot s has its own bound, the quad's raster box over the lens
+ * positions its slot takes (lens[tile * spp + s], the box of slot s after
+ * the tile's entries: (lx0, lx1), (ly0, ly1)), and each sample in it moves
+ * the four vertices by its own lens position before the same fixed-point
+ * edge tests. Shared vertices move alike in every sample, so the grid stays
+ * watertight in each. Triangles keep the pinhole view's culling (`keep`). */
+inline void mp_raster_quad_lens(const float4* p, const float4* c, const float4* n, uint keep, uint mp_id, float opacity,
+                                FrameParams f, __global const ushort* offsets, __global const float2* lens, uint pass,
+                                volatile __global ulong* keys, __global float* colors, __global uint* normals) {
+  int spp = f.spp_x * f.spp_y;
+  float q[4], k[4];
+  for (int i = 0; i < 4; ++i) {
+    float inv = 1.0f / (-p[i].z);
+    q[i] = inv;
+    k[i] = 1.0f / f.focus_distance - inv;
+  }
+  __global const float2* slot_boxes = lens + MP_SAMPLE_TILE * MP_SAMPLE_TILE * spp;
+  for (int s = 0; s < spp; ++s) {
+    float2 bx = slot_boxes[2 * s], by = slot_boxes[2 * s + 1];
+    float xmin = 3.0e38f, xmax = -3.0e38f, ymin = 3.0e38f, ymax = -3.0e38f;
+    for (int i = 0; i < 4; ++i) {
+      float x0 = f.ax * (p[i].x * q[i] + bx.x * k[i]) + f.bx, x1 = f.ax * (p[i].x * q[i] + bx.y * k[i]) + f.bx;
+      float y0 = f.ay * (p[i].y * q[i] + by.x * k[i]) + f.by, y1 = f.ay * (p[i].y * q[i] + by.y * k[i]) + f.by;
+      xmin = fmin(xmin, fmin(x0, x1)), xmax = fmax(xmax, fmax(x0, x1));
+      ymin = fmin(ymin, fmin(y0, y1)), ymax = fmax(ymax, fmax(y0, y1));
+    }
+    /* One fixed-point unit of slack for the rounding of positions. */
+    long fx0 = mp_to_fixed(xmin) - 1, fx1 = mp_to_fixed(xmax) + 1, fy0 = mp_to_fixed(ymin) - 1, fy1 = mp_to_fixed(ymax) + 1;
+    int px0 = (int)max(fx0 >> MP_SUBPIXEL_BITS, (long)0), px1 = (int)min(fx1 >> MP_SUBPIXEL_BITS, (long)f.width - 1);
+    int py0 = (int)max(fy0 >> MP_SUBPIXEL_BITS, (long)0), py1 = (int)min(fy1 >> MP_SUBPIXEL_BITS, (long)f.height - 1);
+    for (int py = py0; py <= py1; ++py)
+      for (int px = px0; px <= px1; ++px) {
+        MpFixed2 sq = mp_sample_position(px, py, s, spp, f, offsets);
+        if (sq.x < fx0 || sq.x > fx1 || sq.y < fy0 || sq.y > fy1) continue;
+        int tx = (px + f.crop_x0) & (MP_SAMPLE_TILE - 1), ty = (py + f.crop_y0) & (MP_SAMPLE_TILE - 1);
+        float2 L = lens[(ty * MP_SAMPLE_TILE + tx) * spp + s];
+        MpRasterVertex v[4];
+        int ok = 1;
+        for (int i = 0; i < 4; ++i) {
+          float rx, ry, inv_d;
+          ok &= mp_project_lens(p[i].xyz, L, f, &rx, &ry, &inv_d);
+          ok &= fabs(rx) < MP_RASTER_GUARD && fabs(ry) < MP_RASTER_GUARD;
+          v[i].p.x = mp_to_fixed(rx);
+          v[i].p.y = mp_to_fixed(ry);
+          v[i].inv_d = inv_d;
+          v[i].c_over_d = c[i].xyz * inv_d;
+          v[i].n_over_d = n[i].xyz * inv_d;
+        }
+        if (!ok) continue;
+        MpTriangle tris[2];
+        tris[0] = mp_setup_triangle(v[0], v[1], v[2]);
+        tris[1] = mp_setup_triangle(v[0], v[2], v[3]);
+        tris[0].e.valid &= (int)(keep & 1u);
+        tris[1].e.valid &= (int)(keep >> 1);
+        float la, lb, lc;
+        int t = 0;
+        if (!mp_edge_triangle_covers(&tris[0].e, sq, &la, &lb, &lc)) {
+          t = 1;
+          if (!mp_edge_triangle_covers(&tris[1].e, sq, &la, &lb, &lc)) continue;
+        }
+        const MpTriangle* tri = &tris[t];
+        float d = 1.0f / (la * tri->a.inv_d + lb * tri->b.inv_d + lc * tri->c.inv_d);
+        if (!(d >= f.clip_near && d <= f.clip_far)) continue;
+        ulong index = ((ulong)py * (ulong)f.width + (ulong)px) * (ulong)spp + (ulong)s;
+        if (opacity < 1.0f && mp_hash_unit(mp_hash_combine(mp_id, (uint)index)) >= opacity) continue;
+        ulong key = ((ulong)as_uint(d) << 32) | (ulong)mp_id;
+        if (pass == MP_PASS_DEPTH) {
+          if (key < keys[index]) atom_min(&keys[index], key);
+        } else if (keys[index] == key) {
+          float3 col = (la * tri->a.c_over_d + lb * tri->b.c_over_d + lc * tri->c.c_over_d) * d;
+          float3 nrm = (la * tri->a.n_over_d + lb * tri->b.n_over_d + lc * tri->c.n_over_d) * d;
+          vstore3(col, index, colors);
+          if (f.normal_pass) normals[index] = mp_encode_normal(normalize(nrm));
+        }
+      }
+  }
+}
+
 /* Micropolygons that reach the rasteriser and their total screen area, summed
  * per work-group in local memory (one atomic per group): the dicing density
  * the benchmarks report as micropolygons per pixel of surface. */
@@ -150,7 +229,8 @@ void sample_micropolygons(__global const SubPatch* diceable, uint first, uint co
                                    __global const float4* grid_n, __global const ushort* sample_offsets, uint pass,
                                    volatile __global ulong* keys,
                                    __global float* colors, __global uint* normals, volatile __global ulong* totals,
-                                   __global uchar* occlusion_dirty, OcclusionParams occ) {
+                                   __global uchar* occlusion_dirty, OcclusionParams occ,
+                                   __global const float2* sample_lens) {
   __local ulong area_sum[64];
   __local uint count_sum[64];
   uint stride = (uint)f.max_grid + 1u;
@@ -168,12 +248,14 @@ void sample_micropolygons(__global const SubPatch* diceable, uint first, uint co
     live = mp_grid_micropolygon(&g, m, q);
   }
   MpRasterVertex v[4]; /* counter-clockwise in (u, v) */
+  float4 vp[4], vc[4], vn[4];
   ulong grid_base = (ulong)slot * stride * stride;
   if (live) {
     int ok = 1;
     for (int k = 0; k < 4; ++k) {
       ulong idx = grid_base + q[k];
-      v[k] = mp_raster_vertex(grid_p[idx], grid_c[idx], grid_n[idx], f, &ok);
+      vp[k] = grid_p[idx], vc[k] = grid_c[idx], vn[k] = grid_n[idx];
+      v[k] = mp_raster_vertex(vp[k], vc[k], vn[k], f, &ok);
     }
     live = ok;
   }
@@ -200,5 +282,8 @@ void sample_micropolygons(__global const SubPatch* diceable, uint first, uint co
   uint mp_id = mp_hash_combine(grid_id, m);
   float opacity = grid_c[grid_base + q[0]].w;
   if (pass == MP_PASS_DEPTH && occlusion_dirty) mp_mark_occlusion_cells(occlusion_dirty, occ, f, v[0].p, v[1].p, v[2].p, v[3].p);
-  mp_raster_quad(v[0], v[1], v[2], v[3], keep, mp_id, opacity, f, sample_offsets, pass, keys, colors, normals);
+  if (mp_lens_on(f))
+    mp_raster_quad_lens(vp, vc, vn, keep, mp_id, opacity, f, sample_offsets, sample_lens, pass, keys, colors, normals);
+  else
+    mp_raster_quad(v[0], v[1], v[2], v[3], keep, mp_id, opacity, f, sample_offsets, pass, keys, colors, normals);
 }

@@ -81,6 +81,40 @@ def export_camera(native_scene, scene, camera_object, width, height):
     native_scene.set_camera(_matrix(camera_object.matrix_world.inverted()), orthographic=cam.type == "ORTHO",
                             fov_degrees=90.0, clip_near=max(cam.clip_start, 1e-6), clip_far=cam.clip_end,
                             screen_window=window)
+    export_depth_of_field(native_scene, camera_object)
+
+
+def _focus_point(dof):
+    """World position of the depth of field's focus object (its bone's head
+    where a bone is named, Blender 4.x's focus_subtarget), or None."""
+    target = dof.focus_object
+    if target is None:
+        return None
+    bone = getattr(dof, "focus_subtarget", "")
+    if bone and target.type == "ARMATURE" and bone in target.pose.bones:
+        return target.matrix_world @ target.pose.bones[bone].head
+    return target.matrix_world.translation
+
+
+def export_depth_of_field(native_scene, camera_object):
+    """The camera's Depth of Field as Cycles reads it (blender/camera.cpp):
+    aperture radius = focal length / (2 f-stop) in scene units (the lens in
+    millimetres), the focus distance along the view axis (to the focus
+    object when one is set), blades < 3 a round aperture. Orthographic
+    cameras render without it (docs/blender.md)."""
+    cam = camera_object.data
+    dof = cam.dof
+    if not dof.use_dof or cam.type != "PERSP":
+        native_scene.set_depth_of_field(0.0, 1.0)
+        return
+    focus = dof.focus_distance
+    point = _focus_point(dof)
+    if point is not None:
+        axis = camera_object.matrix_world.to_3x3().col[2].normalized()
+        focus = abs(axis.dot(point - camera_object.matrix_world.translation))
+    radius = cam.lens * 1e-3 / (2.0 * max(dof.aperture_fstop, 1e-5))
+    native_scene.set_depth_of_field(radius, max(focus, 1e-5), dof.aperture_blades, dof.aperture_rotation,
+                                    dof.aperture_ratio)
 
 
 @dataclass

@@ -178,6 +178,21 @@ TEST(RibCamera, CameraTransformOrder) {
   expect_near(apply(r.scene.camera.world_to_camera, {1, 0, 0}), {0, 0, -6});
 }
 
+TEST(RibCamera, DepthOfFieldIsAThinLens) {
+  // Radius = focallength / (2 fstop), as RenderMan; the shape from Option "micropoly".
+  const mp::RibResult r = parse(
+      "Option \"micropoly\" \"integer apertureblades\" 6 \"float aperturerotation\" 0.5 \"float apertureratio\" 2\n"
+      "Projection \"perspective\" \"fov\" 40\nDepthOfField 2.8 0.05 3.5\nWorldBegin\nWorldEnd\n");
+  const mp::Camera& cam = r.scene.camera;
+  EXPECT_FLOAT_EQ(cam.lens_radius, 0.05f / 5.6f);
+  EXPECT_FLOAT_EQ(cam.focus_distance, 3.5f);
+  EXPECT_EQ(cam.aperture_blades, 6);
+  EXPECT_FLOAT_EQ(cam.aperture_rotation, 0.5f);
+  EXPECT_FLOAT_EQ(cam.aperture_ratio, 2.0f);
+  // No arguments: a pinhole again.
+  EXPECT_EQ(parse("DepthOfField 2.8 0.05 3.5\nDepthOfField\nWorldBegin\nWorldEnd\n").scene.camera.lens_radius, 0.0f);
+}
+
 TEST(RibCamera, ProjectionScreenWindowClipping) {
   mp::RibResult r = parse(
       "Projection \"orthographic\"\nScreenWindow -2 2 -1 1\nClipping 0.5 20\nWorldBegin\nWorldEnd\n");

@@ -82,6 +82,8 @@ TEST(RibErrors, WrongArgumentTypesAndCounts) {
   expect_error("Projection \"perspective\" \"fov\" 180\n", 1, "fov");
   expect_error("Projection \"perspective\" \"fov\" \"wide\"\n", 1, "expects numbers");
   expect_error("Clipping 0 10\n", 1, "0 < near < far");
+  expect_error("DepthOfField 0 0.05 3\n", 1, "fstop > 0");
+  expect_error("DepthOfField 2 0.05 -1\n", 1, "focaldistance > 0");
   expect_error("ScreenWindow 1 1 -1 1\n", 1, "empty screen window");
   expect_error("PixelSamples 1000 2\n", 1, "samples per axis");
   expect_error("PixelFilter \"box\" 0 1\n", 1, "filter widths");

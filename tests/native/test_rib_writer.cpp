@@ -83,6 +83,13 @@ void expect_same_camera(const Camera& a, const Camera& b) {
   // RenderMan needs near > 0: 0 comes back as the smallest positive float.
   EXPECT_EQ(a.clip_near > 0 ? a.clip_near : std::numeric_limits<float>::denorm_min(), b.clip_near);
   EXPECT_EQ(a.clip_far, b.clip_far);
+  EXPECT_EQ(a.lens_radius, b.lens_radius);
+  if (a.lens_radius > 0.0f) {
+    EXPECT_EQ(a.focus_distance, b.focus_distance);
+    EXPECT_EQ(a.aperture_blades, b.aperture_blades);
+    EXPECT_EQ(a.aperture_rotation, b.aperture_rotation);
+    EXPECT_EQ(a.aperture_ratio, b.aperture_ratio);
+  }
 }
 
 // The fields each model shades with (scene.h); the others have no effect.
@@ -931,6 +938,32 @@ TEST_F(RibWriterRender, FullSceneWithoutCropRendersTheSame) {
   s.settings.filter = PixelFilter::Gaussian;
   s.settings.filter_width = 2.0f;
   s.settings.bound_split = BoundSplitMethod::Bounded;
+  EXPECT_LE(max_difference(s), 1.0f / 255.0f);
+}
+
+// Depth of field travels as DepthOfField (radius = focallength / 2 fstop)
+// and the aperture's shape as Option "micropoly"; the image is the same.
+Scene defocused_scene() {
+  Scene s = full_scene();
+  s.camera.lens_radius = 0.37f;
+  s.camera.focus_distance = 4.3f;
+  s.camera.aperture_blades = 5;
+  s.camera.aperture_rotation = 0.3f;
+  s.camera.aperture_ratio = 1.7f;
+  s.settings.dof_dice_factor = 0.75f;
+  return s;
+}
+
+TEST(RibWriter, DepthOfFieldRoundTrips) {
+  const Scene s = defocused_scene();
+  const Scene back = round_trip(s);
+  expect_same_scene(s, back);
+  EXPECT_EQ(back.settings.dof_dice_factor, 0.75f);
+}
+
+TEST_F(RibWriterRender, DefocusedSceneRendersTheSame) {
+  Scene s = defocused_scene();
+  set_samples_per_pixel(s.settings, 4);
   EXPECT_LE(max_difference(s), 1.0f / 255.0f);
 }
 

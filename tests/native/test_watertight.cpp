@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <queue>
@@ -18,6 +19,8 @@
 #include <vector>
 
 #include "host_dicer.h"
+#include "mp_lens.h"
+#include "pipeline/frame_params.h"
 #include "renderer_fixture.h"
 #include "scene_fixtures.h"
 
@@ -132,11 +135,12 @@ TEST(Watertight, EverySharedGridEdgeMatchesBitForBit) {
 struct PinholeCount {
   int pinholes = 0, inside = 0;
 };
-PinholeCount count_pinholes(const RenderResult& r) {
+// `full`: the alpha from which a pixel counts as covered.
+PinholeCount count_pinholes(const RenderResult& r, float full_alpha = 1.0f - 1e-3f) {
   const int w = r.width, h = r.height;
   auto alpha = [&](int x, int y) { return r.rgba[(size_t(y) * w + x) * 4 + 3]; };
   auto depth = [&](int x, int y) { return r.depth[size_t(y) * w + x]; };
-  auto full = [&](int x, int y) { return alpha(x, y) >= 1.0f - 1e-3f; };
+  auto full = [&](int x, int y) { return alpha(x, y) >= full_alpha; };
   std::vector<char> seen(size_t(w) * h, 0);
   PinholeCount c;
   for (int y0 = 0; y0 < h; ++y0)
@@ -195,6 +199,63 @@ TEST_F(WatertightRender, NoPinholesInsideTheSilhouetteFrom50Views) {
   }
 }
 
+// Pixels farther than `reach` pixels (a square's half side) from any pixel
+// less than half covered or past a silhouette (depth more than 10% off the
+// pixel's: the torus' hole), and of those the ones with alpha below `full`.
+// Near a blurred silhouette coverage is legitimately partial (and noisy: a
+// pixel just inside the blur may miss one sample); farther in, a pixel that
+// misses a sample sees through a crack.
+PinholeCount count_deep_pinholes(const RenderResult& r, int reach, float full) {
+  const int w = r.width, h = r.height;
+  auto alpha = [&](int x, int y) { return r.rgba[(size_t(y) * w + x) * 4 + 3]; };
+  auto depth = [&](int x, int y) { return r.depth[size_t(y) * w + x]; };
+  PinholeCount c;
+  for (int y = reach; y < h - reach; ++y)
+    for (int x = reach; x < w - reach; ++x) {
+      bool deep = true;
+      const float d = depth(x, y);
+      for (int dy = -reach; dy <= reach && deep; ++dy)
+        for (int dx = -reach; dx <= reach && deep; ++dx)
+          deep = alpha(x + dx, y + dy) >= 0.5f && std::fabs(depth(x + dx, y + dy) - d) <= 0.1f * d;
+      if (!deep) continue;
+      ++c.inside;
+      c.pinholes += alpha(x, y) < full;
+    }
+  return c;
+}
+
+// Seen through a lens, every sample moves the grid's vertices alike, so a
+// defocused closed surface has no pinholes either: away from its blurred
+// silhouette, no pixel misses a sample (alpha below 1 - 0.5/spp with a box
+// filter; the torus' hole counts as silhouette).
+TEST_F(WatertightRender, NoPinholesOutOfFocus) {
+  std::mt19937 rng(1723);
+  for (const Closed& object : closed_surfaces()) {
+    int views_with_inside = 0;
+    for (int view = 0; view < 12; ++view) {
+      Scene s = view_scene(object, seeded_view(rng, object.radius), 160, 120);
+      s.settings.filter = PixelFilter::Box;
+      s.settings.filter_width = 1.0f;
+      const float distance = glm::length(glm::vec3(s.camera.world_to_camera[3]));
+      // In front of or behind the object by turns, a few pixels of blur.
+      s.camera.focus_distance = distance * (view % 2 ? 0.6f : 1.8f);
+      s.camera.lens_radius = 0.1f * object.radius;
+      s.camera.aperture_blades = view % 3 == 0 ? 6 : 0;
+      RenderResult r = renderer_->render(s);
+      const int spp = s.settings.samples_x * s.settings.samples_y;
+      // The largest circle of confusion over the object's depths, in pixels.
+      const FrameParams f = make_frame_setup(s).params;
+      const float dmin = std::max(distance - object.radius, 0.05f * distance), dmax = distance + object.radius;
+      const float coc = std::max(mp_coc_diameter(f, dmin), mp_coc_diameter(f, dmax));
+      PinholeCount c = count_deep_pinholes(r, int(std::ceil(coc)) + 1, 1.0f - 0.5f / float(spp));
+      views_with_inside += c.inside > 200;
+      EXPECT_EQ(c.pinholes, 0) << object.name << ", defocused view " << view << " of seed 1723: " << c.pinholes
+                               << " of " << c.inside << " inside pixels miss a sample";
+    }
+    EXPECT_GE(views_with_inside, 6) << object.name;
+  }
+}
+
 // The check itself finds cracks: one face of a grid, given vertices of its
 // own and shrunk by 2%, leaves a thin gap all round it.
 TEST_F(WatertightRender, PinholeCountSeesAGap) {
@@ -210,6 +271,13 @@ TEST_F(WatertightRender, PinholeCountSeesAGap) {
   }
   s.meshes = {m};
   EXPECT_GT(count_pinholes(renderer_->render(s)).pinholes, 20);
+  // And through a lens, with the threshold of NoPinholesOutOfFocus.
+  s.settings.filter = PixelFilter::Box;
+  s.settings.filter_width = 1.0f;
+  s.camera.lens_radius = 0.05f;
+  s.camera.focus_distance = 3.0f;
+  const int spp = s.settings.samples_x * s.settings.samples_y;
+  EXPECT_GT(count_deep_pinholes(renderer_->render(s), 3, 1.0f - 0.5f / float(spp)).pinholes, 20);
 }
 
 }  // namespace

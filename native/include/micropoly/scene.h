@@ -198,6 +198,16 @@ struct Camera {
   float screen_left = 0, screen_right = 0, screen_bottom = 0, screen_top = 0;
   float clip_near = 0.01f;
   float clip_far = 1.0e30f;
+  // Depth of field (a thin lens; perspective cameras): the aperture's radius
+  // in scene units (0: a pinhole), the distance in focus along the view
+  // axis, the aperture's polygon (blades < 3: round) and its rotation in
+  // radians, and the anamorphic ratio (the aperture's x is radius / ratio),
+  // as Cycles defines them.
+  float lens_radius = 0.0f;
+  float focus_distance = 10.0f;
+  int aperture_blades = 0;
+  float aperture_rotation = 0.0f;
+  float aperture_ratio = 1.0f;
 };
 
 enum class PixelFilter { Box, Gaussian, Triangle, BlackmanHarris };
@@ -238,6 +248,10 @@ struct RenderSettings {
   // The world's light is shadowed through this many probe directions
   // (world_lighting.h), each a soft-shadowed distant light.
   int world_probes = 16;
+  // Out of focus, a sub-patch's target micropolygon edge grows to this
+  // fraction of its circle of confusion's diameter where that is longer
+  // (RenderMan's focus factor): blurred surfaces are diced coarser. 0: off.
+  float dof_dice_factor = 0.5f;
 };
 
 struct Scene {

@@ -1,5 +1,6 @@
 #include "pipeline/micropolygon_stages.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <thread>
@@ -150,6 +151,14 @@ void SampleStage::sampled_totals(size_t& micropolygons, double& area_px) {
   area_px = static_cast<double>(t[1]) / (2.0 * MP_SUBPIXEL_ONE * MP_SUBPIXEL_ONE);
 }
 
+SamplePattern sample_pattern(const FrameParams& f) {
+  SamplePattern p;
+  p.spp_x = f.spp_x, p.spp_y = f.spp_y, p.seed = f.seed;
+  p.lens = mp_lens_on(f);
+  if (p.lens) p.blades = f.aperture_blades, p.radius = f.lens_radius, p.x_scale = f.lens_x_scale, p.rotation = f.aperture_rotation;
+  return p;
+}
+
 void SampleStage::mark_occlusion_cells(const cl::Buffer& dirty, const OcclusionParams& params) {
   kernel_.setArg(17, dirty);
   kernel_.setArg(18, params);
@@ -169,18 +178,37 @@ void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer) {
     normals_ = device_buffer(session_, samples * sizeof(cl_uint), "sample normal buffer");
     sample_capacity_ = samples;
   }
-  if (f.spp_x != spp_x_ || f.spp_y != spp_y_) {
-    // Sample positions of one tile (kernels/mp_raster.h), computed here once.
-    std::vector<cl_ushort> offsets(static_cast<size_t>(MP_SAMPLE_TILE) * MP_SAMPLE_TILE * spp);
+  const SamplePattern pattern = sample_pattern(f);
+  if (!(pattern == pattern_) || !offsets_()) {
+    // Sample positions (and lens positions) of one tile (kernels/mp_raster.h,
+    // mp_lens.h), computed here once.
+    const size_t tile = static_cast<size_t>(MP_SAMPLE_TILE) * MP_SAMPLE_TILE * spp;
+    std::vector<cl_ushort> offsets(tile);
+    // Lens positions per tile pixel and slot, then each slot's box (lx0,
+    // lx1), (ly0, ly1) over the tile: the bound the rasteriser uses per slot.
+    std::vector<cl_float2> lens(mp_lens_on(f) ? tile + 2 * size_t(spp) : 1, cl_float2{{0.0f, 0.0f}});
+    for (int s = 0; s < spp && mp_lens_on(f); ++s) {
+      lens[tile + 2 * s] = cl_float2{{3e38f, -3e38f}};
+      lens[tile + 2 * s + 1] = cl_float2{{3e38f, -3e38f}};
+    }
     for (int ty = 0; ty < MP_SAMPLE_TILE; ++ty)
       for (int tx = 0; tx < MP_SAMPLE_TILE; ++tx)
-        for (int s = 0; s < spp; ++s)
-          offsets[(static_cast<size_t>(ty) * MP_SAMPLE_TILE + tx) * spp + s] =
-              static_cast<cl_ushort>(mp_sample_offset_packed(tx, ty, s, f));
+        for (int s = 0; s < spp; ++s) {
+          const size_t i = (static_cast<size_t>(ty) * MP_SAMPLE_TILE + tx) * spp + s;
+          offsets[i] = static_cast<cl_ushort>(mp_sample_offset_packed(tx, ty, s, f));
+          if (!mp_lens_on(f)) continue;
+          const float2 l = mp_sample_lens(tx, ty, s, f);
+          lens[i] = cl_float2{{l.x, l.y}};
+          cl_float2& bx = lens[tile + 2 * s];
+          cl_float2& by = lens[tile + 2 * s + 1];
+          bx.s[0] = std::min(bx.s[0], l.x), bx.s[1] = std::max(bx.s[1], l.x);
+          by.s[0] = std::min(by.s[0], l.y), by.s[1] = std::max(by.s[1], l.y);
+        }
     offsets_ = cl::Buffer(session_.context(), CL_MEM_READ_ONLY, offsets.size() * sizeof(cl_ushort));
     session_.queue().enqueueWriteBuffer(offsets_, CL_TRUE, 0, offsets.size() * sizeof(cl_ushort), offsets.data());
-    spp_x_ = f.spp_x;
-    spp_y_ = f.spp_y;
+    lens_ = cl::Buffer(session_.context(), CL_MEM_READ_ONLY, lens.size() * sizeof(cl_float2));
+    session_.queue().enqueueWriteBuffer(lens_, CL_TRUE, 0, lens.size() * sizeof(cl_float2), lens.data());
+    pattern_ = pattern;
   }
   cl_ulong zero = 0;
   session_.queue().enqueueFillBuffer(totals_, zero, 0, 2 * sizeof zero);
@@ -214,6 +242,7 @@ void SampleStage::run(const cl::Buffer& diceable, cl_uint first, cl_uint count, 
   kernel_.setArg(14, colors_);
   kernel_.setArg(15, normals_);
   kernel_.setArg(16, totals_);
+  kernel_.setArg(19, lens_);
   // Pass 0 finds each sample's nearest key; pass 1 lets its owner write.
   for (cl_uint pass = 0; pass < 2; ++pass) {
     kernel_.setArg(12, pass);
@@ -257,7 +286,8 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
     return cl_float4{{r.x, r.y, r.z, 0.0f}};
   };
   filter_width = std::max(filter_width, 1e-3f);
-  if (type != weights_type_ || filter_width != weights_width_ || f.spp_x != weights_spp_x_ || f.spp_y != weights_spp_y_) {
+  const SamplePattern pattern = sample_pattern(f);
+  if (type != weights_type_ || filter_width != weights_width_ || !(pattern == weights_pattern_)) {
     const int reach = static_cast<int>(std::ceil(0.5f * filter_width - 0.5f)), side = 2 * reach + 1;
     const int spp = f.spp_x * f.spp_y;
     const size_t count = size_t(MP_SAMPLE_TILE) * MP_SAMPLE_TILE * side * side * spp;
@@ -280,7 +310,7 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
     }
     weights_ = cl::Buffer(session_.context(), CL_MEM_READ_ONLY, w.size() * sizeof(float));
     session_.queue().enqueueWriteBuffer(weights_, CL_TRUE, 0, w.size() * sizeof(float), w.data());
-    weights_type_ = type, weights_width_ = filter_width, weights_spp_x_ = f.spp_x, weights_spp_y_ = f.spp_y;
+    weights_type_ = type, weights_width_ = filter_width, weights_pattern_ = pattern;
   }
   kernel_.setArg(0, f);
   kernel_.setArg(1, type);

@@ -13,6 +13,20 @@
 
 namespace mp {
 
+// What the per-tile sample tables (positions, lens positions) and the
+// resolve's filter weights depend on.
+struct SamplePattern {
+  int spp_x = 0, spp_y = 0;
+  cl_uint seed = 0;
+  int lens = 0, blades = 0;
+  float radius = 0, x_scale = 0, rotation = 0;
+  bool operator==(const SamplePattern& o) const {
+    return spp_x == o.spp_x && spp_y == o.spp_y && seed == o.seed && lens == o.lens && blades == o.blades &&
+           radius == o.radius && x_scale == o.x_scale && rotation == o.rotation;
+  }
+};
+SamplePattern sample_pattern(const FrameParams& f);
+
 struct GridBuffers {
   GridBuffers(DeviceSession& session, cl_uint capacity, int max_grid);
   cl::Buffer p, n, c;  // float4 per grid vertex
@@ -99,9 +113,9 @@ class SampleStage {
   DeviceSession& session_;
   cl::Kernel kernel_;
   cl::Kernel clear_;
-  cl::Buffer keys_, colors_, normals_, offsets_, totals_;
+  cl::Buffer keys_, colors_, normals_, offsets_, lens_, totals_;
   size_t sample_capacity_ = 0;  // samples the buffers hold (they only grow)
-  int spp_x_ = 0, spp_y_ = 0;
+  SamplePattern pattern_;
 };
 
 class ResolveStage {
@@ -123,7 +137,8 @@ class ResolveStage {
   // rebuilt when the filter or the sampling pattern changes.
   cl::Buffer weights_;
   bool use_weights_ = false;
-  int weights_type_ = -1, weights_spp_x_ = 0, weights_spp_y_ = 0;
+  int weights_type_ = -1;
+  SamplePattern weights_pattern_;
   float weights_width_ = 0;
   // On discrete GPUs the image is read back through a pinned (page-locked)
   // staging buffer, which the driver copies into at full bus speed.

@@ -16,6 +16,7 @@
 #include "pipeline/scene_fingerprint.h"
 #include "pipeline/shadow_maps.h"
 #include "pipeline/world_lighting.h"
+#include "mp_lens.h"
 
 namespace mp {
 namespace {
@@ -215,7 +216,9 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       keep_going(0.0f);
     }
     PassOcclusion camera_occlusion;
-    if (scene.settings.occlusion_culling) {
+    // A blurred occluder hides only part of what lies behind it: culling
+    // against the pinhole view's depths would lose what the lens sees past it.
+    if (scene.settings.occlusion_culling && !mp_lens_on(f)) {
       OcclusionCulling& occ = impl_->occlusion;
       occ.begin_frame(f, timer);
       camera_occlusion.pyramid = occ.pyramid();

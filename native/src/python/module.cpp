@@ -174,7 +174,8 @@ PYBIND11_MODULE(_native, m) {
       .def_readwrite("keep_shadow_pages", &RenderSettings::keep_shadow_pages)
       .def_readwrite("soft_shadow_pages", &RenderSettings::soft_shadow_pages)
       .def_readwrite("occlusion_culling", &RenderSettings::occlusion_culling)
-      .def_readwrite("world_probes", &RenderSettings::world_probes);
+      .def_readwrite("world_probes", &RenderSettings::world_probes)
+      .def_readwrite("dof_dice_factor", &RenderSettings::dof_dice_factor);
 
   py::class_<Scene>(m, "Scene")
       .def(py::init<>())
@@ -197,6 +198,19 @@ PYBIND11_MODULE(_native, m) {
           py::arg("world_to_camera"), py::arg("orthographic") = false, py::arg("fov_degrees") = 90.0f,
           py::arg("clip_near") = 0.01f, py::arg("clip_far") = 1e30f, py::arg("screen_window") = std::vector<float>{},
           "Camera looking down -Z of its space (Blender's convention); world_to_camera is row-major.")
+      .def(
+          "set_depth_of_field",
+          [](Scene& s, float lens_radius, float focus_distance, int blades, float rotation, float ratio) {
+            s.camera.lens_radius = lens_radius;
+            s.camera.focus_distance = focus_distance;
+            s.camera.aperture_blades = blades;
+            s.camera.aperture_rotation = rotation;
+            s.camera.aperture_ratio = ratio;
+          },
+          py::arg("lens_radius"), py::arg("focus_distance"), py::arg("blades") = 0, py::arg("rotation") = 0.0f,
+          py::arg("ratio") = 1.0f,
+          "Thin-lens depth of field: aperture radius (scene units; 0 turns it off), distance in focus along the "
+          "view axis, aperture polygon (blades < 3: round), its rotation (radians) and anamorphic ratio, as Cycles.")
       .def(
           "add_material",
           [](Scene& s, const std::string& name, const std::string& model, std::vector<float> color,

@@ -71,11 +71,20 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   s.shadow_shading_rate = params.get_float_checked("shadowshadingrate", s.shadow_shading_rate, positive,
                                                    "a positive number");
   params.get_int("worldshadowdirections", 0, 64, &s.world_probes);
+  // Depth of field beyond RiDepthOfField: Cycles' aperture shape and the
+  // coarser dicing of blurred surfaces.
+  Camera& cam = result_.scene.camera;
+  params.get_int("apertureblades", 0, 1000, &cam.aperture_blades);
+  cam.aperture_rotation = params.get_float_checked("aperturerotation", cam.aperture_rotation,
+                                                   [](float v) { return std::isfinite(v); }, "a finite angle in radians");
+  cam.aperture_ratio = params.get_float_checked("apertureratio", cam.aperture_ratio, positive, "a positive number");
+  s.dof_dice_factor = params.get_float_checked("focusfactor", s.dof_dice_factor,
+                                               [](float v) { return v >= 0.0f && std::isfinite(v); }, "a number >= 0");
   const int line = args.request().line;
   warn_unknown(params,
                {"boundsplit", "boundsplitmemory", "maxgridsize", "maxsplitdepth", "backfaceculling",
                 "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate", "occlusionculling",
-                "worldshadowdirections"},
+                "worldshadowdirections", "apertureblades", "aperturerotation", "apertureratio", "focusfactor"},
                [&](const std::string& name) {
                  warn_once("option-micropoly:" + name, line,
                            "Option \"micropoly\": parameter \"" + name + "\" is ignored");

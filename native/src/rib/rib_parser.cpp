@@ -65,6 +65,7 @@ const std::unordered_map<std::string, Parser::Handler>& Parser::handlers() {
       {"ScreenWindow", &Parser::req_screen_window},
       {"CropWindow", &Parser::req_crop_window},
       {"Clipping", &Parser::req_clipping},
+      {"DepthOfField", &Parser::req_depth_of_field},
       {"PixelSamples", &Parser::req_pixel_samples},
       {"PixelFilter", &Parser::req_pixel_filter},
       {"ShadingRate", &Parser::req_shading_rate},
@@ -394,6 +395,25 @@ void Parser::req_clipping(ArgReader& args) {
   if (!(near_z > 0.0) || !(far_z > near_z)) args.fail("needs 0 < near < far");
   result_.scene.camera.clip_near = static_cast<float>(near_z);
   result_.scene.camera.clip_far = static_cast<float>(far_z);
+}
+
+// DepthOfField fstop focallength focaldistance: a thin lens of radius
+// focallength / (2 fstop) in camera units, focused at focaldistance
+// (RenderMan's RiDepthOfField); no arguments, or an infinite f-stop, is a
+// pinhole. The aperture's shape comes from Option "micropoly".
+void Parser::req_depth_of_field(ArgReader& args) {
+  Camera& cam = result_.scene.camera;
+  if (args.at_end()) {
+    cam.lens_radius = 0.0f;
+    return;
+  }
+  const std::vector<double> v = args.numbers(3);
+  args.done();
+  const double fstop = v[0], focal = v[1], focus = v[2];
+  if (!(fstop > 0.0) || !(focal >= 0.0) || !std::isfinite(focal) || !(focus > 0.0) || !std::isfinite(focus))
+    args.fail("needs fstop > 0, focallength >= 0 and focaldistance > 0");
+  cam.lens_radius = std::isfinite(fstop) ? static_cast<float>(focal / (2.0 * fstop)) : 0.0f;
+  cam.focus_distance = static_cast<float>(focus);
 }
 
 void Parser::req_pixel_samples(ArgReader& args) {

@@ -164,6 +164,7 @@ class Parser {
   void req_screen_window(ArgReader&);
   void req_crop_window(ArgReader&);
   void req_clipping(ArgReader&);
+  void req_depth_of_field(ArgReader&);
   void req_pixel_samples(ArgReader&);
   void req_pixel_filter(ArgReader&);
   void req_shading_rate(ArgReader&);

@@ -184,7 +184,7 @@ const char* filter_name(PixelFilter f) {
   return "gaussian";
 }
 
-void write_options(std::string& o, const RenderSettings& s) {
+void write_options(std::string& o, const RenderSettings& s, const Camera& c) {
   // Settings with no RenderMan request (docs/rib.md, "Option micropoly").
   o += "Option \"micropoly\"";
   param(o, "string boundsplit", s.bound_split == BoundSplitMethod::Breadth ? "breadth" : "bounded");
@@ -204,6 +204,12 @@ void write_options(std::string& o, const RenderSettings& s) {
     param(o, "integer occlusionculling", static_cast<long long>(s.occlusion_culling ? 1 : 0));
   if (s.world_probes != def.world_probes)
     param(o, "integer worldshadowdirections", static_cast<long long>(s.world_probes));
+  if (differs(s.dof_dice_factor, def.dof_dice_factor)) param(o, "float focusfactor", s.dof_dice_factor);
+  if (c.lens_radius > 0.0f) {
+    param(o, "integer apertureblades", static_cast<long long>(c.aperture_blades));
+    param(o, "float aperturerotation", c.aperture_rotation);
+    param(o, "float apertureratio", c.aperture_ratio);
+  }
   o += '\n';
 }
 
@@ -242,6 +248,14 @@ void write_image_and_camera(std::string& o, const Scene& scene) {
     o += "Projection \"perspective\"";
     param(o, "fov", c.fov_degrees);
     o += '\n';
+    // Radius = focallength / (2 fstop): written with fstop 1, exact in float.
+    if (c.lens_radius > 0.0f) {
+      o += "DepthOfField 1 ";
+      put_float(o, 2.0f * c.lens_radius);
+      o += ' ';
+      put_float(o, c.focus_distance);
+      o += '\n';
+    }
   } else {
     o += "Projection \"orthographic\"\n";
   }
@@ -575,7 +589,7 @@ void write_valid_scene(const Scene& scene, std::ostream& out, const std::string&
   o += "##RenderMan RIB\n# Written by Micropoly ";
   o += MICROPOLY_VERSION;
   o += "; the micropoly extensions are described in docs/rib.md.\nversion 3.04\n";
-  write_options(o, scene.settings);
+  write_options(o, scene.settings, scene.camera);
   write_images(o, scene.images, image_folder, image_reference);
   o += "FrameBegin 1\n";
   if (!display_name.empty()) {

@@ -121,6 +121,18 @@ void validate_scene(const Scene& scene) {
   bool window_set = c.screen_right != c.screen_left || c.screen_top != c.screen_bottom;
   if (window_set && !(c.screen_right > c.screen_left && c.screen_top > c.screen_bottom))
     throw Error("camera screen window must have left < right and bottom < top");
+  if (!(c.lens_radius >= 0) || !std::isfinite(c.lens_radius))
+    throw Error("camera aperture radius must be a finite number >= 0");
+  if (c.lens_radius > 0) {
+    if (!(c.focus_distance > 0) || !std::isfinite(c.focus_distance))
+      throw Error("camera focus distance must be a positive number when depth of field is on");
+    if (!(c.aperture_ratio > 0) || !std::isfinite(c.aperture_ratio))
+      throw Error("camera aperture ratio must be a positive number");
+    if (!std::isfinite(c.aperture_rotation) || c.aperture_blades < 0)
+      throw Error("camera aperture blades must be >= 0 and its rotation finite");
+  }
+  if (!(s.dof_dice_factor >= 0) || !std::isfinite(s.dof_dice_factor))
+    throw Error("defocus dicing factor must be a finite number >= 0");
 
   for (size_t i = 0; i < scene.materials.size(); ++i) {
     const Material& m = scene.materials[i];
