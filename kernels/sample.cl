@@ -58,6 +58,29 @@ inline MpTriangle mp_setup_triangle(MpRasterVertex a, MpRasterVertex b, MpRaster
   return t;
 }
 
+/* Sample s of pixel (px, py), covered by triangle t at barycentrics (la,
+ * lb, lc): within the clip range and the stochastic opacity, the depth pass
+ * keeps the nearest key and the attribute pass lets its owner write. */
+inline void mp_sample_write(const MpTriangle* t, float la, float lb, float lc, int px, int py, int s, int spp,
+                            uint mp_id, float opacity, FrameParams f, uint pass, volatile __global ulong* keys,
+                            __global float* colors, __global uint* normals) {
+  float inv_d = la * t->a.inv_d + lb * t->b.inv_d + lc * t->c.inv_d;
+  float d = f.ortho ? inv_d : 1.0f / inv_d;
+  if (!(d >= f.clip_near && d <= f.clip_far)) return;
+  ulong index = ((ulong)py * (ulong)f.width + (ulong)px) * (ulong)spp + (ulong)s;
+  if (opacity < 1.0f && mp_hash_unit(mp_hash_combine(mp_id, (uint)index)) >= opacity) return;
+  ulong key = ((ulong)as_uint(d) << 32) | (ulong)mp_id;
+  if (pass == MP_PASS_DEPTH) {
+    if (key < keys[index]) atom_min(&keys[index], key);
+  } else if (keys[index] == key) {
+    float w = f.ortho ? 1.0f : d;
+    float3 col = (la * t->a.c_over_d + lb * t->b.c_over_d + lc * t->c.c_over_d) * w;
+    float3 nrm = (la * t->a.n_over_d + lb * t->b.n_over_d + lc * t->c.n_over_d) * w;
+    vstore3(col, index, colors);
+    if (f.normal_pass) normals[index] = mp_encode_normal(normalize(nrm));
+  }
+}
+
 /* Rasterises the quad's triangles (v00, v10, v11) and (v00, v11, v01) that
  * `keep` selects (bit 0 and bit 1). */
 inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVertex v11, MpRasterVertex v01, uint keep,
@@ -84,22 +107,7 @@ inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVerte
           k = 1;
           if (!mp_edge_triangle_covers(&tris[1].e, q, &la, &lb, &lc)) continue;
         }
-        const MpTriangle* t = &tris[k];
-        float inv_d = la * t->a.inv_d + lb * t->b.inv_d + lc * t->c.inv_d;
-        float d = f.ortho ? inv_d : 1.0f / inv_d;
-        if (!(d >= f.clip_near && d <= f.clip_far)) continue;
-        ulong index = ((ulong)py * (ulong)f.width + (ulong)px) * (ulong)spp + (ulong)s;
-        if (opacity < 1.0f && mp_hash_unit(mp_hash_combine(mp_id, (uint)index)) >= opacity) continue;
-        ulong key = ((ulong)as_uint(d) << 32) | (ulong)mp_id;
-        if (pass == MP_PASS_DEPTH) {
-          if (key < keys[index]) atom_min(&keys[index], key);
-        } else if (keys[index] == key) {
-          float w = f.ortho ? 1.0f : d;
-          float3 col = (la * t->a.c_over_d + lb * t->b.c_over_d + lc * t->c.c_over_d) * w;
-          float3 nrm = (la * t->a.n_over_d + lb * t->b.n_over_d + lc * t->c.n_over_d) * w;
-          vstore3(col, index, colors);
-          if (f.normal_pass) normals[index] = mp_encode_normal(normalize(nrm));
-        }
+        mp_sample_write(&tris[k], la, lb, lc, px, py, s, spp, mp_id, opacity, f, pass, keys, colors, normals);
       }
 }
 
@@ -164,20 +172,7 @@ inline void mp_raster_quad_lens(const float4* p, const float4* c, const float4* 
           t = 1;
           if (!mp_edge_triangle_covers(&tris[1].e, sq, &la, &lb, &lc)) continue;
         }
-        const MpTriangle* tri = &tris[t];
-        float d = 1.0f / (la * tri->a.inv_d + lb * tri->b.inv_d + lc * tri->c.inv_d);
-        if (!(d >= f.clip_near && d <= f.clip_far)) continue;
-        ulong index = ((ulong)py * (ulong)f.width + (ulong)px) * (ulong)spp + (ulong)s;
-        if (opacity < 1.0f && mp_hash_unit(mp_hash_combine(mp_id, (uint)index)) >= opacity) continue;
-        ulong key = ((ulong)as_uint(d) << 32) | (ulong)mp_id;
-        if (pass == MP_PASS_DEPTH) {
-          if (key < keys[index]) atom_min(&keys[index], key);
-        } else if (keys[index] == key) {
-          float3 col = (la * tri->a.c_over_d + lb * tri->b.c_over_d + lc * tri->c.c_over_d) * d;
-          float3 nrm = (la * tri->a.n_over_d + lb * tri->b.n_over_d + lc * tri->c.n_over_d) * d;
-          vstore3(col, index, colors);
-          if (f.normal_pass) normals[index] = mp_encode_normal(normalize(nrm));
-        }
+        mp_sample_write(&tris[t], la, lb, lc, px, py, s, spp, mp_id, opacity, f, pass, keys, colors, normals);
       }
   }
 }
