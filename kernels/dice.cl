@@ -75,3 +75,39 @@ __kernel void displaced_normals(__global const SubPatch* diceable, uint count, _
   n /= len;
   grid_n[index] = (float4)(dot(n, old) < 0.0f ? -n : n, 0.0f);
 }
+
+/* Motion blur: the positions of the same grid vertices at one motion step,
+ * from that step's control points and edge curves (the same patches, moved),
+ * (points + point_offset, curves + curve_offset) into grid_p + out_offset.
+ * The same (u, v) and the same edge rates as the shutter centre's grid, so
+ * shared edges stay shared at every step. */
+__kernel void dice_motion_positions(__global const SubPatch* diceable, uint count, __global const float4* points,
+                                    ulong point_offset, __global const uint* patch_info, __global const uint* edges,
+                                    __global const float4* curves, ulong curve_offset, FrameParams f,
+                                    __global float4* grid_p, ulong out_offset, __global const uint* vertex_offsets) {
+  uint gid = get_global_id(0), i, j;
+  SubPatch sp;
+  float2 uv;
+  ulong index;
+  if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
+  float3 p, dpdu, dpdv;
+  mp_surface_point(points + point_offset, patch_info, edges, curves + curve_offset, sp.patch, uv.x, uv.y, &p, &dpdu,
+                   &dpdv);
+  grid_p[out_offset + index] = (float4)(p, 1.0f);
+}
+
+/* Motion blur of displaced grids: the displacement the shutter centre's
+ * grid received (grid_p - rest) moves each step's vertex alike (a
+ * translation: the surface's turn during the shutter does not turn it). */
+__kernel void motion_displacement(__global const SubPatch* diceable, uint count, FrameParams f,
+                                  __global const float4* grid_p, __global const float4* rest, __global float4* steps,
+                                  ulong stride, int step_count, __global const uint* vertex_offsets) {
+  uint gid = get_global_id(0), i, j;
+  SubPatch sp;
+  float2 uv;
+  ulong index;
+  if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
+  float4 d = grid_p[index] - rest[index];
+  if (d.x == 0.0f && d.y == 0.0f && d.z == 0.0f) return;
+  for (int k = 0; k < step_count; ++k) steps[(ulong)k * stride + index] += (float4)(d.xyz, 0.0f);
+}

@@ -19,7 +19,7 @@
 #include "mp_surface.h"
 #include "mp_grid.h" /* mp_corner */
 #include "mp_occlusion.h"
-#include "mp_lens.h"
+#include "mp_blur.h"
 
 #define MP_CULL 0u
 #define MP_DICE 1u
@@ -111,10 +111,14 @@ MP_INLINE void mp_subpatch_hull(const MP_GLOBAL float4* cp, uint type, const Sub
   float v1 = fmax(fmax(sp->corner[1], sp->corner[3]), fmax(sp->corner[5], sp->corner[7]));
   mp_subpatch_net_boxes(cp, type, u0, v0, u1, v1, lo, hi);
   float reach = MP_PATCH_DISPLACEMENT_BOUND(cp);
-  if (reach > 0.0f)
+  /* Moving patches: the sub-net at every step lies within the centre's
+   * boxes grown by the patch's motion reach (its points are the same convex
+   * combinations of control points that each moved at most that far). */
+  float3 grow = MP_F3(reach, reach, reach) + MP_PATCH_MOTION_REACH(cp);
+  if (grow.x > 0.0f || grow.y > 0.0f || grow.z > 0.0f)
     for (int k = 0; k < 16; ++k) {
-      lo[k] -= MP_F3(reach, reach, reach);
-      hi[k] += MP_F3(reach, reach, reach);
+      lo[k] -= grow;
+      hi[k] += grow;
     }
 }
 

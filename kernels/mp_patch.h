@@ -36,6 +36,9 @@
 /* The w of the first control point is the patch's displacement bound: how
  * far (camera space) its material's displacement can move the surface. */
 #define MP_PATCH_DISPLACEMENT_BOUND(cp) ((cp)[0].w)
+/* Motion blur: how far (camera x, y, z) the patch's control points move
+ * away from these, the shutter centre's, during the shutter. */
+#define MP_PATCH_MOTION_REACH(cp) MP_F3((cp)[1].w, (cp)[2].w, (cp)[3].w)
 
 /* Patch edges. Edge e of a patch is the boundary curve v = 0 (e = 0), u = 1
  * (e = 1), v = 1 (e = 2) or u = 0 (e = 3), parametrised by u (e = 0, 2) or v

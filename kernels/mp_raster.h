@@ -8,7 +8,7 @@
 
 #include "mp_compat.h"
 #include "mp_hash.h"
-#include "mp_lens.h"
+#include "mp_blur.h"
 #include "mp_types.h"
 
 #define MP_SUBPIXEL_BITS 8
@@ -30,9 +30,9 @@ MP_INLINE long mp_to_fixed(float r) { return (long)floor(r * (float)MP_SUBPIXEL_
 #define MP_SAMPLE_TILE 32
 
 MP_INLINE uint mp_sample_offset_packed(int tx, int ty, int s, FrameParams f) {
-  /* With a lens, slot s is lens stratum s (mp_sample_lens); its position
+  /* Blurred, slot s is a time or lens stratum (mp_blur.h); its position
    * stratum is shuffled per pixel so the two do not follow each other. */
-  int p = mp_lens_on(f) ? (int)mp_permute((uint)s, (uint)(f.spp_x * f.spp_y),
+  int p = mp_blur_on(f) ? (int)mp_permute((uint)s, (uint)(f.spp_x * f.spp_y),
                                           mp_hash_combine(mp_hash32((uint)tx ^ f.seed), (uint)ty))
                         : s;
   int sx = p % f.spp_x, sy = p / f.spp_x;

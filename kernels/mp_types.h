@@ -77,7 +77,7 @@ typedef struct {
   int page_side;
   int page_origin_x, page_origin_y;
   uint page_mask;
-  /* Depth of field (the camera's view only; mp_lens.h): a thin lens of
+  /* Depth of field (the camera's view only; mp_blur.h): a thin lens of
    * radius lens_radius (scene units, y; x is lens_radius * lens_x_scale, the
    * anamorphic ratio) focused on the plane at depth focus_distance, with
    * aperture_blades sides (0: round) turned by aperture_rotation radians.
@@ -90,6 +90,9 @@ typedef struct {
   int aperture_blades;
   float aperture_rotation;
   float dof_dice_factor;
+  /* Motion blur (the camera's view only): grid vertices have positions at
+   * motion_steps times evenly spread over the shutter; 0: no motion. */
+  int motion_steps;
 } FrameParams;
 
 /* The camera view's occlusion pyramid (mp_occlusion.h): level 0 has a cell

@@ -111,35 +111,82 @@ inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVerte
       }
 }
 
-/* The quad as samples that carry lens positions see it (mp_lens.h): each
- * sample slot s has its own bound, the quad's raster box over the lens
- * positions its slot takes (lens[tile * spp + s], the box of slot s after
- * the tile's entries: (lx0, lx1), (ly0, ly1)), and each sample in it moves
- * the four vertices by its own lens position before the same fixed-point
- * edge tests. Shared vertices move alike in every sample, so the grid stays
- * watertight in each. Triangles keep the pinhole view's culling (`keep`). */
-inline void mp_raster_quad_lens(const float4* p, const float4* c, const float4* n, uint keep, uint mp_id, float opacity,
-                                FrameParams f, __global const ushort* offsets, __global const float2* lens, uint pass,
+/* Raster vertex of view-space point p seen from lens position L (zero
+ * without a lens), with its attributes; 0 where it cannot be rasterised. */
+inline int mp_blur_vertex(float3 p, float2 L, float4 c, float4 n, FrameParams f, MpRasterVertex* v) {
+  float rx, ry, inv_d;
+  if (f.ortho) {
+    rx = f.ax * p.x + f.bx, ry = f.ay * p.y + f.by, inv_d = -p.z;
+  } else if (!mp_project_lens(p, L, f, &rx, &ry, &inv_d)) {
+    return 0;
+  }
+  if (!(fabs(rx) < MP_RASTER_GUARD && fabs(ry) < MP_RASTER_GUARD)) return 0;
+  float w = f.ortho ? 1.0f : inv_d;
+  v->p.x = mp_to_fixed(rx);
+  v->p.y = mp_to_fixed(ry);
+  v->inv_d = inv_d;
+  v->c_over_d = c.xyz * w;
+  v->n_over_d = n.xyz * w;
+  return 1;
+}
+
+/* Grows the raster box by view-space point p seen from every lens position
+ * of the box bx (x range) by (y range); 0 where p is behind the lens. */
+inline int mp_blur_box(float3 p, float2 bx, float2 by, FrameParams f, float* box) {
+  float x0, x1, y0, y1;
+  if (f.ortho) {
+    x0 = x1 = f.ax * p.x + f.bx, y0 = y1 = f.ay * p.y + f.by;
+  } else {
+    float d = -p.z;
+    if (!(d > 0.0f)) return 0;
+    float inv = 1.0f / d, k = 1.0f / f.focus_distance - inv;
+    x0 = f.ax * (p.x * inv + bx.x * k) + f.bx, x1 = f.ax * (p.x * inv + bx.y * k) + f.bx;
+    y0 = f.ay * (p.y * inv + by.x * k) + f.by, y1 = f.ay * (p.y * inv + by.y * k) + f.by;
+  }
+  box[0] = fmin(box[0], fmin(x0, x1)), box[1] = fmax(box[1], fmax(x0, x1));
+  box[2] = fmin(box[2], fmin(y0, y1)), box[3] = fmax(box[3], fmax(y0, y1));
+  return 1;
+}
+
+/* The quad as samples that carry times and lens positions see it
+ * (mp_blur.h): each sample slot s has its own bound, the quad's raster box
+ * over the times and lens positions its slot takes (the table's box of slot
+ * s after the tile's entries: (lx0, lx1, ly0, ly1), (t0, t1)), and each
+ * sample in it moves the four vertices to its own time and lens position
+ * before the same fixed-point edge tests. Shared vertices move alike in
+ * every sample, so the grid stays watertight in each. Triangles keep the
+ * shutter centre's culling (`keep`); attributes are the centre's (shading
+ * once per grid vertex). Motion positions: pm[idx[i] + k * stride] for step k. */
+inline void mp_raster_quad_blur(const float4* p, __global const float4* pm, const ulong* idx, ulong stride,
+                                const float4* c, const float4* n, uint keep, uint mp_id, float opacity, FrameParams f,
+                                __global const ushort* offsets, __global const float4* table, uint pass,
                                 volatile __global ulong* keys, __global float* colors, __global uint* normals) {
   int spp = f.spp_x * f.spp_y;
-  float q[4], k[4];
-  for (int i = 0; i < 4; ++i) {
-    float inv = 1.0f / (-p[i].z);
-    q[i] = inv;
-    k[i] = 1.0f / f.focus_distance - inv;
-  }
-  __global const float2* slot_boxes = lens + MP_SAMPLE_TILE * MP_SAMPLE_TILE * spp;
+  int steps = mp_motion_on(f) ? f.motion_steps : 0;
+  __global const float4* slot_boxes = table + MP_SAMPLE_TILE * MP_SAMPLE_TILE * spp;
   for (int s = 0; s < spp; ++s) {
-    float2 bx = slot_boxes[2 * s], by = slot_boxes[2 * s + 1];
-    float xmin = 3.0e38f, xmax = -3.0e38f, ymin = 3.0e38f, ymax = -3.0e38f;
-    for (int i = 0; i < 4; ++i) {
-      float x0 = f.ax * (p[i].x * q[i] + bx.x * k[i]) + f.bx, x1 = f.ax * (p[i].x * q[i] + bx.y * k[i]) + f.bx;
-      float y0 = f.ay * (p[i].y * q[i] + by.x * k[i]) + f.by, y1 = f.ay * (p[i].y * q[i] + by.y * k[i]) + f.by;
-      xmin = fmin(xmin, fmin(x0, x1)), xmax = fmax(xmax, fmax(x0, x1));
-      ymin = fmin(ymin, fmin(y0, y1)), ymax = fmax(ymax, fmax(y0, y1));
+    float4 lb = slot_boxes[2 * s], tb = slot_boxes[2 * s + 1];
+    float2 bx = (float2)(lb.x, lb.y), by = (float2)(lb.z, lb.w);
+    float box[4] = {3.0e38f, -3.0e38f, 3.0e38f, -3.0e38f};
+    int ok = 1;
+    for (int i = 0; i < 4 && ok; ++i) {
+      if (!steps) {
+        ok = mp_blur_box(p[i].xyz, bx, by, f, box);
+        continue;
+      }
+      /* Linear between steps: the ends of the slot's time range and the
+       * steps inside it bound the path (perspective keeps lines straight). */
+      ok = mp_blur_box(mp_motion_position(pm + idx[i], stride, steps, tb.x).xyz, bx, by, f, box) &&
+           mp_blur_box(mp_motion_position(pm + idx[i], stride, steps, tb.y).xyz, bx, by, f, box);
+      for (int k = 1; k + 1 < steps && ok; ++k) {
+        float tk = (float)k / (float)(steps - 1);
+        if (tk > tb.x && tk < tb.y) ok = mp_blur_box(pm[idx[i] + (ulong)k * stride].xyz, bx, by, f, box);
+      }
     }
+    if (!ok) continue;
     /* One fixed-point unit of slack for the rounding of positions. */
-    long fx0 = mp_to_fixed(xmin) - 1, fx1 = mp_to_fixed(xmax) + 1, fy0 = mp_to_fixed(ymin) - 1, fy1 = mp_to_fixed(ymax) + 1;
+    long fx0 = mp_to_fixed(box[0]) - 1, fx1 = mp_to_fixed(box[1]) + 1;
+    long fy0 = mp_to_fixed(box[2]) - 1, fy1 = mp_to_fixed(box[3]) + 1;
     int px0 = (int)max(fx0 >> MP_SUBPIXEL_BITS, (long)0), px1 = (int)min(fx1 >> MP_SUBPIXEL_BITS, (long)f.width - 1);
     int py0 = (int)max(fy0 >> MP_SUBPIXEL_BITS, (long)0), py1 = (int)min(fy1 >> MP_SUBPIXEL_BITS, (long)f.height - 1);
     for (int py = py0; py <= py1; ++py)
@@ -147,20 +194,14 @@ inline void mp_raster_quad_lens(const float4* p, const float4* c, const float4* 
         MpFixed2 sq = mp_sample_position(px, py, s, spp, f, offsets);
         if (sq.x < fx0 || sq.x > fx1 || sq.y < fy0 || sq.y > fy1) continue;
         int tx = (px + f.crop_x0) & (MP_SAMPLE_TILE - 1), ty = (py + f.crop_y0) & (MP_SAMPLE_TILE - 1);
-        float2 L = lens[(ty * MP_SAMPLE_TILE + tx) * spp + s];
+        float4 e = table[(ty * MP_SAMPLE_TILE + tx) * spp + s];
         MpRasterVertex v[4];
-        int ok = 1;
+        int live = 1;
         for (int i = 0; i < 4; ++i) {
-          float rx, ry, inv_d;
-          ok &= mp_project_lens(p[i].xyz, L, f, &rx, &ry, &inv_d);
-          ok &= fabs(rx) < MP_RASTER_GUARD && fabs(ry) < MP_RASTER_GUARD;
-          v[i].p.x = mp_to_fixed(rx);
-          v[i].p.y = mp_to_fixed(ry);
-          v[i].inv_d = inv_d;
-          v[i].c_over_d = c[i].xyz * inv_d;
-          v[i].n_over_d = n[i].xyz * inv_d;
+          float3 q = steps ? mp_motion_position(pm + idx[i], stride, steps, e.z).xyz : p[i].xyz;
+          live &= mp_blur_vertex(q, (float2)(e.x, e.y), c[i], n[i], f, &v[i]);
         }
-        if (!ok) continue;
+        if (!live) continue;
         MpTriangle tris[2];
         tris[0] = mp_setup_triangle(v[0], v[1], v[2]);
         tris[1] = mp_setup_triangle(v[0], v[2], v[3]);
@@ -225,7 +266,8 @@ void sample_micropolygons(__global const SubPatch* diceable, uint first, uint co
                                    volatile __global ulong* keys,
                                    __global float* colors, __global uint* normals, volatile __global ulong* totals,
                                    __global uchar* occlusion_dirty, OcclusionParams occ,
-                                   __global const float2* sample_lens) {
+                                   __global const float4* sample_table, __global const float4* grid_pm,
+                                   ulong motion_stride) {
   __local ulong area_sum[64];
   __local uint count_sum[64];
   uint stride = (uint)f.max_grid + 1u;
@@ -277,8 +319,11 @@ void sample_micropolygons(__global const SubPatch* diceable, uint first, uint co
   uint mp_id = mp_hash_combine(grid_id, m);
   float opacity = grid_c[grid_base + q[0]].w;
   if (pass == MP_PASS_DEPTH && occlusion_dirty) mp_mark_occlusion_cells(occlusion_dirty, occ, f, v[0].p, v[1].p, v[2].p, v[3].p);
-  if (mp_lens_on(f))
-    mp_raster_quad_lens(vp, vc, vn, keep, mp_id, opacity, f, sample_offsets, sample_lens, pass, keys, colors, normals);
-  else
+  if (mp_blur_on(f)) {
+    ulong idx[4];
+    for (int k = 0; k < 4; ++k) idx[k] = grid_base + q[k];
+    mp_raster_quad_blur(vp, grid_pm, idx, motion_stride, vc, vn, keep, mp_id, opacity, f, sample_offsets, sample_table, pass,
+                        keys, colors, normals);
+  } else
     mp_raster_quad(v[0], v[1], v[2], v[3], keep, mp_id, opacity, f, sample_offsets, pass, keys, colors, normals);
 }

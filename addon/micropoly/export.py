@@ -162,12 +162,14 @@ def export_settings(native_scene, scene, width, height):
     settings.shadow_memory_mib = mp.shadow_memory
     settings.shadow_shading_rate = mp.shadow_shading_rate
     settings.world_probes = mp.world_shadow_directions
+    settings.dof_dice_factor = mp.dof_dice_factor
 
 
-def export_scene(depsgraph, view=None, meshes=None):
+def export_scene(depsgraph, view=None, meshes=None, motion=None):
     """Returns an ExportedScene; raises ExportError for scenes that cannot render.
     view: a ViewCamera to render instead of the scene camera (the viewport);
-    meshes: a MeshCache kept between exports (the viewport's), else a new one."""
+    meshes: a MeshCache kept between exports (the viewport's), else a new one;
+    motion: an export_motion.Motion (final renders with motion blur)."""
     scene = depsgraph.scene
     camera = scene.camera
     if camera is None and view is None:
@@ -181,6 +183,12 @@ def export_scene(depsgraph, view=None, meshes=None):
         export_camera(native_scene, scene, camera.evaluated_get(depsgraph), width, height)
     else:
         view.apply(native_scene)
+    if motion is not None:
+        try:
+            motion.apply(native_scene)
+        except RuntimeError as e:
+            raise ExportError(f"motion blur: {e}") from e
+        out.warnings.extend(motion.warnings)
     materials = export_materials.MaterialTable(native_scene, out.warnings)
     meshes = meshes if meshes is not None else export_mesh.MeshCache()
     out.background = export_lights.export_world(native_scene, scene.world, materials, out.warnings,
@@ -195,8 +203,10 @@ def export_scene(depsgraph, view=None, meshes=None):
         if obj.type == "MESH":
             try:
                 if export_mesh.export_object(native_scene, materials, meshes, obj, _matrix(inst.matrix_world),
-                                             out.warnings, is_instance=inst.is_instance):
+                                             out.warnings, is_instance=inst.is_instance, depsgraph=depsgraph):
                     out.objects += 1
+                    if motion is not None and not inst.is_instance:
+                        motion.apply_to_mesh(native_scene, obj.name)
             except RuntimeError as e:  # numpy/native rejections of the data
                 raise ExportError(f"object '{obj.name}': {e}") from e
         elif obj.type == "LIGHT":

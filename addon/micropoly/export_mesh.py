@@ -50,6 +50,43 @@ def subdivision_modifier(obj):
     return None, False
 
 
+def _shape_keys(obj, depsgraph):
+    """The cage's relative shape keys with the values they have at the
+    depsgraph's time (its evaluated Key), or None."""
+    keys = obj.original.data.shape_keys
+    if keys is None or not keys.use_relative or len(keys.key_blocks) < 2:
+        return None
+    return keys.evaluated_get(depsgraph) if depsgraph is not None else keys
+
+
+def _key_co(block):
+    co = np.empty(len(block.data) * 3, dtype=np.float32)
+    block.data.foreach_get("co", co)
+    return co.reshape(-1, 3)
+
+
+def cage_points(obj, depsgraph=None, points=None):
+    """The points of the cage under a Subdivision Surface as they are at the
+    depsgraph's time: the mesh's vertices with its relative shape keys mixed
+    in, Basis + sum of value x (key - its relative key), for keys not muted
+    (a key's vertex group is not applied). `points`: the vertices, if read."""
+    mesh = obj.original.data
+    if points is None:
+        points = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+        mesh.vertices.foreach_get("co", points)
+        points = points.reshape(-1, 3)
+    keys = _shape_keys(obj, depsgraph)
+    if keys is None:
+        return points
+    out = points.copy()
+    reference = keys.reference_key.name
+    for block in keys.key_blocks:
+        if block.name == reference or block.mute or block.value == 0.0:
+            continue
+        out += block.value * (_key_co(block) - _key_co(block.relative_key))
+    return out
+
+
 class MeshCache:
     """Arrays per mesh, so instances of one mesh export it once, and the
     viewport re-reads only meshes whose geometry changed. Keys: ("cage", mesh
@@ -196,9 +233,10 @@ def ray_visibility(obj):
     return bool(getattr(obj, "visible_camera", True)), bool(getattr(obj, "visible_shadow", True))
 
 
-def export_object(native_scene, materials, cache, obj, matrix, warnings, is_instance=False):
+def export_object(native_scene, materials, cache, obj, matrix, warnings, is_instance=False, depsgraph=None):
     """Adds one mesh instance; returns False when it has no faces or nothing
-    it would be seen in (neither the camera nor shadows)."""
+    it would be seen in (neither the camera nor shadows). `depsgraph` gives
+    the cage's shape keys their values at its time."""
     visible_camera, cast_shadows = ray_visibility(obj)
     if not visible_camera and not cast_shadows:
         return False
@@ -211,7 +249,10 @@ def export_object(native_scene, materials, cache, obj, matrix, warnings, is_inst
     cache.for_uv_names(materials.uv_names)
     # Instances made by geometry nodes or particles may carry meshes of their
     # own under the instanced object's name: only real objects are cached.
+    keys = _shape_keys(obj, depsgraph) if cage is not None else None
     key = ("cage", cage.name_full) if cage is not None else (("eval", obj.name_full) if not is_instance else None)
+    if keys is not None:  # shape keys move the cage: their values are part of it
+        key = key + tuple(block.value for block in keys.key_blocks)
     arrays = cache.arrays.get(key) if key else None
     if arrays is None:
         if cage is not None and obj.original.mode == "EDIT":
@@ -220,6 +261,8 @@ def export_object(native_scene, materials, cache, obj, matrix, warnings, is_inst
         try:
             arrays = _mesh_arrays(mesh, with_creases=subsurf is not None and subsurf.use_creases,
                                   uv_names=materials.uv_names, smooth_normals=subsurf is None)
+            if keys is not None:
+                arrays["points"] = cage_points(obj, depsgraph, arrays["points"])
         finally:
             if cage is None:
                 obj.to_mesh_clear()

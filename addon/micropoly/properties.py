@@ -51,6 +51,12 @@ class MicropolySceneSettings(bpy.types.PropertyGroup):
                                          "scene shadows its world's light, each a soft shadow map placed where the "
                                          "world is bright; 0 leaves world light unshadowed", default=16, min=0,
                                          max=64)
+    motion_steps: IntProperty(name="Motion Steps", description="Accuracy of motion blur: the scene is evaluated "
+                              "at 2^steps + 1 times over the shutter (Cycles' per-object steps, for the whole "
+                              "scene) and moves linearly between them", default=1, min=1, max=5)
+    dof_dice_factor: FloatProperty(name="Defocus Dicing", description="Out of focus, micropolygons grow to this "
+                                   "fraction of the circle of confusion (RenderMan's focus factor); 0 dices "
+                                   "blurred surfaces as sharp ones", default=0.5, min=0.0, max=4.0)
 
 
 class MicropolyMaterialSettings(bpy.types.PropertyGroup):

@@ -59,6 +59,28 @@ class MICROPOLY_PT_dicing(MicropolyPanel, bpy.types.Panel):
         col.prop(settings, "shading_rate", text="Render Shading Rate")
         col.prop(settings, "viewport_shading_rate", text="Viewport")
         layout.prop(settings, "max_grid_size")
+        layout.prop(settings, "dof_dice_factor")
+
+
+class MICROPOLY_PT_motion_blur(MicropolyPanel, bpy.types.Panel):
+    """Render > Motion Blur: Blender's own settings (as Cycles reads them)
+    and the number of motion steps."""
+    bl_label = "Motion Blur"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw_header(self, context):
+        self.layout.prop(context.scene.render, "use_motion_blur", text="")
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        scene = context.scene
+        layout.active = scene.render.use_motion_blur
+        owner = scene.render if hasattr(scene.render, "motion_blur_position") else getattr(scene, "cycles", None)
+        if owner is not None and hasattr(owner, "motion_blur_position"):
+            layout.prop(owner, "motion_blur_position", text="Position")
+        layout.prop(scene.render, "motion_blur_shutter")
+        layout.prop(scene.micropoly, "motion_steps")
 
 
 class MICROPOLY_PT_bound_split(MicropolyPanel, bpy.types.Panel):
@@ -167,7 +189,7 @@ class MICROPOLY_PT_material_displacement(MicropolyPanel, bpy.types.Panel):
 
 
 CLASSES = (MICROPOLY_PT_sampling, MICROPOLY_PT_dicing, MICROPOLY_PT_bound_split, MICROPOLY_PT_shadows,
-           MICROPOLY_PT_film, MICROPOLY_PT_material_displacement, MICROPOLY_PT_light_shadow,
+           MICROPOLY_PT_film, MICROPOLY_PT_motion_blur, MICROPOLY_PT_material_displacement, MICROPOLY_PT_light_shadow,
            MICROPOLY_PT_object_visibility)
 
 

@@ -398,3 +398,34 @@ def pinholes(rgba, depth):
         if not (edge or uncovered >= 12 or dmax > 1.1 * dmin):
             count += size
     return count, int(full.sum())
+
+
+def ramp_width(alpha):
+    """Median over the middle rows of the distance from 5% to 95% alpha along
+    the row (the first crossing of each from the left, interpolated)."""
+    h = alpha.shape[0]
+    widths = []
+    for row in alpha[h // 4: 3 * h // 4]:
+        row = np.convolve(row, np.ones(3) / 3.0, mode="same")  # tame sample noise
+
+        def crossing(level):
+            i = int(np.argmax(row >= level))
+            if i == 0:
+                return None
+            return i - 1 + (level - row[i - 1]) / max(row[i] - row[i - 1], 1e-6)
+
+        lo, hi = crossing(0.05), crossing(0.95)
+        if lo is not None and hi is not None:
+            widths.append(hi - lo)
+    return float(np.median(widths)) if widths else float("nan")
+
+
+def save_side_by_side(folder, name, cycles, micro):
+    """Cycles, Micropoly and their difference x4 side by side in
+    folder/name.png (nothing without a folder)."""
+    if not folder:
+        return
+    os.makedirs(folder, exist_ok=True)
+    diff = np.abs(cycles[..., :3] - micro[..., :3]) * 4.0
+    row = np.concatenate([cycles[..., :3], micro[..., :3], diff], axis=1)
+    save_png(os.path.join(folder, name + ".png"), np.power(np.clip(row, 0, 1), 1 / 2.2))

@@ -84,17 +84,8 @@ def render_both(scene, name):
     ru.setup_cycles(scene, samples=CYCLES_SAMPLES)
     cycles = ru.render_passes(scene, "CYCLES", W, H)["rgba"]
     micro = ru.render_passes(scene, "MICROPOLY", W, H, samples=MICROPOLY_SPP)["rgba"]
-    save(name, cycles, micro)
+    ru.save_side_by_side(OUTPUT, name, cycles, micro)
     return cycles, micro
-
-
-def save(name, cycles, micro):
-    if not OUTPUT:
-        return
-    os.makedirs(OUTPUT, exist_ok=True)
-    diff = np.abs(cycles[..., :3] - micro[..., :3]) * 4.0
-    row = np.concatenate([cycles[..., :3], micro[..., :3], diff], axis=1)
-    ru.save_png(os.path.join(OUTPUT, name + ".png"), np.power(np.clip(row, 0, 1), 1 / 2.2))
 
 
 def frame_psnr(a, b):
@@ -124,29 +115,10 @@ def case_three_depths(name, **kwargs):
     return not failures
 
 
-def ramp_width(alpha):
-    """Mean over the middle rows of the distance from 5% to 95% alpha along
-    the row (the first crossing of each from the left, interpolated)."""
-    widths = []
-    for row in alpha[H // 4: 3 * H // 4]:
-        row = np.convolve(row, np.ones(3) / 3.0, mode="same")  # tame sample noise
-
-        def crossing(level):
-            i = int(np.argmax(row >= level))
-            if i == 0:
-                return None
-            return i - 1 + (level - row[i - 1]) / max(row[i] - row[i - 1], 1e-6)
-
-        lo, hi = crossing(0.05), crossing(0.95)
-        if lo is not None and hi is not None:
-            widths.append(hi - lo)
-    return float(np.median(widths)) if widths else float("nan")
-
-
 def case_blur_extent():
     scene = edge_scene()
     cycles, micro = render_both(scene, "edge")
-    wc, wm = ramp_width(cycles[..., 3]), ramp_width(micro[..., 3])
+    wc, wm = ru.ramp_width(cycles[..., 3]), ru.ramp_width(micro[..., 3])
     cam = scene.camera.data
     # The circle of confusion Cycles' thin lens gives this edge: diameter in
     # pixels = focal length in pixels x aperture diameter x |1/F - 1/d|.

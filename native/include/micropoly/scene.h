@@ -50,6 +50,11 @@ struct Mesh {
   // casting shadows (in the lights' shadow maps).
   bool visible_camera = true;
   bool cast_shadows = true;
+  // Motion blur (Scene::motion_steps): the points (deformation) and the
+  // transform at each motion step, or empty where they do not move; the
+  // fields above are the shutter centre's.
+  std::vector<std::vector<glm::vec3>> motion_points;
+  std::vector<glm::mat4> motion_object_to_world;
 };
 
 // Bicubic patches already converted to Bezier form: 16 control points per
@@ -208,6 +213,8 @@ struct Camera {
   int aperture_blades = 0;
   float aperture_rotation = 0.0f;
   float aperture_ratio = 1.0f;
+  // Motion blur (Scene::motion_steps): the camera at each step, or empty.
+  std::vector<glm::mat4> motion_world_to_camera;
 };
 
 enum class PixelFilter { Box, Gaussian, Triangle, BlackmanHarris };
@@ -264,7 +271,15 @@ struct Scene {
   World world;
   std::vector<Mesh> meshes;
   std::vector<BezierPatches> bezier_patches;
+  // Motion blur: 0 (none), or the number (2 to kMaxMotionSteps) of times,
+  // evenly spread over the shutter from its opening (0) to its closing (1),
+  // at which the camera, meshes and their transforms give their positions
+  // (motion_* fields). Each sample takes its own time in the shutter and sees
+  // the scene linearly between the steps; shading uses the transforms and
+  // points of the shutter's centre (the objects' own fields).
+  int motion_steps = 0;
 };
+constexpr int kMaxMotionSteps = 33;
 
 // Checks indices, counts and finite values; throws mp::Error naming the object.
 void validate_scene(const Scene& scene);

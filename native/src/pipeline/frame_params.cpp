@@ -57,7 +57,7 @@ FrameSetup make_frame_setup(const Scene& scene) {
   f.seed = 0u;
   f.crop_x0 = out.crop_x0;
   f.crop_y0 = out.crop_y0;
-  // A thin lens for perspective cameras (kernels/mp_lens.h).
+  // A thin lens for perspective cameras (kernels/mp_blur.h).
   const bool lens = !ortho && cam.lens_radius > 0.0f;
   f.lens_radius = lens ? cam.lens_radius : 0.0f;
   f.lens_x_scale = lens ? 1.0f / cam.aperture_ratio : 1.0f;
@@ -65,6 +65,7 @@ FrameSetup make_frame_setup(const Scene& scene) {
   f.aperture_blades = lens && cam.aperture_blades >= 3 ? cam.aperture_blades : 0;
   f.aperture_rotation = lens ? cam.aperture_rotation : 0.0f;
   f.dof_dice_factor = s.dof_dice_factor;
+  f.motion_steps = scene.motion_steps >= 2 ? scene.motion_steps : 0;
   out.camera_to_world = glm::transpose(glm::mat3(cam.world_to_camera));  // rotation part inverse
   return out;
 }

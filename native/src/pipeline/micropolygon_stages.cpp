@@ -85,7 +85,63 @@ void GridLayoutStage::run(const cl::Buffer& diceable, cl_uint count, const Frame
                                       grids.micropolygon_offsets_host.data());
 }
 
-DiceStage::DiceStage(DeviceSession& session) : session_(session), kernel_(session.program(), "dice_grids") {}
+DiceStage::DiceStage(DeviceSession& session)
+    : session_(session),
+      kernel_(session.program(), "dice_grids"),
+      motion_kernel_(session.program(), "dice_motion_positions"),
+      displaced_kernel_(session.program(), "motion_displacement") {}
+
+void GridBuffers::ensure_motion(DeviceSession& session, int steps) {
+  if (steps <= motion_steps) return;
+  motion_p = cl::Buffer();
+  motion_p = device_buffer(session, size_t(steps) * slot_space() * sizeof(cl_float4), "grid motion positions");
+  if (!rest_p()) rest_p = device_buffer(session, slot_space() * sizeof(cl_float4), "grid rest positions");
+  motion_steps = steps;
+}
+
+void DiceStage::run_motion(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+                           GridBuffers& grids, StageTimer& timer) {
+  grids.ensure_motion(session_, int(scene.motion_steps));
+  cl::CommandQueue& q = session_.queue();
+  // The centre's positions before displacement (for `displaced`).
+  q.enqueueCopyBuffer(grids.p, grids.rest_p, 0, 0, size_t(count) * grids.vertices_per_slot * sizeof(cl_float4));
+  for (cl_uint k = 0; k < scene.motion_steps; ++k) {
+    // Step k's control points and curves follow the steps before it.
+    motion_kernel_.setArg(0, diceable);
+    motion_kernel_.setArg(1, count);
+    motion_kernel_.setArg(2, scene.motion_points);
+    motion_kernel_.setArg(3, cl_ulong(size_t(k) * scene.point_count));
+    motion_kernel_.setArg(4, scene.patch_info);
+    motion_kernel_.setArg(5, scene.patch_edges);
+    motion_kernel_.setArg(6, scene.motion_curves);
+    motion_kernel_.setArg(7, cl_ulong(size_t(k) * scene.curve_count));
+    motion_kernel_.setArg(8, f);
+    motion_kernel_.setArg(9, grids.motion_p);
+    motion_kernel_.setArg(10, cl_ulong(size_t(k) * grids.slot_space()));
+    motion_kernel_.setArg(11, grids.vertex_offsets);
+    cl::Event e;
+    q.enqueueNDRangeKernel(motion_kernel_, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64), nullptr,
+                           &e);
+    timer.add(Stage::Dice, e);
+  }
+}
+
+void DiceStage::displaced(const cl::Buffer& diceable, cl_uint count, const FrameParams& f, GridBuffers& grids,
+                          StageTimer& timer) {
+  displaced_kernel_.setArg(0, diceable);
+  displaced_kernel_.setArg(1, count);
+  displaced_kernel_.setArg(2, f);
+  displaced_kernel_.setArg(3, grids.p);
+  displaced_kernel_.setArg(4, grids.rest_p);
+  displaced_kernel_.setArg(5, grids.motion_p);
+  displaced_kernel_.setArg(6, cl_ulong(grids.slot_space()));
+  displaced_kernel_.setArg(7, cl_int(f.motion_steps));
+  displaced_kernel_.setArg(8, grids.vertex_offsets);
+  cl::Event e;
+  session_.queue().enqueueNDRangeKernel(displaced_kernel_, cl::NullRange, round_up_range(grids.vertex_total),
+                                        cl::NDRange(64), nullptr, &e);
+  timer.add(Stage::Dice, e);
+}
 
 void DiceStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
                     GridBuffers& grids, StageTimer& timer) {
@@ -155,6 +211,7 @@ SamplePattern sample_pattern(const FrameParams& f) {
   SamplePattern p;
   p.spp_x = f.spp_x, p.spp_y = f.spp_y, p.seed = f.seed;
   p.lens = mp_lens_on(f);
+  p.motion = mp_motion_on(f);
   if (p.lens) p.blades = f.aperture_blades, p.radius = f.lens_radius, p.x_scale = f.lens_x_scale, p.rotation = f.aperture_rotation;
   return p;
 }
@@ -180,34 +237,38 @@ void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer) {
   }
   const SamplePattern pattern = sample_pattern(f);
   if (!(pattern == pattern_) || !offsets_()) {
-    // Sample positions (and lens positions) of one tile (kernels/mp_raster.h,
-    // mp_lens.h), computed here once.
+    // Sample positions, and times and lens positions, of one tile
+    // (kernels/mp_raster.h, mp_blur.h), computed here once.
     const size_t tile = static_cast<size_t>(MP_SAMPLE_TILE) * MP_SAMPLE_TILE * spp;
     std::vector<cl_ushort> offsets(tile);
-    // Lens positions per tile pixel and slot, then each slot's box (lx0,
-    // lx1), (ly0, ly1) over the tile: the bound the rasteriser uses per slot.
-    std::vector<cl_float2> lens(mp_lens_on(f) ? tile + 2 * size_t(spp) : 1, cl_float2{{0.0f, 0.0f}});
-    for (int s = 0; s < spp && mp_lens_on(f); ++s) {
-      lens[tile + 2 * s] = cl_float2{{3e38f, -3e38f}};
-      lens[tile + 2 * s + 1] = cl_float2{{3e38f, -3e38f}};
+    // (lx, ly, t, 0) per tile pixel and slot, then each slot's box over the
+    // tile, (lx0, lx1, ly0, ly1) and (t0, t1, 0, 0): the bound the
+    // rasteriser uses per slot. Without lens or motion their values are 0.
+    const bool blur = mp_blur_on(f);
+    std::vector<cl_float4> table(blur ? tile + 2 * size_t(spp) : 1, cl_float4{{0.0f, 0.0f, 0.0f, 0.0f}});
+    for (int s = 0; s < spp && blur; ++s) {
+      table[tile + 2 * s] = cl_float4{{3e38f, -3e38f, 3e38f, -3e38f}};
+      table[tile + 2 * s + 1] = cl_float4{{3e38f, -3e38f, 0.0f, 0.0f}};
     }
     for (int ty = 0; ty < MP_SAMPLE_TILE; ++ty)
       for (int tx = 0; tx < MP_SAMPLE_TILE; ++tx)
         for (int s = 0; s < spp; ++s) {
           const size_t i = (static_cast<size_t>(ty) * MP_SAMPLE_TILE + tx) * spp + s;
           offsets[i] = static_cast<cl_ushort>(mp_sample_offset_packed(tx, ty, s, f));
-          if (!mp_lens_on(f)) continue;
-          const float2 l = mp_sample_lens(tx, ty, s, f);
-          lens[i] = cl_float2{{l.x, l.y}};
-          cl_float2& bx = lens[tile + 2 * s];
-          cl_float2& by = lens[tile + 2 * s + 1];
-          bx.s[0] = std::min(bx.s[0], l.x), bx.s[1] = std::max(bx.s[1], l.x);
-          by.s[0] = std::min(by.s[0], l.y), by.s[1] = std::max(by.s[1], l.y);
+          if (!blur) continue;
+          const float2 l = mp_lens_on(f) ? mp_sample_lens(tx, ty, s, f) : float2{0.0f, 0.0f};
+          const float t = mp_motion_on(f) ? mp_sample_time(tx, ty, s, f) : 0.5f;
+          table[i] = cl_float4{{l.x, l.y, t, 0.0f}};
+          cl_float4& lb = table[tile + 2 * s];
+          cl_float4& tb = table[tile + 2 * s + 1];
+          lb.s[0] = std::min(lb.s[0], l.x), lb.s[1] = std::max(lb.s[1], l.x);
+          lb.s[2] = std::min(lb.s[2], l.y), lb.s[3] = std::max(lb.s[3], l.y);
+          tb.s[0] = std::min(tb.s[0], t), tb.s[1] = std::max(tb.s[1], t);
         }
     offsets_ = cl::Buffer(session_.context(), CL_MEM_READ_ONLY, offsets.size() * sizeof(cl_ushort));
     session_.queue().enqueueWriteBuffer(offsets_, CL_TRUE, 0, offsets.size() * sizeof(cl_ushort), offsets.data());
-    lens_ = cl::Buffer(session_.context(), CL_MEM_READ_ONLY, lens.size() * sizeof(cl_float2));
-    session_.queue().enqueueWriteBuffer(lens_, CL_TRUE, 0, lens.size() * sizeof(cl_float2), lens.data());
+    blur_ = cl::Buffer(session_.context(), CL_MEM_READ_ONLY, table.size() * sizeof(cl_float4));
+    session_.queue().enqueueWriteBuffer(blur_, CL_TRUE, 0, table.size() * sizeof(cl_float4), table.data());
     pattern_ = pattern;
   }
   cl_ulong zero = 0;
@@ -242,7 +303,10 @@ void SampleStage::run(const cl::Buffer& diceable, cl_uint first, cl_uint count, 
   kernel_.setArg(14, colors_);
   kernel_.setArg(15, normals_);
   kernel_.setArg(16, totals_);
-  kernel_.setArg(19, lens_);
+  kernel_.setArg(19, blur_);
+  // Motion positions (any valid buffer when there are none).
+  kernel_.setArg(20, grids.motion_p() ? grids.motion_p : grids.p);
+  kernel_.setArg(21, cl_ulong(grids.slot_space()));
   // Pass 0 finds each sample's nearest key; pass 1 lets its owner write.
   for (cl_uint pass = 0; pass < 2; ++pass) {
     kernel_.setArg(12, pass);

@@ -18,10 +18,11 @@ namespace mp {
 struct SamplePattern {
   int spp_x = 0, spp_y = 0;
   cl_uint seed = 0;
-  int lens = 0, blades = 0;
+  int lens = 0, motion = 0, blades = 0;
   float radius = 0, x_scale = 0, rotation = 0;
   bool operator==(const SamplePattern& o) const {
-    return spp_x == o.spp_x && spp_y == o.spp_y && seed == o.seed && lens == o.lens && blades == o.blades &&
+    return spp_x == o.spp_x && spp_y == o.spp_y && seed == o.seed && lens == o.lens && motion == o.motion &&
+           blades == o.blades &&
            radius == o.radius && x_scale == o.x_scale && rotation == o.rotation;
   }
 };
@@ -32,6 +33,12 @@ struct GridBuffers {
   cl::Buffer p, n, c;  // float4 per grid vertex
   cl_uint capacity;    // sub-patches per batch
   size_t vertices_per_slot;
+  // Motion blur: positions at each motion step (step k from k * slot_space()),
+  // and the centre's positions before displacement; made on first use.
+  cl::Buffer motion_p, rest_p;
+  int motion_steps = 0;
+  size_t slot_space() const { return size_t(capacity) * vertices_per_slot; }
+  void ensure_motion(DeviceSession& session, int steps);
   // The batch's layout (GridLayoutStage): each grid's first vertex and first
   // micropolygon, then the batch's totals (count + 1 uints each). The
   // micropolygon offsets are kept on the host too, to size sample launches.
@@ -72,10 +79,17 @@ class DiceStage {
   explicit DiceStage(DeviceSession& session);
   void run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
            GridBuffers& grids, StageTimer& timer);
+  // Motion blur: the same grids' positions at every motion step
+  // (grids.motion_p). Run before displacement: `displaced` then moves them
+  // by what displacement added at the shutter centre.
+  void run_motion(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+                  GridBuffers& grids, StageTimer& timer);
+  void displaced(const cl::Buffer& diceable, cl_uint count, const FrameParams& f, GridBuffers& grids,
+                 StageTimer& timer);
 
  private:
   DeviceSession& session_;
-  cl::Kernel kernel_;
+  cl::Kernel kernel_, motion_kernel_, displaced_kernel_;
 };
 
 class ShadeStage {
@@ -113,7 +127,7 @@ class SampleStage {
   DeviceSession& session_;
   cl::Kernel kernel_;
   cl::Kernel clear_;
-  cl::Buffer keys_, colors_, normals_, offsets_, lens_, totals_;
+  cl::Buffer keys_, colors_, normals_, offsets_, blur_, totals_;
   size_t sample_capacity_ = 0;  // samples the buffers hold (they only grow)
   SamplePattern pattern_;
 };

@@ -16,7 +16,7 @@
 #include "pipeline/scene_fingerprint.h"
 #include "pipeline/shadow_maps.h"
 #include "pipeline/world_lighting.h"
-#include "mp_lens.h"
+#include "mp_blur.h"
 
 namespace mp {
 namespace {
@@ -197,7 +197,9 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       if (cancelled) return;
       impl_->layout.run(diceable, count, f, grids, timer);
       dice.run(diceable, count, buffers, f, grids, timer);
+      if (mp_motion_on(f)) dice.run_motion(diceable, count, buffers, f, grids, timer);
       impl_->programs.displace(diceable, count, buffers, f, grids, timer);
+      if (mp_motion_on(f)) dice.displaced(diceable, count, f, grids, timer);
       shade.run(diceable, count, buffers, f, grids, shadows, timer);
       impl_->programs.shade(diceable, count, buffers, f, grids, shadows, timer);
       const cl_uint chunk = progress ? kSampleChunk : count;
@@ -217,8 +219,9 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     }
     PassOcclusion camera_occlusion;
     // A blurred occluder hides only part of what lies behind it: culling
-    // against the pinhole view's depths would lose what the lens sees past it.
-    if (scene.settings.occlusion_culling && !mp_lens_on(f)) {
+    // against the shutter centre's pinhole depths would lose what the lens
+    // and the other times see past it.
+    if (scene.settings.occlusion_culling && !mp_blur_on(f)) {
       OcclusionCulling& occ = impl_->occlusion;
       occ.begin_frame(f, timer);
       camera_occlusion.pyramid = occ.pyramid();

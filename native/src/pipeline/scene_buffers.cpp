@@ -66,6 +66,28 @@ float max_scale(const glm::mat4& m) {
   return std::max({glm::length(glm::vec3(m[0])), glm::length(glm::vec3(m[1])), glm::length(glm::vec3(m[2]))});
 }
 
+// Appends an object-space shape's control points and edge curves carried to
+// camera space: points by `to_camera`, the curves' normal halves by its
+// inverse transpose (the kernels normalise them and orient them like the
+// patch, so their scale and sign do not matter).
+void place_positions(const PatchBuffer& shape, const glm::mat4& to_camera, std::vector<glm::vec4>& points,
+                     std::vector<glm::vec4>& curves) {
+  const glm::dmat4 m(to_camera);
+  const glm::dmat3 normal_map = glm::transpose(glm::inverse(glm::dmat3(m)));
+  auto point = [&](const glm::vec4& p) {
+    const glm::dvec4 q = m * glm::dvec4(glm::dvec3(p), 1.0);
+    return glm::vec4(float(q.x), float(q.y), float(q.z), 0.0f);
+  };
+  for (const glm::vec4& p : shape.points) points.push_back(point(p));
+  for (size_t c = 0; c < shape.curves.size(); c += MP_CURVE_FLOAT4S) {
+    for (int k = 0; k < 4; ++k) curves.push_back(point(shape.curves[c + size_t(k)]));
+    for (int k = 4; k < MP_CURVE_FLOAT4S; ++k) {
+      const glm::dvec3 n = normal_map * glm::dvec3(glm::vec3(shape.curves[c + size_t(k)]));
+      curves.emplace_back(float(n.x), float(n.y), float(n.z), 0.0f);
+    }
+  }
+}
+
 // Appends an object-space shape (patch_cache.h) as object `object`: control
 // points and edge curves carried to camera space, edge-curve references
 // rebased, and the object's materials (per face through the patch's
@@ -73,9 +95,7 @@ float max_scale(const glm::mat4& m) {
 void place_shape(const PatchBuffer& shape, const glm::mat4& to_camera, const Mesh* mesh, const BezierPatches* set,
                  uint32_t object, const Scene& scene, PatchBuffer& out) {
   const glm::dmat4 m(to_camera);
-  // Edge curves' second half is a cubic of normals (mp_patch.h); normals map
-  // by the inverse transpose. The kernels normalise it and orient it like the
-  // patch, so its scale and sign do not matter.
+  // Shading normals map by the inverse transpose.
   const glm::dmat3 normal_map = glm::transpose(glm::inverse(glm::dmat3(m)));
   unsigned flags = object << 8;
   if (mesh ? mesh->double_sided : set->double_sided) flags |= MP_PATCH_DOUBLE_SIDED;
@@ -86,14 +106,9 @@ void place_shape(const PatchBuffer& shape, const glm::mat4& to_camera, const Mes
   // pipeline flips the geometric normal instead of reordering control points.
   if (glm::determinant(glm::dmat3(m)) < 0.0) flags |= MP_PATCH_FLIP_ORIENTATION;
   const float bound_scale = max_scale(to_camera);
-  auto point = [&](const glm::vec4& p) {
-    const glm::dvec4 q = m * glm::dvec4(glm::dvec3(p), 1.0);
-    return glm::vec4(float(q.x), float(q.y), float(q.z), 0.0f);
-  };
-
   const size_t first = out.size();
   const uint32_t curve_base = uint32_t(out.curves.size() / MP_CURVE_FLOAT4S);
-  for (const glm::vec4& p : shape.points) out.points.push_back(point(p));
+  place_positions(shape, to_camera, out.points, out.curves);
   for (size_t p = 0; p < shape.size(); ++p) {
     glm::uvec4 info = shape.info[p];
     const int material = mesh ? (mesh->face_materials.empty() ? mesh->material : mesh->face_materials[info.w])
@@ -109,17 +124,56 @@ void place_shape(const PatchBuffer& shape, const glm::mat4& to_camera, const Mes
     }
   }
   for (uint32_t ref : shape.edges) out.edges.push_back(ref == MP_NO_CURVE ? ref : ref + (curve_base << 1));
-  for (size_t c = 0; c < shape.curves.size(); c += MP_CURVE_FLOAT4S) {
-    for (int k = 0; k < 4; ++k) out.curves.push_back(point(shape.curves[c + size_t(k)]));
-    for (int k = 4; k < MP_CURVE_FLOAT4S; ++k) {
-      const glm::dvec3 n = normal_map * glm::dvec3(glm::vec3(shape.curves[c + size_t(k)]));
-      out.curves.emplace_back(float(n.x), float(n.y), float(n.z), 0.0f);
-    }
-  }
   out.uvs.insert(out.uvs.end(), shape.uvs.begin(), shape.uvs.end());
   for (const glm::vec4& n : shape.normals) {
     const glm::dvec3 m = normal_map * glm::dvec3(glm::vec3(n));
     out.normals.emplace_back(float(m.x), float(m.y), float(m.z), 0.0f);
+  }
+}
+
+// Motion blur: every surface's control points and edge curves in camera
+// space at each motion step (its points rebuilt into the same patches where
+// it deforms), and each patch's reach: how far (per camera axis) any of its
+// control points moves away from the shutter centre's, in w of its control
+// points 1 to 3 (MP_PATCH_MOTION_REACH), which bounds keep for culling.
+void place_motion(const Scene& scene, const std::vector<PatchCache::Surface>& surfaces, PatchCache* cache,
+                  HostSceneData& out) {
+  const size_t steps = size_t(scene.motion_steps);
+  out.motion_steps = scene.motion_steps;
+  out.motion_points.reserve(steps * out.patches.points.size());
+  out.motion_curves.reserve(steps * out.patches.curves.size());
+  std::vector<Mesh> moved(scene.meshes.size());
+  for (size_t k = 0; k < steps; ++k) {
+    std::vector<PatchCache::Surface> at_step = surfaces;
+    for (size_t i = 0; i < scene.meshes.size(); ++i)
+      if (!scene.meshes[i].motion_points.empty()) {
+        moved[i] = scene.meshes[i];
+        moved[i].points = scene.meshes[i].motion_points[k];
+        at_step[i].mesh = &moved[i];
+      }
+    const auto shapes = cache->shapes(at_step, out.patches.uv_layers);
+    const glm::mat4& w2c = scene.camera.motion_world_to_camera.empty() ? scene.camera.world_to_camera
+                                                                        : scene.camera.motion_world_to_camera[k];
+    for (size_t i = 0; i < surfaces.size(); ++i) {
+      const Mesh* mesh = surfaces[i].mesh;
+      const glm::mat4& o2w = mesh ? (mesh->motion_object_to_world.empty() ? mesh->object_to_world
+                                                                          : mesh->motion_object_to_world[k])
+                                  : surfaces[i].set->object_to_world;
+      place_positions(*shapes[i], w2c * o2w, out.motion_points, out.motion_curves);
+    }
+    if (out.motion_points.size() != (k + 1) * out.patches.points.size() ||
+        out.motion_curves.size() != (k + 1) * out.patches.curves.size())
+      throw Error("motion step " + std::to_string(k) + " changes the scene's patches (a topology that moves?)");
+  }
+  const size_t n = out.patches.points.size();
+  for (size_t p = 0; p < out.patches.size(); ++p) {
+    glm::vec3 reach(0.0f);
+    for (size_t k = 0; k < steps; ++k)
+      for (size_t c = 0; c < MP_PATCH_POINTS; ++c) {
+        const size_t i = p * MP_PATCH_POINTS + c;
+        reach = glm::max(reach, glm::abs(glm::vec3(out.motion_points[k * n + i]) - glm::vec3(out.patches.points[i])));
+      }
+    for (int a = 0; a < 3; ++a) out.patches.points[p * MP_PATCH_POINTS + 1 + size_t(a)].w = reach[a];
   }
 }
 
@@ -190,9 +244,10 @@ std::vector<glm::vec4> patch_bounds(const PatchBuffer& patches) {
     const glm::vec4* cp = &patches.points[p * MP_PATCH_POINTS];
     glm::vec3 lo(cp[0]), hi(cp[0]);
     for (int k = 1; k < MP_PATCH_POINTS; ++k) lo = glm::min(lo, glm::vec3(cp[k])), hi = glm::max(hi, glm::vec3(cp[k]));
-    const float reach = cp[0].w;  // MP_PATCH_DISPLACEMENT_BOUND
-    out[2 * p] = glm::vec4(lo - glm::vec3(reach), 0.0f);
-    out[2 * p + 1] = glm::vec4(hi + glm::vec3(reach), 0.0f);
+    // MP_PATCH_DISPLACEMENT_BOUND and MP_PATCH_MOTION_REACH.
+    const glm::vec3 reach = glm::vec3(cp[0].w) + glm::vec3(cp[1].w, cp[2].w, cp[3].w);
+    out[2 * p] = glm::vec4(lo - reach, 0.0f);
+    out[2 * p + 1] = glm::vec4(hi + reach, 0.0f);
   }
   return out;
 }
@@ -251,6 +306,7 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
                                                   mesh->points)
                                : to_device_object(to_camera, to_world, glm::vec3(0.0f), glm::vec3(0.0f), set->control_points));
   }
+  if (scene.motion_steps >= 2) place_motion(scene, surfaces, cache ? cache : &local, out);
   if (scene.materials.empty()) out.materials.push_back(to_device(Material{}));
   for (const Material& m : scene.materials) out.materials.push_back(to_device(m));
   out.lights = device_lights(scene.lights, w2c);
@@ -295,6 +351,11 @@ SceneBuffers upload_scene_data(cl::Context& context, cl::CommandQueue& queue, co
   b.images = upload(context, queue, data.images);
   b.texels = upload(context, queue, data.texels);
   b.world_glossy = upload(context, queue, std::vector<glm::vec4>(1, glm::vec4(0.0f)));
+  b.motion_points = upload(context, queue, data.motion_points);
+  b.motion_curves = upload(context, queue, data.motion_curves);
+  b.motion_steps = static_cast<cl_uint>(data.motion_steps);
+  b.point_count = static_cast<cl_uint>(data.patches.points.size());
+  b.curve_count = static_cast<cl_uint>(data.patches.curves.size());
   b.uv_layers = static_cast<cl_uint>(data.patches.uv_layers);
   b.image_count = static_cast<cl_uint>(data.images.size());
   b.patch_count = static_cast<cl_uint>(data.patches.size());

@@ -20,6 +20,11 @@ struct HostSceneData {
   std::vector<DeviceObject> objects;  // one per surface, in patch order (MP_PATCH_OBJECT)
   std::vector<DeviceImage> images;
   std::vector<glm::vec4> texels;      // every image's pixels, one after the other
+  // Motion blur (Scene::motion_steps): the patches' control points and edge
+  // curves in camera space at each step, step after step, each step laid
+  // out as patches.points and patches.curves.
+  int motion_steps = 0;
+  std::vector<glm::vec4> motion_points, motion_curves;
 };
 // Surfaces' object-space patches come from `cache` when given (kept by the
 // caller between scenes; patch_cache.h), else they are built for this call.
@@ -43,6 +48,9 @@ struct SceneBuffers {
   cl::Buffer images;      // DeviceImage per image
   cl::Buffer texels;      // float4
   cl::Buffer world_glossy;  // float4: the world's glossy maps (kernels/mp_world.h), or one zero texel
+  cl::Buffer motion_points, motion_curves;  // HostSceneData's (one float4 when there is no motion)
+  cl_uint motion_steps = 0;
+  cl_uint point_count = 0, curve_count = 0;  // float4s of one step
   cl_uint patch_count = 0;
   cl_uint light_count = 0;
   cl_uint uv_layers = 0;

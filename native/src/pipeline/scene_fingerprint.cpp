@@ -94,7 +94,12 @@ void hash_surfaces(Hasher& h, const Scene& scene) {
     h.value(m.texspace_size);
     h.value(m.visible_camera);
     h.value(m.cast_shadows);
+    h.value(m.motion_points.size());
+    for (const std::vector<glm::vec3>& step : m.motion_points) h.values(step);
+    h.values(m.motion_object_to_world);
   }
+  h.value(scene.motion_steps);
+  h.values(scene.camera.motion_world_to_camera);
   h.value(scene.bezier_patches.size());
   for (const BezierPatches& b : scene.bezier_patches) {
     h.values(b.control_points);

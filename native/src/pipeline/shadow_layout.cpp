@@ -89,7 +89,8 @@ FrameParams shadow_view_base(const FrameParams& camera, const RenderSettings& s)
   v.normal_pass = 0;
   v.spp_x = v.spp_y = 1;
   v.crop_x0 = v.crop_y0 = 0;
-  v.lens_radius = 0.0f;  // lights see through pinholes
+  v.lens_radius = 0.0f;  // lights see through pinholes,
+  v.motion_steps = 0;    // the shutter centre's scene
   return v;
 }
 

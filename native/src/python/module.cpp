@@ -48,6 +48,18 @@ glm::mat4 to_matrix(const Array<float>& a, const char* what) {
   return m;
 }
 
+// (steps, 4, 4) row-major matrices, one per motion step.
+std::vector<glm::mat4> to_matrices(const Array<float>& a, const char* what) {
+  if (a.size() == 0) return {};
+  if (a.ndim() != 3 || a.shape(1) != 4 || a.shape(2) != 4) throw Error(std::string(what) + " must be a (steps, 4, 4) array");
+  std::vector<glm::mat4> out(size_t(a.shape(0)));
+  auto r = a.unchecked<3>();
+  for (size_t k = 0; k < out.size(); ++k)
+    for (int row = 0; row < 4; ++row)
+      for (int col = 0; col < 4; ++col) out[k][col][row] = r(py::ssize_t(k), row, col);
+  return out;
+}
+
 glm::vec3 to_vec3(const std::vector<float>& v, const char* what) {
   if (v.size() != 3) throw Error(std::string(what) + " needs 3 values");
   return {v[0], v[1], v[2]};
@@ -198,6 +210,37 @@ PYBIND11_MODULE(_native, m) {
           py::arg("world_to_camera"), py::arg("orthographic") = false, py::arg("fov_degrees") = 90.0f,
           py::arg("clip_near") = 0.01f, py::arg("clip_far") = 1e30f, py::arg("screen_window") = std::vector<float>{},
           "Camera looking down -Z of its space (Blender's convention); world_to_camera is row-major.")
+      .def(
+          "set_motion",
+          [](Scene& s, int steps, const Array<float>& camera_world_to_camera) {
+            s.motion_steps = steps;
+            s.camera.motion_world_to_camera = to_matrices(camera_world_to_camera, "camera_world_to_camera");
+          },
+          py::arg("steps"), py::arg("camera_world_to_camera") = Array<float>(),
+          "Motion blur: `steps` (0, or 2 and more) times evenly spread over the shutter, and the camera's "
+          "world-to-camera matrix at each (row-major (steps, 4, 4)), or none where it does not move.")
+      .def(
+          "set_mesh_motion",
+          [](Scene& s, int index, const Array<float>& points, const Array<float>& object_to_world) {
+            const int n = int(s.meshes.size());
+            if (index < -n || index >= n) throw Error("set_mesh_motion: no mesh " + std::to_string(index));
+            Mesh& m = s.meshes[size_t(index < 0 ? index + n : index)];
+            m.motion_object_to_world = to_matrices(object_to_world, "object_to_world");
+            m.motion_points.clear();
+            if (points.size() > 0) {
+              if (points.ndim() != 3 || points.shape(2) != 3)
+                throw Error("mesh '" + m.name + "': motion points must be a (steps, N, 3) array");
+              const size_t count = size_t(points.shape(1));
+              for (py::ssize_t k = 0; k < points.shape(0); ++k) {
+                std::vector<glm::vec3> step(count);
+                std::memcpy(step.data(), points.data() + size_t(k) * count * 3, count * sizeof(glm::vec3));
+                m.motion_points.push_back(std::move(step));
+              }
+            }
+          },
+          py::arg("index"), py::arg("points") = Array<float>(), py::arg("object_to_world") = Array<float>(),
+          "Motion of mesh `index` (negative: from the end): its points (steps, N, 3) where it deforms, its "
+          "object-to-world matrices (steps, 4, 4) where it moves; empty for what stays.")
       .def(
           "set_depth_of_field",
           [](Scene& s, float lens_radius, float focus_distance, int blades, float rotation, float ratio) {

@@ -31,6 +31,31 @@ void check_material_index(int index, size_t count, const std::string& what, cons
     fail(what, name, "material index " + std::to_string(index) + " out of range (" + std::to_string(available) + " materials)");
 }
 
+// Motion steps of a mesh: one per Scene step, the topology's point count
+// each (the same patches move), finite.
+void validate_mesh_motion(const Mesh& m, size_t steps) {
+  const char* what = "mesh";
+  if (!m.motion_object_to_world.empty()) {
+    if (m.motion_object_to_world.size() != steps)
+      fail(what, m.name, "has " + std::to_string(m.motion_object_to_world.size()) + " motion transforms for " +
+                             std::to_string(steps) + " motion steps");
+    for (const glm::mat4& t : m.motion_object_to_world)
+      if (!finite(t)) fail(what, m.name, "has a motion transform with NaN or infinite values");
+  }
+  if (m.motion_points.empty()) return;
+  if (m.motion_points.size() != steps)
+    fail(what, m.name, "has " + std::to_string(m.motion_points.size()) + " sets of motion points for " +
+                           std::to_string(steps) + " motion steps");
+  for (size_t k = 0; k < steps; ++k) {
+    if (m.motion_points[k].size() != m.points.size())
+      fail(what, m.name, "changes its topology during the shutter: motion step " + std::to_string(k) + " has " +
+                             std::to_string(m.motion_points[k].size()) + " points, not " +
+                             std::to_string(m.points.size()));
+    for (const glm::vec3& p : m.motion_points[k])
+      if (!finite(p)) fail(what, m.name, "has a NaN or infinite motion point at step " + std::to_string(k));
+  }
+}
+
 void validate_mesh(const Mesh& m, size_t materials) {
   const char* what = "mesh";
   if (!finite(m.object_to_world)) fail(what, m.name, "transform contains NaN or infinite values");
@@ -131,6 +156,18 @@ void validate_scene(const Scene& scene) {
     if (!std::isfinite(c.aperture_rotation) || c.aperture_blades < 0)
       throw Error("camera aperture blades must be >= 0 and its rotation finite");
   }
+  if (scene.motion_steps != 0 && (scene.motion_steps < 2 || scene.motion_steps > kMaxMotionSteps))
+    throw Error("motion blur needs 2 to " + std::to_string(kMaxMotionSteps) + " motion steps, not " +
+                std::to_string(scene.motion_steps));
+  const size_t steps = size_t(scene.motion_steps);
+  if (!c.motion_world_to_camera.empty()) {
+    if (c.motion_world_to_camera.size() != steps)
+      throw Error("the camera has " + std::to_string(c.motion_world_to_camera.size()) + " motion transforms for " +
+                  std::to_string(steps) + " motion steps");
+    for (const glm::mat4& m : c.motion_world_to_camera)
+      if (!finite(m) || std::abs(glm::determinant(glm::mat3(m))) < 1e-12f)
+        throw Error("a camera motion transform is degenerate or not finite");
+  }
   if (!(s.dof_dice_factor >= 0) || !std::isfinite(s.dof_dice_factor))
     throw Error("defocus dicing factor must be a finite number >= 0");
 
@@ -170,7 +207,10 @@ void validate_scene(const Scene& scene) {
     if (!(l.angle >= 0) || !(l.angle <= 3.14159266f))
       fail("light", std::to_string(i), "needs an angle between 0 and pi");
   }
-  for (const Mesh& m : scene.meshes) validate_mesh(m, scene.materials.size());
+  for (const Mesh& m : scene.meshes) {
+    validate_mesh(m, scene.materials.size());
+    validate_mesh_motion(m, size_t(scene.motion_steps));
+  }
   for (const Image& im : scene.images) {
     if (im.width <= 0 || im.height <= 0 || im.pixels.size() != size_t(im.width) * size_t(im.height))
       fail("image", im.name, "needs width * height pixels");

@@ -1,6 +1,13 @@
-/* Depth of field with a thin lens, as a stochastic rasteriser sees it (Cook,
+/* Motion blur and depth of field as a stochastic rasteriser sees them (Cook,
  * Porter & Carpenter 1984; Cook, Carpenter & Catmull 1987): every sample of
- * the camera's view carries a lens position L = (lx, ly) on the aperture
+ * the camera's view carries a time t in the shutter [0, 1] and a lens
+ * position.
+ *
+ * Motion: a grid vertex has a camera-space position at each of the
+ * Scene's motion steps, evenly spread over the shutter, and moves linearly
+ * between them; a sample sees every vertex at its own time.
+ *
+ * Lens: the sample's lens position L = (lx, ly) on the aperture
  * (camera units, the lens in the plane z = 0) and sees a camera-space point
  * P at depth d = -z where the ray from L through P crosses the plane in
  * focus, z = -F, projected through the lens centre:
@@ -13,17 +20,19 @@
  * a disk, or a regular polygon of `blades` corners turned by the blade
  * rotation, its x scaled by 1 / the anamorphic ratio. Shared by the kernels
  * and host code. */
-#ifndef MP_LENS_H
-#define MP_LENS_H
+#ifndef MP_BLUR_H
+#define MP_BLUR_H
 
 #include "mp_compat.h"
 #include "mp_hash.h"
 #include "mp_types.h"
 
-/* Whether samples of view f carry lens positions. */
+/* Whether samples of view f carry lens positions, times, either. */
 MP_INLINE int mp_lens_on(FrameParams f) {
   return f.lens_radius > 0.0f && !f.ortho && f.view_kind == MP_VIEW_CAMERA;
 }
+MP_INLINE int mp_motion_on(FrameParams f) { return f.motion_steps >= 2 && f.view_kind == MP_VIEW_CAMERA; }
+MP_INLINE int mp_blur_on(FrameParams f) { return mp_lens_on(f) || mp_motion_on(f); }
 
 /* Largest |1/F - 1/d| over depths [dmin, dmax] (dmin > 0): at an end. */
 MP_INLINE float mp_defocus_max(FrameParams f, float dmin, float dmax) {
@@ -105,18 +114,40 @@ MP_INLINE uint mp_permute(uint i, uint n, uint seed) {
   return x;
 }
 
+/* Time of sample slot s of the sample tile's pixel (tx, ty): slot s is time
+ * stratum s of spp, jittered per pixel, so a slot's times stay within its
+ * stratum (the rasteriser bounds each slot apart). */
+MP_INLINE float mp_sample_time(int tx, int ty, int s, FrameParams f) {
+  int spp = f.spp_x * f.spp_y;
+  uint h = mp_hash_combine(mp_hash_combine(mp_hash32((uint)tx ^ (f.seed + 0x2545f491u)), (uint)ty), (uint)s);
+  return ((float)s + mp_hash_unit(h)) / (float)spp;
+}
+
 /* Lens position (camera units) of sample slot s of the sample tile's pixel
- * (tx, ty): slot s is the lens stratum s of a spp_x x spp_y grid over the
- * unit square, jittered per pixel, so a slot's lens positions stay within
- * its stratum's image on the aperture (the rasteriser bounds each slot
- * apart). */
+ * (tx, ty): without motion, slot s is the lens stratum s of a spp_x x spp_y
+ * grid over the unit square, jittered per pixel, so a slot's lens positions
+ * stay within its stratum's image on the aperture; with motion the slots
+ * are time strata and the lens stratum is shuffled per pixel. */
 MP_INLINE float2 mp_sample_lens(int tx, int ty, int s, FrameParams f) {
+  if (mp_motion_on(f))
+    s = (int)mp_permute((uint)s, (uint)(f.spp_x * f.spp_y),
+                        mp_hash_combine(mp_hash32((uint)ty ^ 0x7feb352du), (uint)tx) ^ f.seed);
   int sx = s % f.spp_x, sy = s / f.spp_x;
   uint h = mp_hash_combine(mp_hash_combine(mp_hash32((uint)tx ^ (f.seed + 0x51ed2701u)), (uint)ty), (uint)s);
   float u = ((float)sx + mp_hash_unit(h)) / (float)f.spp_x;
   float v = ((float)sy + mp_hash_unit(mp_hash32(h ^ 0x68bc21ebu))) / (float)f.spp_y;
   float2 a = mp_aperture_point(u, v, f.aperture_blades, f.aperture_rotation);
   return MP_F2(a.x * f.lens_radius * f.lens_x_scale, a.y * f.lens_radius);
+}
+
+/* Position at time t of a grid vertex whose positions at the motion steps
+ * lie `stride` apart from p[0]. */
+MP_INLINE float4 mp_motion_position(const MP_GLOBAL float4* p, ulong stride, int steps, float t) {
+  float x = clamp(t, 0.0f, 1.0f) * (float)(steps - 1);
+  int i = min((int)x, steps - 2);
+  float w = x - (float)i;
+  float4 a = p[(ulong)i * stride], b = p[(ulong)(i + 1) * stride];
+  return a + w * (b - a);
 }
 
 /* Raster position of view-space point p seen from lens position L (above);

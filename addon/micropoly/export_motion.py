@@ -1,0 +1,119 @@
+"""Motion blur: the scene at the motion steps of the shutter.
+
+Render > Motion Blur as Cycles reads it: the shutter lasts
+`motion_blur_shutter` frames and starts at the frame (START), is centred on
+it (CENTER) or ends at it (END); the position is a Render setting from 4.x
+and a Cycles one before. The scene is evaluated (RenderEngine.frame_set) at
+2^steps + 1 times evenly spread over the shutter, like Cycles' object motion
+steps, and the camera's transform, each object's transform and, where it
+deforms, its points are kept per step. The native scene moves linearly
+between steps; shading uses the shutter's centre, at which the scene is
+exported last. Instances (geometry nodes, particles) render without motion.
+"""
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import export_mesh
+
+
+def shutter_position(scene):
+    owner = scene.render if hasattr(scene.render, "motion_blur_position") else getattr(scene, "cycles", None)
+    return getattr(owner, "motion_blur_position", "CENTER")
+
+
+def step_times(scene):
+    """Frame times (floats) of the motion steps, or [] without motion blur."""
+    r = scene.render
+    if not r.use_motion_blur or not r.motion_blur_shutter > 0.0:
+        return []
+    steps = 2 ** scene.micropoly.motion_steps + 1
+    shutter = r.motion_blur_shutter
+    frame = scene.frame_current + scene.frame_subframe
+    position = shutter_position(scene)
+    first = frame if position == "START" else frame - shutter if position == "END" else frame - 0.5 * shutter
+    return [first + shutter * k / (steps - 1) for k in range(steps)]
+
+
+def frame_set(engine, time):
+    frame = math.floor(time)
+    engine.frame_set(int(frame), float(time - frame))
+
+
+def _object_blurs(obj):
+    """Object > Motion Blur (Cycles' per-object switch, where present)."""
+    settings = getattr(obj, "cycles", None)
+    return bool(getattr(settings, "use_motion_blur", True))
+
+
+def _points(obj, depsgraph):
+    subsurf, only = export_mesh.subdivision_modifier(obj)
+    if subsurf is not None and only:
+        return export_mesh.cage_points(obj, depsgraph)
+    mesh = obj.to_mesh()
+    try:
+        points = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+        mesh.vertices.foreach_get("co", points)
+    finally:
+        obj.to_mesh_clear()
+    return points.reshape(-1, 3)
+
+
+@dataclass
+class Motion:
+    """What moves during the shutter: per step the camera's world-to-camera
+    matrix, and per object name its matrices and (deforming) points."""
+    times: list
+    camera: np.ndarray = None
+    matrices: dict = field(default_factory=dict)
+    points: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
+
+    def apply(self, native_scene):
+        camera = self.camera if self.camera is not None else np.zeros(0, dtype=np.float32)
+        native_scene.set_motion(len(self.times), camera_world_to_camera=camera)
+
+    def apply_to_mesh(self, native_scene, name):
+        """Motion of the native scene's last mesh, the object `name`'s."""
+        matrices, points = self.matrices.get(name), self.points.get(name)
+        if matrices is None and points is None:
+            return
+        empty = np.zeros(0, dtype=np.float32)
+        native_scene.set_mesh_motion(-1, points=empty if points is None else points,
+                                     object_to_world=empty if matrices is None else matrices)
+
+
+def sample(engine, depsgraph, times):
+    """Evaluates the scene at each time (leaving it at the last) and returns
+    its Motion; what does not move is left out."""
+    camera, matrices, points = [], {}, {}
+    for time in times:
+        frame_set(engine, time)
+        scene = depsgraph.scene
+        camera.append(np.array(scene.camera.evaluated_get(depsgraph).matrix_world.inverted(), dtype=np.float32))
+        for inst in depsgraph.object_instances:
+            obj = inst.object
+            if inst.is_instance or obj.type != "MESH" or not _object_blurs(obj):
+                continue
+            matrices.setdefault(obj.name, []).append(np.array(inst.matrix_world, dtype=np.float32))
+            points.setdefault(obj.name, []).append(_points(obj, depsgraph))
+    motion = Motion(times=times)
+    camera = np.stack(camera)
+    motion.camera = camera if not np.all(camera == camera[0]) else None
+    for name, steps in matrices.items():
+        if len(steps) != len(times):
+            continue  # not in every step: rendered still
+        stacked = np.stack(steps)
+        if not np.all(stacked == stacked[0]):
+            motion.matrices[name] = stacked
+        counts = {p.shape[0] for p in points[name]}
+        if len(counts) != 1:
+            motion.warnings.append(f"'{name}' changes its vertex count during the shutter: it renders without "
+                                   "deformation blur")
+            continue
+        stacked = np.stack(points[name])
+        if not np.all(stacked == stacked[0]):
+            motion.points[name] = stacked
+    return motion
