@@ -9,7 +9,7 @@ import time
 import bpy
 import numpy as np
 
-from . import export, export_mesh, export_motion, preferences, viewport
+from . import export, export_mesh, preferences, viewport
 
 PASSES = (("Depth", 1, "Z", "VALUE"), ("Normal", 3, "XYZ", "VECTOR"))
 
@@ -118,22 +118,11 @@ class MicropolyRenderEngine(bpy.types.RenderEngine):
             return
         scene = depsgraph.scene
         view_layer = depsgraph.view_layer
-        frame, subframe = scene.frame_current, scene.frame_subframe
-        times = export_motion.step_times(scene)
         try:
-            motion = None
-            if times:
-                # The scene at every motion step, then at the shutter's
-                # centre, where it is exported and shaded.
-                motion = export_motion.sample(self, depsgraph, times)
-                export_motion.frame_set(self, 0.5 * (times[0] + times[-1]))
-            exported = export.export_scene(depsgraph, motion=motion)
+            exported = export.export_final(depsgraph, self.frame_set)
         except export.ExportError as e:
             self.report({"ERROR"}, f"Micropoly: {e}")
             return
-        finally:
-            if times:
-                self.frame_set(frame, subframe)
         for warning in exported.warnings:
             self.report({"WARNING"}, f"Micropoly: {warning}")
         native_scene = exported.scene

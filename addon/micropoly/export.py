@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _native, export_lights, export_materials, export_mesh
+from . import _native, export_lights, export_materials, export_mesh, export_motion
 
 
 class ExportError(Exception):
@@ -163,6 +163,24 @@ def export_settings(native_scene, scene, width, height):
     settings.shadow_shading_rate = mp.shadow_shading_rate
     settings.world_probes = mp.world_shadow_directions
     settings.dof_dice_factor = mp.dof_dice_factor
+
+
+def export_final(depsgraph, frame_set):
+    """export_scene for a final frame (F12, RIB export): with Render > Motion
+    Blur, the scene is first evaluated at every motion step, then exported at
+    the shutter's centre (frame_set(frame, subframe) moves it: the render
+    engine's, or the scene's); the frame is restored afterwards."""
+    scene = depsgraph.scene
+    frame, subframe = scene.frame_current, scene.frame_subframe
+    times = export_motion.step_times(scene)
+    if not times:
+        return export_scene(depsgraph)
+    try:
+        motion = export_motion.sample(frame_set, depsgraph, times)
+        export_motion.frame_set(frame_set, 0.5 * (times[0] + times[-1]))
+        return export_scene(depsgraph, motion=motion)
+    finally:
+        frame_set(frame, subframe)
 
 
 def export_scene(depsgraph, view=None, meshes=None, motion=None):

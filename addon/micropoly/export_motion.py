@@ -37,9 +37,10 @@ def step_times(scene):
     return [first + shutter * k / (steps - 1) for k in range(steps)]
 
 
-def frame_set(engine, time):
+def frame_set(setter, time):
+    """setter(frame, subframe): RenderEngine.frame_set, or the scene's."""
     frame = math.floor(time)
-    engine.frame_set(int(frame), float(time - frame))
+    setter(int(frame), float(time - frame))
 
 
 def _object_blurs(obj):
@@ -85,12 +86,12 @@ class Motion:
                                      object_to_world=empty if matrices is None else matrices)
 
 
-def sample(engine, depsgraph, times):
+def sample(setter, depsgraph, times):
     """Evaluates the scene at each time (leaving it at the last) and returns
     its Motion; what does not move is left out."""
     camera, matrices, points = [], {}, {}
     for time in times:
-        frame_set(engine, time)
+        frame_set(setter, time)
         scene = depsgraph.scene
         camera.append(np.array(scene.camera.evaluated_get(depsgraph).matrix_world.inverted(), dtype=np.float32))
         for inst in depsgraph.object_instances:

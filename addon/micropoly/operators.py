@@ -11,7 +11,8 @@ def export_rib(depsgraph, path):
     Returns the list of export warnings."""
     from . import _native, export
 
-    exported = export.export_scene(depsgraph)
+    scene = depsgraph.scene
+    exported = export.export_final(depsgraph, lambda frame, subframe: scene.frame_set(frame, subframe=subframe))
     _native.write_rib(exported.scene, path)
     return exported.warnings
 

@@ -429,3 +429,42 @@ def save_side_by_side(folder, name, cycles, micro):
     diff = np.abs(cycles[..., :3] - micro[..., :3]) * 4.0
     row = np.concatenate([cycles[..., :3], micro[..., :3], diff], axis=1)
     save_png(os.path.join(folder, name + ".png"), np.power(np.clip(row, 0, 1), 1 / 2.2))
+
+
+def rib_against_f12(scene, width, height, samples, must_contain, transparent=False):
+    """Renders `scene` with F12 (8-bit PNG), exports it as RIB (checking
+    that the file holds `must_contain`), renders that with micropoly-render
+    and returns the largest difference of the two images (0..1), or None
+    when MICROPOLY_CLI is not set."""
+    import subprocess
+
+    cli = os.environ.get("MICROPOLY_CLI")
+    if not cli:
+        print("skip RIB: MICROPOLY_CLI is not set")
+        return None
+    from micropoly import operators
+    folder = tempfile.mkdtemp(prefix="mp-rib-")
+    r = scene.render
+    r.engine = "MICROPOLY"
+    r.resolution_x, r.resolution_y, r.resolution_percentage = width, height, 100
+    r.film_transparent = transparent
+    r.dither_intensity = 0.0
+    r.image_settings.file_format = "PNG"
+    r.image_settings.color_mode = "RGBA"
+    r.image_settings.color_depth = "8"
+    scene.view_settings.view_transform = "Standard"
+    scene.micropoly.samples = samples
+    r.filepath = os.path.join(folder, "f12.png")
+    bpy.ops.render.render(write_still=True)
+    rib, png = os.path.join(folder, "scene.rib"), os.path.join(folder, "cli.png")
+    operators.export_rib(bpy.context.evaluated_depsgraph_get(), rib)
+    text = open(rib).read()
+    for needle in must_contain:
+        assert needle in text, f"the RIB should hold {needle!r}"
+    proc = subprocess.run([cli, rib, "-o", png], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    a, b = bpy.data.images.load(r.filepath), bpy.data.images.load(png)
+    assert tuple(a.size) == tuple(b.size) == (width, height), (tuple(a.size), tuple(b.size))
+    pa = np.array(a.pixels[:], dtype=np.float32).reshape(-1, 4)
+    pb = np.array(b.pixels[:], dtype=np.float32).reshape(-1, 4)
+    return float(np.abs(pa - pb).max())

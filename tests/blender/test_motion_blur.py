@@ -188,8 +188,28 @@ def case_blur_extent():
     return ok
 
 
+def case_rib():
+    """The moving and turning Suzanne, exported to RIB, renders in
+    micropoly-render as F12 renders it: the motion travels in the file."""
+    scene = moving_scene()
+    cam = scene.camera
+    cam.rotation_euler.z += math.radians(3)
+    cam.keyframe_insert("rotation_euler", frame=1)
+    cam.rotation_euler.z -= math.radians(6)
+    cam.keyframe_insert("rotation_euler", frame=3)
+    linear(cam)
+    scene.frame_set(FRAME)
+    diff = ru.rib_against_f12(scene, W, H, 16, ["Shutter 0 1", "MotionBegin"], transparent=True)
+    if diff is None:
+        return True
+    ok = diff <= 1.0 / 255.0 + 1e-6
+    print(f"{'ok  ' if ok else 'FAIL'} RIB: micropoly-render against F12, max difference {diff * 255:.2f}/255")
+    return ok
+
+
 def main():
     results = [
+        case_rib(),
         case("moving sideways", moving_scene),
         case("turning", turning_scene),
         # Cycles blurs deformation of adaptively subdivided meshes wrongly

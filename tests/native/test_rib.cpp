@@ -702,12 +702,47 @@ TEST(RibStructure, OnlyTheFirstFrameIsRendered) {
   EXPECT_EQ(count_warnings(r, "first frame"), 1);
 }
 
-TEST(RibStructure, MotionBlocksUseTheFirstSample) {
+TEST(RibMotion, TransformsMoveObjectsOverTheShutter) {
+  // Two times over the shutter: two steps; the centre is their mean. A
+  // transformation after the block moves both steps alike.
   const mp::RibResult r = parse_world(
-      "MotionBegin [0 1]\nTranslate 1 0 0\nTranslate 5 0 0\nMotionEnd\n"
+      "MotionBegin [0 1]\nTranslate 1 0 0\nTranslate 5 0 0\nMotionEnd\nTranslate 0 2 0\n"
+      "Polygon \"P\" [0 0 0 1 0 0 0 1 0]\n");
+  ASSERT_EQ(r.scene.meshes.size(), 1u);
+  const mp::Mesh& m = r.scene.meshes[0];
+  EXPECT_EQ(r.scene.motion_steps, 2);
+  ASSERT_EQ(m.motion_object_to_world.size(), 2u);
+  expect_near(apply(m.motion_object_to_world[0], {0, 0, 0}), {1, 2, 0});
+  expect_near(apply(m.motion_object_to_world[1], {0, 0, 0}), {5, 2, 0});
+  expect_near(apply(m.object_to_world, {0, 0, 0}), {3, 2, 0});
+  EXPECT_TRUE(r.warnings.empty());
+}
+
+TEST(RibMotion, ShutterCameraAndDeformation) {
+  const mp::RibResult r = parse(
+      "Shutter 0 0.5\nMotionBegin [0 0.25 0.5]\nTranslate 0 0 5\nTranslate 0 0 6\nTranslate 0 0 7\nMotionEnd\n"
+      "WorldBegin\nMotionBegin [0 0.25 0.5]\n"
+      "PointsPolygons [3] [0 1 2] \"P\" [0 0 0 1 0 0 0 1 0]\n"
+      "PointsPolygons [3] [0 1 2] \"P\" [0 0 0 2 0 0 0 1 0]\n"
+      "PointsPolygons [3] [0 1 2] \"P\" [0 0 0 3 0 0 0 1 0]\nMotionEnd\nWorldEnd\n");
+  EXPECT_EQ(r.scene.motion_steps, 3);
+  ASSERT_EQ(r.scene.camera.motion_world_to_camera.size(), 3u);
+  expect_near(apply(r.scene.camera.motion_world_to_camera[2], {0, 0, 0}), {0, 0, -7});
+  expect_near(apply(r.scene.camera.world_to_camera, {0, 0, 0}), {0, 0, -6});
+  ASSERT_EQ(r.scene.meshes.size(), 1u);
+  const mp::Mesh& m = r.scene.meshes[0];
+  ASSERT_EQ(m.motion_points.size(), 3u);
+  EXPECT_FLOAT_EQ(m.motion_points[2][1].x, 3.0f);
+  EXPECT_FLOAT_EQ(m.points[1].x, 2.0f);  // the middle step
+}
+
+TEST(RibMotion, UnevenTimesUseTheFirstSample) {
+  const mp::RibResult r = parse_world(
+      "Shutter 0 1\nMotionBegin [0 0.2 1]\nTranslate 1 0 0\nTranslate 2 0 0\nTranslate 5 0 0\nMotionEnd\n"
       "Polygon \"P\" [0 0 0 1 0 0 0 1 0]\n");
   expect_near(apply(r.scene.meshes[0].object_to_world, {0, 0, 0}), {1, 0, 0});
-  EXPECT_EQ(count_warnings(r, "motion"), 1);
+  EXPECT_TRUE(r.scene.meshes[0].motion_object_to_world.empty());
+  EXPECT_EQ(count_warnings(r, "evenly spread"), 1);
 }
 
 TEST(RibStructure, LexicalDetails) {

@@ -83,6 +83,11 @@ TEST(RibErrors, WrongArgumentTypesAndCounts) {
   expect_error("Projection \"perspective\" \"fov\" \"wide\"\n", 1, "expects numbers");
   expect_error("Clipping 0 10\n", 1, "0 < near < far");
   expect_error("DepthOfField 0 0.05 3\n", 1, "fstop > 0");
+  expect_error("MotionBegin [0 1]\nTranslate 1 0 0\nMotionEnd\n", 1, "2 times but 1 requests");
+  expect_error("MotionBegin [0 1]\nTranslate 1 0 0\nScale 1 1 1\nMotionEnd\n", 3, "of one kind");
+  expect_error("WorldBegin\nMotionBegin [0 1]\nPointsPolygons [3] [0 1 2] \"P\" [0 0 0 1 0 0 0 1 0]\n"
+               "PointsPolygons [4] [0 1 2 3] \"P\" [0 0 0 1 0 0 1 1 0 0 1 0]\nMotionEnd\n", 4, "topology");
+  expect_error("Shutter 1 0\n", 1, "open <= close");
   expect_error("DepthOfField 2 0.05 -1\n", 1, "focaldistance > 0");
   expect_error("ScreenWindow 1 1 -1 1\n", 1, "empty screen window");
   expect_error("PixelSamples 1000 2\n", 1, "samples per axis");

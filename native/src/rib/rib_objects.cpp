@@ -132,7 +132,8 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
   Scene& scene = result_.scene;
 
   // Runs of Polygon or Patch requests with the same state share one object.
-  const bool merge = prim.mergeable && has_merge_target_ && merge_.kind == prim.kind &&
+  const bool moving = !attrs.motion_ctm.empty();
+  const bool merge = prim.mergeable && !moving && has_merge_target_ && merge_.kind == prim.kind &&
                      merge_.object_to_world == object_to_world && merge_.material == material &&
                      merge_.double_sided == attrs.double_sided &&
                      merge_.visible_camera == attrs.visible_camera &&
@@ -162,6 +163,7 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
     mesh.double_sided = attrs.double_sided;
     mesh.visible_camera = attrs.visible_camera;
     mesh.cast_shadows = attrs.cast_shadows;
+    for (const glm::mat4& m : attrs.motion_ctm) mesh.motion_object_to_world.push_back(m * prim.local);
     if (flip) reverse_faces(mesh, 0, 0);
     scene.meshes.push_back(std::move(mesh));
   } else {
@@ -173,6 +175,8 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
       if (flip) mirror_patches_u(dst.control_points, first);
       return;
     }
+    if (moving)
+      warn_once("motion-patches", line, "patches (Patch, PatchMesh) do not move: they render at the shutter's centre");
     BezierPatches set;
     set.name = name;
     set.control_points = prim.patch_points;
@@ -184,8 +188,8 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
     if (flip) mirror_patches_u(set.control_points, 0);
     scene.bezier_patches.push_back(std::move(set));
   }
-  has_merge_target_ = prim.mergeable;
-  if (prim.mergeable) {
+  has_merge_target_ = prim.mergeable && !moving;
+  if (has_merge_target_) {
     merge_.kind = prim.kind;
     merge_.index = prim.kind == Primitive::Kind::Mesh ? scene.meshes.size() - 1
                                                       : scene.bezier_patches.size() - 1;

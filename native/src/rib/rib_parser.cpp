@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_set>
 
 #include "rib/rib_file.h"
 
@@ -59,6 +60,7 @@ const std::unordered_map<std::string, Parser::Handler>& Parser::handlers() {
       {"SolidBegin", &Parser::req_solid_begin},
       {"SolidEnd", &Parser::req_solid_end},
       {"MotionBegin", &Parser::req_motion_begin},
+      {"Shutter", &Parser::req_shutter},
       {"MotionEnd", &Parser::req_motion_end},
       {"Format", &Parser::req_format},
       {"Projection", &Parser::req_projection},
@@ -122,16 +124,36 @@ void Parser::parse(std::string_view text, const std::string& file, const std::st
 void Parser::execute(const Request& req) {
   if (skipping_) return;  // later frames are tokenized (syntax-checked) only
   if (motion_depth_ > 0) {
-    // Motion blur is not supported: the first request of each motion block
-    // (the state at the shutter open time) is used and the others dropped.
+    // A motion block's requests are collected and run together at MotionEnd.
     if (req.name == "MotionEnd") {
       motion_depth_ = 0;
+      run_motion_block(req.line);
       return;
     }
     if (req.name == "MotionBegin") fail(req.line, "MotionBegin: nested motion blocks");
-    if (motion_first_done_) return;
-    motion_first_done_ = true;
+    motion_requests_.push_back(req);
+    return;
   }
+  // A transformation after a moving one moves every step's alike.
+  static const std::unordered_set<std::string> kTransforms = {"Translate", "Rotate", "Scale", "ConcatTransform",
+                                                              "Transform", "Identity", "CoordSysTransform"};
+  if (!attrs_.motion_ctm.empty() && kTransforms.count(req.name)) {
+    const glm::mat4 centre = attrs_.ctm;
+    std::vector<glm::mat4> steps = attrs_.motion_ctm;
+    for (glm::mat4& m : steps) {
+      attrs_.ctm = m;
+      run_handler(req);
+      m = attrs_.ctm;
+    }
+    attrs_.ctm = centre;
+    run_handler(req);
+    attrs_.motion_ctm = steps;
+    return;
+  }
+  run_handler(req);
+}
+
+void Parser::run_handler(const Request& req) {
   const auto& table = handlers();
   auto it = table.find(req.name);
   if (it == table.end()) {
@@ -273,8 +295,12 @@ void Parser::req_world_begin(ArgReader& args) {
   const glm::mat4 mirror_z(glm::vec4(1, 0, 0, 0), glm::vec4(0, 1, 0, 0), glm::vec4(0, 0, -1, 0),
                            glm::vec4(0, 0, 0, 1));
   result_.scene.camera.world_to_camera = mirror_z * camera_;
+  // A camera that moves: its transformation at each motion step.
+  result_.scene.camera.motion_world_to_camera.clear();
+  for (const glm::mat4& m : attrs_.motion_ctm) result_.scene.camera.motion_world_to_camera.push_back(mirror_z * m);
   push_block(Block::Kind::World, line);
   attrs_.ctm = glm::mat4(1.0f);
+  attrs_.motion_ctm.clear();
   in_world_ = true;
   convert_camera_lights(line);
 }
@@ -318,13 +344,122 @@ void Parser::req_motion_end(ArgReader& args) {
   args.fail("without a matching MotionBegin");
 }
 
+// MotionBegin [times] ... MotionEnd: one request per time, all of one kind.
+// The Scene's motion steps are evenly spread over the shutter, so the times
+// must be too (from its opening to its closing), and every block must have
+// as many as the first; otherwise the block's first request stands for it.
+// Transformations give each step its own current transformation (and the
+// camera's at WorldBegin); meshes (PointsPolygons, SubdivisionMesh, Polygon,
+// GeneralPolygon, PointsGeneralPolygons) give their points per step, the same
+// topology each time. The shutter centre's state is the middle step (the
+// mean of the two middle ones for an even count).
 void Parser::req_motion_begin(ArgReader& args) {
-  args.number_array();
+  const Arg& times = args.number_array();
   args.done();
-  warn_once("request:MotionBegin", args.request().line,
-            "motion blur is not supported: the first request of each motion block is used");
+  motion_times_.assign(times.numbers.begin(), times.numbers.end());
+  if (motion_times_.empty()) args.fail("needs at least one time");
+  motion_requests_.clear();
+  motion_line_ = args.request().line;
   motion_depth_ = 1;
-  motion_first_done_ = false;
+}
+
+void Parser::req_shutter(ArgReader& args) {
+  const double open = args.number(), close = args.number();
+  args.done();
+  if (!std::isfinite(open) || !std::isfinite(close) || close < open) args.fail("needs open <= close");
+  shutter_open_ = open, shutter_close_ = close;
+  shutter_set_ = true;
+}
+
+bool Parser::motion_usable(int line) {
+  const size_t n = motion_times_.size();
+  if (n < 2) return false;
+  if (!shutter_set_) {
+    shutter_open_ = motion_times_.front(), shutter_close_ = motion_times_.back();
+    shutter_set_ = true;
+  }
+  const double span = shutter_close_ - shutter_open_;
+  bool even = span > 0.0 && n <= size_t(kMaxMotionSteps);
+  for (size_t k = 0; k < n && even; ++k)
+    even = std::fabs(motion_times_[k] - (shutter_open_ + span * double(k) / double(n - 1))) <= 1e-4 * span;
+  int& steps = result_.scene.motion_steps;
+  if (even && steps != 0 && steps != int(n)) even = false;
+  if (!even) {
+    warn_once("motion-times", line,
+              "MotionBegin: times must be 2 to " + std::to_string(kMaxMotionSteps) +
+                  " evenly spread from the Shutter's opening to its closing, as many in every block; this "
+                  "block's first request is used");
+    return false;
+  }
+  steps = int(n);
+  return true;
+}
+
+void Parser::run_motion_block(int line) {
+  const size_t n = motion_times_.size();
+  if (motion_requests_.size() != n)
+    fail(motion_line_, "MotionBegin: " + std::to_string(n) + " times but " + std::to_string(motion_requests_.size()) +
+                           " requests before MotionEnd");
+  for (const Request& r : motion_requests_)
+    if (r.name != motion_requests_[0].name)
+      fail(r.line, "MotionBegin: a motion block's requests must be of one kind (" + motion_requests_[0].name +
+                       ", then " + r.name + ")");
+  const std::vector<Request> requests = std::move(motion_requests_);
+  motion_requests_.clear();
+  static const std::unordered_set<std::string> kTransforms = {"Translate", "Rotate", "Scale", "ConcatTransform",
+                                                              "Transform"};
+  static const std::unordered_set<std::string> kMeshes = {"PointsPolygons", "SubdivisionMesh", "Polygon",
+                                                          "GeneralPolygon", "PointsGeneralPolygons"};
+  const std::string& kind = requests[0].name;
+  const bool transform = kTransforms.count(kind) > 0, mesh = kMeshes.count(kind) > 0 && in_world_ && !defining_active_;
+  if (!(transform || mesh)) {
+    warn_once("motion-kind:" + kind, line, "MotionBegin: " + kind + " does not move here; its first request is used");
+    run_handler(requests[0]);
+    return;
+  }
+  if (!motion_usable(line)) {
+    execute(requests[0]);
+    return;
+  }
+  if (transform) {
+    std::vector<glm::mat4> steps(n);
+    for (size_t k = 0; k < n; ++k) {
+      attrs_.ctm = attrs_.motion_ctm.empty() ? attrs_.ctm : attrs_.motion_ctm[k];
+      const glm::mat4 before = attrs_.ctm;
+      run_handler(requests[k]);
+      steps[k] = attrs_.ctm;
+      attrs_.ctm = before;
+    }
+    attrs_.motion_ctm = steps;
+    attrs_.ctm = n % 2 ? steps[n / 2] : 0.5f * (steps[n / 2 - 1] + steps[n / 2]);
+    return;
+  }
+  // Meshes: each request adds its own; the last keeps every step's points.
+  std::vector<std::vector<glm::vec3>> points;
+  std::vector<int> counts, indices;
+  Scene& scene = result_.scene;
+  for (size_t k = 0; k < n; ++k) {
+    has_merge_target_ = false;
+    const size_t before = scene.meshes.size();
+    execute(requests[k]);
+    if (scene.meshes.size() != before + 1) fail(requests[k].line, "MotionBegin: the request made no mesh");
+    const Mesh& made = scene.meshes.back();
+    if (k == 0) {
+      counts = made.face_vertex_counts, indices = made.face_vertex_indices;
+    } else if (made.face_vertex_counts != counts || made.face_vertex_indices != indices ||
+               made.points.size() != points[0].size()) {
+      fail(requests[k].line, "MotionBegin: a mesh's topology must stay the same at every time");
+    }
+    points.push_back(made.points);
+    if (k + 1 < n) scene.meshes.pop_back();
+  }
+  has_merge_target_ = false;
+  Mesh& m = scene.meshes.back();
+  m.motion_points = points;
+  if (n % 2 == 0)
+    for (size_t i = 0; i < m.points.size(); ++i) m.points[i] = 0.5f * (points[n / 2 - 1][i] + points[n / 2][i]);
+  else
+    m.points = points[n / 2];
 }
 
 // --- options and camera -----------------------------------------------------------

@@ -45,6 +45,9 @@ struct Limits {
 // column-vector convention (the transpose of RenderMan's row-vector matrices).
 struct Attributes {
   glm::mat4 ctm{1.0f};
+  // The current transformation at each motion step after a MotionBegin of
+  // transformations (empty: it does not move); ctm is the shutter centre's.
+  std::vector<glm::mat4> motion_ctm;
   glm::vec3 color{1.0f};
   glm::vec3 opacity{1.0f};
   Material surface;           // model and shader parameters; color/opacity apply at emission
@@ -158,6 +161,7 @@ class Parser {
   void req_solid_begin(ArgReader&);
   void req_solid_end(ArgReader&);
   void req_motion_begin(ArgReader&);
+  void req_shutter(ArgReader&);
   void req_motion_end(ArgReader&);
   void req_format(ArgReader&);
   void req_projection(ArgReader&);
@@ -264,7 +268,14 @@ class Parser {
   bool world_done_ = false;    // the first world block has ended
   bool skipping_ = false;      // later frames: requests are read but not executed
   int motion_depth_ = 0;       // inside MotionBegin/MotionEnd
-  bool motion_first_done_ = false;
+  std::vector<double> motion_times_;     // of the open block
+  std::vector<Request> motion_requests_;  // collected until MotionEnd
+  int motion_line_ = 0;
+  double shutter_open_ = 0.0, shutter_close_ = 0.0;
+  bool shutter_set_ = false;
+  void run_motion_block(int line);
+  void run_handler(const Request& req);
+  bool motion_usable(int line);
   glm::mat4 camera_{1.0f};     // RenderMan world-to-camera (column-vector convention)
   glm::mat4 camera_inv_{1.0f};
   bool camera_inv_valid_ = false;

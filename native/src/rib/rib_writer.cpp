@@ -184,6 +184,43 @@ const char* filter_name(PixelFilter f) {
   return "gaussian";
 }
 
+// MotionBegin with the Scene's motion steps as times over the shutter [0, 1].
+void begin_motion(std::string& o, size_t steps, const char* indent) {
+  o += indent;
+  o += "MotionBegin [";
+  for (size_t k = 0; k < steps; ++k) {
+    if (k) o += ' ';
+    put_float(o, float(double(k) / double(steps - 1)));
+  }
+  o += "]\n";
+}
+
+// A transformation, or one per motion step in a motion block.
+void write_transform(std::string& o, const glm::mat4& m, const std::vector<glm::mat4>& steps, const char* indent) {
+  if (steps.empty()) {
+    o += indent;
+    o += "Transform ";
+    put_matrix(o, m);
+    o += '\n';
+    return;
+  }
+  begin_motion(o, steps.size(), indent);
+  for (const glm::mat4& s : steps) {
+    o += indent;
+    o += "  Transform ";
+    put_matrix(o, s);
+    o += '\n';
+  }
+  o += indent;
+  o += "MotionEnd\n";
+}
+
+const std::vector<glm::mat4>& motion_transforms(const Mesh& m) { return m.motion_object_to_world; }
+const std::vector<glm::mat4>& motion_transforms(const BezierPatches&) {
+  static const std::vector<glm::mat4> none;
+  return none;
+}
+
 void write_options(std::string& o, const RenderSettings& s, const Camera& c) {
   // Settings with no RenderMan request (docs/rib.md, "Option micropoly").
   o += "Option \"micropoly\"";
@@ -271,11 +308,15 @@ void write_image_and_camera(std::string& o, const Scene& scene) {
   // left-handed world-to-camera and mirrors z into the Scene's right-handed
   // camera space; mirroring here first gives back the same matrix (negating
   // a row is exact).
-  glm::mat4 rm = c.world_to_camera;
-  for (int col = 0; col < 4; ++col) rm[col][2] = rm[col][2] == 0.0f ? 0.0f : -rm[col][2];  // no "-0"
-  o += "# world to camera, z mirrored into RenderMan's left-handed camera space\nTransform ";
-  put_matrix(o, rm);
-  o += '\n';
+  auto mirrored = [](glm::mat4 m) {
+    for (int col = 0; col < 4; ++col) m[col][2] = m[col][2] == 0.0f ? 0.0f : -m[col][2];  // no "-0"
+    return m;
+  };
+  if (scene.motion_steps >= 2) o += "Shutter 0 1\n";
+  std::vector<glm::mat4> steps;
+  for (const glm::mat4& m : c.motion_world_to_camera) steps.push_back(mirrored(m));
+  o += "# world to camera, z mirrored into RenderMan's left-handed camera space\n";
+  write_transform(o, mirrored(c.world_to_camera), steps, "");
 }
 
 // Shadows as RenderMan's lights ask for them, by naming a shadow map: any
@@ -414,18 +455,16 @@ void write_object_state(std::string& o, const Object& object, const std::vector<
                         const std::vector<MaterialProgram>& programs) {
   o += "  Attribute \"identifier\"";
   param(o, "name", object.name);
-  o += "\n  Transform ";
-  put_matrix(o, object.object_to_world);
-  o += object.double_sided ? "\n  Sides 2\n" : "\n  Sides 1\n";
+  o += '\n';
+  write_transform(o, object.object_to_world, motion_transforms(object), "  ");
+  o += object.double_sided ? "  Sides 2\n" : "  Sides 1\n";
   write_visibility(o, object.visible_camera, object.cast_shadows);
   const int material = object.material;
   write_material(o, materials[static_cast<size_t>(material)], material, "  ", programs);
 }
 
-void write_mesh(std::string& o, const Mesh& m, const std::vector<Material>& materials,
-                const std::vector<MaterialProgram>& programs) {
-  o += "AttributeBegin\n";
-  write_object_state(o, m, materials, programs);
+// The mesh's geometry request with the given points.
+void write_mesh_geometry(std::string& o, const Mesh& m, const std::vector<glm::vec3>& points) {
   if (m.scheme == SubdivScheme::CatmullClark) {
     o += "  SubdivisionMesh \"catmull-clark\" ";
     put_ints(o, m.face_vertex_counts);
@@ -478,7 +517,7 @@ void write_mesh(std::string& o, const Mesh& m, const std::vector<Material>& mate
     put_ints(o, m.face_vertex_indices);
   }
   o += "\n    \"P\" ";
-  put_points(o, m.points);
+  put_points(o, points);
   if (!m.face_materials.empty()) {
     o += "\n    \"uniform integer micropoly:material\" ";
     put_ints(o, m.face_materials);
@@ -499,7 +538,22 @@ void write_mesh(std::string& o, const Mesh& m, const std::vector<Material>& mate
     o += " \"constant float[3] micropoly:texspacesize\" ";
     put_vec3(o, m.texspace_size);
   }
-  o += "\nAttributeEnd\n";
+  o += '\n';
+}
+
+void write_mesh(std::string& o, const Mesh& m, const std::vector<Material>& materials,
+                const std::vector<MaterialProgram>& programs) {
+  o += "AttributeBegin\n";
+  write_object_state(o, m, materials, programs);
+  if (m.motion_points.empty()) {
+    write_mesh_geometry(o, m, m.points);
+  } else {
+    // A deforming mesh: the whole request once per motion step.
+    begin_motion(o, m.motion_points.size(), "  ");
+    for (const std::vector<glm::vec3>& step : m.motion_points) write_mesh_geometry(o, m, step);
+    o += "  MotionEnd\n";
+  }
+  o += "AttributeEnd\n";
 }
 
 void write_patches(std::string& o, const BezierPatches& b, const std::vector<Material>& materials,
