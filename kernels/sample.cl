@@ -85,7 +85,8 @@ inline void mp_sample_write(const MpTriangle* t, float la, float lb, float lc, i
  * `keep` selects (bit 0 and bit 1). */
 inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVertex v11, MpRasterVertex v01, uint keep,
                            uint mp_id, float opacity, FrameParams f, __global const ushort* offsets, uint pass,
-                           volatile __global ulong* keys, __global float* colors, __global uint* normals) {
+                           volatile __global ulong* keys, __global float* colors, __global uint* normals,
+                           uint* tests) {
   MpTriangle tris[2];
   tris[0] = mp_setup_triangle(v00, v10, v11);
   tris[1] = mp_setup_triangle(v00, v11, v01);
@@ -101,6 +102,7 @@ inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVerte
       for (int s = 0; s < spp; ++s) {
         MpFixed2 q = mp_sample_position(px, py, s, spp, f, offsets);
         if (q.x < xmin || q.x > xmax || q.y < ymin || q.y > ymax) continue;
+        ++*tests;
         float la, lb, lc;
         int k = 0;
         if (!mp_edge_triangle_covers(&tris[0].e, q, &la, &lb, &lc)) {
@@ -109,25 +111,6 @@ inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVerte
         }
         mp_sample_write(&tris[k], la, lb, lc, px, py, s, spp, mp_id, opacity, f, pass, keys, colors, normals);
       }
-}
-
-/* Raster vertex of view-space point p seen from lens position L (zero
- * without a lens), with its attributes; 0 where it cannot be rasterised. */
-inline int mp_blur_vertex(float3 p, float2 L, float4 c, float4 n, FrameParams f, MpRasterVertex* v) {
-  float rx, ry, inv_d;
-  if (f.ortho) {
-    rx = f.ax * p.x + f.bx, ry = f.ay * p.y + f.by, inv_d = -p.z;
-  } else if (!mp_project_lens(p, L, f, &rx, &ry, &inv_d)) {
-    return 0;
-  }
-  if (!(fabs(rx) < MP_RASTER_GUARD && fabs(ry) < MP_RASTER_GUARD)) return 0;
-  float w = f.ortho ? 1.0f : inv_d;
-  v->p.x = mp_to_fixed(rx);
-  v->p.y = mp_to_fixed(ry);
-  v->inv_d = inv_d;
-  v->c_over_d = c.xyz * w;
-  v->n_over_d = n.xyz * w;
-  return 1;
 }
 
 /* Grows the raster box by view-space point p seen from every lens position
@@ -148,42 +131,153 @@ inline int mp_blur_box(float3 p, float2 bx, float2 by, FrameParams f, float* box
   return 1;
 }
 
+/* Motion steps a work-item keeps in registers per vertex; with more, the
+ * positions are read from the grid's step buffer at each test. */
+#define MP_BLUR_LOCAL_STEPS 3
+/* A quad whose whole blurred bound covers at most this many pixels has all
+ * the samples of those pixels tested, with no bound per sample slot (which
+ * costs more than it saves on so few). */
+#ifndef MP_BLUR_SMALL_PIXELS
+#define MP_BLUR_SMALL_PIXELS 9
+#endif
+
+/* Position at time t of vertex i (mp_motion_position over its steps, from
+ * registers when they are there). */
+inline float3 mp_blur_position(int i, float t, int steps, const float4* p, float4 ps[4][MP_BLUR_LOCAL_STEPS],
+                               __global const float4* pm, const ulong* idx, ulong stride) {
+  if (!steps) return p[i].xyz;
+  if (steps > MP_BLUR_LOCAL_STEPS) return mp_motion_position(pm + idx[i], stride, steps, t).xyz;
+  float x = clamp(t, 0.0f, 1.0f) * (float)(steps - 1);
+  int k = min((int)x, steps - 2);
+  float w = x - (float)k;
+  return (ps[i][k] + w * (ps[i][k + 1] - ps[i][k])).xyz;
+}
+
+/* One sample of a blurred quad: its four vertices at the sample's time and
+ * lens position, a cheap box rejection, then the fixed-point edge tests. */
+inline void mp_blur_sample(int px, int py, int s, int spp, MpFixed2 sq, float4 e, int steps, const float4* p,
+                           float4 ps[4][MP_BLUR_LOCAL_STEPS], __global const float4* pm, const ulong* idx, ulong stride,
+                           float8* still, const float4* c, const float4* n, uint keep, uint mp_id, float opacity,
+                           FrameParams f, uint pass, volatile __global ulong* keys, __global float* colors,
+                           __global uint* normals) {
+  float3 q[4];
+  MpRasterVertex v[4];
+  for (int i = 0; i < 4; ++i) {
+    float rx, ry, inv_d;
+    if (!steps) {
+      /* Without motion the lens alone moves the vertex: two multiply-adds. */
+      rx = still[i].s0 + e.x * still[i].s2, ry = still[i].s1 + e.y * still[i].s3, inv_d = still[i].s4;
+      if (!(fabs(rx) < MP_RASTER_GUARD && fabs(ry) < MP_RASTER_GUARD)) return;
+      v[i].p.x = mp_to_fixed(rx);
+      v[i].p.y = mp_to_fixed(ry);
+      v[i].inv_d = inv_d;
+      continue;
+    }
+    q[i] = mp_blur_position(i, e.z, steps, p, ps, pm, idx, stride);
+    if (f.ortho) {
+      rx = f.ax * q[i].x + f.bx, ry = f.ay * q[i].y + f.by, inv_d = -q[i].z;
+    } else if (!mp_project_lens(q[i], (float2)(e.x, e.y), f, &rx, &ry, &inv_d)) {
+      return;
+    }
+    if (!(fabs(rx) < MP_RASTER_GUARD && fabs(ry) < MP_RASTER_GUARD)) return;
+    v[i].p.x = mp_to_fixed(rx);
+    v[i].p.y = mp_to_fixed(ry);
+    v[i].inv_d = inv_d;
+  }
+  /* Most samples of a slot's bound miss the quad where it is at their time. */
+  if (sq.x < min(min(v[0].p.x, v[1].p.x), min(v[2].p.x, v[3].p.x)) ||
+      sq.x > max(max(v[0].p.x, v[1].p.x), max(v[2].p.x, v[3].p.x)) ||
+      sq.y < min(min(v[0].p.y, v[1].p.y), min(v[2].p.y, v[3].p.y)) ||
+      sq.y > max(max(v[0].p.y, v[1].p.y), max(v[2].p.y, v[3].p.y)))
+    return;
+  for (int i = 0; i < 4; ++i) {
+    float w = f.ortho ? 1.0f : v[i].inv_d;
+    v[i].c_over_d = c[i].xyz * w;
+    v[i].n_over_d = n[i].xyz * w;
+  }
+  MpTriangle tris[2];
+  tris[0] = mp_setup_triangle(v[0], v[1], v[2]);
+  tris[1] = mp_setup_triangle(v[0], v[2], v[3]);
+  tris[0].e.valid &= (int)(keep & 1u);
+  tris[1].e.valid &= (int)(keep >> 1);
+  float la, lb, lc;
+  int t = 0;
+  if (!mp_edge_triangle_covers(&tris[0].e, sq, &la, &lb, &lc)) {
+    t = 1;
+    if (!mp_edge_triangle_covers(&tris[1].e, sq, &la, &lb, &lc)) return;
+  }
+  mp_sample_write(&tris[t], la, lb, lc, px, py, s, spp, mp_id, opacity, f, pass, keys, colors, normals);
+}
+
+/* Grows the raster box by vertex i over the times [t0, t1] (its positions
+ * there and at the steps between: straight lines in between stay straight
+ * in perspective) seen from every lens position of the box (bx, by). */
+inline int mp_blur_path_box(int i, float t0, float t1, float2 bx, float2 by, int steps, const float4* p,
+                            float4 ps[4][MP_BLUR_LOCAL_STEPS], __global const float4* pm, const ulong* idx,
+                            ulong stride, FrameParams f, float* box) {
+  if (!steps) return mp_blur_box(p[i].xyz, bx, by, f, box);
+  int ok = mp_blur_box(mp_blur_position(i, t0, steps, p, ps, pm, idx, stride), bx, by, f, box) &&
+           mp_blur_box(mp_blur_position(i, t1, steps, p, ps, pm, idx, stride), bx, by, f, box);
+  for (int k = 1; k + 1 < steps && ok; ++k) {
+    float tk = (float)k / (float)(steps - 1);
+    if (tk > t0 && tk < t1) ok = mp_blur_box(mp_blur_position(i, tk, steps, p, ps, pm, idx, stride), bx, by, f, box);
+  }
+  return ok;
+}
+
 /* The quad as samples that carry times and lens positions see it
- * (mp_blur.h): each sample slot s has its own bound, the quad's raster box
- * over the times and lens positions its slot takes (the table's box of slot
- * s after the tile's entries: (lx0, lx1, ly0, ly1), (t0, t1)), and each
- * sample in it moves the four vertices to its own time and lens position
- * before the same fixed-point edge tests. Shared vertices move alike in
- * every sample, so the grid stays watertight in each. Triangles keep the
- * shutter centre's culling (`keep`); attributes are the centre's (shading
- * once per grid vertex). Motion positions: pm[idx[i] + k * stride] for step k. */
+ * (mp_blur.h): each sample moves the four vertices to its own time and lens
+ * position before the same fixed-point edge tests, so shared vertices move
+ * alike in every sample and the grid stays watertight in each. Which
+ * samples are tested: where the quad's whole blurred bound (all times, the
+ * whole aperture) covers few pixels (MP_BLUR_SMALL_PIXELS), every sample of
+ * those pixels;
+ * else each sample slot s apart, over the quad's bound for the times and
+ * lens positions its slot takes (the table's box of slot s after the tile's
+ * entries: (lx0, lx1, ly0, ly1), (t0, t1)). Triangles keep the shutter
+ * centre's culling (`keep`); attributes are the centre's (shading once per
+ * grid vertex). Motion positions: pm[idx[i] + k * stride] for step k. */
 inline void mp_raster_quad_blur(const float4* p, __global const float4* pm, const ulong* idx, ulong stride,
                                 const float4* c, const float4* n, uint keep, uint mp_id, float opacity, FrameParams f,
                                 __global const ushort* offsets, __global const float4* table, uint pass,
-                                volatile __global ulong* keys, __global float* colors, __global uint* normals) {
+                                volatile __global ulong* keys, __global float* colors, __global uint* normals,
+                                uint* tests) {
   int spp = f.spp_x * f.spp_y;
   int steps = mp_motion_on(f) ? f.motion_steps : 0;
-  __global const float4* slot_boxes = table + MP_SAMPLE_TILE * MP_SAMPLE_TILE * spp;
-  for (int s = 0; s < spp; ++s) {
-    float4 lb = slot_boxes[2 * s], tb = slot_boxes[2 * s + 1];
-    float2 bx = (float2)(lb.x, lb.y), by = (float2)(lb.z, lb.w);
-    float box[4] = {3.0e38f, -3.0e38f, 3.0e38f, -3.0e38f};
-    int ok = 1;
-    for (int i = 0; i < 4 && ok; ++i) {
-      if (!steps) {
-        ok = mp_blur_box(p[i].xyz, bx, by, f, box);
-        continue;
-      }
-      /* Linear between steps: the ends of the slot's time range and the
-       * steps inside it bound the path (perspective keeps lines straight). */
-      ok = mp_blur_box(mp_motion_position(pm + idx[i], stride, steps, tb.x).xyz, bx, by, f, box) &&
-           mp_blur_box(mp_motion_position(pm + idx[i], stride, steps, tb.y).xyz, bx, by, f, box);
-      for (int k = 1; k + 1 < steps && ok; ++k) {
-        float tk = (float)k / (float)(steps - 1);
-        if (tk > tb.x && tk < tb.y) ok = mp_blur_box(pm[idx[i] + (ulong)k * stride].xyz, bx, by, f, box);
-      }
+  float4 ps[4][MP_BLUR_LOCAL_STEPS];
+  if (steps && steps <= MP_BLUR_LOCAL_STEPS)
+    for (int i = 0; i < 4; ++i)
+      for (int k = 0; k < steps; ++k) ps[i][k] = pm[idx[i] + (ulong)k * stride];
+  /* Without motion (a lens only; mp_project_lens): each vertex's pinhole
+   * raster position, its raster shift per unit of lens offset, and 1/d. */
+  float8 still[4];
+  if (!steps)
+    for (int i = 0; i < 4; ++i) {
+      float inv = 1.0f / (-p[i].z), k = 1.0f / f.focus_distance - inv;
+      still[i] = (float8)(f.ax * p[i].x * inv + f.bx, f.ay * p[i].y * inv + f.by, f.ax * k, f.ay * k, inv, 0.0f,
+                          0.0f, 0.0f);
     }
-    if (!ok) continue;
+  __global const float4* slot_boxes = table + MP_SAMPLE_TILE * MP_SAMPLE_TILE * spp;
+  /* The whole bound: every time, the whole aperture. */
+  float rx = mp_lens_on(f) ? f.lens_radius * f.lens_x_scale : 0.0f, ry = mp_lens_on(f) ? f.lens_radius : 0.0f;
+  float whole[4] = {3.0e38f, -3.0e38f, 3.0e38f, -3.0e38f};
+  int ok = 1;
+  for (int i = 0; i < 4 && ok; ++i)
+    ok = mp_blur_path_box(i, 0.0f, 1.0f, (float2)(-rx, rx), (float2)(-ry, ry), steps, p, ps, pm, idx, stride, f,
+                          whole);
+  if (!ok) return;
+  int small = ((int)floor(whole[1]) - (int)floor(whole[0]) + 1) * ((int)floor(whole[3]) - (int)floor(whole[2]) + 1) <=
+              MP_BLUR_SMALL_PIXELS;
+  for (int s = 0; s < (small ? 1 : spp); ++s) {
+    float box[4] = {whole[0], whole[1], whole[2], whole[3]};
+    if (!small) {
+      float4 lb = slot_boxes[2 * s], tb = slot_boxes[2 * s + 1];
+      box[0] = box[2] = 3.0e38f, box[1] = box[3] = -3.0e38f;
+      for (int i = 0; i < 4 && ok; ++i)
+        ok = mp_blur_path_box(i, tb.x, tb.y, (float2)(lb.x, lb.y), (float2)(lb.z, lb.w), steps, p, ps, pm, idx,
+                              stride, f, box);
+      if (!ok) return;
+    }
     /* One fixed-point unit of slack for the rounding of positions. */
     long fx0 = mp_to_fixed(box[0]) - 1, fx1 = mp_to_fixed(box[1]) + 1;
     long fy0 = mp_to_fixed(box[2]) - 1, fy1 = mp_to_fixed(box[3]) + 1;
@@ -191,29 +285,14 @@ inline void mp_raster_quad_blur(const float4* p, __global const float4* pm, cons
     int py0 = (int)max(fy0 >> MP_SUBPIXEL_BITS, (long)0), py1 = (int)min(fy1 >> MP_SUBPIXEL_BITS, (long)f.height - 1);
     for (int py = py0; py <= py1; ++py)
       for (int px = px0; px <= px1; ++px) {
-        MpFixed2 sq = mp_sample_position(px, py, s, spp, f, offsets);
-        if (sq.x < fx0 || sq.x > fx1 || sq.y < fy0 || sq.y > fy1) continue;
         int tx = (px + f.crop_x0) & (MP_SAMPLE_TILE - 1), ty = (py + f.crop_y0) & (MP_SAMPLE_TILE - 1);
-        float4 e = table[(ty * MP_SAMPLE_TILE + tx) * spp + s];
-        MpRasterVertex v[4];
-        int live = 1;
-        for (int i = 0; i < 4; ++i) {
-          float3 q = steps ? mp_motion_position(pm + idx[i], stride, steps, e.z).xyz : p[i].xyz;
-          live &= mp_blur_vertex(q, (float2)(e.x, e.y), c[i], n[i], f, &v[i]);
+        for (int k = small ? 0 : s; k < (small ? spp : s + 1); ++k) {
+          MpFixed2 sq = mp_sample_position(px, py, k, spp, f, offsets);
+          if (sq.x < fx0 || sq.x > fx1 || sq.y < fy0 || sq.y > fy1) continue;
+          ++*tests;
+          mp_blur_sample(px, py, k, spp, sq, table[(ty * MP_SAMPLE_TILE + tx) * spp + k], steps, p, ps, pm, idx,
+                         stride, still, c, n, keep, mp_id, opacity, f, pass, keys, colors, normals);
         }
-        if (!live) continue;
-        MpTriangle tris[2];
-        tris[0] = mp_setup_triangle(v[0], v[1], v[2]);
-        tris[1] = mp_setup_triangle(v[0], v[2], v[3]);
-        tris[0].e.valid &= (int)(keep & 1u);
-        tris[1].e.valid &= (int)(keep >> 1);
-        float la, lb, lc;
-        int t = 0;
-        if (!mp_edge_triangle_covers(&tris[0].e, sq, &la, &lb, &lc)) {
-          t = 1;
-          if (!mp_edge_triangle_covers(&tris[1].e, sq, &la, &lb, &lc)) continue;
-        }
-        mp_sample_write(&tris[t], la, lb, lc, px, py, s, spp, mp_id, opacity, f, pass, keys, colors, normals);
       }
   }
 }
@@ -237,6 +316,20 @@ inline void mp_count_sampled(uint l, long area2, uint pass, volatile __global ul
     atom_add(&totals[0], (ulong)count_sum[0]);
     atom_add(&totals[1], area_sum[0]);
   }
+}
+
+/* Sample tests (a sample inside a micropolygon's bound, tested against its
+ * edges) of the depth pass, summed like mp_count_sampled: the rasteriser's
+ * work per sample, which blur multiplies. */
+inline void mp_count_tests(uint l, uint tests, uint pass, volatile __global ulong* totals, __local ulong* sum) {
+  barrier(CLK_LOCAL_MEM_FENCE);
+  sum[l] = (ulong)tests;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (uint s = 32u; s > 0u; s >>= 1) {
+    if (l < s) sum[l] += sum[l + s];
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+  if (pass == MP_PASS_DEPTH && l == 0u && sum[0] > 0u) atom_add(&totals[2], sum[0]);
 }
 
 /* Marks the occlusion pyramid's level-0 cells under the micropolygon's
@@ -313,17 +406,21 @@ void sample_micropolygons(__global const SubPatch* diceable, uint first, uint co
     area2 = ((keep & 1u) ? (a0 < 0 ? -a0 : a0) : 0) + ((keep & 2u) ? (a1 < 0 ? -a1 : a1) : 0);
   }
   mp_count_sampled(get_local_id(0), area2, pass, totals, area_sum, count_sum);
-  if (!keep) return;
-  uint grid_id = mp_hash32(sp.patch);
-  for (int k = 0; k < 8; ++k) grid_id = mp_hash_combine(grid_id, as_uint(sp.corner[k]));
-  uint mp_id = mp_hash_combine(grid_id, m);
-  float opacity = grid_c[grid_base + q[0]].w;
-  if (pass == MP_PASS_DEPTH && occlusion_dirty) mp_mark_occlusion_cells(occlusion_dirty, occ, f, v[0].p, v[1].p, v[2].p, v[3].p);
-  if (mp_blur_on(f)) {
-    ulong idx[4];
-    for (int k = 0; k < 4; ++k) idx[k] = grid_base + q[k];
-    mp_raster_quad_blur(vp, grid_pm, idx, motion_stride, vc, vn, keep, mp_id, opacity, f, sample_offsets, sample_table, pass,
-                        keys, colors, normals);
-  } else
-    mp_raster_quad(v[0], v[1], v[2], v[3], keep, mp_id, opacity, f, sample_offsets, pass, keys, colors, normals);
+  uint tests = 0u;
+  if (keep) {
+    uint grid_id = mp_hash32(sp.patch);
+    for (int k = 0; k < 8; ++k) grid_id = mp_hash_combine(grid_id, as_uint(sp.corner[k]));
+    uint mp_id = mp_hash_combine(grid_id, m);
+    float opacity = grid_c[grid_base + q[0]].w;
+    if (pass == MP_PASS_DEPTH && occlusion_dirty) mp_mark_occlusion_cells(occlusion_dirty, occ, f, v[0].p, v[1].p, v[2].p, v[3].p);
+    if (mp_blur_on(f)) {
+      ulong idx[4];
+      for (int k = 0; k < 4; ++k) idx[k] = grid_base + q[k];
+      mp_raster_quad_blur(vp, grid_pm, idx, motion_stride, vc, vn, keep, mp_id, opacity, f, sample_offsets, sample_table, pass,
+                          keys, colors, normals, &tests);
+    } else {
+      mp_raster_quad(v[0], v[1], v[2], v[3], keep, mp_id, opacity, f, sample_offsets, pass, keys, colors, normals, &tests);
+    }
+  }
+  mp_count_tests(get_local_id(0), tests, pass, totals, area_sum);
 }

@@ -71,6 +71,9 @@ struct RenderStats {
   // pixel of surface, i.e. per covered pixel per depth layer.
   size_t micropolygons_sampled = 0;
   double sampled_area_px = 0;
+  // Samples the rasteriser tested against micropolygon edges (depth pass):
+  // per sample of the frame, the stochastic rasteriser's cost of blur.
+  size_t sample_tests = 0;
   // Occlusion culling (RenderSettings::occlusion_culling): sub-patches bound
   // & split dropped as hidden behind what was already sampled; pixels with a
   // surface in any sample. sampled_area_px / covered_pixels is the depth

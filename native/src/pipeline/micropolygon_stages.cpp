@@ -196,13 +196,14 @@ void ShadeStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffe
 
 SampleStage::SampleStage(DeviceSession& session)
     : session_(session), kernel_(session.program(), "sample_micropolygons"), clear_(session.program(), "clear_samples") {
-  totals_ = cl::Buffer(session.context(), CL_MEM_READ_WRITE, 2 * sizeof(cl_ulong));
+  totals_ = cl::Buffer(session.context(), CL_MEM_READ_WRITE, 3 * sizeof(cl_ulong));
 }
 
-void SampleStage::sampled_totals(size_t& micropolygons, double& area_px) {
-  cl_ulong t[2] = {0, 0};
+void SampleStage::sampled_totals(size_t& micropolygons, double& area_px, size_t& tests) {
+  cl_ulong t[3] = {0, 0, 0};
   session_.queue().enqueueReadBuffer(totals_, CL_TRUE, 0, sizeof t, t);
   micropolygons = static_cast<size_t>(t[0]);
+  tests = static_cast<size_t>(t[2]);
   // The sampler sums twice the area in fixed-point units (mp_raster.h).
   area_px = static_cast<double>(t[1]) / (2.0 * MP_SUBPIXEL_ONE * MP_SUBPIXEL_ONE);
 }
@@ -272,7 +273,7 @@ void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer) {
     pattern_ = pattern;
   }
   cl_ulong zero = 0;
-  session_.queue().enqueueFillBuffer(totals_, zero, 0, 2 * sizeof zero);
+  session_.queue().enqueueFillBuffer(totals_, zero, 0, 3 * sizeof zero);
   clear_.setArg(0, keys_);
   clear_.setArg(1, static_cast<cl_ulong>(samples));
   cl::Event e;

@@ -120,8 +120,9 @@ class SampleStage {
   const cl::Buffer& normals() const { return normals_; }
   const cl::Buffer& offsets() const { return offsets_; }
   // Micropolygons rasterised this frame and their total screen area in
-  // pixels (front faces only when back faces are culled; blocking read).
-  void sampled_totals(size_t& micropolygons, double& area_px);
+  // pixels (front faces only when back faces are culled), and the samples
+  // tested against their edges in the depth pass (blocking read).
+  void sampled_totals(size_t& micropolygons, double& area_px, size_t& tests);
 
  private:
   DeviceSession& session_;

@@ -41,6 +41,9 @@ std::string RenderStats::to_json() const {
   j += "  \"subpatches_diced\": " + std::to_string(subpatches_diced) + ",\n";
   j += "  \"micropolygons\": " + std::to_string(micropolygons) + ",\n";
   j += "  \"micropolygons_sampled\": " + std::to_string(micropolygons_sampled) + ",\n";
+  j += "  \"sample_tests\": " + std::to_string(sample_tests) + ",\n";
+  j += "  \"sample_tests_per_sample\": " +
+       num(width && height && spp ? double(sample_tests) / (double(width) * double(height) * double(spp)) : 0.0) + ",\n";
   j += "  \"sampled_area_px\": " + num(sampled_area_px) + ",\n";
   j += "  \"subpatches_occluded\": " + std::to_string(subpatches_occluded) + ",\n";
   j += "  \"covered_pixels\": " + std::to_string(covered_pixels) + ",\n";

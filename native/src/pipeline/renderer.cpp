@@ -258,7 +258,7 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     st.timings_ms.readback = ms_since(t_resolve);
     timer.collect();
     st.micropolygons = impl_->layout.micropolygons();
-    sample.sampled_totals(st.micropolygons_sampled, st.sampled_area_px);
+    sample.sampled_totals(st.micropolygons_sampled, st.sampled_area_px, st.sample_tests);
     st.timings_ms.bound_split = timer.ms(Stage::BoundSplit);
     st.timings_ms.dice = timer.ms(Stage::Dice);
     st.timings_ms.shade = timer.ms(Stage::Shade);

@@ -75,6 +75,7 @@ py::dict stats_dict(const RenderStats& s) {
   d["subpatches_diced"] = s.subpatches_diced;
   d["micropolygons"] = s.micropolygons;
   d["micropolygons_sampled"] = s.micropolygons_sampled;
+  d["sample_tests"] = s.sample_tests;
   d["sampled_area_px"] = s.sampled_area_px;
   d["subpatches_occluded"] = s.subpatches_occluded;
   d["covered_pixels"] = s.covered_pixels;
