@@ -131,11 +131,14 @@ class ViewCamera:
     clip_near: float
     clip_far: float
     crop: tuple = None
+    lens_camera: object = None  # looking through the scene camera: its Depth of Field applies
 
     def apply(self, native_scene):
         native_scene.set_camera(self.world_to_camera, orthographic=self.orthographic, fov_degrees=90.0,
                                 clip_near=self.clip_near, clip_far=self.clip_far,
                                 screen_window=list(self.screen_window))
+        if self.lens_camera is not None and not self.orthographic:
+            export_depth_of_field(native_scene, self.lens_camera)
         s = native_scene.settings
         s.width, s.height, s.pixel_aspect = self.width, self.height, 1.0
         s.crop_x0, s.crop_x1, s.crop_y0, s.crop_y1 = self.crop or (0.0, 1.0, 0.0, 1.0)

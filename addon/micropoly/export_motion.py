@@ -8,7 +8,8 @@ and a Cycles one before. The scene is evaluated (RenderEngine.frame_set) at
 steps, and the camera's transform, each object's transform and, where it
 deforms, its points are kept per step. The native scene moves linearly
 between steps; shading uses the shutter's centre, at which the scene is
-exported last. Instances (geometry nodes, particles) render without motion.
+exported last. The shutter curve shapes when samples see the scene.
+Instances (geometry nodes, particles) render without motion.
 """
 
 import math
@@ -35,6 +36,24 @@ def step_times(scene):
     position = shutter_position(scene)
     first = frame if position == "START" else frame - shutter if position == "END" else frame - 0.5 * shutter
     return [first + shutter * k / (steps - 1) for k in range(steps)]
+
+
+CURVE_SAMPLES = 65
+
+
+def shutter_curve(scene):
+    """Render > Motion Blur > Shutter Curve sampled evenly over the shutter,
+    or an empty array where it is flat (fully open throughout)."""
+    mapping = getattr(scene.render, "motion_blur_shutter_curve", None)
+    if mapping is None or not mapping.curves:
+        return np.zeros(0, dtype=np.float32)
+    mapping.initialize()
+    values = np.array([mapping.evaluate(mapping.curves[0], k / (CURVE_SAMPLES - 1)) for k in range(CURVE_SAMPLES)],
+                      dtype=np.float32)
+    values = np.maximum(values, 0.0)
+    if np.all(values == values[0]) or not values.sum() > 0.0:
+        return np.zeros(0, dtype=np.float32)
+    return values
 
 
 def frame_set(setter, time):
@@ -68,13 +87,15 @@ class Motion:
     matrix, and per object name its matrices and (deforming) points."""
     times: list
     camera: np.ndarray = None
+    curve: np.ndarray = None
     matrices: dict = field(default_factory=dict)
     points: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
 
     def apply(self, native_scene):
-        camera = self.camera if self.camera is not None else np.zeros(0, dtype=np.float32)
-        native_scene.set_motion(len(self.times), camera_world_to_camera=camera)
+        empty = np.zeros(0, dtype=np.float32)
+        native_scene.set_motion(len(self.times), camera_world_to_camera=self.camera if self.camera is not None else empty,
+                                shutter_curve=self.curve if self.curve is not None else empty)
 
     def apply_to_mesh(self, native_scene, name):
         """Motion of the native scene's last mesh, the object `name`'s."""
@@ -100,7 +121,7 @@ def sample(setter, depsgraph, times):
                 continue
             matrices.setdefault(obj.name, []).append(np.array(inst.matrix_world, dtype=np.float32))
             points.setdefault(obj.name, []).append(_points(obj, depsgraph))
-    motion = Motion(times=times)
+    motion = Motion(times=times, curve=shutter_curve(depsgraph.scene))
     camera = np.stack(camera)
     motion.camera = camera if not np.all(camera == camera[0]) else None
     for name, steps in matrices.items():

@@ -54,7 +54,7 @@ def _window_from_projection(p, orthographic):
     return tuple(float(x) for x in window), float(near), float(far)
 
 
-def view_from_matrices(view_matrix, window_matrix, orthographic, width, height, crop=None):
+def view_from_matrices(view_matrix, window_matrix, orthographic, width, height, crop=None, lens_camera=None):
     view = np.array(view_matrix, dtype=np.float32).reshape(4, 4)
     proj = np.array(window_matrix, dtype=np.float64).reshape(4, 4)
     window, near, far = _window_from_projection(proj, orthographic)
@@ -68,7 +68,7 @@ def view_from_matrices(view_matrix, window_matrix, orthographic, width, height, 
         near, far = near + shift, far + shift
     return export.ViewCamera(width=width, height=height, world_to_camera=view, orthographic=orthographic,
                              screen_window=window, clip_near=max(near, 1e-6), clip_far=max(far, near + 1e-3),
-                             crop=crop)
+                             crop=crop, lens_camera=lens_camera)
 
 
 def _camera_frame_in_region(context, scene):
@@ -99,8 +99,9 @@ def view_from_context(context):
     region, rv3d, space = context.region, context.region_data, context.space_data
     scene = context.scene
     width, height = region.width, region.height
-    crop = None
+    crop, lens_camera = None, None
     if rv3d.view_perspective == "CAMERA" and scene.camera is not None:
+        lens_camera = scene.camera  # through the camera, its depth of field shows, as in Cycles
         if scene.render.use_border:
             frame = _camera_frame_in_region(context, scene)
             if frame is not None:
@@ -111,7 +112,8 @@ def view_from_context(context):
     elif getattr(space, "use_render_border", False):
         crop = _crop(space.render_border_min_x * width, space.render_border_max_x * width,
                      space.render_border_min_y * height, space.render_border_max_y * height, width, height)
-    return view_from_matrices(rv3d.view_matrix, rv3d.window_matrix, not rv3d.is_perspective, width, height, crop)
+    return view_from_matrices(rv3d.view_matrix, rv3d.window_matrix, not rv3d.is_perspective, width, height, crop,
+                              lens_camera)
 
 
 def view_from_camera(scene, depsgraph, width, height):
@@ -120,7 +122,7 @@ def view_from_camera(scene, depsgraph, width, height):
     cam = scene.camera.evaluated_get(depsgraph)
     view = np.array(cam.matrix_world.inverted(), dtype=np.float32)
     proj = cam.calc_matrix_camera(depsgraph, x=width, y=height)
-    return view_from_matrices(view, proj, cam.data.type == "ORTHO", width, height)
+    return view_from_matrices(view, proj, cam.data.type == "ORTHO", width, height, lens_camera=cam)
 
 
 def scene_signature(scene):

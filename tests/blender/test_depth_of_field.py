@@ -130,6 +130,32 @@ def case_blur_extent():
     return ok
 
 
+def case_viewport():
+    """Through the camera, the viewport's render shows the camera's depth of
+    field: its view (viewport.view_from_camera) renders the alpha F12 renders,
+    and does not without the lens."""
+    from micropoly import _native, export, viewport
+
+    scene = three_depths_scene()
+    f12 = ru.render_passes(scene, "MICROPOLY", W, H, samples=MICROPOLY_SPP)["rgba"]
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    renderer = _native.Renderer()
+
+    def through_camera(lens):
+        view = viewport.view_from_camera(scene, depsgraph, W, H)
+        if not lens:
+            view.lens_camera = None
+        exported = export.export_scene(depsgraph, view=view)
+        return np.asarray(renderer.render(exported.scene)["rgba"])
+
+    db = ru.psnr(f12[..., 3], through_camera(True)[..., 3], peak=1.0)
+    db_sharp = ru.psnr(f12[..., 3], through_camera(False)[..., 3], peak=1.0)
+    ok = db >= 40.0 and db_sharp < 30.0
+    print(f"{'ok  ' if ok else 'FAIL'} viewport through the camera: alpha against F12 {db:.2f} dB "
+          f"(>= 40), without the lens {db_sharp:.2f} dB (< 30)")
+    return ok
+
+
 def case_panels_shown():
     """The camera's Depth of Field panels are shown for Micropoly."""
     ru.reset_scene()
@@ -142,6 +168,7 @@ def case_panels_shown():
 def main():
     results = [
         case_panels_shown(),
+        case_viewport(),
         case_three_depths("round aperture"),
         case_three_depths("6 blades turned 10 degrees", blades=6, rotation=math.radians(10)),
         case_three_depths("focus object", focus_object=True),

@@ -179,6 +179,36 @@ def case(name, build, adaptive_subdivision=True):
     return not failures
 
 
+def closing_curve(scene, points):
+    """Render > Motion Blur > Shutter Curve through `points` (x, openness)."""
+    mapping = scene.render.motion_blur_shutter_curve
+    curve = mapping.curves[0]
+    while len(curve.points) > 2:
+        curve.points.remove(curve.points[1])
+    curve.points[0].location, curve.points[1].location = points[0], points[-1]
+    for x, y in points[1:-1]:
+        curve.points.new(x, y)
+    for p in curve.points:
+        p.handle_type = "VECTOR"  # straight lines between points
+    mapping.update()
+
+
+def case_shutter_curve():
+    """A shutter that opens at once and closes slowly (openness 1 until a
+    quarter, then down to 0): agreement with Cycles, and a Micropoly render
+    with a flat curve misses it."""
+    scene = moving_scene()
+    closing_curve(scene, [(0.0, 1.0), (0.25, 1.0), (1.0, 0.0)])
+    cycles, micro = render_both(scene, "shutter curve")
+    db = ru.psnr(cycles, micro, peak=1.0)
+    closing_curve(scene, [(0.0, 1.0), (1.0, 1.0)])
+    flat = ru.render_passes(scene, "MICROPOLY", W, H, samples=MICROPOLY_SPP)["rgba"]
+    db_flat = ru.psnr(cycles, flat, peak=1.0)
+    ok = db >= THRESHOLD_DB and db_flat < THRESHOLD_DB
+    print(f"{'ok  ' if ok else 'FAIL'} shutter curve: PSNR {db:.2f} dB; with a flat curve {db_flat:.2f} dB")
+    return ok
+
+
 def case_blur_extent():
     scene = card_scene()
     cycles, micro = render_both(scene, "moving edge")
@@ -216,6 +246,7 @@ def main():
         # (a star of streaks): its reference is the modifier's level-3 mesh.
         case("deforming (shape key on the cage)", deforming_scene, adaptive_subdivision=False),
         case("camera pan", pan_scene),
+        case_shutter_curve(),
         case_blur_extent(),
     ]
     return 0 if all(results) else 1

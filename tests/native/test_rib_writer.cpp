@@ -217,6 +217,7 @@ void expect_same_images(const std::vector<Image>& a, const std::vector<Image>& b
 void expect_same_scene(const Scene& a, const Scene& b) {
   expect_same_settings(a.settings, b.settings);
   EXPECT_EQ(a.motion_steps, b.motion_steps);
+  EXPECT_EQ(a.shutter_curve, b.shutter_curve);
   EXPECT_EQ(a.camera.motion_world_to_camera, b.camera.motion_world_to_camera);
   expect_same_camera(a.camera, b.camera);
   if (a.materials.empty()) {
@@ -964,6 +965,7 @@ Scene defocused_scene() {
 Scene moving_scene() {
   Scene s = full_scene();
   s.motion_steps = 3;
+  s.shutter_curve = {1.0f, 0.75f, 0.125f, 0.0f};
   for (int k = 0; k < 3; ++k) {
     const float t = float(k - 1);
     s.camera.motion_world_to_camera.push_back(glm::translate(glm::mat4(1.0f), glm::vec3(0.05f * t, 0.0f, 0.0f)) *

@@ -65,6 +65,26 @@ def test_moving_square_conserves_coverage_and_spreads_by_its_travel(renderer):
     assert moving[H // 2, cols_moving[0]] < 0.2 and moving[H // 2, cols_moving[-1]] < 0.2
 
 
+def test_shutter_curve_weights_time(renderer):
+    """A shutter closing linearly (openness 1 -> 0) sees the start of the
+    path more: the coverage's centroid lies a third of the travel along."""
+    travel = 0.8
+
+    def centroid(curve):
+        scene = square_scene()
+        scene.set_motion(2, shutter_curve=np.array(curve, dtype=np.float32))
+        scene.set_mesh_motion(0, object_to_world=np.stack([translate(-travel / 2), translate(travel / 2)]))
+        alpha = renderer.render(scene)["rgba"][..., 3]
+        cols = np.arange(W) + 0.5
+        return (alpha.sum(axis=0) * cols).sum() / alpha.sum()
+
+    px = travel / 4.0 * FOCAL_PX  # the travel on screen
+    start = W / 2 - px / 2
+    assert centroid([]) == pytest.approx(start + px / 2, abs=0.3)
+    assert centroid([1.0, 0.0]) == pytest.approx(start + px / 3, abs=0.4)
+    assert centroid([0.0, 1.0]) == pytest.approx(start + 2 * px / 3, abs=0.4)
+
+
 def test_moving_camera_is_motion_too(renderer):
     """The camera sliding right is the square sliding left."""
     scene = square_scene()

@@ -278,8 +278,13 @@ struct Scene {
   // the scene linearly between the steps; shading uses the transforms and
   // points of the shutter's centre (the objects' own fields).
   int motion_steps = 0;
+  // How open the shutter is over its time (Render > Motion Blur > Shutter
+  // Curve), sampled evenly from its opening to its closing (piecewise
+  // linear between); samples' times follow it. Empty: fully open throughout.
+  std::vector<float> shutter_curve;
 };
 constexpr int kMaxMotionSteps = 33;
+constexpr size_t kMaxShutterCurve = 4096;
 
 // Checks indices, counts and finite values; throws mp::Error naming the object.
 void validate_scene(const Scene& scene);

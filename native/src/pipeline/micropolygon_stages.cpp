@@ -208,11 +208,33 @@ void SampleStage::sampled_totals(size_t& micropolygons, double& area_px, size_t&
   area_px = static_cast<double>(t[1]) / (2.0 * MP_SUBPIXEL_ONE * MP_SUBPIXEL_ONE);
 }
 
-SamplePattern sample_pattern(const FrameParams& f) {
+float warp_shutter_time(float u, const std::vector<float>& curve) {
+  const size_t n = curve.size();
+  if (n < 2) return u;
+  // Segment k spans [k, k + 1] / (n - 1) with openness from curve[k] to curve[k + 1].
+  std::vector<double> area(n, 0.0);
+  for (size_t k = 0; k + 1 < n; ++k) area[k + 1] = area[k] + 0.5 * (double(curve[k]) + double(curve[k + 1]));
+  const double target = std::clamp(double(u), 0.0, 1.0) * area[n - 1];
+  size_t k = size_t(std::upper_bound(area.begin(), area.end(), target) - area.begin());
+  k = std::clamp<size_t>(k, 1, n - 1) - 1;
+  const double a = curve[k], b = curve[k + 1], r = target - area[k];
+  // Area over x in [0, 1] of the segment: a x + (b - a) x^2 / 2 = r.
+  double x;
+  if (std::fabs(b - a) < 1e-12) {
+    x = a > 0.0 ? r / a : 0.0;
+  } else {
+    const double disc = a * a + 2.0 * (b - a) * r;
+    x = (-a + std::sqrt(std::max(disc, 0.0))) / (b - a);
+  }
+  return float((double(k) + std::clamp(x, 0.0, 1.0)) / double(n - 1));
+}
+
+SamplePattern sample_pattern(const FrameParams& f, const std::vector<float>& shutter_curve) {
   SamplePattern p;
   p.spp_x = f.spp_x, p.spp_y = f.spp_y, p.seed = f.seed;
   p.lens = mp_lens_on(f);
   p.motion = mp_motion_on(f);
+  if (p.motion) p.shutter_curve = shutter_curve;
   if (p.lens) p.blades = f.aperture_blades, p.radius = f.lens_radius, p.x_scale = f.lens_x_scale, p.rotation = f.aperture_rotation;
   return p;
 }
@@ -222,7 +244,7 @@ void SampleStage::mark_occlusion_cells(const cl::Buffer& dirty, const OcclusionP
   kernel_.setArg(18, params);
 }
 
-void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer) {
+void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer, const std::vector<float>& shutter_curve) {
   mark_occlusion_cells(cl::Buffer(), OcclusionParams{});
   const int spp = f.spp_x * f.spp_y;
   size_t samples = static_cast<size_t>(f.width) * static_cast<size_t>(f.height) * static_cast<size_t>(spp);
@@ -236,7 +258,7 @@ void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer) {
     normals_ = device_buffer(session_, samples * sizeof(cl_uint), "sample normal buffer");
     sample_capacity_ = samples;
   }
-  const SamplePattern pattern = sample_pattern(f);
+  const SamplePattern pattern = sample_pattern(f, shutter_curve);
   if (!(pattern == pattern_) || !offsets_()) {
     // Sample positions, and times and lens positions, of one tile
     // (kernels/mp_raster.h, mp_blur.h), computed here once.
@@ -258,7 +280,7 @@ void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer) {
           offsets[i] = static_cast<cl_ushort>(mp_sample_offset_packed(tx, ty, s, f));
           if (!blur) continue;
           const float2 l = mp_lens_on(f) ? mp_sample_lens(tx, ty, s, f) : float2{0.0f, 0.0f};
-          const float t = mp_motion_on(f) ? mp_sample_time(tx, ty, s, f) : 0.5f;
+          const float t = mp_motion_on(f) ? warp_shutter_time(mp_sample_time(tx, ty, s, f), shutter_curve) : 0.5f;
           table[i] = cl_float4{{l.x, l.y, t, 0.0f}};
           cl_float4& lb = table[tile + 2 * s];
           cl_float4& tb = table[tile + 2 * s + 1];

@@ -20,13 +20,20 @@ struct SamplePattern {
   cl_uint seed = 0;
   int lens = 0, motion = 0, blades = 0;
   float radius = 0, x_scale = 0, rotation = 0;
+  std::vector<float> shutter_curve;  // with motion (Scene::shutter_curve)
   bool operator==(const SamplePattern& o) const {
     return spp_x == o.spp_x && spp_y == o.spp_y && seed == o.seed && lens == o.lens && motion == o.motion &&
-           blades == o.blades &&
-           radius == o.radius && x_scale == o.x_scale && rotation == o.rotation;
+           blades == o.blades && radius == o.radius && x_scale == o.x_scale && rotation == o.rotation &&
+           shutter_curve == o.shutter_curve;
   }
 };
-SamplePattern sample_pattern(const FrameParams& f);
+SamplePattern sample_pattern(const FrameParams& f, const std::vector<float>& shutter_curve = {});
+
+// A time in the shutter as a shutter curve opens it: uniform times [0, 1]
+// through the inverse of the curve's cumulative openness (piecewise linear
+// curve, so a piecewise quadratic CDF; solved per segment). Monotonic, so
+// strata of times stay strata.
+float warp_shutter_time(float u, const std::vector<float>& curve);
 
 struct GridBuffers {
   GridBuffers(DeviceSession& session, cl_uint capacity, int max_grid);
@@ -108,7 +115,7 @@ class SampleStage {
   explicit SampleStage(DeviceSession& session);
   // Makes the sample buffers (key, color, normal per sample) fit the frame,
   // reusing them when the size is unchanged, and clears them.
-  void begin_frame(const FrameParams& f, StageTimer& timer);
+  void begin_frame(const FrameParams& f, StageTimer& timer, const std::vector<float>& shutter_curve = {});
   // Samples the grids of diceable sub-patches [first, first + count).
   void run(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
            GridBuffers& grids, StageTimer& timer);

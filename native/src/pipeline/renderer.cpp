@@ -153,7 +153,7 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       out.rgba.clear(), out.depth.clear(), out.normal.clear();
       return;
     }
-    sample.begin_frame(f, timer);
+    sample.begin_frame(f, timer, scene.shutter_curve);
 
     // Cancellation: the caller's progress callback is asked between bound &
     // split launches and between sample chunks, so a cancel takes effect within

@@ -99,6 +99,7 @@ void hash_surfaces(Hasher& h, const Scene& scene) {
     h.values(m.motion_object_to_world);
   }
   h.value(scene.motion_steps);
+  h.values(scene.shutter_curve);
   h.values(scene.camera.motion_world_to_camera);
   h.value(scene.bezier_patches.size());
   for (const BezierPatches& b : scene.bezier_patches) {

@@ -213,13 +213,16 @@ PYBIND11_MODULE(_native, m) {
           "Camera looking down -Z of its space (Blender's convention); world_to_camera is row-major.")
       .def(
           "set_motion",
-          [](Scene& s, int steps, const Array<float>& camera_world_to_camera) {
+          [](Scene& s, int steps, const Array<float>& camera_world_to_camera, const Array<float>& shutter_curve) {
             s.motion_steps = steps;
             s.camera.motion_world_to_camera = to_matrices(camera_world_to_camera, "camera_world_to_camera");
+            s.shutter_curve = to_vector(shutter_curve);
           },
           py::arg("steps"), py::arg("camera_world_to_camera") = Array<float>(),
-          "Motion blur: `steps` (0, or 2 and more) times evenly spread over the shutter, and the camera's "
-          "world-to-camera matrix at each (row-major (steps, 4, 4)), or none where it does not move.")
+          py::arg("shutter_curve") = Array<float>(),
+          "Motion blur: `steps` (0, or 2 and more) times evenly spread over the shutter, the camera's "
+          "world-to-camera matrix at each (row-major (steps, 4, 4)), or none where it does not move, and how "
+          "open the shutter is over its time (samples evenly spread; none: fully open).")
       .def(
           "set_mesh_motion",
           [](Scene& s, int index, const Array<float>& points, const Array<float>& object_to_world) {

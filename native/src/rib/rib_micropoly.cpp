@@ -78,13 +78,18 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   cam.aperture_rotation = params.get_float_checked("aperturerotation", cam.aperture_rotation,
                                                    [](float v) { return std::isfinite(v); }, "a finite angle in radians");
   cam.aperture_ratio = params.get_float_checked("apertureratio", cam.aperture_ratio, positive, "a positive number");
+  if (const Param* curve = params.find("shuttercurve")) {
+    std::vector<float>& out = result_.scene.shutter_curve;
+    out.clear();
+    for (double v : curve->value->numbers) out.push_back(static_cast<float>(v));
+  }
   s.dof_dice_factor = params.get_float_checked("focusfactor", s.dof_dice_factor,
                                                [](float v) { return v >= 0.0f && std::isfinite(v); }, "a number >= 0");
   const int line = args.request().line;
   warn_unknown(params,
                {"boundsplit", "boundsplitmemory", "maxgridsize", "maxsplitdepth", "backfaceculling",
                 "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate", "occlusionculling",
-                "worldshadowdirections", "apertureblades", "aperturerotation", "apertureratio", "focusfactor"},
+                "worldshadowdirections", "apertureblades", "aperturerotation", "apertureratio", "focusfactor", "shuttercurve"},
                [&](const std::string& name) {
                  warn_once("option-micropoly:" + name, line,
                            "Option \"micropoly\": parameter \"" + name + "\" is ignored");

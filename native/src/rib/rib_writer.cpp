@@ -313,6 +313,11 @@ void write_image_and_camera(std::string& o, const Scene& scene) {
     return m;
   };
   if (scene.motion_steps >= 2) o += "Shutter 0 1\n";
+  if (!scene.shutter_curve.empty()) {
+    o += "Option \"micropoly\" \"float[" + std::to_string(scene.shutter_curve.size()) + "] shuttercurve\" ";
+    put_floats(o, scene.shutter_curve.data(), scene.shutter_curve.size());
+    o += '\n';
+  }
   std::vector<glm::mat4> steps;
   for (const glm::mat4& m : c.motion_world_to_camera) steps.push_back(mirrored(m));
   o += "# world to camera, z mirrored into RenderMan's left-handed camera space\n";

@@ -168,6 +168,16 @@ void validate_scene(const Scene& scene) {
       if (!finite(m) || std::abs(glm::determinant(glm::mat3(m))) < 1e-12f)
         throw Error("a camera motion transform is degenerate or not finite");
   }
+  if (!scene.shutter_curve.empty()) {
+    double sum = 0.0;
+    for (float v : scene.shutter_curve) {
+      if (!(v >= 0.0f) || !std::isfinite(v)) throw Error("the shutter curve must be finite and not negative");
+      sum += v;
+    }
+    if (scene.shutter_curve.size() < 2 || scene.shutter_curve.size() > kMaxShutterCurve || !(sum > 0.0))
+      throw Error("the shutter curve needs 2 to " + std::to_string(kMaxShutterCurve) +
+                  " samples, not all zero");
+  }
   if (!(s.dof_dice_factor >= 0) || !std::isfinite(s.dof_dice_factor))
     throw Error("defocus dicing factor must be a finite number >= 0");
 
