@@ -299,37 +299,29 @@ inline void mp_raster_quad_blur(const float4* p, __global const float4* pm, cons
 
 /* Micropolygons that reach the rasteriser and their total screen area, summed
  * per work-group in local memory (one atomic per group): the dicing density
- * the benchmarks report as micropolygons per pixel of surface. */
-inline void mp_count_sampled(uint l, long area2, uint pass, volatile __global ulong* totals, __local ulong* area_sum,
-                             __local uint* count_sum) {
+ * the benchmarks report as micropolygons per pixel of surface; and the
+ * samples tested against micropolygon edges (inside a micropolygon's
+ * bound): the rasteriser's work per sample, which blur multiplies. Counted
+ * in the depth pass. */
+inline void mp_count_sampled(uint l, long area2, uint tests, uint pass, volatile __global ulong* totals,
+                             __local ulong* area_sum, __local uint* count_sum, __local uint* test_sum) {
   area_sum[l] = (ulong)area2;
   count_sum[l] = area2 > 0 ? 1u : 0u;
+  test_sum[l] = tests;
   barrier(CLK_LOCAL_MEM_FENCE);
   for (uint s = 32u; s > 0u; s >>= 1) {
     if (l < s) {
       area_sum[l] += area_sum[l + s];
       count_sum[l] += count_sum[l + s];
+      test_sum[l] += test_sum[l + s];
     }
     barrier(CLK_LOCAL_MEM_FENCE);
   }
   if (pass == MP_PASS_DEPTH && l == 0u && count_sum[0] > 0u) {
     atom_add(&totals[0], (ulong)count_sum[0]);
     atom_add(&totals[1], area_sum[0]);
+    atom_add(&totals[2], (ulong)test_sum[0]);
   }
-}
-
-/* Sample tests (a sample inside a micropolygon's bound, tested against its
- * edges) of the depth pass, summed like mp_count_sampled: the rasteriser's
- * work per sample, which blur multiplies. */
-inline void mp_count_tests(uint l, uint tests, uint pass, volatile __global ulong* totals, __local ulong* sum) {
-  barrier(CLK_LOCAL_MEM_FENCE);
-  sum[l] = (ulong)tests;
-  barrier(CLK_LOCAL_MEM_FENCE);
-  for (uint s = 32u; s > 0u; s >>= 1) {
-    if (l < s) sum[l] += sum[l + s];
-    barrier(CLK_LOCAL_MEM_FENCE);
-  }
-  if (pass == MP_PASS_DEPTH && l == 0u && sum[0] > 0u) atom_add(&totals[2], sum[0]);
 }
 
 /* Marks the occlusion pyramid's level-0 cells under the micropolygon's
@@ -346,23 +338,27 @@ inline void mp_mark_occlusion_cells(__global uchar* dirty, OcclusionParams o, Fr
     for (int x = x0; x <= x1; ++x) dirty[y * o.base_w + x] = (uchar)1;
 }
 
+/* The sampler's body for one work-item; `blur` (a constant in each kernel
+ * below) picks the stochastic path, so the pinhole kernel carries none of
+ * its code. */
+#define MP_SAMPLE_ARGS                                                                                                 \
+  __global const SubPatch *diceable, uint first, uint count, __global const uint *offsets, uint base, uint total,    \
+      __global const uint *patch_info, FrameParams f, __global const float4 *grid_p, __global const float4 *grid_c,   \
+      __global const float4 *grid_n, __global const ushort *sample_offsets, uint pass, volatile __global ulong *keys, \
+      __global float *colors, __global uint *normals, volatile __global ulong *totals,                               \
+      __global uchar *occlusion_dirty, OcclusionParams occ, __global const float4 *sample_table,                      \
+      __global const float4 *grid_pm, ulong motion_stride
+#define MP_SAMPLE_PASS                                                                                                 \
+  diceable, first, count, offsets, base, total, patch_info, f, grid_p, grid_c, grid_n, sample_offsets, pass, keys,    \
+      colors, normals, totals, occlusion_dirty, occ, sample_table, grid_pm, motion_stride
+
 /* One work-item per micropolygon of grids [first, first + count): `offsets`
  * holds each grid of the batch's first micropolygon (from the batch's
  * layout, GridLayoutStage), `base` is the first of these grids' and `total`
  * their number. A work-item finds its grid by binary search, so no
  * work-item idles on an unused grid slot. */
-__kernel __attribute__((reqd_work_group_size(64, 1, 1)))
-void sample_micropolygons(__global const SubPatch* diceable, uint first, uint count, __global const uint* offsets,
-                                   uint base, uint total, __global const uint* patch_info,
-                                   FrameParams f, __global const float4* grid_p, __global const float4* grid_c,
-                                   __global const float4* grid_n, __global const ushort* sample_offsets, uint pass,
-                                   volatile __global ulong* keys,
-                                   __global float* colors, __global uint* normals, volatile __global ulong* totals,
-                                   __global uchar* occlusion_dirty, OcclusionParams occ,
-                                   __global const float4* sample_table, __global const float4* grid_pm,
-                                   ulong motion_stride) {
-  __local ulong area_sum[64];
-  __local uint count_sum[64];
+inline void mp_sample(MP_SAMPLE_ARGS, __local ulong* area_sum, __local uint* count_sum, __local uint* test_sum,
+                      const int blur) {
   uint stride = (uint)f.max_grid + 1u;
   uint gid = get_global_id(0);
   int live = gid < total && count > 0u;
@@ -405,7 +401,6 @@ void sample_micropolygons(__global const SubPatch* diceable, uint first, uint co
     }
     area2 = ((keep & 1u) ? (a0 < 0 ? -a0 : a0) : 0) + ((keep & 2u) ? (a1 < 0 ? -a1 : a1) : 0);
   }
-  mp_count_sampled(get_local_id(0), area2, pass, totals, area_sum, count_sum);
   uint tests = 0u;
   if (keep) {
     uint grid_id = mp_hash32(sp.patch);
@@ -413,7 +408,7 @@ void sample_micropolygons(__global const SubPatch* diceable, uint first, uint co
     uint mp_id = mp_hash_combine(grid_id, m);
     float opacity = grid_c[grid_base + q[0]].w;
     if (pass == MP_PASS_DEPTH && occlusion_dirty) mp_mark_occlusion_cells(occlusion_dirty, occ, f, v[0].p, v[1].p, v[2].p, v[3].p);
-    if (mp_blur_on(f)) {
+    if (blur) {
       ulong idx[4];
       for (int k = 0; k < 4; ++k) idx[k] = grid_base + q[k];
       mp_raster_quad_blur(vp, grid_pm, idx, motion_stride, vc, vn, keep, mp_id, opacity, f, sample_offsets, sample_table, pass,
@@ -422,5 +417,18 @@ void sample_micropolygons(__global const SubPatch* diceable, uint first, uint co
       mp_raster_quad(v[0], v[1], v[2], v[3], keep, mp_id, opacity, f, sample_offsets, pass, keys, colors, normals, &tests);
     }
   }
-  mp_count_tests(get_local_id(0), tests, pass, totals, area_sum);
+  mp_count_sampled(get_local_id(0), area2, tests, pass, totals, area_sum, count_sum, test_sum);
+}
+
+__kernel __attribute__((reqd_work_group_size(64, 1, 1))) void sample_micropolygons(MP_SAMPLE_ARGS) {
+  __local ulong area_sum[64];
+  __local uint count_sum[64], test_sum[64];
+  mp_sample(MP_SAMPLE_PASS, area_sum, count_sum, test_sum, 0);
+}
+
+/* Samples with times and lens positions (mp_blur.h). */
+__kernel __attribute__((reqd_work_group_size(64, 1, 1))) void sample_micropolygons_blur(MP_SAMPLE_ARGS) {
+  __local ulong area_sum[64];
+  __local uint count_sum[64], test_sum[64];
+  mp_sample(MP_SAMPLE_PASS, area_sum, count_sum, test_sum, 1);
 }

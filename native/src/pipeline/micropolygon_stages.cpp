@@ -195,7 +195,10 @@ void ShadeStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffe
 }
 
 SampleStage::SampleStage(DeviceSession& session)
-    : session_(session), kernel_(session.program(), "sample_micropolygons"), clear_(session.program(), "clear_samples") {
+    : session_(session),
+      kernel_(session.program(), "sample_micropolygons"),
+      blur_kernel_(session.program(), "sample_micropolygons_blur"),
+      clear_(session.program(), "clear_samples") {
   totals_ = cl::Buffer(session.context(), CL_MEM_READ_WRITE, 3 * sizeof(cl_ulong));
 }
 
@@ -240,8 +243,8 @@ SamplePattern sample_pattern(const FrameParams& f, const std::vector<float>& shu
 }
 
 void SampleStage::mark_occlusion_cells(const cl::Buffer& dirty, const OcclusionParams& params) {
-  kernel_.setArg(17, dirty);
-  kernel_.setArg(18, params);
+  occlusion_dirty_ = dirty;
+  occlusion_ = params;
 }
 
 void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer, const std::vector<float>& shutter_curve) {
@@ -310,31 +313,34 @@ void SampleStage::run(const cl::Buffer& diceable, cl_uint first, cl_uint count, 
   const cl_uint base = grids.micropolygon_offsets_host[first];
   const cl_uint total = grids.micropolygon_offsets_host[first + count] - base;
   if (total == 0) return;
-  kernel_.setArg(0, diceable);
-  kernel_.setArg(1, first);
-  kernel_.setArg(2, count);
-  kernel_.setArg(3, grids.micropolygon_offsets);
-  kernel_.setArg(4, base);
-  kernel_.setArg(5, total);
-  kernel_.setArg(6, scene.patch_info);
-  kernel_.setArg(7, f);
-  kernel_.setArg(8, grids.p);
-  kernel_.setArg(9, grids.c);
-  kernel_.setArg(10, grids.n);
-  kernel_.setArg(11, offsets_);
-  kernel_.setArg(13, keys_);
-  kernel_.setArg(14, colors_);
-  kernel_.setArg(15, normals_);
-  kernel_.setArg(16, totals_);
-  kernel_.setArg(19, blur_);
+  cl::Kernel& k = mp_blur_on(f) ? blur_kernel_ : kernel_;
+  k.setArg(0, diceable);
+  k.setArg(1, first);
+  k.setArg(2, count);
+  k.setArg(3, grids.micropolygon_offsets);
+  k.setArg(4, base);
+  k.setArg(5, total);
+  k.setArg(6, scene.patch_info);
+  k.setArg(7, f);
+  k.setArg(8, grids.p);
+  k.setArg(9, grids.c);
+  k.setArg(10, grids.n);
+  k.setArg(11, offsets_);
+  k.setArg(13, keys_);
+  k.setArg(14, colors_);
+  k.setArg(15, normals_);
+  k.setArg(16, totals_);
+  k.setArg(17, occlusion_dirty_);
+  k.setArg(18, occlusion_);
+  k.setArg(19, blur_);
   // Motion positions (any valid buffer when there are none).
-  kernel_.setArg(20, grids.motion_p() ? grids.motion_p : grids.p);
-  kernel_.setArg(21, cl_ulong(grids.slot_space()));
+  k.setArg(20, grids.motion_p() ? grids.motion_p : grids.p);
+  k.setArg(21, cl_ulong(grids.slot_space()));
   // Pass 0 finds each sample's nearest key; pass 1 lets its owner write.
   for (cl_uint pass = 0; pass < 2; ++pass) {
-    kernel_.setArg(12, pass);
+    k.setArg(12, pass);
     cl::Event e;
-    session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(total), cl::NDRange(64), nullptr, &e);
+    session_.queue().enqueueNDRangeKernel(k, cl::NullRange, round_up_range(total), cl::NDRange(64), nullptr, &e);
     timer.add(Stage::Sample, e);
   }
 }

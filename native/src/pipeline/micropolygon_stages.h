@@ -133,8 +133,10 @@ class SampleStage {
 
  private:
   DeviceSession& session_;
-  cl::Kernel kernel_;
+  cl::Kernel kernel_, blur_kernel_;  // pinhole samples; samples with times and lens positions
   cl::Kernel clear_;
+  cl::Buffer occlusion_dirty_;
+  OcclusionParams occlusion_{};
   cl::Buffer keys_, colors_, normals_, offsets_, blur_, totals_;
   size_t sample_capacity_ = 0;  // samples the buffers hold (they only grow)
   SamplePattern pattern_;
