@@ -7,10 +7,10 @@
  * Scene's motion steps, evenly spread over the shutter, and moves linearly
  * between them; a sample sees every vertex at its own time.
  *
- * Lens: the sample's lens position L = (lx, ly) on the aperture
- * (camera units, the lens in the plane z = 0) and sees a camera-space point
- * P at depth d = -z where the ray from L through P crosses the plane in
- * focus, z = -F, projected through the lens centre:
+ * Lens: a sample with lens position L = (lx, ly) on the aperture (camera
+ * units, the lens in the plane z = 0) sees a camera-space point P at depth
+ * d = -z where the ray from L through P crosses the plane in focus, z = -F,
+ * projected through the lens centre:
  *
  *   rx = ax * (P.x / d + lx * (1/F - 1/d)) + bx    (likewise y)
  *
@@ -27,7 +27,7 @@
 #include "mp_hash.h"
 #include "mp_types.h"
 
-/* Whether samples of view f carry lens positions, times, either. */
+/* Whether samples of view f carry lens positions, times, or either. */
 MP_INLINE int mp_lens_on(FrameParams f) {
   return f.lens_radius > 0.0f && !f.ortho && f.view_kind == MP_VIEW_CAMERA;
 }
