@@ -83,6 +83,18 @@ class MICROPOLY_PT_motion_blur(MicropolyPanel, bpy.types.Panel):
         layout.prop(scene.micropoly, "motion_steps")
 
 
+class MICROPOLY_PT_motion_blur_curve(MicropolyPanel, bpy.types.Panel):
+    """Render > Motion Blur > Shutter Curve: how open the shutter is over its time."""
+    bl_label = "Shutter Curve"
+    bl_parent_id = "MICROPOLY_PT_motion_blur"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        render = context.scene.render
+        self.layout.active = render.use_motion_blur
+        self.layout.template_curve_mapping(render, "motion_blur_shutter_curve")
+
+
 class MICROPOLY_PT_bound_split(MicropolyPanel, bpy.types.Panel):
     bl_label = "Bound & Split"
     bl_options = {"DEFAULT_CLOSED"}
@@ -189,7 +201,8 @@ class MICROPOLY_PT_material_displacement(MicropolyPanel, bpy.types.Panel):
 
 
 CLASSES = (MICROPOLY_PT_sampling, MICROPOLY_PT_dicing, MICROPOLY_PT_bound_split, MICROPOLY_PT_shadows,
-           MICROPOLY_PT_film, MICROPOLY_PT_motion_blur, MICROPOLY_PT_material_displacement, MICROPOLY_PT_light_shadow,
+           MICROPOLY_PT_film, MICROPOLY_PT_motion_blur, MICROPOLY_PT_motion_blur_curve,
+           MICROPOLY_PT_material_displacement, MICROPOLY_PT_light_shadow,
            MICROPOLY_PT_object_visibility)
 
 
