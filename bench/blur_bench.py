@@ -21,7 +21,6 @@ per-stage timings and sample-test counts (bench/blur_bench.sh)."""
 import math
 import os
 import sys
-import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "blender"))
@@ -77,22 +76,10 @@ def build_scene(kind):
 
 def export_ribs():
     ru.enable_addon()
-    from micropoly import operators
-    folder = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
-    os.makedirs(folder, exist_ok=True)
     for kind in KINDS:
         scene = build_scene(kind)
-        scene.render.engine = "MICROPOLY"
         scene.micropoly.samples = SAMPLES
-        path = os.path.join(folder, f"blur_{kind}.rib")
-        operators.export_rib(bpy.context.evaluated_depsgraph_get(), path)
-        print(f"wrote {path}")
-
-
-def f12(scene):
-    started = time.perf_counter()
-    bpy.ops.render.render()
-    return time.perf_counter() - started
+        ru.write_bench_rib(scene, f"blur_{kind}")
 
 
 def side_by_side():
@@ -104,12 +91,12 @@ def side_by_side():
         scene = build_scene(kind)
         scene.render.engine = "MICROPOLY"
         scene.micropoly.samples = SAMPLES
-        micro = f12(scene)
+        micro = ru.f12_seconds(scene)
         scene = build_scene(kind)
         ru.setup_cycles(scene, samples=SAMPLES, shadows=True)
         c = scene.cycles
         c.max_bounces, c.diffuse_bounces, c.glossy_bounces = 12, 4, 4  # Cycles' defaults
-        cycles = f12(scene)
+        cycles = ru.f12_seconds(scene)
         print(f"| {kind} | {micro:.2f} | {cycles:.2f} | {cycles / micro:.1f}x |", flush=True)
 
 

@@ -20,7 +20,6 @@ CLI's per-stage timings (bench/world_bench.sh)."""
 import math
 import os
 import sys
-import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "blender"))
 
@@ -69,21 +68,8 @@ def build_scene(lighting):
 
 def export_ribs():
     ru.enable_addon()
-    from micropoly import operators
-    folder = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
-    os.makedirs(folder, exist_ok=True)
     for lighting in ("hdri", "lights4", "none"):
-        scene = build_scene(lighting)
-        scene.render.engine = "MICROPOLY"
-        path = os.path.join(folder, f"world_{lighting}.rib")
-        operators.export_rib(bpy.context.evaluated_depsgraph_get(), path)
-        print(f"wrote {path}")
-
-
-def f12(scene):
-    started = time.perf_counter()
-    bpy.ops.render.render()
-    return time.perf_counter() - started
+        ru.write_bench_rib(build_scene(lighting), f"world_{lighting}")
 
 
 def side_by_side():
@@ -91,15 +77,15 @@ def side_by_side():
     print(f"world_hdri, {W}x{H}, {SAMPLES} samples, F12 wall time, one run each")
     scene = build_scene("hdri")
     scene.render.engine = "MICROPOLY"
-    print(f"Micropoly: {f12(scene):.2f} s")
+    print(f"Micropoly: {ru.f12_seconds(scene):.2f} s")
     scene = build_scene("hdri")
     ru.setup_cycles(scene, samples=SAMPLES)
-    print(f"Cycles, direct light (max bounces 0), adaptive subdivision 1 px: {f12(scene):.2f} s")
+    print(f"Cycles, direct light (max bounces 0), adaptive subdivision 1 px: {ru.f12_seconds(scene):.2f} s")
     scene = build_scene("hdri")
     ru.setup_cycles(scene, samples=SAMPLES)
     c = scene.cycles
     c.max_bounces, c.diffuse_bounces, c.glossy_bounces, c.transmission_bounces = 12, 4, 4, 12
-    print(f"Cycles, default light paths, adaptive subdivision 1 px: {f12(scene):.2f} s")
+    print(f"Cycles, default light paths, adaptive subdivision 1 px: {ru.f12_seconds(scene):.2f} s")
 
 
 if "--rib-only" in args:

@@ -140,13 +140,21 @@ MP_INLINE float2 mp_sample_lens(int tx, int ty, int s, FrameParams f) {
   return MP_F2(a.x * f.lens_radius * f.lens_x_scale, a.y * f.lens_radius);
 }
 
+/* The motion step k that time t follows and its weight w towards step
+ * k + 1 (steps evenly spread over the shutter, linear between). */
+MP_INLINE int mp_motion_segment(float t, int steps, float* w) {
+  float x = clamp(t, 0.0f, 1.0f) * (float)(steps - 1);
+  int k = min((int)x, steps - 2);
+  *w = x - (float)k;
+  return k;
+}
+
 /* Position at time t of a grid vertex whose positions at the motion steps
  * lie `stride` apart from p[0]. */
 MP_INLINE float4 mp_motion_position(const MP_GLOBAL float4* p, ulong stride, int steps, float t) {
-  float x = clamp(t, 0.0f, 1.0f) * (float)(steps - 1);
-  int i = min((int)x, steps - 2);
-  float w = x - (float)i;
-  float4 a = p[(ulong)i * stride], b = p[(ulong)(i + 1) * stride];
+  float w;
+  int k = mp_motion_segment(t, steps, &w);
+  float4 a = p[(ulong)k * stride], b = p[(ulong)(k + 1) * stride];
   return a + w * (b - a);
 }
 

@@ -147,9 +147,8 @@ inline float3 mp_blur_position(int i, float t, int steps, const float4* p, float
                                __global const float4* pm, const ulong* idx, ulong stride) {
   if (!steps) return p[i].xyz;
   if (steps > MP_BLUR_LOCAL_STEPS) return mp_motion_position(pm + idx[i], stride, steps, t).xyz;
-  float x = clamp(t, 0.0f, 1.0f) * (float)(steps - 1);
-  int k = min((int)x, steps - 2);
-  float w = x - (float)k;
+  float w;
+  int k = mp_motion_segment(t, steps, &w);
   return (ps[i][k] + w * (ps[i][k + 1] - ps[i][k])).xyz;
 }
 

@@ -468,3 +468,26 @@ def rib_against_f12(scene, width, height, samples, must_contain, transparent=Fal
     pa = np.array(a.pixels[:], dtype=np.float32).reshape(-1, 4)
     pb = np.array(b.pixels[:], dtype=np.float32).reshape(-1, 4)
     return float(np.abs(pa - pb).max())
+
+
+def f12_seconds(scene):
+    """Wall time of one F12 render of `scene` (its engine as set)."""
+    import time
+
+    started = time.perf_counter()
+    bpy.ops.render.render()
+    return time.perf_counter() - started
+
+
+def write_bench_rib(scene, name):
+    """`scene` rendered by Micropoly, as RIB in bench/out/<name>.rib (for the
+    CLI's benchmarks on PoCL and on a GPU)."""
+    enable_addon()
+    from micropoly import operators
+
+    folder = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "bench", "out")
+    os.makedirs(folder, exist_ok=True)
+    scene.render.engine = "MICROPOLY"
+    path = os.path.abspath(os.path.join(folder, name + ".rib"))
+    operators.export_rib(bpy.context.evaluated_depsgraph_get(), path)
+    print(f"wrote {path}")

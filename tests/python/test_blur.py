@@ -147,6 +147,8 @@ def test_in_focus_stays_sharp(renderer):
      "changes its topology"),
     (lambda s: (s.set_motion(2), s.set_mesh_motion(0, points=np.full((2, 4, 3), np.nan, dtype=np.float32))),
      "NaN"),
+    (lambda s: s.set_motion(2, shutter_curve=np.array([1.0, -0.5], dtype=np.float32)), "shutter curve"),
+    (lambda s: s.set_motion(2, shutter_curve=np.zeros(4, dtype=np.float32)), "not all zero"),
     (lambda s: s.set_depth_of_field(0.1, -1.0), "focus distance"),
     (lambda s: s.set_depth_of_field(0.1, 2.0, ratio=0.0), "aperture ratio"),
 ])
