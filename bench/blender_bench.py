@@ -38,6 +38,11 @@ QUICK = "--quick" in args
 # (Displacement Only), the issue-5 benchmark scene.
 DISPLACED = "--displaced" in args
 SHADOWS = "--shadows" in args
+# --deep: the Suzannes in five rows one behind the other (30 of them, each
+# row hiding most of the next): high depth complexity.
+DEEP = "--deep" in args
+# --engines A,B: only these engines (default: Micropoly, Cycles and EEVEE).
+ENGINES = args[args.index("--engines") + 1].split(",") if "--engines" in args else None
 W, H = (480, 270) if QUICK else (1920, 1080)
 SAMPLES = 16
 
@@ -45,13 +50,13 @@ SAMPLES = 16
 def build_scene():
     scene = ru.reset_scene()
     scene.world.color = (0.05, 0.05, 0.06)
-    for i in range(6):
-        x, y = (i % 3 - 1) * 2.6, (i // 3) * 2.6
+    for i in range(30 if DEEP else 6):
+        x, y = ((i % 6) - 2.5) * 1.5 if DEEP else (i % 3 - 1) * 2.6, (i // 6 if DEEP else i // 3) * 2.6
         bpy.ops.mesh.primitive_monkey_add(size=2.0, location=(x, y, 0.0), rotation=(0.0, 0.0, math.radians(20 * i)))
         obj = bpy.context.object
         obj.modifiers.new("Subdivision", "SUBSURF").render_levels = 2
         bpy.ops.object.shade_smooth()
-        mat = ru.diffuse_material(f"m{i}", (0.2 + 0.12 * i, 0.5, 0.8 - 0.1 * i))
+        mat = ru.diffuse_material(f"m{i}", (0.2 + 0.12 * (i % 6), 0.5, 0.8 - 0.1 * (i % 6)))
         if DISPLACED:
             ru.add_noise_displacement(mat, 4.0, 0.15)
         obj.data.materials.append(mat)
@@ -87,6 +92,32 @@ def time_engine(scene, engine):
         bpy.ops.render.render()
         times.append(time.perf_counter() - started)
     return times
+
+
+def f12_breakdown(scene):
+    """Where one Micropoly F12 goes: the export (export_final), the native
+    render (its own total, from the stats) and the rest (Blender around the
+    render: the render result, writing the passes, colour management), the
+    renderer kept from the F12 runs before."""
+    from micropoly import engine, export
+
+    scene.render.engine = "MICROPOLY"
+    scene.micropoly.samples = SAMPLES
+    started = time.perf_counter()
+    bpy.ops.render.render()
+    f12 = time.perf_counter() - started
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    started = time.perf_counter()
+    exported = export.export_final(depsgraph, scene.frame_set)
+    export_s = time.perf_counter() - started
+    renderer = engine._final_renderers.acquire("")
+    try:
+        stats = renderer.render(exported.scene)["stats"]
+    finally:
+        engine._final_renderers.release()
+    native_s = stats["timings_ms"]["total"] / 1000.0
+    return {"f12_s": f12, "export_s": export_s, "native_s": native_s, "outside_s": f12 - export_s - native_s,
+            "stages_ms": stats["timings_ms"], "micropolygons": stats["micropolygons"]}
 
 
 def export_time():
@@ -181,12 +212,13 @@ def shadow_stats(scene):
 
 def main():
     if "--rib-only" in args:
-        export_rib("shadow_suzannes" if SHADOWS else "displaced_suzannes" if DISPLACED else "suzannes")
+        export_rib("shadow_suzannes" if SHADOWS else "displaced_suzannes" if DISPLACED else
+                   "deep_suzannes" if DEEP else "suzannes")
         return
     if SHADOWS:
         shadow_bench()
         return
-    engines = ("MICROPOLY", "CYCLES", "BLENDER_EEVEE_NEXT" if bpy.app.version >= (4, 2, 0) else "BLENDER_EEVEE")
+    engines = ENGINES or ("MICROPOLY", "CYCLES", "BLENDER_EEVEE_NEXT" if bpy.app.version >= (4, 2, 0) else "BLENDER_EEVEE")
     results = {}
     for engine in engines:
         scene = build_scene()
@@ -194,6 +226,7 @@ def main():
             results[engine] = time_engine(scene, engine)
         except Exception as e:  # EEVEE needs an OpenGL context some machines lack
             print(f"{engine}: could not render ({e})")
+    breakdown = f12_breakdown(build_scene())
     faces, export_times = export_time()
     print(f"\nBlender {bpy.app.version_string}, {W}x{H}, {SAMPLES} samples, median of {REPEAT} F12 renders")
     micro = statistics.median(results["MICROPOLY"])
@@ -202,10 +235,14 @@ def main():
     for engine, times in results.items():
         med = statistics.median(times)
         print(f"| {engine} | {med:.2f} | {', '.join(f'{t:.2f}' for t in times)} | {med / micro:.1f}x |")
+    print(f"\nMicropoly F12 {breakdown['f12_s']:.2f} s: export {breakdown['export_s']:.2f} s, native render "
+          f"{breakdown['native_s']:.2f} s, around the render {breakdown['outside_s']:.2f} s; "
+          f"{breakdown['micropolygons']:,} micropolygons; stages (ms) "
+          + ", ".join(f"{k} {v:.0f}" for k, v in breakdown["stages_ms"].items() if v))
     print(f"\nexport of a {faces:,}-face mesh: median {statistics.median(export_times):.3f} s "
           f"({', '.join(f'{t:.3f}' for t in export_times)})")
     print(json.dumps({"version": bpy.app.version_string, "width": W, "height": H, "renders": results,
-                      "export_faces": faces, "export_s": export_times}))
+                      "export_faces": faces, "export_s": export_times, "breakdown": breakdown}))
 
 
 if __name__ == "__main__":

@@ -165,8 +165,8 @@ MP_INLINE int mp_project_lens(float3 p, float2 L, FrameParams f, float* rx, floa
   if (!(d > 0.0f)) return 0;
   float inv = 1.0f / d;
   float k = 1.0f / f.focus_distance - inv;
-  *rx = f.ax * (p.x * inv + L.x * k) + f.bx;
-  *ry = f.ay * (p.y * inv + L.y * k) + f.by;
+  *rx = f.ax * (p.x * inv + L.x * k) + f.frame_bx;
+  *ry = f.ay * (p.y * inv + L.y * k) + f.frame_by;
   *inv_d = inv;
   return 1;
 }

@@ -136,6 +136,15 @@ MP_INLINE float2 mp_project_view(float3 v, FrameParams f) {
   return MP_F2(f.ax * v.x * inv + f.bx, f.ay * v.y * inv + f.by);
 }
 
+/* The same without the raster's offset: differences of these are raster
+ * lengths that do not depend on where the raster's origin lies (a bucket's,
+ * buckets.h, or the whole frame's), so a sub-patch gets the same rates in
+ * every bucket. */
+MP_INLINE float2 mp_project_view_unplaced(float3 v, FrameParams f) {
+  float inv = f.ortho ? 1.0f : 1.0f / (-v.z);
+  return MP_F2(f.ax * v.x * inv, f.ay * v.y * inv);
+}
+
 /* Raster position of a camera-space point in the view. */
 MP_INLINE float2 mp_project(float3 p, FrameParams f) { return mp_project_view(mp_to_view(p, f), f); }
 
@@ -249,7 +258,7 @@ MP_INLINE float mp_polyline_screen_length(float3* p, int count, FrameParams f) {
     if (!mp_view_point_usable(p[k], f)) return MP_UNMEASURABLE;
   }
   for (int k = 0; k + 1 < count; ++k) {
-    float2 d = mp_project_view(p[k + 1], f) - mp_project_view(p[k], f);
+    float2 d = mp_project_view_unplaced(p[k + 1], f) - mp_project_view_unplaced(p[k], f);
     len += sqrt(d.x * d.x + d.y * d.y);
   }
   /* Out of focus, the target edge grows with the circle of confusion of the
@@ -334,7 +343,8 @@ MP_INLINE float mp_mid_screen_length(const MP_GLOBAL float4* cp, uint type, cons
     mp_eval_patch(cp, type, uv.x, uv.y, &p[k], &du, &dv);
   }
   float len = mp_polyline_screen_length(p, MP_EDGE_SEGMENTS + 1, f);
-  *chord = len >= 0.0f ? mp_project_view(p[MP_EDGE_SEGMENTS], f) - mp_project_view(p[0], f) : MP_F2(0.0f, 0.0f);
+  *chord = len >= 0.0f ? mp_project_view_unplaced(p[MP_EDGE_SEGMENTS], f) - mp_project_view_unplaced(p[0], f)
+                        : MP_F2(0.0f, 0.0f);
   return len;
 }
 

@@ -29,6 +29,10 @@ MP_INLINE long mp_to_fixed(float r) { return (long)floor(r * (float)MP_SUBPIXEL_
  * function and read by the sampler and the resolve pass, which must agree. */
 #define MP_SAMPLE_TILE 32
 
+/* Pixels per side of the screen tiles the CPU's sampler bins grids into
+ * (sample_tiles.cl): a tile's samples belong to one work-item. */
+#define MP_RASTER_TILE 32
+
 MP_INLINE uint mp_sample_offset_packed(int tx, int ty, int s, FrameParams f) {
   /* Blurred, slot s is a time or lens stratum (mp_blur.h); its position
    * stratum is shuffled per pixel so the two do not follow each other. */
@@ -50,6 +54,15 @@ MP_INLINE MpFixed2 mp_sample_position(int px, int py, int s, int spp, FrameParam
   p.x = (long)px * MP_SUBPIXEL_ONE + (long)(o & 0xffu);
   p.y = (long)py * MP_SUBPIXEL_ONE + (long)(o >> 8);
   return p;
+}
+
+/* A raster position of the whole crop region's frame (FrameParams.frame_bx)
+ * in fixed point in the sample buffer, whose origin is its bucket's. */
+MP_INLINE MpFixed2 mp_sample_fixed(float rx, float ry, FrameParams f) {
+  MpFixed2 q;
+  q.x = mp_to_fixed(rx) - ((long)f.bucket_x0 << MP_SUBPIXEL_BITS);
+  q.y = mp_to_fixed(ry) - ((long)f.bucket_y0 << MP_SUBPIXEL_BITS);
+  return q;
 }
 
 /* Twice the signed area of (a, b, p); in raster space (y down) a triangle whose

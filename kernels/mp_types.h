@@ -93,6 +93,15 @@ typedef struct {
   /* Motion blur (the camera's view only): grid vertices have positions at
    * motion_steps times evenly spread over the shutter; 0: no motion. */
   int motion_steps;
+  /* Buckets (native/src/pipeline/buckets.h): the sample buffer holds pixels
+   * from (bucket_x0, bucket_y0) of the crop region on. bx and by place the
+   * raster at the bucket's origin (for bound & split's culling); the
+   * samplers instead place points with the whole crop region's frame_bx and
+   * frame_by and subtract the bucket's origin in fixed point, so a point
+   * lands on the same sub-pixel position in every bucket as in the whole
+   * frame. */
+  float frame_bx, frame_by;
+  int bucket_x0, bucket_y0;
 } FrameParams;
 
 /* The camera view's occlusion pyramid (mp_occlusion.h): level 0 has a cell

@@ -9,10 +9,10 @@
 
 /* One work-item per level-0 cell: the farthest depth of its samples, and
  * (into covered[0]) how many of its pixels have a sample with a surface.
- * Unless `all` is set, only cells the sample stage marked in `dirty` since
+ * Only pixels in count_region ([x, z) x [y, w)) are counted. Unless `all` is set, only cells the sample stage marked in `dirty` since
  * the last build are read (the others have not changed). */
 __kernel void occlusion_base(__global const ulong* keys, FrameParams f, OcclusionParams o, __global uint* pyramid,
-                             __global uchar* dirty, int all, volatile __global uint* covered) {
+                             __global uchar* dirty, int all, volatile __global uint* covered, int4 count_region) {
   int cx = get_global_id(0), cy = get_global_id(1);
   if (cx >= o.base_w || cy >= o.base_h) return;
   if (!all) {
@@ -30,7 +30,7 @@ __kernel void occlusion_base(__global const ulong* keys, FrameParams f, Occlusio
         far_bits = max(far_bits, key == MP_EMPTY_KEY ? 0xffffffffu : (uint)(key >> 32));
         any |= key != MP_EMPTY_KEY;
       }
-      count += any;
+      count += any && px >= count_region.x && px < count_region.z && py >= count_region.y && py < count_region.w;
     }
   pyramid[cy * o.base_w + cx] = far_bits;
   if (count) atomic_add(covered, count);

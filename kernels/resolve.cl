@@ -15,7 +15,10 @@ __kernel void clear_samples(__global ulong* keys, ulong n) {
   if (i < n) keys[i] = (ulong)0xffffffffffffffffUL;
 }
 
-/* `weights`, when use_weights is set, holds the filter weight of every sample
+/* One work-item per pixel of the region [region.x, region.z) x [region.y,
+ * region.w) of the sample buffer (a bucket's pixels, buckets.h), written to
+ * the image (out_width pixels wide) at its pixel plus `origin`.
+ * `weights`, when use_weights is set, holds the filter weight of every sample
  * of every neighbour for each of the 32x32 positions a pixel can have in the
  * repeating sample tile (built on the host from the same functions), so the
  * filter is not re-evaluated per sample. */
@@ -23,9 +26,10 @@ __kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width,
                              __global const float* weights, int use_weights, __global const ulong* keys,
                              __global const float* colors, __global const uint* normals,
                              float4 cam_to_world_x, float4 cam_to_world_y, float4 cam_to_world_z,
-                             __global float4* rgba, __global float* depth, __global float* normal_out, int want_passes) {
-  int px = get_global_id(0), py = get_global_id(1);
-  if (px >= f.width || py >= f.height) return;
+                             __global float4* rgba, __global float* depth, __global float* normal_out, int want_passes,
+                             int4 region, int2 origin, int out_width) {
+  int px = region.x + (int)get_global_id(0), py = region.y + (int)get_global_id(1);
+  if (px >= region.z || py >= region.w) return;
   int spp = f.spp_x * f.spp_y;
   int reach = (int)ceil(0.5f * filter_width - 0.5f);
   float4 sum = (float4)(0.0f);
@@ -53,7 +57,8 @@ __kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width,
       }
     }
   ulong pixel = (ulong)py * (ulong)f.width + (ulong)px;
-  rgba[pixel] = wsum > 0.0f ? sum / wsum : (float4)(0.0f);
+  ulong out = (ulong)(py + origin.y) * (ulong)out_width + (ulong)(px + origin.x);
+  rgba[out] = wsum > 0.0f ? sum / wsum : (float4)(0.0f);
   if (!want_passes) return;
 
   float zmin = MP_NO_DEPTH;
@@ -62,9 +67,10 @@ __kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width,
     ulong key = keys[pixel * (ulong)spp + (ulong)s];
     if (key == (ulong)0xffffffffffffffffUL) continue;
     zmin = fmin(zmin, as_float((uint)(key >> 32)));
+    if (!f.normal_pass) continue; /* samples hold no normals: the Normal pass is off */
     float3 n = mp_decode_normal(normals[pixel * (ulong)spp + (ulong)s]);
     nsum += (float3)(dot(cam_to_world_x.xyz, n), dot(cam_to_world_y.xyz, n), dot(cam_to_world_z.xyz, n));
   }
-  depth[pixel] = zmin;
-  vstore3(nsum / (float)spp, pixel, normal_out);
+  depth[out] = zmin;
+  vstore3(nsum / (float)spp, out, normal_out);
 }

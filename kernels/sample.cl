@@ -15,48 +15,10 @@
 #include "mp_raster.h"
 #include "mp_grid.h"
 #include "mp_occlusion.h"
+#include "mp_sample.h"
 
 #define MP_PASS_DEPTH 0u
 #define MP_PASS_ATTRIBUTES 1u
-
-typedef struct {
-  MpFixed2 p;
-  float inv_d;    /* 1/depth (perspective) or depth (orthographic) */
-  float3 c_over_d;
-  float3 n_over_d;
-} MpRasterVertex;
-
-inline MpRasterVertex mp_raster_vertex(float4 p, float4 c, float4 n, FrameParams f, int* ok) {
-  MpRasterVertex v;
-  float d = -p.z;
-  float inv = f.ortho ? 1.0f : 1.0f / d;
-  float rx = f.ax * p.x * inv + f.bx, ry = f.ay * p.y * inv + f.by;
-  if (!(fabs(rx) < MP_RASTER_GUARD && fabs(ry) < MP_RASTER_GUARD) || (!f.ortho && !(d > 0.0f))) *ok = 0;
-  v.p.x = mp_to_fixed(rx);
-  v.p.y = mp_to_fixed(ry);
-  /* Perspective-correct interpolation: attributes / d and 1/d are affine in screen space. */
-  float w = f.ortho ? 1.0f : inv;
-  v.inv_d = f.ortho ? d : inv;
-  v.c_over_d = c.xyz * w;
-  v.n_over_d = n.xyz * w;
-  return v;
-}
-
-/* A triangle set up for coverage tests (mp_edge_triangle) with the
- * attributes of its vertices in the same order. */
-typedef struct {
-  MpEdgeTriangle e;
-  MpRasterVertex a, b, c;
-} MpTriangle;
-
-inline MpTriangle mp_setup_triangle(MpRasterVertex a, MpRasterVertex b, MpRasterVertex c) {
-  MpTriangle t;
-  t.e = mp_edge_triangle(a.p, b.p, c.p);
-  t.a = a;
-  t.b = t.e.swapped ? c : b;
-  t.c = t.e.swapped ? b : c;
-  return t;
-}
 
 /* Sample s of pixel (px, py), covered by triangle t at barycentrics (la,
  * lb, lc): within the clip range and the stochastic opacity, the depth pass
@@ -64,18 +26,16 @@ inline MpTriangle mp_setup_triangle(MpRasterVertex a, MpRasterVertex b, MpRaster
 inline void mp_sample_write(const MpTriangle* t, float la, float lb, float lc, int px, int py, int s, int spp,
                             uint mp_id, float opacity, FrameParams f, uint pass, volatile __global ulong* keys,
                             __global float* colors, __global uint* normals) {
-  float inv_d = la * t->a.inv_d + lb * t->b.inv_d + lc * t->c.inv_d;
-  float d = f.ortho ? inv_d : 1.0f / inv_d;
-  if (!(d >= f.clip_near && d <= f.clip_far)) return;
+  float d;
+  if (!mp_triangle_depth(t, la, lb, lc, f, &d)) return;
+  if (!mp_opacity_keeps(mp_id, px, py, s, opacity, f)) return;
   ulong index = ((ulong)py * (ulong)f.width + (ulong)px) * (ulong)spp + (ulong)s;
-  if (opacity < 1.0f && mp_hash_unit(mp_hash_combine(mp_id, (uint)index)) >= opacity) return;
   ulong key = ((ulong)as_uint(d) << 32) | (ulong)mp_id;
   if (pass == MP_PASS_DEPTH) {
     if (key < keys[index]) atom_min(&keys[index], key);
   } else if (keys[index] == key) {
-    float w = f.ortho ? 1.0f : d;
-    float3 col = (la * t->a.c_over_d + lb * t->b.c_over_d + lc * t->c.c_over_d) * w;
-    float3 nrm = (la * t->a.n_over_d + lb * t->b.n_over_d + lc * t->c.n_over_d) * w;
+    float3 col, nrm;
+    mp_triangle_attributes(t, la, lb, lc, d, f, &col, &nrm);
     vstore3(col, index, colors);
     if (f.normal_pass) normals[index] = mp_encode_normal(normalize(nrm));
   }
@@ -118,13 +78,13 @@ inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVerte
 inline int mp_blur_box(float3 p, float2 bx, float2 by, FrameParams f, float* box) {
   float x0, x1, y0, y1;
   if (f.ortho) {
-    x0 = x1 = f.ax * p.x + f.bx, y0 = y1 = f.ay * p.y + f.by;
+    x0 = x1 = f.ax * p.x + f.frame_bx, y0 = y1 = f.ay * p.y + f.frame_by;
   } else {
     float d = -p.z;
     if (!(d > 0.0f)) return 0;
     float inv = 1.0f / d, k = 1.0f / f.focus_distance - inv;
-    x0 = f.ax * (p.x * inv + bx.x * k) + f.bx, x1 = f.ax * (p.x * inv + bx.y * k) + f.bx;
-    y0 = f.ay * (p.y * inv + by.x * k) + f.by, y1 = f.ay * (p.y * inv + by.y * k) + f.by;
+    x0 = f.ax * (p.x * inv + bx.x * k) + f.frame_bx, x1 = f.ax * (p.x * inv + bx.y * k) + f.frame_bx;
+    y0 = f.ay * (p.y * inv + by.x * k) + f.frame_by, y1 = f.ay * (p.y * inv + by.y * k) + f.frame_by;
   }
   box[0] = fmin(box[0], fmin(x0, x1)), box[1] = fmax(box[1], fmax(x0, x1));
   box[2] = fmin(box[2], fmin(y0, y1)), box[3] = fmax(box[3], fmax(y0, y1));
@@ -167,20 +127,18 @@ inline void mp_blur_sample(int px, int py, int s, int spp, MpFixed2 sq, float4 e
       /* Without motion the lens alone moves the vertex: two multiply-adds. */
       rx = still[i].s0 + e.x * still[i].s2, ry = still[i].s1 + e.y * still[i].s3, inv_d = still[i].s4;
       if (!(fabs(rx) < MP_RASTER_GUARD && fabs(ry) < MP_RASTER_GUARD)) return;
-      v[i].p.x = mp_to_fixed(rx);
-      v[i].p.y = mp_to_fixed(ry);
+      v[i].p = mp_sample_fixed(rx, ry, f);
       v[i].inv_d = inv_d;
       continue;
     }
     q[i] = mp_blur_position(i, e.z, steps, p, ps, pm, idx, stride);
     if (f.ortho) {
-      rx = f.ax * q[i].x + f.bx, ry = f.ay * q[i].y + f.by, inv_d = -q[i].z;
+      rx = f.ax * q[i].x + f.frame_bx, ry = f.ay * q[i].y + f.frame_by, inv_d = -q[i].z;
     } else if (!mp_project_lens(q[i], (float2)(e.x, e.y), f, &rx, &ry, &inv_d)) {
       return;
     }
     if (!(fabs(rx) < MP_RASTER_GUARD && fabs(ry) < MP_RASTER_GUARD)) return;
-    v[i].p.x = mp_to_fixed(rx);
-    v[i].p.y = mp_to_fixed(ry);
+    v[i].p = mp_sample_fixed(rx, ry, f);
     v[i].inv_d = inv_d;
   }
   /* Most samples of a slot's bound miss the quad where it is at their time. */
@@ -253,7 +211,7 @@ inline void mp_raster_quad_blur(const float4* p, __global const float4* pm, cons
   if (!steps)
     for (int i = 0; i < 4; ++i) {
       float inv = 1.0f / (-p[i].z), k = 1.0f / f.focus_distance - inv;
-      still[i] = (float8)(f.ax * p[i].x * inv + f.bx, f.ay * p[i].y * inv + f.by, f.ax * k, f.ay * k, inv, 0.0f,
+      still[i] = (float8)(f.ax * p[i].x * inv + f.frame_bx, f.ay * p[i].y * inv + f.frame_by, f.ax * k, f.ay * k, inv, 0.0f,
                           0.0f, 0.0f);
     }
   __global const float4* slot_boxes = table + MP_SAMPLE_TILE * MP_SAMPLE_TILE * spp;
@@ -278,8 +236,8 @@ inline void mp_raster_quad_blur(const float4* p, __global const float4* pm, cons
       if (!ok) return;
     }
     /* One fixed-point unit of slack for the rounding of positions. */
-    long fx0 = mp_to_fixed(box[0]) - 1, fx1 = mp_to_fixed(box[1]) + 1;
-    long fy0 = mp_to_fixed(box[2]) - 1, fy1 = mp_to_fixed(box[3]) + 1;
+    MpFixed2 lo = mp_sample_fixed(box[0], box[2], f), hi = mp_sample_fixed(box[1], box[3], f);
+    long fx0 = lo.x - 1, fx1 = hi.x + 1, fy0 = lo.y - 1, fy1 = hi.y + 1;
     int px0 = (int)max(fx0 >> MP_SUBPIXEL_BITS, (long)0), px1 = (int)min(fx1 >> MP_SUBPIXEL_BITS, (long)f.width - 1);
     int py0 = (int)max(fy0 >> MP_SUBPIXEL_BITS, (long)0), py1 = (int)min(fy1 >> MP_SUBPIXEL_BITS, (long)f.height - 1);
     for (int py = py0; py <= py1; ++py)
@@ -323,18 +281,13 @@ inline void mp_count_sampled(uint l, long area2, uint tests, uint pass, volatile
   }
 }
 
-/* Marks the occlusion pyramid's level-0 cells under the micropolygon's
- * raster bound as changed (occlusion.cl rebuilds only those). */
+/* Marks the occlusion cells under the micropolygon's raster bound. */
 inline void mp_mark_occlusion_cells(__global uchar* dirty, OcclusionParams o, FrameParams f, MpFixed2 a, MpFixed2 b,
                                     MpFixed2 c, MpFixed2 d) {
   long xmin = min(min(a.x, b.x), min(c.x, d.x)), xmax = max(max(a.x, b.x), max(c.x, d.x));
   long ymin = min(min(a.y, b.y), min(c.y, d.y)), ymax = max(max(a.y, b.y), max(c.y, d.y));
-  int x0 = (int)clamp(xmin >> MP_SUBPIXEL_BITS, (long)0, (long)f.width - 1) >> o.cell_shift;
-  int x1 = (int)clamp(xmax >> MP_SUBPIXEL_BITS, (long)0, (long)f.width - 1) >> o.cell_shift;
-  int y0 = (int)clamp(ymin >> MP_SUBPIXEL_BITS, (long)0, (long)f.height - 1) >> o.cell_shift;
-  int y1 = (int)clamp(ymax >> MP_SUBPIXEL_BITS, (long)0, (long)f.height - 1) >> o.cell_shift;
-  for (int y = y0; y <= y1; ++y)
-    for (int x = x0; x <= x1; ++x) dirty[y * o.base_w + x] = (uchar)1;
+  mp_mark_occlusion_rect(dirty, o, f, xmin >> MP_SUBPIXEL_BITS, ymin >> MP_SUBPIXEL_BITS, xmax >> MP_SUBPIXEL_BITS,
+                         ymax >> MP_SUBPIXEL_BITS);
 }
 
 /* The sampler's body for one work-item; `blur` (a constant in each kernel
@@ -387,24 +340,11 @@ inline void mp_sample(MP_SAMPLE_ARGS, __local ulong* area_sum, __local uint* cou
   uint keep = 0u;
   long area2 = 0;
   if (live) {
-    /* Front faces run counter-clockwise on screen, i.e. negative raster
-     * area. Each triangle is culled on its own: a quad of a stitching strip
-     * can turn one triangle away near a silhouette while the other still
-     * faces the camera. */
-    uint flags = patch_info[4 * (ulong)sp.patch + 2];
-    long a0 = mp_edge(v[0].p, v[1].p, v[2].p), a1 = mp_edge(v[0].p, v[2].p, v[3].p);
-    keep = 3u;
-    if (f.backface_culling && !(flags & MP_PATCH_DOUBLE_SIDED)) {
-      int flip = (flags & MP_PATCH_FLIP_ORIENTATION) != 0u;
-      keep = ((flip ? a0 > 0 : a0 < 0) ? 1u : 0u) | ((flip ? a1 > 0 : a1 < 0) ? 2u : 0u);
-    }
-    area2 = ((keep & 1u) ? (a0 < 0 ? -a0 : a0) : 0) + ((keep & 2u) ? (a1 < 0 ? -a1 : a1) : 0);
+    keep = mp_quad_facing(v[0].p, v[1].p, v[2].p, v[3].p, patch_info[4 * (ulong)sp.patch + 2], f, &area2);
   }
   uint tests = 0u;
   if (keep) {
-    uint grid_id = mp_hash32(sp.patch);
-    for (int k = 0; k < 8; ++k) grid_id = mp_hash_combine(grid_id, as_uint(sp.corner[k]));
-    uint mp_id = mp_hash_combine(grid_id, m);
+    uint mp_id = mp_micropolygon_id(mp_grid_id(&sp), m);
     float opacity = grid_c[grid_base + q[0]].w;
     if (pass == MP_PASS_DEPTH && occlusion_dirty) mp_mark_occlusion_cells(occlusion_dirty, occ, f, v[0].p, v[1].p, v[2].p, v[3].p);
     if (blur) {

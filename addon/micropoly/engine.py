@@ -14,6 +14,53 @@ from . import export, export_mesh, preferences, viewport
 PASSES = (("Depth", 1, "Z", "VALUE"), ("Normal", 3, "XYZ", "VECTOR"))
 
 
+class FinalRenderers:
+    """The native renderer of final renders, kept from one F12 to the next
+    while the device stays the same: its OpenCL context, compiled programs,
+    uploaded scene and patch cache carry over, so a second F12 (or the next
+    frame of an animation) skips building them. One at a time: Blender runs
+    one final render at a time, and the lock makes sure of it."""
+
+    def __init__(self):
+        self._lock = threading.Lock()
+        self._selector = None
+        self._renderer = None
+
+    def acquire(self, selector):
+        """The renderer for `selector`, locked until release(); a new one if
+        the device changed (the old one is freed first)."""
+        from . import _native
+
+        self._lock.acquire()
+        try:
+            if self._renderer is None or self._selector != selector:
+                self._renderer = None
+                self._renderer = _native.Renderer(selector)
+                self._selector = selector
+            return self._renderer
+        except BaseException:
+            self._lock.release()
+            raise
+
+    def release(self):
+        self._lock.release()
+
+    def forget(self):
+        """Called while acquired, after a render failed: the next render
+        starts from a new renderer."""
+        self._renderer = None
+        self._selector = None
+
+    def drop(self):
+        """Frees the device (at unregister)."""
+        with self._lock:
+            self._renderer = None
+            self._selector = None
+
+
+_final_renderers = FinalRenderers()
+
+
 class MicropolyRenderEngine(bpy.types.RenderEngine):
     bl_idname = "MICROPOLY"
     bl_label = "Micropoly"
@@ -127,11 +174,18 @@ class MicropolyRenderEngine(bpy.types.RenderEngine):
             self.report({"WARNING"}, f"Micropoly: {warning}")
         native_scene = exported.scene
         native_scene.settings.depth_and_normal_passes = view_layer.use_pass_z or view_layer.use_pass_normal
+        native_scene.settings.normal_pass = view_layer.use_pass_normal  # Depth needs no normals
         try:
-            renderer = _native.Renderer(preferences.device_selector(bpy.context))
+            renderer = _final_renderers.acquire(preferences.device_selector(bpy.context))
         except RuntimeError as e:
             self.report({"ERROR"}, f"Micropoly: {e}")
             return
+        try:
+            self._render_with(renderer, scene, view_layer, exported, native_scene)
+        finally:
+            _final_renderers.release()
+
+    def _render_with(self, renderer, scene, view_layer, exported, native_scene):
         self.update_stats("", f"Micropoly | {renderer.device} | {exported.summary}")
 
         outcome = {}
@@ -158,6 +212,7 @@ class MicropolyRenderEngine(bpy.types.RenderEngine):
             self.update_progress(progress["value"])
         if "error" in outcome:
             self.report({"ERROR"}, f"Micropoly: {outcome['error']}")
+            _final_renderers.forget()
             return
         result = outcome["result"]
         stats = result["stats"]
@@ -216,3 +271,4 @@ def register():
 
 def unregister():
     bpy.utils.unregister_class(MicropolyRenderEngine)
+    _final_renderers.drop()

@@ -166,6 +166,7 @@ def export_settings(native_scene, scene, width, height):
     settings.shadow_shading_rate = mp.shadow_shading_rate
     settings.world_probes = mp.world_shadow_directions
     settings.dof_dice_factor = mp.dof_dice_factor
+    settings.sample_memory_mib = mp.sample_memory
 
 
 def export_final(depsgraph, frame_set):

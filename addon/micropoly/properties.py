@@ -54,6 +54,9 @@ class MicropolySceneSettings(bpy.types.PropertyGroup):
     motion_steps: IntProperty(name="Motion Steps", description="Accuracy of motion blur: the scene is evaluated "
                               "at 2^steps + 1 times over the shutter (Cycles' per-object steps, for the whole "
                               "scene) and moves linearly between them", default=1, min=1, max=5)
+    sample_memory: FloatProperty(name="Sample Memory", description="Device memory for the frame's samples "
+                                 "(24 bytes each), in MiB; a frame that needs more renders in buckets that fit",
+                                 default=2048.0, min=16.0, max=1048576.0)
     dof_dice_factor: FloatProperty(name="Defocus Dicing", description="Out of focus, micropolygons grow to this "
                                    "fraction of the circle of confusion (RenderMan's focus factor); 0 dices "
                                    "blurred surfaces as sharp ones", default=0.5, min=0.0, max=4.0)

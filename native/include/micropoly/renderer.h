@@ -83,6 +83,8 @@ struct RenderStats {
   size_t bound_split_peak_bytes = 0;
   size_t batches = 0;
   size_t bound_split_launches = 0;
+  // Buckets the frame was rendered in (RenderSettings::sample_memory_mib).
+  size_t buckets = 1;
   double program_build_ms = 0;       // 0 when the binary cache was used... see program_cache_hit
   bool program_cache_hit = false;
   bool cancelled = false;

@@ -219,6 +219,11 @@ struct Camera {
 
 enum class PixelFilter { Box, Gaussian, Triangle, BlackmanHarris };
 enum class BoundSplitMethod { Bounded, Breadth };
+// The sample stage: screen tiles, one work-item owning each tile's samples
+// (kernels/sample_tiles.cl, made for CPUs), or one work-item per
+// micropolygon with atomics (kernels/sample.cl, made for GPUs). Both give
+// the same image; Auto picks by the device's type.
+enum class Sampler { Auto, Tiles, Micropolygons };
 
 struct RenderSettings {
   int width = 640, height = 480;
@@ -235,6 +240,7 @@ struct RenderSettings {
   int max_split_depth = 26;                    // eye-split and runaway limit
   bool backface_culling = true;                // for single-sided surfaces
   bool depth_and_normal_passes = true;         // resolve and return Depth and Normal
+  bool normal_pass = true;                     // with them, samples keep normals (Depth needs none)
   // Shadow maps (kernels/mp_shadow.h): on for lights that cast shadows; the
   // device memory their pages, page tables and requests may take; the area
   // of a shadow view's micropolygons in texels of its map.
@@ -259,6 +265,11 @@ struct RenderSettings {
   // fraction of its circle of confusion's diameter where that is longer
   // (RenderMan's focus factor): blurred surfaces are diced coarser. 0: off.
   float dof_dice_factor = 0.5f;
+  Sampler sampler = Sampler::Auto;
+  // Device memory the frame's samples may take (24 bytes each, 20 without
+  // the Normal pass): a frame that needs more is rendered in buckets that
+  // fit, each with the pixel filter's reach of samples around it.
+  float sample_memory_mib = 2048.0f;
 };
 
 struct Scene {

@@ -19,13 +19,14 @@ const char* kUsage =
     "                        [--device cpu|gpu|INDEX] [--bound-split bounded|breadth]\n"
     "                        [--bound-split-memory MIB] [--shadows on|off] [--shadow-memory MIB]\n"
     "                        [--fresh-shadows] [--occlusion-culling on|off] [--stats FILE.json]\n"
+    "                        [--sampler auto|tiles|micropolygons] [--sample-memory MIB]\n"
     "                        [--repeat N]\n"
     "       micropoly-render --list-devices\n";
 
 struct Options {
-  std::string scene, output, device, stats, bound_split, shadows, occlusion;
+  std::string scene, output, device, stats, bound_split, shadows, occlusion, sampler;
   int spp = 0, repeat = 1;
-  float shading_rate = 0, memory_mib = 0, shadow_memory_mib = 0;
+  float shading_rate = 0, memory_mib = 0, shadow_memory_mib = 0, sample_memory_mib = 0;
   bool list_devices = false;
   bool fresh_shadows = false;  // every --repeat frame renders its shadow maps anew
 };
@@ -71,6 +72,11 @@ Options parse(int argc, char** argv) {
       o.occlusion = value();
       if (o.occlusion != "on" && o.occlusion != "off") usage_error("--occlusion-culling is on or off");
     }
+    else if (a == "--sampler") {
+      o.sampler = value();
+      if (o.sampler != "auto" && o.sampler != "tiles" && o.sampler != "micropolygons")
+        usage_error("--sampler is auto, tiles or micropolygons");
+    } else if (a == "--sample-memory") o.sample_memory_mib = static_cast<float>(parse_number(a, value(), 1, 1 << 24));
     else if (a == "--stats") o.stats = value();
     else if (a == "--repeat") o.repeat = static_cast<int>(parse_number(a, value(), 1, 10000));
     else if (a == "--list-devices") o.list_devices = true;
@@ -114,6 +120,11 @@ int main(int argc, char** argv) {
     if (o.shadow_memory_mib > 0) scene.settings.shadow_memory_mib = o.shadow_memory_mib;
     if (o.fresh_shadows) scene.settings.keep_shadow_pages = false;
     if (!o.occlusion.empty()) scene.settings.occlusion_culling = o.occlusion == "on";
+    if (!o.sampler.empty())
+      scene.settings.sampler = o.sampler == "tiles"           ? mp::Sampler::Tiles
+                               : o.sampler == "micropolygons" ? mp::Sampler::Micropolygons
+                                                              : mp::Sampler::Auto;
+    if (o.sample_memory_mib > 0) scene.settings.sample_memory_mib = o.sample_memory_mib;
     // Only EXR files hold the Depth and Normal passes.
     auto dot = output.find_last_of('.');
     std::string ext = dot == std::string::npos ? "" : output.substr(dot + 1);

@@ -53,10 +53,12 @@ FrameSetup make_frame_setup(const Scene& scene) {
   // nearer than the near clip plane is clipped per sample anyway.
   f.eye_epsilon = std::max(0.5f * f.clip_near, 1e-6f);
   f.backface_culling = s.backface_culling ? 1 : 0;
-  f.normal_pass = s.depth_and_normal_passes ? 1 : 0;
+  f.normal_pass = s.depth_and_normal_passes && s.normal_pass ? 1 : 0;
   f.seed = 0u;
   f.crop_x0 = out.crop_x0;
   f.crop_y0 = out.crop_y0;
+  f.frame_bx = f.bx, f.frame_by = f.by;  // one bucket: the whole crop region
+  f.bucket_x0 = f.bucket_y0 = 0;
   // A thin lens for perspective cameras (kernels/mp_blur.h).
   const bool lens = !ortho && cam.lens_radius > 0.0f;
   f.lens_radius = lens ? cam.lens_radius : 0.0f;

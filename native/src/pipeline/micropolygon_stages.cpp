@@ -198,7 +198,9 @@ SampleStage::SampleStage(DeviceSession& session)
     : session_(session),
       kernel_(session.program(), "sample_micropolygons"),
       blur_kernel_(session.program(), "sample_micropolygons_blur"),
-      clear_(session.program(), "clear_samples") {
+      clear_(session.program(), "clear_samples"),
+      project_(session.program(), "project_grids"),
+      tile_kernel_(session.program(), "sample_tiles") {
   totals_ = cl::Buffer(session.context(), CL_MEM_READ_WRITE, 3 * sizeof(cl_ulong));
 }
 
@@ -247,8 +249,10 @@ void SampleStage::mark_occlusion_cells(const cl::Buffer& dirty, const OcclusionP
   occlusion_ = params;
 }
 
-void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer, const std::vector<float>& shutter_curve) {
+void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer, const std::vector<float>& shutter_curve,
+                              bool tiles) {
   mark_occlusion_cells(cl::Buffer(), OcclusionParams{});
+  tiles_ = tiles && !mp_blur_on(f);
   const int spp = f.spp_x * f.spp_y;
   size_t samples = static_cast<size_t>(f.width) * static_cast<size_t>(f.height) * static_cast<size_t>(spp);
   // The buffers only grow: the viewport alternates a small preview with the
@@ -291,6 +295,17 @@ void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer, const std
           lb.s[2] = std::min(lb.s[2], l.y), lb.s[3] = std::max(lb.s[3], l.y);
           tb.s[0] = std::min(tb.s[0], t), tb.s[1] = std::max(tb.s[1], t);
         }
+    const int chunks = (spp + 15) / 16;
+    std::vector<cl_ushort> soa(size_t(MP_SAMPLE_TILE) * MP_SAMPLE_TILE * chunks * 32, 0);
+    for (size_t p = 0; p < size_t(MP_SAMPLE_TILE) * MP_SAMPLE_TILE; ++p)
+      for (int s = 0; s < spp; ++s) {
+        const cl_ushort o = offsets[p * spp + s];
+        cl_ushort* chunk = &soa[(p * chunks + s / 16) * 32];
+        chunk[s % 16] = o & 0xffu;
+        chunk[16 + s % 16] = o >> 8;
+      }
+    offsets_soa_ = cl::Buffer(session_.context(), CL_MEM_READ_ONLY, soa.size() * sizeof(cl_ushort));
+    session_.queue().enqueueWriteBuffer(offsets_soa_, CL_TRUE, 0, soa.size() * sizeof(cl_ushort), soa.data());
     offsets_ = cl::Buffer(session_.context(), CL_MEM_READ_ONLY, offsets.size() * sizeof(cl_ushort));
     session_.queue().enqueueWriteBuffer(offsets_, CL_TRUE, 0, offsets.size() * sizeof(cl_ushort), offsets.data());
     blur_ = cl::Buffer(session_.context(), CL_MEM_READ_ONLY, table.size() * sizeof(cl_float4));
@@ -313,6 +328,10 @@ void SampleStage::run(const cl::Buffer& diceable, cl_uint first, cl_uint count, 
   const cl_uint base = grids.micropolygon_offsets_host[first];
   const cl_uint total = grids.micropolygon_offsets_host[first + count] - base;
   if (total == 0) return;
+  if (tiles_) {
+    run_tiles(diceable, first, count, scene, f, grids, timer);
+    return;
+  }
   cl::Kernel& k = mp_blur_on(f) ? blur_kernel_ : kernel_;
   k.setArg(0, diceable);
   k.setArg(1, first);
@@ -360,14 +379,15 @@ ResolveStage::~ResolveStage() {
   }
 }
 
-void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, PixelFilter filter, float filter_width,
-                       bool passes, RenderResult& out, StageTimer& timer) {
+void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, const FrameParams& fb, const Bucket& b,
+                       PixelFilter filter, float filter_width, bool passes, StageTimer& timer) {
   const FrameParams& f = frame.params;
   size_t pixels = static_cast<size_t>(f.width) * static_cast<size_t>(f.height);
   if (pixels != pixels_) {
-    rgba_ = cl::Buffer(session_.context(), CL_MEM_WRITE_ONLY, pixels * sizeof(cl_float4));
-    depth_ = cl::Buffer(session_.context(), CL_MEM_WRITE_ONLY, pixels * sizeof(cl_float));
-    normal_ = cl::Buffer(session_.context(), CL_MEM_WRITE_ONLY, pixels * 3 * sizeof(cl_float));
+    rgba_ = cl::Buffer(), depth_ = cl::Buffer(), normal_ = cl::Buffer();
+    rgba_ = session_.allocate(pixels * sizeof(cl_float4), "image buffer");
+    depth_ = session_.allocate(pixels * sizeof(cl_float), "depth pass buffer");
+    normal_ = session_.allocate(pixels * 3 * sizeof(cl_float), "normal pass buffer");
     pixels_ = pixels;
   }
   int type = filter == PixelFilter::Box        ? MP_FILTER_BOX
@@ -381,7 +401,7 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
   filter_width = std::max(filter_width, 1e-3f);
   const SamplePattern pattern = sample_pattern(f);
   if (type != weights_type_ || filter_width != weights_width_ || !(pattern == weights_pattern_)) {
-    const int reach = static_cast<int>(std::ceil(0.5f * filter_width - 0.5f)), side = 2 * reach + 1;
+    const int reach = filter_reach(filter_width), side = 2 * reach + 1;
     const int spp = f.spp_x * f.spp_y;
     const size_t count = size_t(MP_SAMPLE_TILE) * MP_SAMPLE_TILE * side * side * spp;
     use_weights_ = count * sizeof(float) <= (size_t(64) << 20);
@@ -405,7 +425,7 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
     session_.queue().enqueueWriteBuffer(weights_, CL_TRUE, 0, w.size() * sizeof(float), w.data());
     weights_type_ = type, weights_width_ = filter_width, weights_pattern_ = pattern;
   }
-  kernel_.setArg(0, f);
+  kernel_.setArg(0, fb);
   kernel_.setArg(1, type);
   kernel_.setArg(2, filter_width);
   kernel_.setArg(3, samples.offsets());
@@ -421,10 +441,18 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, Pixe
   kernel_.setArg(13, depth_);
   kernel_.setArg(14, normal_);
   kernel_.setArg(15, passes ? 1 : 0);
-  size_t gx = ((static_cast<size_t>(f.width) + 7) / 8) * 8, gy = ((static_cast<size_t>(f.height) + 7) / 8) * 8;
+  kernel_.setArg(16, cl_int4{{b.x0 - b.sx0, b.y0 - b.sy0, b.x1 - b.sx0, b.y1 - b.sy0}});
+  kernel_.setArg(17, cl_int2{{b.sx0, b.sy0}});
+  kernel_.setArg(18, cl_int(f.width));
+  size_t gx = ((static_cast<size_t>(b.x1 - b.x0) + 7) / 8) * 8, gy = ((static_cast<size_t>(b.y1 - b.y0) + 7) / 8) * 8;
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(gx, gy), cl::NDRange(8, 8), nullptr, &e);
   timer.add(Stage::Resolve, e);
+}
+
+void ResolveStage::read_back(const FrameSetup& frame, bool passes, RenderResult& out) {
+  const FrameParams& f = frame.params;
+  const size_t pixels = static_cast<size_t>(f.width) * static_cast<size_t>(f.height);
   out.width = f.width;
   out.height = f.height;
   out.rgba.resize(pixels * 4);

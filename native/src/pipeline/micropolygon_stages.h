@@ -3,10 +3,13 @@
 // frame. Grids live in fixed slots of (max_grid+1)^2 vertices.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "cl/device_session.h"
 #include "micropoly/renderer.h"
+#include "pipeline/buckets.h"
 #include "pipeline/frame_params.h"
 #include "pipeline/scene_buffers.h"
 #include "pipeline/stage_timer.h"
@@ -28,6 +31,11 @@ struct SamplePattern {
   }
 };
 SamplePattern sample_pattern(const FrameParams& f, const std::vector<float>& shutter_curve = {});
+
+// Pixels on each side whose samples a pixel filter of this width reads.
+inline int filter_reach(float filter_width) {
+  return static_cast<int>(std::ceil(0.5f * std::max(filter_width, 1e-3f) - 0.5f));
+}
 
 // A time in the shutter as a shutter curve opens it: uniform times [0, 1]
 // through the inverse of the curve's cumulative openness (piecewise linear
@@ -114,8 +122,12 @@ class SampleStage {
  public:
   explicit SampleStage(DeviceSession& session);
   // Makes the sample buffers (key, color, normal per sample) fit the frame,
-  // reusing them when the size is unchanged, and clears them.
-  void begin_frame(const FrameParams& f, StageTimer& timer, const std::vector<float>& shutter_curve = {});
+  // reusing them when the size is unchanged, and clears them. `tiles`: the
+  // frame is sampled by screen tiles (sample_tiles.cl), else one work-item
+  // per micropolygon (sample.cl); frames with blur always use the latter.
+  void begin_frame(const FrameParams& f, StageTimer& timer, const std::vector<float>& shutter_curve = {},
+                   bool tiles = false);
+  bool tiles() const { return tiles_; }
   // Samples the grids of diceable sub-patches [first, first + count).
   void run(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
            GridBuffers& grids, StageTimer& timer);
@@ -133,11 +145,24 @@ class SampleStage {
 
  private:
   DeviceSession& session_;
+  // The tile sampler (sample_tiles.cpp): projects the grids, sorts them
+  // into per-tile lists on the host, then samples each tile.
+  void run_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
+                 const FrameParams& f, GridBuffers& grids, StageTimer& timer);
   cl::Kernel kernel_, blur_kernel_;  // pinhole samples; samples with times and lens positions
   cl::Kernel clear_;
+  cl::Kernel project_, tile_kernel_;
+  bool tiles_ = false;
+  cl::Buffer projected_, rects_, tile_ids_, tile_starts_, tile_entries_;
+  size_t projected_slots_ = 0, rect_slots_ = 0, tile_slots_ = 0, start_slots_ = 0, entry_slots_ = 0;
+  std::vector<cl_int> rects_host_;
+  std::vector<cl_uint> tile_counts_, tile_ids_host_, tile_starts_host_, tile_entries_host_;
   cl::Buffer occlusion_dirty_;
   OcclusionParams occlusion_{};
   cl::Buffer keys_, colors_, normals_, offsets_, blur_, totals_;
+  // The sample offsets of `offsets_` for the tile sampler's 16-lane tests:
+  // per tile pixel, chunks of 16 x offsets then 16 y offsets.
+  cl::Buffer offsets_soa_;
   size_t sample_capacity_ = 0;  // samples the buffers hold (they only grow)
   SamplePattern pattern_;
 };
@@ -148,9 +173,12 @@ class ResolveStage {
   ~ResolveStage();
   ResolveStage(const ResolveStage&) = delete;
   ResolveStage& operator=(const ResolveStage&) = delete;
-  // Resolves pixels and reads them back; Depth and Normal only if `passes`.
-  void run(const SampleStage& samples, const FrameSetup& frame, PixelFilter filter, float filter_width, bool passes,
-           RenderResult& out, StageTimer& timer);
+  // Resolves bucket b's pixels (its samples in `samples`, of frame fb) into
+  // the image of `frame`; Depth and Normal only if `passes`.
+  void run(const SampleStage& samples, const FrameSetup& frame, const FrameParams& fb, const Bucket& b,
+           PixelFilter filter, float filter_width, bool passes, StageTimer& timer);
+  // Reads the image (and the passes) back once every bucket is resolved.
+  void read_back(const FrameSetup& frame, bool passes, RenderResult& out);
 
  private:
   DeviceSession& session_;

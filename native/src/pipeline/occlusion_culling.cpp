@@ -55,7 +55,8 @@ void OcclusionCulling::begin_frame(const FrameParams& f, StageTimer& timer) {
   timer.add(Stage::Occlusion, e2);
 }
 
-void OcclusionCulling::build_base(const cl::Buffer& keys, const FrameParams& f, bool all, StageTimer& timer) {
+void OcclusionCulling::build_base(const cl::Buffer& keys, const FrameParams& f, bool all, StageTimer& timer,
+                                  const cl_int4& count_region) {
   cl::CommandQueue& q = session_.queue();
   q.enqueueFillBuffer(covered_, cl_uint(0), 0, sizeof(cl_uint));
   base_.setArg(0, keys);
@@ -65,13 +66,14 @@ void OcclusionCulling::build_base(const cl::Buffer& keys, const FrameParams& f, 
   base_.setArg(4, dirty_);
   base_.setArg(5, cl_int(all ? 1 : 0));
   base_.setArg(6, covered_);
+  base_.setArg(7, count_region);
   cl::Event e;
   q.enqueueNDRangeKernel(base_, cl::NullRange, range_2d(params_.base_w, params_.base_h), cl::NDRange(8, 8), nullptr, &e);
   timer.add(Stage::Occlusion, e);
 }
 
 void OcclusionCulling::refresh(const cl::Buffer& keys, const FrameParams& f, StageTimer& timer) {
-  build_base(keys, f, false, timer);
+  build_base(keys, f, false, timer, cl_int4{{0, 0, f.width, f.height}});
   for (int k = 1; k < params_.levels; ++k) {
     reduce_.setArg(0, pyramid_);
     reduce_.setArg(1, params_);
@@ -84,9 +86,10 @@ void OcclusionCulling::refresh(const cl::Buffer& keys, const FrameParams& f, Sta
   }
 }
 
-size_t OcclusionCulling::covered_pixels(const cl::Buffer& keys, const FrameParams& f, StageTimer& timer) {
+size_t OcclusionCulling::covered_pixels(const cl::Buffer& keys, const FrameParams& f, StageTimer& timer,
+                                        const Bucket& b) {
   size_for(f);
-  build_base(keys, f, true, timer);
+  build_base(keys, f, true, timer, cl_int4{{b.x0 - b.sx0, b.y0 - b.sy0, b.x1 - b.sx0, b.y1 - b.sy0}});
   cl_uint n = 0;
   session_.queue().enqueueReadBuffer(covered_, CL_TRUE, 0, sizeof n, &n);
   return n;

@@ -11,6 +11,7 @@
 
 #include "cl/device_session.h"
 #include "mp_types.h"
+#include "pipeline/buckets.h"
 #include "pipeline/stage_timer.h"
 
 namespace mp {
@@ -23,8 +24,9 @@ class OcclusionCulling {
   void begin_frame(const FrameParams& f, StageTimer& timer);
   // Rebuilds the pyramid from the samples written so far.
   void refresh(const cl::Buffer& keys, const FrameParams& f, StageTimer& timer);
-  // Pixels with a surface in any of their samples (a pass over the samples).
-  size_t covered_pixels(const cl::Buffer& keys, const FrameParams& f, StageTimer& timer);
+  // Pixels of bucket b (whose samples `keys` holds, of frame f) with a
+  // surface in any of their samples (a pass over the samples).
+  size_t covered_pixels(const cl::Buffer& keys, const FrameParams& f, StageTimer& timer, const Bucket& b);
   const cl::Buffer& pyramid() const { return pyramid_; }
   // A byte per level-0 cell the sample stage sets where it writes samples;
   // a refresh reads only those cells.
@@ -38,7 +40,7 @@ class OcclusionCulling {
 
  private:
   void size_for(const FrameParams& f);
-  void build_base(const cl::Buffer& keys, const FrameParams& f, bool all, StageTimer& timer);
+  void build_base(const cl::Buffer& keys, const FrameParams& f, bool all, StageTimer& timer, const cl_int4& count_region);
   DeviceSession& session_;
   cl::Kernel base_, reduce_;
   cl::Buffer pyramid_, dirty_, covered_;

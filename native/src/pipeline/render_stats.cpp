@@ -53,6 +53,7 @@ std::string RenderStats::to_json() const {
   j += "  \"bound_split_peak_bytes\": " + std::to_string(bound_split_peak_bytes) + ",\n";
   j += "  \"bound_split_launches\": " + std::to_string(bound_split_launches) + ",\n";
   j += "  \"batches\": " + std::to_string(batches) + ",\n";
+  j += "  \"buckets\": " + std::to_string(buckets) + ",\n";
   j += "  \"program_build_ms\": " + num(program_build_ms) + ",\n";
   j += "  \"program_cache_hit\": " + std::string(program_cache_hit ? "true" : "false") + ",\n";
   j += "  \"cancelled\": " + std::string(cancelled ? "true" : "false") + ",\n";

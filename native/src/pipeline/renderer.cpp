@@ -8,6 +8,7 @@
 #include "cl/device_session.h"
 #include "micropoly/error.h"
 #include "pipeline/bound_split.h"
+#include "pipeline/buckets.h"
 #include "pipeline/frame_params.h"
 #include "pipeline/material_programs.h"
 #include "pipeline/micropolygon_stages.h"
@@ -153,15 +154,26 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       out.rgba.clear(), out.depth.clear(), out.normal.clear();
       return;
     }
-    sample.begin_frame(f, timer, scene.shutter_curve);
+    const bool tiles = scene.settings.sampler == Sampler::Tiles ||
+                       (scene.settings.sampler == Sampler::Auto && s.info().type == "cpu");
+    // Buckets within the sample memory budget (buckets.h); a key, a color
+    // and a normal per sample, and no buffer larger than the device allows.
+    const size_t sample_bytes = sizeof(cl_ulong) + 3 * sizeof(cl_float) + sizeof(cl_uint);
+    const size_t budget = static_cast<size_t>(double(scene.settings.sample_memory_mib) * 1048576.0);
+    const size_t max_samples = std::min(budget / sample_bytes, s.max_alloc_bytes() / (3 * sizeof(cl_float)));
+    const std::vector<Bucket> buckets =
+        plan_buckets(f.width, f.height, f.spp_x * f.spp_y, filter_reach(scene.settings.filter_width), max_samples);
+    st.buckets = buckets.size();
 
     // Cancellation: the caller's progress callback is asked between bound &
     // split launches and between sample chunks, so a cancel takes effect within
     // one chunk's worth of device work.
     bool cancelled = false;
     float last_progress = 0.0f;
+    float progress_base = 0.0f, progress_scale = 1.0f;  // the bucket's share of the frame
     ProgressCallback keep_going = [&](float p) {
       last_progress = p;
+      p = progress_base + progress_scale * p;
       if (!cancelled && progress && !progress(p)) cancelled = true;
       return !cancelled;
     };
@@ -193,18 +205,20 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     st.timings_ms.shadows_wall = ms_since(t_shadows);
     const ShadowInputs& shadows = impl_->shadow_maps.inputs();
     impl_->layout.begin_frame();
+    FrameParams fb = f;  // the bucket being rendered
     DiceSink sink = [&](const cl::Buffer& diceable, cl_uint count) {
       if (cancelled) return;
-      impl_->layout.run(diceable, count, f, grids, timer);
-      dice.run(diceable, count, buffers, f, grids, timer);
-      if (mp_motion_on(f)) dice.run_motion(diceable, count, buffers, f, grids, timer);
-      impl_->programs.displace(diceable, count, buffers, f, grids, timer);
-      if (mp_motion_on(f)) dice.displaced(diceable, count, f, grids, timer);
-      shade.run(diceable, count, buffers, f, grids, shadows, timer);
-      impl_->programs.shade(diceable, count, buffers, f, grids, shadows, timer);
-      const cl_uint chunk = progress ? kSampleChunk : count;
+      impl_->layout.run(diceable, count, fb, grids, timer);
+      dice.run(diceable, count, buffers, fb, grids, timer);
+      if (mp_motion_on(fb)) dice.run_motion(diceable, count, buffers, fb, grids, timer);
+      impl_->programs.displace(diceable, count, buffers, fb, grids, timer);
+      if (mp_motion_on(fb)) dice.displaced(diceable, count, fb, grids, timer);
+      shade.run(diceable, count, buffers, fb, grids, shadows, timer);
+      impl_->programs.shade(diceable, count, buffers, fb, grids, shadows, timer);
+      // The tile sampler takes a batch at once (its lists cover the batch).
+      const cl_uint chunk = progress && !sample.tiles() ? kSampleChunk : count;
       for (cl_uint first = 0; first < count && !cancelled; first += chunk) {
-        sample.run(diceable, first, std::min(chunk, count - first), buffers, f, grids, timer);
+        sample.run(diceable, first, std::min(chunk, count - first), buffers, fb, grids, timer);
         if (progress) {
           s.queue().finish();
           keep_going(last_progress);
@@ -213,30 +227,48 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       st.subpatches_diced += count;
       ++st.batches;
     };
-    if (progress) {
-      s.queue().finish();  // clearing a large sample buffer takes a while: look again
-      keep_going(0.0f);
+    bool stopped = !shadows_done;
+    size_t covered = 0;
+    for (size_t bi = 0; bi < buckets.size() && !stopped; ++bi) {
+      const Bucket& bucket = buckets[bi];
+      fb = bucket_frame(f, bucket);
+      progress_base = float(bi) / float(buckets.size()), progress_scale = 1.0f / float(buckets.size());
+      sample.begin_frame(fb, timer, scene.shutter_curve, tiles);
+      if (progress) {
+        s.queue().finish();  // clearing a large sample buffer takes a while: look again
+        keep_going(0.0f);
+      }
+      PassOcclusion camera_occlusion;
+      pass_occlusion = &no_occlusion;
+      // A blurred occluder hides only part of what lies behind it: culling
+      // against the shutter centre's pinhole depths would lose what the lens
+      // and the other times see past it.
+      if (scene.settings.occlusion_culling && !mp_blur_on(fb)) {
+        OcclusionCulling& occ = impl_->occlusion;
+        occ.begin_frame(fb, timer);
+        camera_occlusion.pyramid = occ.pyramid();
+        camera_occlusion.params = occ.params();
+        camera_occlusion.root_order = occ.root_order(buffers.host_patch_bounds, impl_->scene_key, fb);
+        camera_occlusion.waves = s.info().type == "cpu";
+        sample.mark_occlusion_cells(occ.dirty(), occ.params());
+        camera_occlusion.refresh = [&] {
+          if (!cancelled) occ.refresh(sample.keys(), fb, timer);
+        };
+        pass_occlusion = &camera_occlusion;
+      }
+      const BoundSplitResult bs = run_pass(fb, PassViews{}, sink);
+      pass_occlusion = &no_occlusion;
+      if (cancelled || bs.cancelled) {
+        stopped = true;
+        break;
+      }
+      covered += impl_->occlusion.covered_pixels(sample.keys(), fb, timer, bucket);
+      auto t_resolve = std::chrono::steady_clock::now();
+      resolve.run(sample, frame, fb, bucket, scene.settings.filter, scene.settings.filter_width,
+                  scene.settings.depth_and_normal_passes, timer);
+      st.timings_ms.readback += ms_since(t_resolve);
     }
-    PassOcclusion camera_occlusion;
-    // A blurred occluder hides only part of what lies behind it: culling
-    // against the shutter centre's pinhole depths would lose what the lens
-    // and the other times see past it.
-    if (scene.settings.occlusion_culling && !mp_blur_on(f)) {
-      OcclusionCulling& occ = impl_->occlusion;
-      occ.begin_frame(f, timer);
-      camera_occlusion.pyramid = occ.pyramid();
-      camera_occlusion.params = occ.params();
-      camera_occlusion.root_order = occ.root_order(buffers.host_patch_bounds, impl_->scene_key, f);
-      camera_occlusion.waves = s.info().type == "cpu";
-      sample.mark_occlusion_cells(occ.dirty(), occ.params());
-      camera_occlusion.refresh = [&] {
-        if (!cancelled) occ.refresh(sample.keys(), f, timer);
-      };
-      pass_occlusion = &camera_occlusion;
-    }
-    BoundSplitResult bs;
-    if (shadows_done) bs = run_pass(f, PassViews{}, sink);
-    if (!shadows_done || cancelled || bs.cancelled) {
+    if (stopped) {
       s.queue().finish();
       st.cancelled = true;
       st.timings_ms.total = ms_since(t_start);
@@ -244,10 +276,9 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       out.rgba.clear(), out.depth.clear(), out.normal.clear();
       return;
     }
-    st.covered_pixels = impl_->occlusion.covered_pixels(sample.keys(), f, timer);
+    st.covered_pixels = covered;
     auto t_resolve = std::chrono::steady_clock::now();
-    resolve.run(sample, frame, scene.settings.filter, scene.settings.filter_width, scene.settings.depth_and_normal_passes,
-                out, timer);
+    resolve.read_back(frame, scene.settings.depth_and_normal_passes, out);
     // The world behind the frame: its program, evaluated per pixel on the
     // device (finer than the baked map), or the map a scene gave.
     if (scene.world.present() && scene.world.camera)
@@ -255,7 +286,7 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
                                                 : world_background(impl_->world_map, frame, scene.camera);
     else
       out.background.clear();
-    st.timings_ms.readback = ms_since(t_resolve);
+    st.timings_ms.readback += ms_since(t_resolve);
     timer.collect();
     st.micropolygons = impl_->layout.micropolygons();
     sample.sampled_totals(st.micropolygons_sampled, st.sampled_area_px, st.sample_tests);

@@ -85,6 +85,7 @@ py::dict stats_dict(const RenderStats& s) {
   d["bound_split_peak_bytes"] = s.bound_split_peak_bytes;
   d["bound_split_launches"] = s.bound_split_launches;
   d["batches"] = s.batches;
+  d["buckets"] = s.buckets;
   d["program_build_ms"] = s.program_build_ms;
   d["program_cache_hit"] = s.program_cache_hit;
   d["cancelled"] = s.cancelled;
@@ -157,6 +158,10 @@ PYBIND11_MODULE(_native, m) {
   py::enum_<BoundSplitMethod>(m, "BoundSplitMethod")
       .value("BOUNDED", BoundSplitMethod::Bounded)
       .value("BREADTH", BoundSplitMethod::Breadth);
+  py::enum_<Sampler>(m, "Sampler")
+      .value("AUTO", Sampler::Auto)
+      .value("TILES", Sampler::Tiles)
+      .value("MICROPOLYGONS", Sampler::Micropolygons);
 
   py::class_<RenderSettings>(m, "RenderSettings")
       .def(py::init<>())
@@ -181,6 +186,7 @@ PYBIND11_MODULE(_native, m) {
       .def_readwrite("max_split_depth", &RenderSettings::max_split_depth)
       .def_readwrite("backface_culling", &RenderSettings::backface_culling)
       .def_readwrite("depth_and_normal_passes", &RenderSettings::depth_and_normal_passes)
+      .def_readwrite("normal_pass", &RenderSettings::normal_pass)
       .def_readwrite("shadows", &RenderSettings::shadows)
       .def_readwrite("shadow_memory_mib", &RenderSettings::shadow_memory_mib)
       .def_readwrite("shadow_shading_rate", &RenderSettings::shadow_shading_rate)
@@ -188,7 +194,9 @@ PYBIND11_MODULE(_native, m) {
       .def_readwrite("soft_shadow_pages", &RenderSettings::soft_shadow_pages)
       .def_readwrite("occlusion_culling", &RenderSettings::occlusion_culling)
       .def_readwrite("world_probes", &RenderSettings::world_probes)
-      .def_readwrite("dof_dice_factor", &RenderSettings::dof_dice_factor);
+      .def_readwrite("dof_dice_factor", &RenderSettings::dof_dice_factor)
+      .def_readwrite("sampler", &RenderSettings::sampler)
+      .def_readwrite("sample_memory_mib", &RenderSettings::sample_memory_mib);
 
   py::class_<Scene>(m, "Scene")
       .def(py::init<>())

@@ -66,6 +66,17 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   params.get_int("occlusionculling", 0, 1, &flag);
   s.occlusion_culling = flag != 0;
   auto positive = [](float v) { return v > 0.0f && std::isfinite(v); };
+  const std::string sampler = params.get_string("sampler", "");
+  if (sampler == "auto")
+    s.sampler = Sampler::Auto;
+  else if (sampler == "tiles")
+    s.sampler = Sampler::Tiles;
+  else if (sampler == "micropolygons")
+    s.sampler = Sampler::Micropolygons;
+  else if (!sampler.empty())
+    args.fail("\"sampler\" must be \"auto\", \"tiles\" or \"micropolygons\", not \"" + sampler + "\"");
+  s.sample_memory_mib = params.get_float_checked("samplememory", s.sample_memory_mib, positive,
+                                                 "a positive number of MiB");
   s.shadow_memory_mib = params.get_float_checked("shadowmemory", s.shadow_memory_mib, positive,
                                                  "a positive number of MiB");
   s.shadow_shading_rate = params.get_float_checked("shadowshadingrate", s.shadow_shading_rate, positive,

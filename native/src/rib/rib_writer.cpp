@@ -242,6 +242,9 @@ void write_options(std::string& o, const RenderSettings& s, const Camera& c) {
   if (s.world_probes != def.world_probes)
     param(o, "integer worldshadowdirections", static_cast<long long>(s.world_probes));
   if (differs(s.dof_dice_factor, def.dof_dice_factor)) param(o, "float focusfactor", s.dof_dice_factor);
+  if (s.sampler != def.sampler)
+    param(o, "string sampler", s.sampler == Sampler::Tiles ? "tiles" : "micropolygons");
+  if (differs(s.sample_memory_mib, def.sample_memory_mib)) param(o, "float samplememory", s.sample_memory_mib);
   if (c.lens_radius > 0.0f) {
     param(o, "integer apertureblades", static_cast<long long>(c.aperture_blades));
     param(o, "float aperturerotation", c.aperture_rotation);

@@ -180,6 +180,8 @@ void validate_scene(const Scene& scene) {
   }
   if (!(s.dof_dice_factor >= 0) || !std::isfinite(s.dof_dice_factor))
     throw Error("defocus dicing factor must be a finite number >= 0");
+  if (!(s.sample_memory_mib >= 1.0f) || !std::isfinite(s.sample_memory_mib))
+    throw Error("the sample memory must be a finite number of MiB, at least 1");
 
   for (size_t i = 0; i < scene.materials.size(); ++i) {
     const Material& m = scene.materials[i];

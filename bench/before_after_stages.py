@@ -1,0 +1,59 @@
+#!/usr/bin/env python3
+"""Per-stage times of two builds of micropoly-render on RIB scenes, side by
+side in one run (rounds interleaved): the median of the frames after the
+first of each, per stage, and the sample stage's nanoseconds per
+micropolygon (kernel time over the micropolygons it rasterised).
+
+  python3 bench/before_after_stages.py --before OLD_CLI --after NEW_CLI [--device gpu] [--repeat 3] [--rounds 2] scene.rib ...
+"""
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import tempfile
+
+STAGES = ("total", "shadows_wall", "bound_split", "dice", "shade", "sample", "resolve", "readback", "occlusion")
+
+
+def run(cli, rib, out, device, repeat):
+    stats = os.path.join(out, "stats.json")
+    cmd = [cli, rib, "-o", os.path.join(out, "image.png"), "--stats", stats, "--repeat", str(repeat)]
+    if device:
+        cmd += ["--device", device]
+    subprocess.run(cmd, check=True, capture_output=True)
+    runs = json.load(open(stats))
+    return runs[1:] if len(runs) > 1 else runs
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--before", required=True)
+    ap.add_argument("--after", required=True)
+    ap.add_argument("--device", default="")
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--rounds", type=int, default=2)
+    ap.add_argument("ribs", nargs="+")
+    a = ap.parse_args()
+    out = tempfile.mkdtemp(prefix="mp-stages-")
+    frames = {(rib, w): [] for rib in a.ribs for w in ("before", "after")}
+    for _ in range(a.rounds):
+        for rib in a.ribs:
+            for which in ("before", "after"):
+                frames[(rib, which)] += run(getattr(a, which), rib, out, a.device, a.repeat)
+    print("| scene | build | micropolygons | " + " | ".join(STAGES) + " | sample ns / micropolygon |")
+    print("|---|---|---|" + "---|" * len(STAGES) + "---|")
+    summary = {}
+    for (rib, which), runs in frames.items():
+        med = {k: statistics.median(r["timings_ms"].get(k, 0.0) for r in runs) for k in STAGES}
+        mps = statistics.median(r.get("micropolygons_sampled", r["micropolygons"]) for r in runs)
+        ns = med["sample"] * 1e6 / mps if mps else 0.0
+        name = os.path.splitext(os.path.basename(rib))[0]
+        summary[f"{name}/{which}"] = {"stages_ms": med, "micropolygons_sampled": mps, "sample_ns_per_micropolygon": ns}
+        print(f"| {name} | {which} | {int(mps):,} | " + " | ".join(f"{med[k]:.0f}" for k in STAGES) + f" | {ns:.0f} |")
+    print(json.dumps(summary))
+
+
+if __name__ == "__main__":
+    main()

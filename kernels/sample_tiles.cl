@@ -1,0 +1,323 @@
+/* Sample, shaped for CPUs: a sort-middle rasteriser (Laine & Karras 2011,
+ * "High-performance software rasterization on GPUs"; RenderMan's buckets).
+ * After shading, each grid's vertices are projected once (project_grids),
+ * which also gives the grid's raster bound in screen tiles of
+ * MP_RASTER_TILE pixels; the host sorts the grids into per-tile lists; then
+ * one work-item per tile rasterises its grids' micropolygons into the
+ * tile's samples, which no other work-item touches. So there are no atomics
+ * and one pass writes depth and attributes together: a sample's nearest key
+ * so far is in hand when a micropolygon covers it. The nearest key wins
+ * whatever the order, so the image equals the per-micropolygon sampler's
+ * (sample.cl), with the same fixed-point edge tests (mp_raster.h, kept
+ * watertight) and the same arithmetic for depth and attributes
+ * (mp_sample.h). On a GPU one work-item per tile leaves most lanes idle,
+ * so GPUs keep sample.cl. */
+#include "mp_compat.h"
+#include "mp_patch.h"
+#include "mp_types.h"
+#include "mp_hash.h"
+#include "mp_raster.h"
+#include "mp_grid.h"
+#include "mp_sample.h"
+
+/* A projected vertex: fixed-point raster x and y, 1/depth's bits, and 1
+ * where the vertex cannot be rasterised (behind the eye, past the guard
+ * band): its micropolygons are skipped, as sample.cl skips them. */
+#define MP_PROJECTED_INVALID 1
+
+/* One work-item per grid of diceable sub-patches [first, first + count):
+ * its vertices' raster positions (into `projected`, slot for slot as the
+ * grid buffers), and the screen tiles its valid vertices reach
+ * (tx0, ty0, tx1, ty1; tx0 > tx1 where none, clipped to the frame). */
+__kernel void project_grids(__global const SubPatch* diceable, uint first, uint count, FrameParams f,
+                            __global const float4* grid_p, __global int4* projected, __global int4* rects) {
+  uint k = get_global_id(0);
+  if (k >= count) return;
+  uint slot = first + k, stride = (uint)f.max_grid + 1u;
+  SubPatch sp = diceable[slot];
+  MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
+  uint n = mp_grid_vertices(&g);
+  ulong base = (ulong)slot * stride * stride;
+  long x0 = LONG_MAX, y0 = LONG_MAX, x1 = LONG_MIN, y1 = LONG_MIN;
+  for (uint o = 0u; o < n; ++o) {
+    uint i, j;
+    mp_grid_vertex_slot(&g, o, &i, &j);
+    ulong idx = base + mp_slot(&g, i, j);
+    int ok = 1;
+    float inv_d;
+    MpFixed2 q = mp_raster_position(grid_p[idx], f, &inv_d, &ok);
+    if (!ok) {
+      projected[idx] = (int4)(0, 0, 0, MP_PROJECTED_INVALID);
+      continue;
+    }
+    projected[idx] = (int4)((int)q.x, (int)q.y, as_int(inv_d), 0);
+    x0 = min(x0, q.x), x1 = max(x1, q.x), y0 = min(y0, q.y), y1 = max(y1, q.y);
+  }
+  int4 r = (int4)(1, 1, 0, 0);
+  if (x0 <= x1 && x1 >= 0 && y1 >= 0 && (x0 >> MP_SUBPIXEL_BITS) < f.width && (y0 >> MP_SUBPIXEL_BITS) < f.height) {
+    int px0 = (int)max(x0 >> MP_SUBPIXEL_BITS, (long)0), px1 = (int)min(x1 >> MP_SUBPIXEL_BITS, (long)f.width - 1);
+    int py0 = (int)max(y0 >> MP_SUBPIXEL_BITS, (long)0), py1 = (int)min(y1 >> MP_SUBPIXEL_BITS, (long)f.height - 1);
+    r = (int4)(px0 / MP_RASTER_TILE, py0 / MP_RASTER_TILE, px1 / MP_RASTER_TILE, py1 / MP_RASTER_TILE);
+  }
+  rects[k] = r;
+}
+
+inline MpFixed2 mp_projected_position(int4 v) {
+  MpFixed2 p;
+  p.x = (long)v.x;
+  p.y = (long)v.y;
+  return p;
+}
+
+/* The same samples one at a time in 64-bit arithmetic (mp_edge_triangle_covers),
+ * for micropolygons too large for the int32 path or not opaque. */
+inline uint mp_sample_tile_slow(const MpTriangle* tris, long xmin, long xmax, long ymin, long ymax, int px0, int px1,
+                                int py0, int py1, uint mp_id, float opacity, FrameParams f,
+                                __global const ushort* sample_offsets, __global ulong* keys, __global float* colors,
+                                __global uint* normals, int* written) {
+  int spp = f.spp_x * f.spp_y;
+  uint tests = 0u;
+  for (int py = py0; py <= py1; ++py)
+    for (int px = px0; px <= px1; ++px) {
+      ulong pixel = ((ulong)py * (ulong)f.width + (ulong)px) * (ulong)spp;
+      for (int s = 0; s < spp; ++s) {
+        MpFixed2 sq = mp_sample_position(px, py, s, spp, f, sample_offsets);
+        if (sq.x < xmin || sq.x > xmax || sq.y < ymin || sq.y > ymax) continue;
+        ++tests;
+        float la, lb, lc;
+        int t = 0;
+        if (!mp_edge_triangle_covers(&tris[0].e, sq, &la, &lb, &lc)) {
+          t = 1;
+          if (!mp_edge_triangle_covers(&tris[1].e, sq, &la, &lb, &lc)) continue;
+        }
+        float d;
+        if (!mp_triangle_depth(&tris[t], la, lb, lc, f, &d)) continue;
+        if (!mp_opacity_keeps(mp_id, px, py, s, opacity, f)) continue;
+        ulong key = ((ulong)as_uint(d) << 32) | (ulong)mp_id;
+        ulong index = pixel + (ulong)s;
+        if (key >= keys[index]) continue;
+        keys[index] = key;
+        float3 col, nrm;
+        mp_triangle_attributes(&tris[t], la, lb, lc, d, f, &col, &nrm);
+        vstore3(col, index, colors);
+        if (f.normal_pass) normals[index] = mp_encode_normal(normalize(nrm));
+        *written = 1;
+      }
+    }
+  return tests;
+}
+
+/* Samples are tested 16 at a time (one pixel's, a chunk of
+ * MP_LANES), in int32: a micropolygon whose raster bound spans at most
+ * MP_FAST_SPAN fixed-point units per axis keeps every edge value of every
+ * sample within a pixel of its bound below 2^28, so the int32 sums equal
+ * mp_edge's 64-bit ones exactly and coverage stays watertight. */
+#define MP_LANES 16
+#define MP_FAST_SPAN (32 << MP_SUBPIXEL_BITS)
+
+/* Edge function of the edge u -> v at the pixel corner p (exact, 64-bit),
+ * and its steps per fixed-point unit of sample offset in x and y: e(p + o)
+ * = e(p) + dx * o.x + dy * o.y, with mp_edge's sign. */
+inline void mp_edge_setup(MpFixed2 u, MpFixed2 v, MpFixed2 p, int* e, int* dx, int* dy) {
+  *e = (int)mp_edge(u, v, p);
+  *dx = -(int)(v.y - u.y);
+  *dy = (int)(v.x - u.x);
+}
+
+/* Whether each lane's edge value counts as inside (mp_edge_inside, with the
+ * edge's own tie rule); -1 where it does. */
+inline int16 mp_inside16(int16 e, int owns) { return (e > 0) | ((e == 0) & (int16)(owns ? -1 : 0)); }
+
+/* Coverage of 16 samples (offsets ox, oy from pixel corner p) by an edge
+ * triangle: -1 per covered lane, and the lane's three edge values. */
+inline int16 mp_cover16(const MpEdgeTriangle* t, MpFixed2 p, int16 ox, int16 oy, int16* e0, int16* e1, int16* e2) {
+  int c0, x0, y0, c1, x1, y1, c2, x2, y2;
+  mp_edge_setup(t->b, t->c, p, &c0, &x0, &y0);
+  mp_edge_setup(t->c, t->a, p, &c1, &x1, &y1);
+  mp_edge_setup(t->a, t->b, p, &c2, &x2, &y2);
+  /* mp_edge_triangle_covers negates mp_edge: inside is >= 0. */
+  *e0 = -((int16)c0 + (int16)x0 * ox + (int16)y0 * oy);
+  *e1 = -((int16)c1 + (int16)x1 * ox + (int16)y1 * oy);
+  *e2 = -((int16)c2 + (int16)x2 * ox + (int16)y2 * oy);
+  if (!t->valid) return (int16)0;
+  return mp_inside16(*e0, t->own0) & mp_inside16(*e1, t->own1) & mp_inside16(*e2, t->own2);
+}
+
+/* A micropolygon's samples in pixels [px0, px1] x [py0, py1] of a tile,
+ * 16 at a time: coverage, depth and attributes in vectors; each covered
+ * sample then compared with its key and written (scalar: lanes past the
+ * pixel's samples belong to other pixels). Opaque micropolygons only (the
+ * stochastic opacity is per sample: mp_sample_tile_slow). */
+inline uint mp_sample_tile_fast(const MpTriangle* tris, long xmin, long xmax, long ymin, long ymax, int px0, int px1,
+                                int py0, int py1, uint mp_id, FrameParams f, __global const ushort* soa,
+                                __global ulong* keys, __global float* colors, __global uint* normals, int* written) {
+  int spp = f.spp_x * f.spp_y, chunks = (spp + MP_LANES - 1) / MP_LANES;
+  const int16 lane = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  uint tests = 0u;
+  float dl[MP_LANES], cx[MP_LANES], cy[MP_LANES], cz[MP_LANES], nx[MP_LANES], ny[MP_LANES], nz[MP_LANES];
+  int cov[MP_LANES];
+  for (int py = py0; py <= py1; ++py)
+    for (int px = px0; px <= px1; ++px) {
+      MpFixed2 p;
+      p.x = (long)px << MP_SUBPIXEL_BITS;
+      p.y = (long)py << MP_SUBPIXEL_BITS;
+      int tp = ((py + f.crop_y0) & (MP_SAMPLE_TILE - 1)) * MP_SAMPLE_TILE + ((px + f.crop_x0) & (MP_SAMPLE_TILE - 1));
+      ulong pixel = ((ulong)py * (ulong)f.width + (ulong)px) * (ulong)spp;
+      for (int c = 0; c < chunks; ++c) {
+        __global const ushort* o = soa + ((ulong)tp * (ulong)chunks + (ulong)c) * (2 * MP_LANES);
+        int16 ox = convert_int16(vload16(0, o)), oy = convert_int16(vload16(1, o));
+        int16 live = lane < (int16)(spp - c * MP_LANES);
+        /* Samples inside the bound: the ones sample.cl tests (a statistic). */
+        int16 sx = (int16)(int)(p.x - xmin) + ox, sy = (int16)(int)(p.y - ymin) + oy;
+        int16 inbox = live & (sx >= 0) & (sx <= (int16)(int)(xmax - xmin)) & (sy >= 0) &
+                      (sy <= (int16)(int)(ymax - ymin));
+        int16 a0, a1, a2, b0, b1, b2;
+        int16 in0 = mp_cover16(&tris[0], p, ox, oy, &a0, &a1, &a2) & inbox;
+        int16 in1 = mp_cover16(&tris[1], p, ox, oy, &b0, &b1, &b2) & inbox & ~in0;
+        int8 h8 = inbox.lo + inbox.hi;
+        int4 h4 = h8.lo + h8.hi;
+        int2 h2 = h4.lo + h4.hi;
+        tests += (uint)(-(h2.x + h2.y));
+        int16 covered = in0 | in1;
+        if (!any(covered)) continue;
+        /* Barycentrics of the covering triangle, in its own vertex order. */
+        float16 la = select(convert_float16(b0) * tris[1].e.inv_area, convert_float16(a0) * tris[0].e.inv_area, in0);
+        float16 lb = select(convert_float16(b1) * tris[1].e.inv_area, convert_float16(a1) * tris[0].e.inv_area, in0);
+        float16 lc = select(convert_float16(b2) * tris[1].e.inv_area, convert_float16(a2) * tris[0].e.inv_area, in0);
+        float16 da = select((float16)tris[1].a.inv_d, (float16)tris[0].a.inv_d, in0);
+        float16 db = select((float16)tris[1].b.inv_d, (float16)tris[0].b.inv_d, in0);
+        float16 dc = select((float16)tris[1].c.inv_d, (float16)tris[0].c.inv_d, in0);
+        float16 inv_d = la * da + lb * db + lc * dc;
+        float16 d = f.ortho ? inv_d : (float16)1.0f / inv_d;
+        covered &= (d >= (float16)f.clip_near) & (d <= (float16)f.clip_far);
+        if (!any(covered)) continue;
+        int first = c * MP_LANES, lanes = min(MP_LANES, spp - first);
+        if (lanes == MP_LANES) {
+          /* A whole chunk of this pixel's samples: keys compared 16 at once. */
+          __global ulong* kp = keys + pixel + (ulong)first;
+          ulong16 old = vload16(0, kp);
+          ulong16 key = (convert_ulong16(as_uint16(d)) << (ulong16)32) | (ulong16)(ulong)mp_id;
+          long16 wins = convert_long16(covered) & (key < old);
+          if (!any(wins)) continue;
+          vstore16(select(old, key, wins), 0, kp);
+          covered = convert_int16(wins);
+        }
+        float16 w = f.ortho ? (float16)1.0f : d;
+#define MP_ATTRIBUTE16(out, field, comp)                                                                   \
+  vstore16((la * select((float16)tris[1].a.field.comp, (float16)tris[0].a.field.comp, in0) +             \
+            lb * select((float16)tris[1].b.field.comp, (float16)tris[0].b.field.comp, in0) +             \
+            lc * select((float16)tris[1].c.field.comp, (float16)tris[0].c.field.comp, in0)) * w, 0, out)
+        MP_ATTRIBUTE16(cx, c_over_d, x);
+        MP_ATTRIBUTE16(cy, c_over_d, y);
+        MP_ATTRIBUTE16(cz, c_over_d, z);
+        if (f.normal_pass) {
+          MP_ATTRIBUTE16(nx, n_over_d, x);
+          MP_ATTRIBUTE16(ny, n_over_d, y);
+          MP_ATTRIBUTE16(nz, n_over_d, z);
+        }
+#undef MP_ATTRIBUTE16
+        vstore16(d, 0, dl);
+        vstore16(covered, 0, cov);
+        for (int l = 0; l < lanes; ++l) {
+          if (!cov[l]) continue;
+          ulong index = pixel + (ulong)(first + l);
+          if (lanes < MP_LANES) {
+            ulong key = ((ulong)as_uint(dl[l]) << 32) | (ulong)mp_id;
+            if (key >= keys[index]) continue;
+            keys[index] = key;
+          }
+          vstore3((float3)(cx[l], cy[l], cz[l]), index, colors);
+          if (f.normal_pass) normals[index] = mp_encode_normal(normalize((float3)(nx[l], ny[l], nz[l])));
+          *written = 1;
+        }
+      }
+    }
+  return tests;
+}
+
+/* One work-item per active tile (tile_ids[a], whose grids are
+ * entries[starts[a], starts[a + 1]), ascending): every micropolygon of
+ * those grids whose raster bound meets the tile is tested against the
+ * tile's samples under that bound. totals: micropolygons, twice their area
+ * (fixed-point units) and samples tested, each micropolygon counted in the
+ * tile that holds its bound's first pixel. */
+__kernel void sample_tiles(__global const SubPatch* diceable, __global const uint* patch_info, FrameParams f,
+                           __global const int4* projected, __global const float4* grid_c,
+                           __global const float4* grid_n, __global const ushort* sample_offsets,
+                           __global const ushort* sample_soa, __global const uint* tile_ids, __global const uint* starts, __global const uint* entries,
+                           uint active, uint tiles_x, __global ulong* keys, __global float* colors,
+                           __global uint* normals, volatile __global ulong* totals, __global uchar* occlusion_dirty,
+                           OcclusionParams occ) {
+  uint a = get_global_id(0);
+  if (a >= active) return;
+  uint tile = tile_ids[a];
+  int tx0 = (int)(tile % tiles_x) * MP_RASTER_TILE, ty0 = (int)(tile / tiles_x) * MP_RASTER_TILE;
+  int tx1 = min(tx0 + MP_RASTER_TILE, f.width) - 1, ty1 = min(ty0 + MP_RASTER_TILE, f.height) - 1;
+  /* The tile's samples lie in this fixed-point rectangle. */
+  long fx0 = (long)tx0 << MP_SUBPIXEL_BITS, fx1 = ((long)(tx1 + 1) << MP_SUBPIXEL_BITS) - 1;
+  long fy0 = (long)ty0 << MP_SUBPIXEL_BITS, fy1 = ((long)(ty1 + 1) << MP_SUBPIXEL_BITS) - 1;
+  int spp = f.spp_x * f.spp_y;
+  uint stride = (uint)f.max_grid + 1u;
+  ulong counted = 0u, area_sum = 0u, tests = 0u;
+  int wx0 = tx1 + 1, wx1 = tx0 - 1, wy0 = ty1 + 1, wy1 = ty0 - 1; /* pixels written */
+  for (uint e = starts[a]; e < starts[a + 1u]; ++e) {
+    uint slot = entries[e];
+    SubPatch sp = diceable[slot];
+    MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
+    uint flags = patch_info[4 * (ulong)sp.patch + 2];
+    uint grid_id = mp_grid_id(&sp);
+    ulong base = (ulong)slot * stride * stride;
+    uint nm = mp_grid_micropolygons(&g);
+    for (uint m = 0u; m < nm; ++m) {
+      uint q[4];
+      mp_grid_micropolygon(&g, m, q);
+      int4 r0 = projected[base + q[0]], r1 = projected[base + q[1]], r2 = projected[base + q[2]],
+           r3 = projected[base + q[3]];
+      if ((r0.w | r1.w | r2.w | r3.w) != 0) continue;
+      MpFixed2 p0 = mp_projected_position(r0), p1 = mp_projected_position(r1), p2 = mp_projected_position(r2),
+               p3 = mp_projected_position(r3);
+      long xmin = min(min(p0.x, p1.x), min(p2.x, p3.x)), xmax = max(max(p0.x, p1.x), max(p2.x, p3.x));
+      long ymin = min(min(p0.y, p1.y), min(p2.y, p3.y)), ymax = max(max(p0.y, p1.y), max(p2.y, p3.y));
+      if (xmax < fx0 || xmin > fx1 || ymax < fy0 || ymin > fy1) continue;
+      long area2;
+      uint keep = mp_quad_facing(p0, p1, p2, p3, flags, f, &area2);
+      if (!keep) continue;
+      /* Counted once: in the tile of the bound's first pixel in the frame. */
+      if (clamp(xmin >> MP_SUBPIXEL_BITS, (long)0, (long)f.width - 1) >= tx0 &&
+          clamp(ymin >> MP_SUBPIXEL_BITS, (long)0, (long)f.height - 1) >= ty0 &&
+          clamp(xmin >> MP_SUBPIXEL_BITS, (long)0, (long)f.width - 1) <= tx1 &&
+          clamp(ymin >> MP_SUBPIXEL_BITS, (long)0, (long)f.height - 1) <= ty1) {
+        counted += area2 > 0 ? 1u : 0u;
+        area_sum += (ulong)area2;
+      }
+      MpRasterVertex v[4];
+      v[0] = mp_raster_attributes(p0, as_float(r0.z), grid_c[base + q[0]], grid_n[base + q[0]], f);
+      v[1] = mp_raster_attributes(p1, as_float(r1.z), grid_c[base + q[1]], grid_n[base + q[1]], f);
+      v[2] = mp_raster_attributes(p2, as_float(r2.z), grid_c[base + q[2]], grid_n[base + q[2]], f);
+      v[3] = mp_raster_attributes(p3, as_float(r3.z), grid_c[base + q[3]], grid_n[base + q[3]], f);
+      MpTriangle tris[2];
+      tris[0] = mp_setup_triangle(v[0], v[1], v[2]);
+      tris[1] = mp_setup_triangle(v[0], v[2], v[3]);
+      tris[0].e.valid &= (int)(keep & 1u);
+      tris[1].e.valid &= (int)(keep >> 1);
+      uint mp_id = mp_micropolygon_id(grid_id, m);
+      float opacity = grid_c[base + q[0]].w;
+      int px0 = (int)max(xmin >> MP_SUBPIXEL_BITS, (long)tx0), px1 = (int)min(xmax >> MP_SUBPIXEL_BITS, (long)tx1);
+      int py0 = (int)max(ymin >> MP_SUBPIXEL_BITS, (long)ty0), py1 = (int)min(ymax >> MP_SUBPIXEL_BITS, (long)ty1);
+      int written = 0;
+      if (xmax - xmin <= MP_FAST_SPAN && ymax - ymin <= MP_FAST_SPAN && opacity >= 1.0f)
+        tests += mp_sample_tile_fast(tris, xmin, xmax, ymin, ymax, px0, px1, py0, py1, mp_id, f, sample_soa, keys,
+                                     colors, normals, &written);
+      else
+        tests += mp_sample_tile_slow(tris, xmin, xmax, ymin, ymax, px0, px1, py0, py1, mp_id, opacity, f,
+                                     sample_offsets, keys, colors, normals, &written);
+      if (written) wx0 = min(wx0, px0), wx1 = max(wx1, px1), wy0 = min(wy0, py0), wy1 = max(wy1, py1);
+    }
+  }
+  if (occlusion_dirty && wx0 <= wx1) mp_mark_occlusion_rect(occlusion_dirty, occ, f, wx0, wy0, wx1, wy1);
+  if (counted || tests) {
+    atom_add(&totals[0], counted);
+    atom_add(&totals[1], area_sum);
+    atom_add(&totals[2], tests);
+  }
+}

@@ -1,0 +1,108 @@
+// The sample stage by screen tiles (kernels/sample_tiles.cl), for CPUs: the
+// grids of a dice batch are projected and bounded on the device, sorted into
+// per-tile lists here (a counting sort over a few thousand grids: cheaper
+// than a device sort's launches, and it keeps each list in batch order, so
+// the output never depends on timing), then each non-empty tile is sampled
+// by one work-item.
+#include <algorithm>
+
+#include "mp_raster.h"
+#include "pipeline/micropolygon_stages.h"
+
+namespace mp {
+namespace {
+
+// Grows `buffer` to hold at least `needed` elements of `size` bytes.
+void ensure(DeviceSession& s, cl::Buffer& buffer, size_t& held, size_t needed, size_t size, const char* what) {
+  if (needed <= held && buffer()) return;
+  buffer = cl::Buffer();
+  held = std::max(needed, held + held / 2);
+  buffer = s.allocate(held * size, what);
+}
+
+// Work-items (tiles) per work-group of the tile sampler.
+constexpr size_t kTileGroup = 1;
+
+}  // namespace
+
+void SampleStage::run_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
+                            const FrameParams& f, GridBuffers& grids, StageTimer& timer) {
+  cl::CommandQueue& q = session_.queue();
+  ensure(session_, projected_, projected_slots_, grids.slot_space(), sizeof(cl_int4), "projected grid vertices");
+  ensure(session_, rects_, rect_slots_, grids.capacity, sizeof(cl_int4), "grid tile bounds");
+  project_.setArg(0, diceable);
+  project_.setArg(1, first);
+  project_.setArg(2, count);
+  project_.setArg(3, f);
+  project_.setArg(4, grids.p);
+  project_.setArg(5, projected_);
+  project_.setArg(6, rects_);
+  cl::Event e;
+  q.enqueueNDRangeKernel(project_, cl::NullRange, round_up_range(count), cl::NDRange(64), nullptr, &e);
+  timer.add(Stage::Sample, e);
+  rects_host_.resize(4 * size_t(count));
+  q.enqueueReadBuffer(rects_, CL_TRUE, 0, rects_host_.size() * sizeof(cl_int), rects_host_.data());
+
+  // Counting sort of (tile, grid) pairs by tile, grids ascending in each.
+  const cl_uint tiles_x = (cl_uint(f.width) + MP_RASTER_TILE - 1) / MP_RASTER_TILE;
+  const cl_uint tiles_y = (cl_uint(f.height) + MP_RASTER_TILE - 1) / MP_RASTER_TILE;
+  tile_counts_.assign(size_t(tiles_x) * tiles_y, 0);
+  auto for_each_tile = [&](cl_uint k, auto&& fn) {
+    const cl_int* r = &rects_host_[4 * size_t(k)];
+    for (cl_int ty = r[1]; ty <= r[3]; ++ty)
+      for (cl_int tx = r[0]; tx <= r[2]; ++tx) fn(cl_uint(ty) * tiles_x + cl_uint(tx));
+  };
+  for (cl_uint k = 0; k < count; ++k) for_each_tile(k, [&](cl_uint t) { ++tile_counts_[t]; });
+  tile_ids_host_.clear();
+  tile_starts_host_.clear();
+  cl_uint entries = 0;
+  for (size_t t = 0; t < tile_counts_.size(); ++t) {
+    if (!tile_counts_[t]) continue;
+    tile_ids_host_.push_back(cl_uint(t));
+    tile_starts_host_.push_back(entries);
+    const cl_uint n = tile_counts_[t];
+    tile_counts_[t] = entries;  // now the tile's next free entry
+    entries += n;
+  }
+  tile_starts_host_.push_back(entries);
+  const cl_uint active = cl_uint(tile_ids_host_.size());
+  if (active == 0) return;
+  tile_entries_host_.resize(entries);
+  for (cl_uint k = 0; k < count; ++k) for_each_tile(k, [&](cl_uint t) { tile_entries_host_[tile_counts_[t]++] = first + k; });
+
+  ensure(session_, tile_ids_, tile_slots_, active, sizeof(cl_uint), "tile list");
+  ensure(session_, tile_starts_, start_slots_, active + 1, sizeof(cl_uint), "tile list starts");
+  ensure(session_, tile_entries_, entry_slots_, entries, sizeof(cl_uint), "tile grid lists");
+  q.enqueueWriteBuffer(tile_ids_, CL_FALSE, 0, active * sizeof(cl_uint), tile_ids_host_.data());
+  q.enqueueWriteBuffer(tile_starts_, CL_FALSE, 0, (active + 1) * sizeof(cl_uint), tile_starts_host_.data());
+  q.enqueueWriteBuffer(tile_entries_, CL_FALSE, 0, entries * sizeof(cl_uint), tile_entries_host_.data());
+
+  cl::Kernel& k = tile_kernel_;
+  k.setArg(0, diceable);
+  k.setArg(1, scene.patch_info);
+  k.setArg(2, f);
+  k.setArg(3, projected_);
+  k.setArg(4, grids.c);
+  k.setArg(5, grids.n);
+  k.setArg(6, offsets_);
+  k.setArg(7, offsets_soa_);
+  k.setArg(8, tile_ids_);
+  k.setArg(9, tile_starts_);
+  k.setArg(10, tile_entries_);
+  k.setArg(11, active);
+  k.setArg(12, tiles_x);
+  k.setArg(13, keys_);
+  k.setArg(14, colors_);
+  k.setArg(15, normals_);
+  k.setArg(16, totals_);
+  k.setArg(17, occlusion_dirty_);
+  k.setArg(18, occlusion_);
+  // A fixed work-group size: PoCL compiles a kernel once per size it meets.
+  cl::Event t;
+  q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(active, kTileGroup), cl::NDRange(kTileGroup), nullptr, &t);
+  timer.add(Stage::Sample, t);
+  // The host lists must outlive their (asynchronous) uploads.
+  q.finish();
+}
+
+}  // namespace mp
