@@ -71,6 +71,7 @@ using std::ceil;
 using std::floor;
 using std::sqrt;
 using std::fabs;
+using std::isfinite;
 #endif
 
 #endif

@@ -49,6 +49,24 @@ MP_INLINE float3 mp_env_irradiance(MP_GLOBAL const DeviceLight* lt, float3 n) {
   return MP_F3(fmax(e.x, 0.0f), fmax(e.y, 0.0f), fmax(e.z, 0.0f));
 }
 
+/* atan2(y, x) for y >= 0, to within 2e-7 radians: octant reduction to
+ * [0, 1], then to |t| <= tan(pi/8), and the minimax polynomial of Cephes'
+ * atanf (Moshier). PoCL's atan2 is a general software routine that cost
+ * the area lights' shading several times their other arithmetic. */
+MP_INLINE float mp_atan2_upper(float y, float x) {
+  float ax = fabs(x), hi = fmax(ax, y), lo = fmin(ax, y);
+  float t = hi > 0.0f ? lo / hi : 0.0f, base = 0.0f;
+  if (t > 0.41421356f) {
+    t = (t - 1.0f) / (t + 1.0f);
+    base = 0.78539816f;
+  }
+  float z = t * t;
+  float r = base + ((((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z -
+                     3.33329491539e-1f) * z * t + t);
+  if (y > ax) r = 1.57079633f - r;
+  return x < 0.0f ? 3.14159265f - r : r;
+}
+
 /* Irradiance factor of a uniformly emitting polygon seen from a point with
  * normal n (vertices relative to the point): the polygon's projected solid
  * angle, by Lambert's formula, after clipping the polygon to the hemisphere
@@ -73,7 +91,7 @@ MP_INLINE float mp_polygon_irradiance(float3 n, float3* v, int count) {
     if (!(lc > 1e-12f)) continue;
     /* atan2 keeps the small angles of distant or grazing lights accurate,
      * where acos(dot) loses most of its digits. */
-    float angle = atan2(lc, dot(ua, ub));
+    float angle = mp_atan2_upper(lc, dot(ua, ub));
     sum += angle * dot(n, c / lc);
   }
   return 0.5f * fabs(sum);

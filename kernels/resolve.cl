@@ -7,6 +7,7 @@
 #include "mp_types.h"
 #include "mp_hash.h"
 #include "mp_raster.h"
+#include "mp_sample.h"
 
 #define MP_NO_DEPTH 1.0e10f
 
@@ -34,6 +35,9 @@ __kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width,
   int reach = (int)ceil(0.5f * filter_width - 0.5f);
   float4 sum = (float4)(0.0f);
   float wsum = 0.0f;
+  /* Sums of the 16-lane loop, added in once at the end. */
+  float16 r16 = (float16)(0.0f), g16 = (float16)(0.0f), b16 = (float16)(0.0f), a16 = (float16)(0.0f),
+          w16 = (float16)(0.0f);
   float cx = (float)px + 0.5f, cy = (float)py + 0.5f;
   int side = 2 * reach + 1;
   int tile = ((py + f.crop_y0) & (MP_SAMPLE_TILE - 1)) * MP_SAMPLE_TILE + ((px + f.crop_x0) & (MP_SAMPLE_TILE - 1));
@@ -41,7 +45,27 @@ __kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width,
     for (int qx = max(px - reach, 0); qx <= min(px + reach, f.width - 1); ++qx) {
       __global const float* wrow = weights + ((ulong)tile * (ulong)(side * side) +
                                               (ulong)((qy - py + reach) * side + (qx - px + reach))) * (ulong)spp;
-      for (int s = 0; s < spp; ++s) {
+      ulong q = (ulong)qy * (ulong)f.width + (ulong)qx;
+      int s = 0;
+      if (use_weights) {
+        /* 16 samples at a time (the weights and each color channel of a
+         * pixel's samples lie together, mp_sample.h). */
+        __global const ulong* k = keys + q * (ulong)spp;
+        __global const float* c = colors + mp_color_index(q, spp, 0);
+        for (; s + 16 <= spp; s += 16) {
+          float16 w = vload16(0, wrow + s);
+          w = select((float16)(0.0f), w, w > (float16)(0.0f));
+          /* Empty samples' colors are whatever the buffer held: selected
+           * away, not multiplied by 0 (which keeps a NaN). */
+          int16 covered = convert_int16(vload16(0, k + s) != (ulong16)0xffffffffffffffffUL);
+          w16 += w;
+          a16 += select((float16)(0.0f), w, covered);
+          r16 += select((float16)(0.0f), w * vload16(0, c + s), covered);
+          g16 += select((float16)(0.0f), w * vload16(0, c + spp + s), covered);
+          b16 += select((float16)(0.0f), w * vload16(0, c + 2 * spp + s), covered);
+        }
+      }
+      for (; s < spp; ++s) {
         float w;
         if (use_weights) {
           w = wrow[s];
@@ -51,11 +75,16 @@ __kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width,
           w = mp_filter_weight(filter_type, dx, dy, filter_width);
         }
         if (w <= 0.0f) continue;
-        ulong index = ((ulong)qy * (ulong)f.width + (ulong)qx) * (ulong)spp + (ulong)s;
+        ulong index = q * (ulong)spp + (ulong)s;
         wsum += w;
-        if (keys[index] != (ulong)0xffffffffffffffffUL) sum += w * (float4)(vload3(index, colors), 1.0f);
+        if (keys[index] != (ulong)0xffffffffffffffffUL) sum += w * (float4)(mp_load_color(colors, q, s, spp), 1.0f);
       }
     }
+#define MP_SUM16(v) (((v).s0 + (v).s1) + ((v).s2 + (v).s3) + ((v).s4 + (v).s5) + ((v).s6 + (v).s7) + \
+                     ((v).s8 + (v).s9) + ((v).sa + (v).sb) + ((v).sc + (v).sd) + ((v).se + (v).sf))
+  wsum += MP_SUM16(w16);
+  sum += (float4)(MP_SUM16(r16), MP_SUM16(g16), MP_SUM16(b16), MP_SUM16(a16));
+#undef MP_SUM16
   ulong pixel = (ulong)py * (ulong)f.width + (ulong)px;
   ulong out = (ulong)(py + origin.y) * (ulong)out_width + (ulong)(px + origin.x);
   rgba[out] = wsum > 0.0f ? sum / wsum : (float4)(0.0f);

@@ -29,14 +29,14 @@ inline void mp_sample_write(const MpTriangle* t, float la, float lb, float lc, i
   float d;
   if (!mp_triangle_depth(t, la, lb, lc, f, &d)) return;
   if (!mp_opacity_keeps(mp_id, px, py, s, opacity, f)) return;
-  ulong index = ((ulong)py * (ulong)f.width + (ulong)px) * (ulong)spp + (ulong)s;
+  ulong pixel = (ulong)py * (ulong)f.width + (ulong)px, index = pixel * (ulong)spp + (ulong)s;
   ulong key = ((ulong)as_uint(d) << 32) | (ulong)mp_id;
   if (pass == MP_PASS_DEPTH) {
     if (key < keys[index]) atom_min(&keys[index], key);
   } else if (keys[index] == key) {
     float3 col, nrm;
     mp_triangle_attributes(t, la, lb, lc, d, f, &col, &nrm);
-    vstore3(col, index, colors);
+    mp_store_color(colors, pixel, s, spp, col);
     if (f.normal_pass) normals[index] = mp_encode_normal(normalize(nrm));
   }
 }

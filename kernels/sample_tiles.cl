@@ -1,9 +1,9 @@
 /* Sample, shaped for CPUs: a sort-middle rasteriser (Laine & Karras 2011,
  * "High-performance software rasterization on GPUs"; RenderMan's buckets).
- * After shading, each grid's vertices are projected once (project_grids),
- * which also gives the grid's raster bound in screen tiles of
- * MP_RASTER_TILE pixels; the host sorts the grids into per-tile lists; then
- * one work-item per tile rasterises its grids' micropolygons into the
+ * After shading, each grid's vertices are projected once (project_grids)
+ * and each run of its micropolygons is bounded in screen tiles of
+ * MP_RASTER_TILE pixels (bound_runs); the host sorts the runs into per-tile
+ * lists; then one work-item per tile rasterises its runs' micropolygons into the
  * tile's samples, which no other work-item touches. So there are no atomics
  * and one pass writes depth and attributes together: a sample's nearest key
  * so far is in hand when a micropolygon covers it. The nearest key wins
@@ -26,11 +26,10 @@
 #define MP_PROJECTED_INVALID 1
 
 /* One work-item per grid of diceable sub-patches [first, first + count):
- * its vertices' raster positions (into `projected`, slot for slot as the
- * grid buffers), and the screen tiles its valid vertices reach
- * (tx0, ty0, tx1, ty1; tx0 > tx1 where none, clipped to the frame). */
+ * its vertices' raster positions, into `projected` slot for slot as the
+ * grid buffers. */
 __kernel void project_grids(__global const SubPatch* diceable, uint first, uint count, FrameParams f,
-                            __global const float4* grid_p, __global int4* projected, __global int4* rects) {
+                            __global const float4* grid_p, __global int4* projected) {
   uint k = get_global_id(0);
   if (k >= count) return;
   uint slot = first + k, stride = (uint)f.max_grid + 1u;
@@ -38,7 +37,6 @@ __kernel void project_grids(__global const SubPatch* diceable, uint first, uint 
   MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
   uint n = mp_grid_vertices(&g);
   ulong base = (ulong)slot * stride * stride;
-  long x0 = LONG_MAX, y0 = LONG_MAX, x1 = LONG_MIN, y1 = LONG_MIN;
   for (uint o = 0u; o < n; ++o) {
     uint i, j;
     mp_grid_vertex_slot(&g, o, &i, &j);
@@ -46,20 +44,45 @@ __kernel void project_grids(__global const SubPatch* diceable, uint first, uint 
     int ok = 1;
     float inv_d;
     MpFixed2 q = mp_raster_position(grid_p[idx], f, &inv_d, &ok);
-    if (!ok) {
-      projected[idx] = (int4)(0, 0, 0, MP_PROJECTED_INVALID);
-      continue;
-    }
-    projected[idx] = (int4)((int)q.x, (int)q.y, as_int(inv_d), 0);
-    x0 = min(x0, q.x), x1 = max(x1, q.x), y0 = min(y0, q.y), y1 = max(y1, q.y);
+    projected[idx] = ok ? (int4)((int)q.x, (int)q.y, as_int(inv_d), 0) : (int4)(0, 0, 0, MP_PROJECTED_INVALID);
+  }
+}
+
+/* Grids are binned by runs of MP_TILE_RUN micropolygons (in the grid's
+ * order: rows of the interior, then the strips), whose bounds are tight
+ * where a whole grid's would put each micropolygon in front of every tile
+ * the grid touches. */
+#define MP_TILE_RUN 16
+
+/* One work-item per run r of grid k (runs_per_grid per grid): the screen
+ * tiles the run's micropolygons reach, (tx0, ty0, tx1, ty1), tx0 > tx1
+ * where none (clipped to the frame). */
+__kernel void bound_runs(__global const SubPatch* diceable, uint first, uint count, FrameParams f,
+                         __global const int4* projected, uint runs_per_grid, __global int4* rects) {
+  uint gid = get_global_id(0), k = gid / runs_per_grid, run = gid % runs_per_grid;
+  if (k >= count) return;
+  uint slot = first + k, stride = (uint)f.max_grid + 1u;
+  SubPatch sp = diceable[slot];
+  MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
+  uint m1 = min(mp_grid_micropolygons(&g), (run + 1u) * MP_TILE_RUN);
+  ulong base = (ulong)slot * stride * stride;
+  int x0 = INT_MAX, y0 = INT_MAX, x1 = INT_MIN, y1 = INT_MIN;
+  for (uint m = run * MP_TILE_RUN; m < m1; ++m) {
+    uint q[4];
+    mp_grid_micropolygon(&g, m, q);
+    int4 r0 = projected[base + q[0]], r1 = projected[base + q[1]], r2 = projected[base + q[2]],
+         r3 = projected[base + q[3]];
+    if ((r0.w | r1.w | r2.w | r3.w) != 0) continue;
+    x0 = min(x0, min(min(r0.x, r1.x), min(r2.x, r3.x))), x1 = max(x1, max(max(r0.x, r1.x), max(r2.x, r3.x)));
+    y0 = min(y0, min(min(r0.y, r1.y), min(r2.y, r3.y))), y1 = max(y1, max(max(r0.y, r1.y), max(r2.y, r3.y)));
   }
   int4 r = (int4)(1, 1, 0, 0);
   if (x0 <= x1 && x1 >= 0 && y1 >= 0 && (x0 >> MP_SUBPIXEL_BITS) < f.width && (y0 >> MP_SUBPIXEL_BITS) < f.height) {
-    int px0 = (int)max(x0 >> MP_SUBPIXEL_BITS, (long)0), px1 = (int)min(x1 >> MP_SUBPIXEL_BITS, (long)f.width - 1);
-    int py0 = (int)max(y0 >> MP_SUBPIXEL_BITS, (long)0), py1 = (int)min(y1 >> MP_SUBPIXEL_BITS, (long)f.height - 1);
+    int px0 = max(x0 >> MP_SUBPIXEL_BITS, 0), px1 = min(x1 >> MP_SUBPIXEL_BITS, f.width - 1);
+    int py0 = max(y0 >> MP_SUBPIXEL_BITS, 0), py1 = min(y1 >> MP_SUBPIXEL_BITS, f.height - 1);
     r = (int4)(px0 / MP_RASTER_TILE, py0 / MP_RASTER_TILE, px1 / MP_RASTER_TILE, py1 / MP_RASTER_TILE);
   }
-  rects[k] = r;
+  rects[gid] = r;
 }
 
 inline MpFixed2 mp_projected_position(int4 v) {
@@ -99,7 +122,7 @@ inline uint mp_sample_tile_slow(const MpTriangle* tris, long xmin, long xmax, lo
         keys[index] = key;
         float3 col, nrm;
         mp_triangle_attributes(&tris[t], la, lb, lc, d, f, &col, &nrm);
-        vstore3(col, index, colors);
+        mp_store_color(colors, pixel / (ulong)spp, s, spp, col);
         if (f.normal_pass) normals[index] = mp_encode_normal(normalize(nrm));
         *written = 1;
       }
@@ -115,69 +138,80 @@ inline uint mp_sample_tile_slow(const MpTriangle* tris, long xmin, long xmax, lo
 #define MP_LANES 16
 #define MP_FAST_SPAN (32 << MP_SUBPIXEL_BITS)
 
-/* Edge function of the edge u -> v at the pixel corner p (exact, 64-bit),
- * and its steps per fixed-point unit of sample offset in x and y: e(p + o)
- * = e(p) + dx * o.x + dy * o.y, with mp_edge's sign. */
-inline void mp_edge_setup(MpFixed2 u, MpFixed2 v, MpFixed2 p, int* e, int* dx, int* dy) {
-  *e = (int)mp_edge(u, v, p);
-  *dx = -(int)(v.y - u.y);
-  *dy = (int)(v.x - u.x);
+/* An edge u -> v of a triangle as the 16-lane tests use it: its value at
+ * the corner of the first pixel of the micropolygon's range, and its steps
+ * per fixed-point unit in x and y (e(p + o) = e(p) + dx o.x + dy o.y, with
+ * mp_edge_triangle_covers' sign: inside is >= 0), and its tie rule. */
+typedef struct {
+  int e, dx, dy, owns;
+} MpEdge16;
+
+inline MpEdge16 mp_edge16(MpFixed2 u, MpFixed2 v, MpFixed2 p, int owns) {
+  MpEdge16 r;
+  r.e = -(int)mp_edge(u, v, p);
+  r.dx = (int)(v.y - u.y);
+  r.dy = -(int)(v.x - u.x);
+  r.owns = owns ? -1 : 0;
+  return r;
 }
 
-/* Whether each lane's edge value counts as inside (mp_edge_inside, with the
- * edge's own tie rule); -1 where it does. */
-inline int16 mp_inside16(int16 e, int owns) { return (e > 0) | ((e == 0) & (int16)(owns ? -1 : 0)); }
-
-/* Coverage of 16 samples (offsets ox, oy from pixel corner p) by an edge
- * triangle: -1 per covered lane, and the lane's three edge values. */
-inline int16 mp_cover16(const MpEdgeTriangle* t, MpFixed2 p, int16 ox, int16 oy, int16* e0, int16* e1, int16* e2) {
-  int c0, x0, y0, c1, x1, y1, c2, x2, y2;
-  mp_edge_setup(t->b, t->c, p, &c0, &x0, &y0);
-  mp_edge_setup(t->c, t->a, p, &c1, &x1, &y1);
-  mp_edge_setup(t->a, t->b, p, &c2, &x2, &y2);
-  /* mp_edge_triangle_covers negates mp_edge: inside is >= 0. */
-  *e0 = -((int16)c0 + (int16)x0 * ox + (int16)y0 * oy);
-  *e1 = -((int16)c1 + (int16)x1 * ox + (int16)y1 * oy);
-  *e2 = -((int16)c2 + (int16)x2 * ox + (int16)y2 * oy);
-  if (!t->valid) return (int16)0;
-  return mp_inside16(*e0, t->own0) & mp_inside16(*e1, t->own1) & mp_inside16(*e2, t->own2);
+/* Lanes (-1) where the sample at offset (ox, oy) from a pixel whose corner
+ * is (sx, sy) units from the range's first corner lies inside the edge
+ * (mp_edge_inside); its value in *value. */
+inline int16 mp_inside16(const MpEdge16* g, int sx, int sy, int16 ox, int16 oy, int16* value) {
+  int base = g->e + g->dx * sx + g->dy * sy;
+  int16 e = (int16)base + (int16)g->dx * ox + (int16)g->dy * oy;
+  *value = e;
+  return (e > 0) | ((e == 0) & (int16)g->owns);
 }
 
 /* A micropolygon's samples in pixels [px0, px1] x [py0, py1] of a tile,
- * 16 at a time: coverage, depth and attributes in vectors; each covered
- * sample then compared with its key and written (scalar: lanes past the
- * pixel's samples belong to other pixels). Opaque micropolygons only (the
- * stochastic opacity is per sample: mp_sample_tile_slow). */
+ * 16 at a time: coverage, depth, the key comparison and the attributes in
+ * vectors; keys and colors of a whole chunk of a pixel's samples are
+ * stored as vectors, a partial chunk's (the lanes past the pixel's samples
+ * belong to other pixels) and normals one by one. Opaque micropolygons
+ * only (the stochastic opacity is per sample: mp_sample_tile_slow). */
 inline uint mp_sample_tile_fast(const MpTriangle* tris, long xmin, long xmax, long ymin, long ymax, int px0, int px1,
                                 int py0, int py1, uint mp_id, FrameParams f, __global const ushort* soa,
                                 __global ulong* keys, __global float* colors, __global uint* normals, int* written) {
   int spp = f.spp_x * f.spp_y, chunks = (spp + MP_LANES - 1) / MP_LANES;
   const int16 lane = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
   uint tests = 0u;
+  MpFixed2 p0;
+  p0.x = (long)px0 << MP_SUBPIXEL_BITS;
+  p0.y = (long)py0 << MP_SUBPIXEL_BITS;
+  MpEdge16 g[6];
+  for (int t = 0; t < 2; ++t) {
+    g[3 * t + 0] = mp_edge16(tris[t].e.b, tris[t].e.c, p0, tris[t].e.own0);
+    g[3 * t + 1] = mp_edge16(tris[t].e.c, tris[t].e.a, p0, tris[t].e.own1);
+    g[3 * t + 2] = mp_edge16(tris[t].e.a, tris[t].e.b, p0, tris[t].e.own2);
+  }
+  int16 valid0 = (int16)(tris[0].e.valid ? -1 : 0), valid1 = (int16)(tris[1].e.valid ? -1 : 0);
   float dl[MP_LANES], cx[MP_LANES], cy[MP_LANES], cz[MP_LANES], nx[MP_LANES], ny[MP_LANES], nz[MP_LANES];
   int cov[MP_LANES];
   for (int py = py0; py <= py1; ++py)
     for (int px = px0; px <= px1; ++px) {
-      MpFixed2 p;
-      p.x = (long)px << MP_SUBPIXEL_BITS;
-      p.y = (long)py << MP_SUBPIXEL_BITS;
+      int sx = (px - px0) << MP_SUBPIXEL_BITS, sy = (py - py0) << MP_SUBPIXEL_BITS;
       int tp = ((py + f.crop_y0) & (MP_SAMPLE_TILE - 1)) * MP_SAMPLE_TILE + ((px + f.crop_x0) & (MP_SAMPLE_TILE - 1));
-      ulong pixel = ((ulong)py * (ulong)f.width + (ulong)px) * (ulong)spp;
+      ulong pixel = (ulong)py * (ulong)f.width + (ulong)px;
+      /* The bound relative to this pixel's corner, for the samples it holds. */
+      int bx0 = (int)(xmin - ((long)px << MP_SUBPIXEL_BITS)), bx1 = (int)(xmax - ((long)px << MP_SUBPIXEL_BITS));
+      int by0 = (int)(ymin - ((long)py << MP_SUBPIXEL_BITS)), by1 = (int)(ymax - ((long)py << MP_SUBPIXEL_BITS));
       for (int c = 0; c < chunks; ++c) {
         __global const ushort* o = soa + ((ulong)tp * (ulong)chunks + (ulong)c) * (2 * MP_LANES);
         int16 ox = convert_int16(vload16(0, o)), oy = convert_int16(vload16(1, o));
         int16 live = lane < (int16)(spp - c * MP_LANES);
         /* Samples inside the bound: the ones sample.cl tests (a statistic). */
-        int16 sx = (int16)(int)(p.x - xmin) + ox, sy = (int16)(int)(p.y - ymin) + oy;
-        int16 inbox = live & (sx >= 0) & (sx <= (int16)(int)(xmax - xmin)) & (sy >= 0) &
-                      (sy <= (int16)(int)(ymax - ymin));
-        int16 a0, a1, a2, b0, b1, b2;
-        int16 in0 = mp_cover16(&tris[0], p, ox, oy, &a0, &a1, &a2) & inbox;
-        int16 in1 = mp_cover16(&tris[1], p, ox, oy, &b0, &b1, &b2) & inbox & ~in0;
+        int16 inbox = live & (ox >= (int16)bx0) & (ox <= (int16)bx1) & (oy >= (int16)by0) & (oy <= (int16)by1);
         int8 h8 = inbox.lo + inbox.hi;
         int4 h4 = h8.lo + h8.hi;
         int2 h2 = h4.lo + h4.hi;
         tests += (uint)(-(h2.x + h2.y));
+        int16 a0, a1, a2, b0, b1, b2;
+        int16 in0 = valid0 & inbox & mp_inside16(&g[0], sx, sy, ox, oy, &a0) & mp_inside16(&g[1], sx, sy, ox, oy, &a1) &
+                    mp_inside16(&g[2], sx, sy, ox, oy, &a2);
+        int16 in1 = valid1 & inbox & ~in0 & mp_inside16(&g[3], sx, sy, ox, oy, &b0) &
+                    mp_inside16(&g[4], sx, sy, ox, oy, &b1) & mp_inside16(&g[5], sx, sy, ox, oy, &b2);
         int16 covered = in0 | in1;
         if (!any(covered)) continue;
         /* Barycentrics of the covering triangle, in its own vertex order. */
@@ -192,51 +226,63 @@ inline uint mp_sample_tile_fast(const MpTriangle* tris, long xmin, long xmax, lo
         covered &= (d >= (float16)f.clip_near) & (d <= (float16)f.clip_far);
         if (!any(covered)) continue;
         int first = c * MP_LANES, lanes = min(MP_LANES, spp - first);
-        if (lanes == MP_LANES) {
+        int whole = lanes == MP_LANES;
+        ulong16 old;
+        __global ulong* kp = keys + pixel * (ulong)spp + (ulong)first;
+        if (whole) {
           /* A whole chunk of this pixel's samples: keys compared 16 at once. */
-          __global ulong* kp = keys + pixel + (ulong)first;
-          ulong16 old = vload16(0, kp);
+          old = vload16(0, kp);
           ulong16 key = (convert_ulong16(as_uint16(d)) << (ulong16)32) | (ulong16)(ulong)mp_id;
           long16 wins = convert_long16(covered) & (key < old);
           if (!any(wins)) continue;
           vstore16(select(old, key, wins), 0, kp);
           covered = convert_int16(wins);
+          *written = 1;
         }
         float16 w = f.ortho ? (float16)1.0f : d;
-#define MP_ATTRIBUTE16(out, field, comp)                                                                   \
-  vstore16((la * select((float16)tris[1].a.field.comp, (float16)tris[0].a.field.comp, in0) +             \
-            lb * select((float16)tris[1].b.field.comp, (float16)tris[0].b.field.comp, in0) +             \
-            lc * select((float16)tris[1].c.field.comp, (float16)tris[0].c.field.comp, in0)) * w, 0, out)
-        MP_ATTRIBUTE16(cx, c_over_d, x);
-        MP_ATTRIBUTE16(cy, c_over_d, y);
-        MP_ATTRIBUTE16(cz, c_over_d, z);
+#define MP_ATTRIBUTE16(field, comp)                                                                        \
+  ((la * select((float16)tris[1].a.field.comp, (float16)tris[0].a.field.comp, in0) +                     \
+    lb * select((float16)tris[1].b.field.comp, (float16)tris[0].b.field.comp, in0) +                     \
+    lc * select((float16)tris[1].c.field.comp, (float16)tris[0].c.field.comp, in0)) * w)
+        float16 r = MP_ATTRIBUTE16(c_over_d, x), gr = MP_ATTRIBUTE16(c_over_d, y), bl = MP_ATTRIBUTE16(c_over_d, z);
+        if (whole) {
+          __global float* cp = colors + mp_color_index(pixel, spp, 0) + (ulong)first;
+          vstore16(select(vload16(0, cp), r, covered), 0, cp);
+          vstore16(select(vload16(0, cp + spp), gr, covered), 0, cp + spp);
+          vstore16(select(vload16(0, cp + 2 * spp), bl, covered), 0, cp + 2 * spp);
+          if (!f.normal_pass) continue;
+        }
+        vstore16(r, 0, cx);
+        vstore16(gr, 0, cy);
+        vstore16(bl, 0, cz);
         if (f.normal_pass) {
-          MP_ATTRIBUTE16(nx, n_over_d, x);
-          MP_ATTRIBUTE16(ny, n_over_d, y);
-          MP_ATTRIBUTE16(nz, n_over_d, z);
+          vstore16(MP_ATTRIBUTE16(n_over_d, x), 0, nx);
+          vstore16(MP_ATTRIBUTE16(n_over_d, y), 0, ny);
+          vstore16(MP_ATTRIBUTE16(n_over_d, z), 0, nz);
         }
 #undef MP_ATTRIBUTE16
         vstore16(d, 0, dl);
         vstore16(covered, 0, cov);
         for (int l = 0; l < lanes; ++l) {
           if (!cov[l]) continue;
-          ulong index = pixel + (ulong)(first + l);
-          if (lanes < MP_LANES) {
+          ulong index = pixel * (ulong)spp + (ulong)(first + l);
+          if (!whole) {
             ulong key = ((ulong)as_uint(dl[l]) << 32) | (ulong)mp_id;
             if (key >= keys[index]) continue;
             keys[index] = key;
+            mp_store_color(colors, pixel, first + l, spp, (float3)(cx[l], cy[l], cz[l]));
+            *written = 1;
           }
-          vstore3((float3)(cx[l], cy[l], cz[l]), index, colors);
           if (f.normal_pass) normals[index] = mp_encode_normal(normalize((float3)(nx[l], ny[l], nz[l])));
-          *written = 1;
         }
       }
     }
   return tests;
 }
 
-/* One work-item per active tile (tile_ids[a], whose grids are
- * entries[starts[a], starts[a + 1]), ascending): every micropolygon of
+/* One work-item per active tile (tile_ids[a], whose runs are
+ * entries[starts[a], starts[a + 1]), ascending; entry slot *
+ * runs_per_grid + run): every micropolygon of
  * those grids whose raster bound meets the tile is tested against the
  * tile's samples under that bound. totals: micropolygons, twice their area
  * (fixed-point units) and samples tested, each micropolygon counted in the
@@ -244,8 +290,8 @@ inline uint mp_sample_tile_fast(const MpTriangle* tris, long xmin, long xmax, lo
 __kernel void sample_tiles(__global const SubPatch* diceable, __global const uint* patch_info, FrameParams f,
                            __global const int4* projected, __global const float4* grid_c,
                            __global const float4* grid_n, __global const ushort* sample_offsets,
-                           __global const ushort* sample_soa, __global const uint* tile_ids, __global const uint* starts, __global const uint* entries,
-                           uint active, uint tiles_x, __global ulong* keys, __global float* colors,
+                           __global const ushort* sample_soa, __global const uint* tile_ids, __global const uint* starts,
+                           __global const uint* entries, uint runs_per_grid, uint active, uint tiles_x, __global ulong* keys, __global float* colors,
                            __global uint* normals, volatile __global ulong* totals, __global uchar* occlusion_dirty,
                            OcclusionParams occ) {
   uint a = get_global_id(0);
@@ -261,14 +307,14 @@ __kernel void sample_tiles(__global const SubPatch* diceable, __global const uin
   ulong counted = 0u, area_sum = 0u, tests = 0u;
   int wx0 = tx1 + 1, wx1 = tx0 - 1, wy0 = ty1 + 1, wy1 = ty0 - 1; /* pixels written */
   for (uint e = starts[a]; e < starts[a + 1u]; ++e) {
-    uint slot = entries[e];
+    uint slot = entries[e] / runs_per_grid, run = entries[e] % runs_per_grid;
     SubPatch sp = diceable[slot];
     MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
     uint flags = patch_info[4 * (ulong)sp.patch + 2];
     uint grid_id = mp_grid_id(&sp);
     ulong base = (ulong)slot * stride * stride;
-    uint nm = mp_grid_micropolygons(&g);
-    for (uint m = 0u; m < nm; ++m) {
+    uint nm = min(mp_grid_micropolygons(&g), (run + 1u) * MP_TILE_RUN);
+    for (uint m = run * MP_TILE_RUN; m < nm; ++m) {
       uint q[4];
       mp_grid_micropolygon(&g, m, q);
       int4 r0 = projected[base + q[0]], r1 = projected[base + q[1]], r2 = projected[base + q[2]],

@@ -200,6 +200,7 @@ SampleStage::SampleStage(DeviceSession& session)
       blur_kernel_(session.program(), "sample_micropolygons_blur"),
       clear_(session.program(), "clear_samples"),
       project_(session.program(), "project_grids"),
+      bound_runs_(session.program(), "bound_runs"),
       tile_kernel_(session.program(), "sample_tiles") {
   totals_ = cl::Buffer(session.context(), CL_MEM_READ_WRITE, 3 * sizeof(cl_ulong));
 }

@@ -151,7 +151,7 @@ class SampleStage {
                  const FrameParams& f, GridBuffers& grids, StageTimer& timer);
   cl::Kernel kernel_, blur_kernel_;  // pinhole samples; samples with times and lens positions
   cl::Kernel clear_;
-  cl::Kernel project_, tile_kernel_;
+  cl::Kernel project_, bound_runs_, tile_kernel_;
   bool tiles_ = false;
   cl::Buffer projected_, rects_, tile_ids_, tile_starts_, tile_entries_;
   size_t projected_slots_ = 0, rect_slots_ = 0, tile_slots_ = 0, start_slots_ = 0, entry_slots_ = 0;

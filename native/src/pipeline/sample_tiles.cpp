@@ -22,6 +22,8 @@ void ensure(DeviceSession& s, cl::Buffer& buffer, size_t& held, size_t needed, s
 
 // Work-items (tiles) per work-group of the tile sampler.
 constexpr size_t kTileGroup = 1;
+// Micropolygons per binned run (MP_TILE_RUN in sample_tiles.cl).
+constexpr cl_uint kTileRun = 16;
 
 }  // namespace
 
@@ -29,30 +31,44 @@ void SampleStage::run_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint c
                             const FrameParams& f, GridBuffers& grids, StageTimer& timer) {
   cl::CommandQueue& q = session_.queue();
   ensure(session_, projected_, projected_slots_, grids.slot_space(), sizeof(cl_int4), "projected grid vertices");
-  ensure(session_, rects_, rect_slots_, grids.capacity, sizeof(cl_int4), "grid tile bounds");
+  // Runs of micropolygons per grid (sample_tiles.cl, MP_TILE_RUN): enough
+  // for the largest grid, (max_grid - 2)^2 + 4 max_grid micropolygons.
+  const cl_uint most = cl_uint(f.max_grid > 2 ? (f.max_grid - 2) * (f.max_grid - 2) : 0) + 4u * cl_uint(f.max_grid);
+  const cl_uint runs_per_grid = (most + kTileRun - 1) / kTileRun;
+  const size_t runs = size_t(count) * runs_per_grid;
+  ensure(session_, rects_, rect_slots_, size_t(grids.capacity) * runs_per_grid, sizeof(cl_int4), "run tile bounds");
   project_.setArg(0, diceable);
   project_.setArg(1, first);
   project_.setArg(2, count);
   project_.setArg(3, f);
   project_.setArg(4, grids.p);
   project_.setArg(5, projected_);
-  project_.setArg(6, rects_);
   cl::Event e;
   q.enqueueNDRangeKernel(project_, cl::NullRange, round_up_range(count), cl::NDRange(64), nullptr, &e);
   timer.add(Stage::Sample, e);
-  rects_host_.resize(4 * size_t(count));
+  bound_runs_.setArg(0, diceable);
+  bound_runs_.setArg(1, first);
+  bound_runs_.setArg(2, count);
+  bound_runs_.setArg(3, f);
+  bound_runs_.setArg(4, projected_);
+  bound_runs_.setArg(5, runs_per_grid);
+  bound_runs_.setArg(6, rects_);
+  cl::Event b;
+  q.enqueueNDRangeKernel(bound_runs_, cl::NullRange, round_up_range(runs), cl::NDRange(64), nullptr, &b);
+  timer.add(Stage::Sample, b);
+  rects_host_.resize(4 * runs);
   q.enqueueReadBuffer(rects_, CL_TRUE, 0, rects_host_.size() * sizeof(cl_int), rects_host_.data());
 
-  // Counting sort of (tile, grid) pairs by tile, grids ascending in each.
+  // Counting sort of (tile, run) pairs by tile, runs in batch order in each.
   const cl_uint tiles_x = (cl_uint(f.width) + MP_RASTER_TILE - 1) / MP_RASTER_TILE;
   const cl_uint tiles_y = (cl_uint(f.height) + MP_RASTER_TILE - 1) / MP_RASTER_TILE;
   tile_counts_.assign(size_t(tiles_x) * tiles_y, 0);
-  auto for_each_tile = [&](cl_uint k, auto&& fn) {
+  auto for_each_tile = [&](size_t k, auto&& fn) {
     const cl_int* r = &rects_host_[4 * size_t(k)];
     for (cl_int ty = r[1]; ty <= r[3]; ++ty)
       for (cl_int tx = r[0]; tx <= r[2]; ++tx) fn(cl_uint(ty) * tiles_x + cl_uint(tx));
   };
-  for (cl_uint k = 0; k < count; ++k) for_each_tile(k, [&](cl_uint t) { ++tile_counts_[t]; });
+  for (size_t k = 0; k < runs; ++k) for_each_tile(k, [&](cl_uint t) { ++tile_counts_[t]; });
   tile_ids_host_.clear();
   tile_starts_host_.clear();
   cl_uint entries = 0;
@@ -68,7 +84,10 @@ void SampleStage::run_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint c
   const cl_uint active = cl_uint(tile_ids_host_.size());
   if (active == 0) return;
   tile_entries_host_.resize(entries);
-  for (cl_uint k = 0; k < count; ++k) for_each_tile(k, [&](cl_uint t) { tile_entries_host_[tile_counts_[t]++] = first + k; });
+  // Entry: the run's grid slot * runs_per_grid + its run.
+  const cl_uint base = first * runs_per_grid;
+  for (size_t k = 0; k < runs; ++k)
+    for_each_tile(k, [&](cl_uint t) { tile_entries_host_[tile_counts_[t]++] = base + cl_uint(k); });
 
   ensure(session_, tile_ids_, tile_slots_, active, sizeof(cl_uint), "tile list");
   ensure(session_, tile_starts_, start_slots_, active + 1, sizeof(cl_uint), "tile list starts");
@@ -89,14 +108,15 @@ void SampleStage::run_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint c
   k.setArg(8, tile_ids_);
   k.setArg(9, tile_starts_);
   k.setArg(10, tile_entries_);
-  k.setArg(11, active);
-  k.setArg(12, tiles_x);
-  k.setArg(13, keys_);
-  k.setArg(14, colors_);
-  k.setArg(15, normals_);
-  k.setArg(16, totals_);
-  k.setArg(17, occlusion_dirty_);
-  k.setArg(18, occlusion_);
+  k.setArg(11, runs_per_grid);
+  k.setArg(12, active);
+  k.setArg(13, tiles_x);
+  k.setArg(14, keys_);
+  k.setArg(15, colors_);
+  k.setArg(16, normals_);
+  k.setArg(17, totals_);
+  k.setArg(18, occlusion_dirty_);
+  k.setArg(19, occlusion_);
   // A fixed work-group size: PoCL compiles a kernel once per size it meets.
   cl::Event t;
   q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(active, kTileGroup), cl::NDRange(kTileGroup), nullptr, &t);
