@@ -120,18 +120,25 @@ inline void mp_triangle_attributes(const MpTriangle* t, float la, float lb, floa
   *nrm = (la * t->a.n_over_d + lb * t->b.n_over_d + lc * t->c.n_over_d) * w;
 }
 
-/* Sample colors: per pixel, its samples' reds, then their greens, then
- * their blues, so a pixel's samples of one channel lie together (the tile
- * sampler loads and stores 16 at once). */
+/* Sample colors: with f.planar_colors (the tile sampler), per pixel its
+ * samples' reds, then their greens, then their blues, so a pixel's samples
+ * of one channel lie together (16 are loaded and stored at once); else
+ * sample by sample, RGB together (one work-item per micropolygon writes a
+ * sample's three at once: what GPUs want). */
 inline ulong mp_color_index(ulong pixel, int spp, int channel) { return (pixel * 3u + (ulong)channel) * (ulong)spp; }
 
-inline void mp_store_color(__global float* colors, ulong pixel, int s, int spp, float3 c) {
+inline void mp_store_color(__global float* colors, ulong pixel, int s, int spp, float3 c, FrameParams f) {
+  if (!f.planar_colors) {
+    vstore3(c, pixel * (ulong)spp + (ulong)s, colors);
+    return;
+  }
   colors[mp_color_index(pixel, spp, 0) + (ulong)s] = c.x;
   colors[mp_color_index(pixel, spp, 1) + (ulong)s] = c.y;
   colors[mp_color_index(pixel, spp, 2) + (ulong)s] = c.z;
 }
 
-inline float3 mp_load_color(__global const float* colors, ulong pixel, int s, int spp) {
+inline float3 mp_load_color(__global const float* colors, ulong pixel, int s, int spp, FrameParams f) {
+  if (!f.planar_colors) return vload3(pixel * (ulong)spp + (ulong)s, colors);
   return (float3)(colors[mp_color_index(pixel, spp, 0) + (ulong)s], colors[mp_color_index(pixel, spp, 1) + (ulong)s],
                   colors[mp_color_index(pixel, spp, 2) + (ulong)s]);
 }

@@ -102,6 +102,9 @@ typedef struct {
    * frame. */
   float frame_bx, frame_by;
   int bucket_x0, bucket_y0;
+  /* Sample colors per pixel channel by channel (the tile sampler's layout,
+   * for 16-lane loads and stores) or sample by sample (mp_sample.h). */
+  int planar_colors;
 } FrameParams;
 
 /* The camera view's occlusion pyramid (mp_occlusion.h): level 0 has a cell

@@ -23,12 +23,20 @@ __kernel void clear_samples(__global ulong* keys, ulong n) {
  * of every neighbour for each of the 32x32 positions a pixel can have in the
  * repeating sample tile (built on the host from the same functions), so the
  * filter is not re-evaluated per sample. */
-__kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width, __global const ushort* offsets,
-                             __global const float* weights, int use_weights, __global const ulong* keys,
-                             __global const float* colors, __global const uint* normals,
-                             float4 cam_to_world_x, float4 cam_to_world_y, float4 cam_to_world_z,
-                             __global float4* rgba, __global float* depth, __global float* normal_out, int want_passes,
-                             int4 region, int2 origin, int out_width) {
+#define MP_RESOLVE_ARGS                                                                                              \
+  FrameParams f, int filter_type, float filter_width, __global const ushort *offsets, __global const float *weights,  \
+      int use_weights, __global const ulong *keys, __global const float *colors, __global const uint *normals,        \
+      float4 cam_to_world_x, float4 cam_to_world_y, float4 cam_to_world_z, __global float4 *rgba,                     \
+      __global float *depth, __global float *normal_out, int want_passes, int4 region, int2 origin, int out_width
+#define MP_RESOLVE_PASS                                                                                              \
+  f, filter_type, filter_width, offsets, weights, use_weights, keys, colors, normals, cam_to_world_x, cam_to_world_y, \
+      cam_to_world_z, rgba, depth, normal_out, want_passes, region, origin, out_width
+
+/* `lanes` (a constant in each kernel below): planar sample colors
+ * (FrameParams.planar_colors, the tile sampler's) summed 16 at a time; the
+ * other kernel carries none of that code, whose registers cost GPUs
+ * occupancy. */
+inline void mp_resolve(MP_RESOLVE_ARGS, const int lanes) {
   int px = region.x + (int)get_global_id(0), py = region.y + (int)get_global_id(1);
   if (px >= region.z || py >= region.w) return;
   int spp = f.spp_x * f.spp_y;
@@ -47,7 +55,7 @@ __kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width,
                                               (ulong)((qy - py + reach) * side + (qx - px + reach))) * (ulong)spp;
       ulong q = (ulong)qy * (ulong)f.width + (ulong)qx;
       int s = 0;
-      if (use_weights) {
+      if (lanes && use_weights) {
         /* 16 samples at a time (the weights and each color channel of a
          * pixel's samples lie together, mp_sample.h). */
         __global const ulong* k = keys + q * (ulong)spp;
@@ -77,13 +85,15 @@ __kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width,
         if (w <= 0.0f) continue;
         ulong index = q * (ulong)spp + (ulong)s;
         wsum += w;
-        if (keys[index] != (ulong)0xffffffffffffffffUL) sum += w * (float4)(mp_load_color(colors, q, s, spp), 1.0f);
+        if (keys[index] != (ulong)0xffffffffffffffffUL) sum += w * (float4)(mp_load_color(colors, q, s, spp, f), 1.0f);
       }
     }
 #define MP_SUM16(v) (((v).s0 + (v).s1) + ((v).s2 + (v).s3) + ((v).s4 + (v).s5) + ((v).s6 + (v).s7) + \
                      ((v).s8 + (v).s9) + ((v).sa + (v).sb) + ((v).sc + (v).sd) + ((v).se + (v).sf))
-  wsum += MP_SUM16(w16);
-  sum += (float4)(MP_SUM16(r16), MP_SUM16(g16), MP_SUM16(b16), MP_SUM16(a16));
+  if (lanes) {
+    wsum += MP_SUM16(w16);
+    sum += (float4)(MP_SUM16(r16), MP_SUM16(g16), MP_SUM16(b16), MP_SUM16(a16));
+  }
 #undef MP_SUM16
   ulong pixel = (ulong)py * (ulong)f.width + (ulong)px;
   ulong out = (ulong)(py + origin.y) * (ulong)out_width + (ulong)(px + origin.x);
@@ -103,3 +113,8 @@ __kernel void resolve_pixels(FrameParams f, int filter_type, float filter_width,
   depth[out] = zmin;
   vstore3(nsum / (float)spp, out, normal_out);
 }
+
+__kernel void resolve_pixels(MP_RESOLVE_ARGS) { mp_resolve(MP_RESOLVE_PASS, 0); }
+
+/* Planar sample colors (the tile sampler's). */
+__kernel void resolve_pixels_planar(MP_RESOLVE_ARGS) { mp_resolve(MP_RESOLVE_PASS, 1); }

@@ -36,7 +36,7 @@ inline void mp_sample_write(const MpTriangle* t, float la, float lb, float lc, i
   } else if (keys[index] == key) {
     float3 col, nrm;
     mp_triangle_attributes(t, la, lb, lc, d, f, &col, &nrm);
-    mp_store_color(colors, pixel, s, spp, col);
+    mp_store_color(colors, pixel, s, spp, col, f);
     if (f.normal_pass) normals[index] = mp_encode_normal(normalize(nrm));
   }
 }

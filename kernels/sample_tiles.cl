@@ -122,7 +122,7 @@ inline uint mp_sample_tile_slow(const MpTriangle* tris, long xmin, long xmax, lo
         keys[index] = key;
         float3 col, nrm;
         mp_triangle_attributes(&tris[t], la, lb, lc, d, f, &col, &nrm);
-        mp_store_color(colors, pixel / (ulong)spp, s, spp, col);
+        mp_store_color(colors, pixel / (ulong)spp, s, spp, col, f);
         if (f.normal_pass) normals[index] = mp_encode_normal(normalize(nrm));
         *written = 1;
       }
@@ -270,7 +270,7 @@ inline uint mp_sample_tile_fast(const MpTriangle* tris, long xmin, long xmax, lo
             ulong key = ((ulong)as_uint(dl[l]) << 32) | (ulong)mp_id;
             if (key >= keys[index]) continue;
             keys[index] = key;
-            mp_store_color(colors, pixel, first + l, spp, (float3)(cx[l], cy[l], cz[l]));
+            mp_store_color(colors, pixel, first + l, spp, (float3)(cx[l], cy[l], cz[l]), f);
             *written = 1;
           }
           if (f.normal_pass) normals[index] = mp_encode_normal(normalize((float3)(nx[l], ny[l], nz[l])));

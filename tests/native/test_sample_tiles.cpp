@@ -1,9 +1,11 @@
 // The tile sampler (kernels/sample_tiles.cl) against the per-micropolygon
 // sampler (kernels/sample.cl), and frames rendered in buckets
 // (pipeline/buckets.h) against the whole frame: the same winner for every
-// sample, so the same image bit for bit, on whichever device runs the tests.
+// sample, so the same image (buckets: bit for bit), on whichever device runs
+// the tests.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -56,7 +58,15 @@ class SampleTilesTest : public SharedRendererTest {
     s.settings.sampler = Sampler::Tiles;
     const RenderResult b = renderer_->render(s);
     ASSERT_FALSE(a.rgba.empty());
-    EXPECT_EQ(a.rgba, b.rgba) << what << ": the samplers' images differ, PSNR " << psnr(a.rgba, b.rgba) << " dB";
+    // The same winner for every sample: the Depth pass (each pixel's nearest
+    // sample) is identical; colors differ only by the order in which the
+    // resolve adds samples (16 at a time on the tile sampler's planar
+    // colors), a few units in the last place.
+    ASSERT_EQ(a.rgba.size(), b.rgba.size());
+    float worst = 0.0f;
+    for (size_t i = 0; i < a.rgba.size(); ++i) worst = std::max(worst, std::fabs(a.rgba[i] - b.rgba[i]));
+    EXPECT_LT(worst, 1e-5f) << what;
+    EXPECT_GE(psnr(a.rgba, b.rgba), 100.0) << what;
     EXPECT_EQ(a.depth, b.depth) << what;
     EXPECT_EQ(a.normal, b.normal) << what;
     EXPECT_EQ(a.stats.sample_tests, b.stats.sample_tests) << what << ": a sampler tested other samples";

@@ -365,7 +365,10 @@ void SampleStage::run(const cl::Buffer& diceable, cl_uint first, cl_uint count, 
   }
 }
 
-ResolveStage::ResolveStage(DeviceSession& session) : session_(session), kernel_(session.program(), "resolve_pixels") {
+ResolveStage::ResolveStage(DeviceSession& session)
+    : session_(session),
+      scalar_kernel_(session.program(), "resolve_pixels"),
+      planar_kernel_(session.program(), "resolve_pixels_planar") {
   use_pinned_ = !session.device().getInfo<CL_DEVICE_HOST_UNIFIED_MEMORY>();
 }
 
@@ -426,28 +429,29 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, cons
     session_.queue().enqueueWriteBuffer(weights_, CL_TRUE, 0, w.size() * sizeof(float), w.data());
     weights_type_ = type, weights_width_ = filter_width, weights_pattern_ = pattern;
   }
-  kernel_.setArg(0, fb);
-  kernel_.setArg(1, type);
-  kernel_.setArg(2, filter_width);
-  kernel_.setArg(3, samples.offsets());
-  kernel_.setArg(4, weights_);
-  kernel_.setArg(5, use_weights_ ? 1 : 0);
-  kernel_.setArg(6, samples.keys());
-  kernel_.setArg(7, samples.colors());
-  kernel_.setArg(8, samples.normals());
-  kernel_.setArg(9, row(0));
-  kernel_.setArg(10, row(1));
-  kernel_.setArg(11, row(2));
-  kernel_.setArg(12, rgba_);
-  kernel_.setArg(13, depth_);
-  kernel_.setArg(14, normal_);
-  kernel_.setArg(15, passes ? 1 : 0);
-  kernel_.setArg(16, cl_int4{{b.x0 - b.sx0, b.y0 - b.sy0, b.x1 - b.sx0, b.y1 - b.sy0}});
-  kernel_.setArg(17, cl_int2{{b.sx0, b.sy0}});
-  kernel_.setArg(18, cl_int(f.width));
+  cl::Kernel& k = fb.planar_colors ? planar_kernel_ : scalar_kernel_;
+  k.setArg(0, fb);
+  k.setArg(1, type);
+  k.setArg(2, filter_width);
+  k.setArg(3, samples.offsets());
+  k.setArg(4, weights_);
+  k.setArg(5, use_weights_ ? 1 : 0);
+  k.setArg(6, samples.keys());
+  k.setArg(7, samples.colors());
+  k.setArg(8, samples.normals());
+  k.setArg(9, row(0));
+  k.setArg(10, row(1));
+  k.setArg(11, row(2));
+  k.setArg(12, rgba_);
+  k.setArg(13, depth_);
+  k.setArg(14, normal_);
+  k.setArg(15, passes ? 1 : 0);
+  k.setArg(16, cl_int4{{b.x0 - b.sx0, b.y0 - b.sy0, b.x1 - b.sx0, b.y1 - b.sy0}});
+  k.setArg(17, cl_int2{{b.sx0, b.sy0}});
+  k.setArg(18, cl_int(f.width));
   size_t gx = ((static_cast<size_t>(b.x1 - b.x0) + 7) / 8) * 8, gy = ((static_cast<size_t>(b.y1 - b.y0) + 7) / 8) * 8;
   cl::Event e;
-  session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(gx, gy), cl::NDRange(8, 8), nullptr, &e);
+  session_.queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(gx, gy), cl::NDRange(8, 8), nullptr, &e);
   timer.add(Stage::Resolve, e);
 }
 

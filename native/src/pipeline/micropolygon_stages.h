@@ -182,7 +182,7 @@ class ResolveStage {
 
  private:
   DeviceSession& session_;
-  cl::Kernel kernel_;
+  cl::Kernel scalar_kernel_, planar_kernel_;  // sample colors sample by sample, or planar (mp_sample.h)
   cl::Buffer rgba_, depth_, normal_;
   size_t pixels_ = 0;
   // Filter weights per tile position, neighbour and sample (see resolve.cl),

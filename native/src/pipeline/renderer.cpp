@@ -94,6 +94,12 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     impl_->first_render = false;
   }
   FrameSetup frame = make_frame_setup(scene);
+  // The sampler (RenderSettings::sampler); blurred frames always take the
+  // per-micropolygon one. The tile sampler keeps its sample colors planar.
+  const bool tiles = (scene.settings.sampler == Sampler::Tiles ||
+                      (scene.settings.sampler == Sampler::Auto && s.info().type == "cpu")) &&
+                     !mp_blur_on(frame.params);
+  frame.params.planar_colors = tiles ? 1 : 0;
   const FrameParams& f = frame.params;
   st.width = f.width;
   st.height = f.height;
@@ -154,8 +160,6 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       out.rgba.clear(), out.depth.clear(), out.normal.clear();
       return;
     }
-    const bool tiles = scene.settings.sampler == Sampler::Tiles ||
-                       (scene.settings.sampler == Sampler::Auto && s.info().type == "cpu");
     // Buckets within the sample memory budget (buckets.h); a key, a color
     // and a normal per sample, and no buffer larger than the device allows.
     const size_t sample_bytes = sizeof(cl_ulong) + 3 * sizeof(cl_float) + sizeof(cl_uint);
