@@ -19,7 +19,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import scenes  # noqa: E402
 
 
-def frame_ms(cli, rib, out, device, repeat):
+def run_frames(cli, rib, out, device, repeat):
+    """The stats of each frame of one `micropoly-render --repeat` run."""
     stats = os.path.join(out, "stats.json")
     cmd = [cli, rib, "-o", os.path.join(out, "image.png"), "--stats", stats, "--repeat", str(repeat)]
     if device:
@@ -28,7 +29,11 @@ def frame_ms(cli, rib, out, device, repeat):
     if proc.returncode:
         raise SystemExit(f"{' '.join(cmd)} failed: {proc.stderr.strip()}")
     runs = json.load(open(stats))
-    runs = runs if isinstance(runs, list) else [runs]
+    return runs if isinstance(runs, list) else [runs]
+
+
+def frame_ms(cli, rib, out, device, repeat):
+    runs = run_frames(cli, rib, out, device, repeat)
     later = runs[1:] or runs
     return statistics.median(r["timings_ms"]["total"] for r in later)
 

@@ -11,19 +11,17 @@ import argparse
 import json
 import os
 import statistics
-import subprocess
+import sys
 import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from before_after import run_frames  # noqa: E402
 
 STAGES = ("total", "shadows_wall", "bound_split", "dice", "shade", "sample", "resolve", "readback", "occlusion")
 
 
 def run(cli, rib, out, device, repeat):
-    stats = os.path.join(out, "stats.json")
-    cmd = [cli, rib, "-o", os.path.join(out, "image.png"), "--stats", stats, "--repeat", str(repeat)]
-    if device:
-        cmd += ["--device", device]
-    subprocess.run(cmd, check=True, capture_output=True)
-    runs = json.load(open(stats))
+    runs = run_frames(cli, rib, out, device, repeat)
     return runs[1:] if len(runs) > 1 else runs
 
 

@@ -48,6 +48,16 @@ __kernel void project_grids(__global const SubPatch* diceable, uint first, uint 
   }
 }
 
+/* Micropolygon m of the grid whose slots start at `base`: its corners'
+ * slots (q) and projected vertices (r); 0 where one of them cannot be
+ * rasterised (the micropolygon is skipped, as sample.cl skips it). */
+inline int mp_projected_micropolygon(__global const int4* projected, ulong base, const MpGridShape* g, uint m, uint* q,
+                                     int4* r) {
+  mp_grid_micropolygon(g, m, q);
+  for (int k = 0; k < 4; ++k) r[k] = projected[base + q[k]];
+  return (r[0].w | r[1].w | r[2].w | r[3].w) == 0;
+}
+
 /* Grids are binned by runs of MP_TILE_RUN micropolygons (in the grid's
  * order: rows of the interior, then the strips), whose bounds are tight
  * where a whole grid's would put each micropolygon in front of every tile
@@ -69,12 +79,9 @@ __kernel void bound_runs(__global const SubPatch* diceable, uint first, uint cou
   int x0 = INT_MAX, y0 = INT_MAX, x1 = INT_MIN, y1 = INT_MIN;
   for (uint m = run * MP_TILE_RUN; m < m1; ++m) {
     uint q[4];
-    mp_grid_micropolygon(&g, m, q);
-    int4 r0 = projected[base + q[0]], r1 = projected[base + q[1]], r2 = projected[base + q[2]],
-         r3 = projected[base + q[3]];
-    if ((r0.w | r1.w | r2.w | r3.w) != 0) continue;
-    x0 = min(x0, min(min(r0.x, r1.x), min(r2.x, r3.x))), x1 = max(x1, max(max(r0.x, r1.x), max(r2.x, r3.x)));
-    y0 = min(y0, min(min(r0.y, r1.y), min(r2.y, r3.y))), y1 = max(y1, max(max(r0.y, r1.y), max(r2.y, r3.y)));
+    int4 r[4];
+    if (!mp_projected_micropolygon(projected, base, &g, m, q, r)) continue;
+    for (int k = 0; k < 4; ++k) x0 = min(x0, r[k].x), x1 = max(x1, r[k].x), y0 = min(y0, r[k].y), y1 = max(y1, r[k].y);
   }
   int4 r = (int4)(1, 1, 0, 0);
   if (x0 <= x1 && x1 >= 0 && y1 >= 0 && (x0 >> MP_SUBPIXEL_BITS) < f.width && (y0 >> MP_SUBPIXEL_BITS) < f.height) {
@@ -316,12 +323,10 @@ __kernel void sample_tiles(__global const SubPatch* diceable, __global const uin
     uint nm = min(mp_grid_micropolygons(&g), (run + 1u) * MP_TILE_RUN);
     for (uint m = run * MP_TILE_RUN; m < nm; ++m) {
       uint q[4];
-      mp_grid_micropolygon(&g, m, q);
-      int4 r0 = projected[base + q[0]], r1 = projected[base + q[1]], r2 = projected[base + q[2]],
-           r3 = projected[base + q[3]];
-      if ((r0.w | r1.w | r2.w | r3.w) != 0) continue;
-      MpFixed2 p0 = mp_projected_position(r0), p1 = mp_projected_position(r1), p2 = mp_projected_position(r2),
-               p3 = mp_projected_position(r3);
+      int4 r[4];
+      if (!mp_projected_micropolygon(projected, base, &g, m, q, r)) continue;
+      MpFixed2 p0 = mp_projected_position(r[0]), p1 = mp_projected_position(r[1]), p2 = mp_projected_position(r[2]),
+               p3 = mp_projected_position(r[3]);
       long xmin = min(min(p0.x, p1.x), min(p2.x, p3.x)), xmax = max(max(p0.x, p1.x), max(p2.x, p3.x));
       long ymin = min(min(p0.y, p1.y), min(p2.y, p3.y)), ymax = max(max(p0.y, p1.y), max(p2.y, p3.y));
       if (xmax < fx0 || xmin > fx1 || ymax < fy0 || ymin > fy1) continue;
@@ -337,10 +342,10 @@ __kernel void sample_tiles(__global const SubPatch* diceable, __global const uin
         area_sum += (ulong)area2;
       }
       MpRasterVertex v[4];
-      v[0] = mp_raster_attributes(p0, as_float(r0.z), grid_c[base + q[0]], grid_n[base + q[0]], f);
-      v[1] = mp_raster_attributes(p1, as_float(r1.z), grid_c[base + q[1]], grid_n[base + q[1]], f);
-      v[2] = mp_raster_attributes(p2, as_float(r2.z), grid_c[base + q[2]], grid_n[base + q[2]], f);
-      v[3] = mp_raster_attributes(p3, as_float(r3.z), grid_c[base + q[3]], grid_n[base + q[3]], f);
+      v[0] = mp_raster_attributes(p0, as_float(r[0].z), grid_c[base + q[0]], grid_n[base + q[0]], f);
+      v[1] = mp_raster_attributes(p1, as_float(r[1].z), grid_c[base + q[1]], grid_n[base + q[1]], f);
+      v[2] = mp_raster_attributes(p2, as_float(r[2].z), grid_c[base + q[2]], grid_n[base + q[2]], f);
+      v[3] = mp_raster_attributes(p3, as_float(r[3].z), grid_c[base + q[3]], grid_n[base + q[3]], f);
       MpTriangle tris[2];
       tris[0] = mp_setup_triangle(v[0], v[1], v[2]);
       tris[1] = mp_setup_triangle(v[0], v[2], v[3]);
