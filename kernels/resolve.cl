@@ -55,7 +55,7 @@ inline void mp_resolve(MP_RESOLVE_ARGS, const int lanes) {
                                               (ulong)((qy - py + reach) * side + (qx - px + reach))) * (ulong)spp;
       ulong q = (ulong)qy * (ulong)f.width + (ulong)qx;
       int s = 0;
-      if (lanes && use_weights) {
+      if (lanes && use_weights && spp >= 16) {
         /* 16 samples at a time (the weights and each color channel of a
          * pixel's samples lie together, mp_sample.h). */
         __global const ulong* k = keys + q * (ulong)spp;
@@ -90,7 +90,7 @@ inline void mp_resolve(MP_RESOLVE_ARGS, const int lanes) {
     }
 #define MP_SUM16(v) (((v).s0 + (v).s1) + ((v).s2 + (v).s3) + ((v).s4 + (v).s5) + ((v).s6 + (v).s7) + \
                      ((v).s8 + (v).s9) + ((v).sa + (v).sb) + ((v).sc + (v).sd) + ((v).se + (v).sf))
-  if (lanes) {
+  if (lanes && spp >= 16) {
     wsum += MP_SUM16(w16);
     sum += (float4)(MP_SUM16(r16), MP_SUM16(g16), MP_SUM16(b16), MP_SUM16(a16));
   }

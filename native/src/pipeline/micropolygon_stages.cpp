@@ -429,7 +429,9 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, cons
     session_.queue().enqueueWriteBuffer(weights_, CL_TRUE, 0, w.size() * sizeof(float), w.data());
     weights_type_ = type, weights_width_ = filter_width, weights_pattern_ = pattern;
   }
-  cl::Kernel& k = fb.planar_colors ? planar_kernel_ : scalar_kernel_;
+  // The 16-lane kernel for planar colors of 16 samples or more; below that
+  // the scalar one, which PoCL vectorises across pixels instead.
+  cl::Kernel& k = fb.planar_colors && fb.spp_x * fb.spp_y >= 16 ? planar_kernel_ : scalar_kernel_;
   k.setArg(0, fb);
   k.setArg(1, type);
   k.setArg(2, filter_width);
