@@ -298,10 +298,10 @@ __kernel void sample_tiles(__global const SubPatch* diceable, __global const uin
                            __global const int4* projected, __global const float4* grid_c,
                            __global const float4* grid_n, __global const ushort* sample_offsets,
                            __global const ushort* sample_soa, __global const uint* tile_ids, __global const uint* starts,
-                           __global const uint* entries, uint runs_per_grid, uint active, uint tiles_x, __global ulong* keys, __global float* colors,
+                           __global const uint* entries, uint runs_per_grid, uint first_tile, uint active, uint tiles_x, __global ulong* keys, __global float* colors,
                            __global uint* normals, volatile __global ulong* totals, __global uchar* occlusion_dirty,
                            OcclusionParams occ) {
-  uint a = get_global_id(0);
+  uint a = first_tile + get_global_id(0);
   if (a >= active) return;
   uint tile = tile_ids[a];
   int tx0 = (int)(tile % tiles_x) * MP_RASTER_TILE, ty0 = (int)(tile / tiles_x) * MP_RASTER_TILE;

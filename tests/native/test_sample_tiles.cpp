@@ -132,6 +132,29 @@ TEST_F(SampleTilesTest, BucketsEqualTheWholeFrame) {
   }
 }
 
+// With a progress callback the tile sampler launches its tiles in parts and
+// asks between them; the image is the same, and a cancel stops the render.
+TEST_F(SampleTilesTest, ProgressAndCancelAcrossTileParts) {
+  Scene s = test_scene(1280, 720, 16);
+  s.settings.sampler = Sampler::Tiles;
+  const RenderResult plain = renderer_->render(s);
+  int asked = 0;
+  const RenderResult watched = renderer_->render(s, [&](float p) {
+    EXPECT_GE(p, 0.0f);
+    EXPECT_LE(p, 1.0f);
+    ++asked;
+    return true;
+  });
+  EXPECT_GT(asked, 3);
+  EXPECT_EQ(plain.rgba, watched.rgba);
+  int calls = 0;
+  const RenderResult cancelled = renderer_->render(s, [&](float) { return ++calls < 3; });
+  EXPECT_TRUE(cancelled.stats.cancelled);
+  EXPECT_TRUE(cancelled.rgba.empty());
+  // The renderer goes on working after a cancel.
+  EXPECT_EQ(renderer_->render(s).rgba, plain.rgba);
+}
+
 TEST(BucketPlan, CoversTheFrameOnceWithinTheBudget) {
   for (const int reach : {0, 1, 2}) {
     const int w = 7680, h = 4320, spp = 64;

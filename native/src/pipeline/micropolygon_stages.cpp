@@ -323,14 +323,15 @@ void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer, const std
 }
 
 void SampleStage::run(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
-                      const FrameParams& f, GridBuffers& grids, StageTimer& timer) {
+                      const FrameParams& f, GridBuffers& grids, StageTimer& timer,
+                      const std::function<bool()>& keep_going) {
   if (count == 0) return;
   // The run's micropolygons, numbered within the batch by its layout.
   const cl_uint base = grids.micropolygon_offsets_host[first];
   const cl_uint total = grids.micropolygon_offsets_host[first + count] - base;
   if (total == 0) return;
   if (tiles_) {
-    run_tiles(diceable, first, count, scene, f, grids, timer);
+    run_tiles(diceable, first, count, scene, f, grids, timer, keep_going);
     return;
   }
   cl::Kernel& k = mp_blur_on(f) ? blur_kernel_ : kernel_;

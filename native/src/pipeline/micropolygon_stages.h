@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <vector>
 
@@ -129,8 +130,10 @@ class SampleStage {
                    bool tiles = false);
   bool tiles() const { return tiles_; }
   // Samples the grids of diceable sub-patches [first, first + count).
+  // `keep_going` (optional): asked between parts of the work (the tile
+  // sampler's launches of kTileChunk tiles); false stops sampling the batch.
   void run(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
-           GridBuffers& grids, StageTimer& timer);
+           GridBuffers& grids, StageTimer& timer, const std::function<bool()>& keep_going = {});
   // From now until the next begin_frame, the depth pass marks the level-0
   // cells of the occlusion pyramid (mp_occlusion.h) it writes in `dirty`.
   void mark_occlusion_cells(const cl::Buffer& dirty, const OcclusionParams& params);
@@ -148,7 +151,7 @@ class SampleStage {
   // The tile sampler (sample_tiles.cpp): projects the grids, sorts them
   // into per-tile lists on the host, then samples each tile.
   void run_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
-                 const FrameParams& f, GridBuffers& grids, StageTimer& timer);
+                 const FrameParams& f, GridBuffers& grids, StageTimer& timer, const std::function<bool()>& keep_going);
   cl::Kernel kernel_, blur_kernel_;  // pinhole samples; samples with times and lens positions
   cl::Kernel clear_;
   cl::Kernel project_, bound_runs_, tile_kernel_;

@@ -219,10 +219,17 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       if (mp_motion_on(fb)) dice.displaced(diceable, count, fb, grids, timer);
       shade.run(diceable, count, buffers, fb, grids, shadows, timer);
       impl_->programs.shade(diceable, count, buffers, fb, grids, shadows, timer);
-      // The tile sampler takes a batch at once (its lists cover the batch).
+      // The tile sampler takes a batch at once (its lists cover the batch)
+      // and asks between parts of its tiles.
       const cl_uint chunk = progress && !sample.tiles() ? kSampleChunk : count;
+      std::function<bool()> ask;
+      if (progress)
+        ask = [&] {
+          s.queue().finish();
+          return keep_going(last_progress);
+        };
       for (cl_uint first = 0; first < count && !cancelled; first += chunk) {
-        sample.run(diceable, first, std::min(chunk, count - first), buffers, fb, grids, timer);
+        sample.run(diceable, first, std::min(chunk, count - first), buffers, fb, grids, timer, ask);
         if (progress) {
           s.queue().finish();
           keep_going(last_progress);

@@ -22,13 +22,17 @@ void ensure(DeviceSession& s, cl::Buffer& buffer, size_t& held, size_t needed, s
 
 // Work-items (tiles) per work-group of the tile sampler.
 constexpr size_t kTileGroup = 1;
+// Tiles per launch when the caller may cancel: a few tens of milliseconds
+// of a 2-core CPU's work.
+constexpr cl_uint kTileChunk = 128;
 // Micropolygons per binned run (MP_TILE_RUN in sample_tiles.cl).
 constexpr cl_uint kTileRun = 16;
 
 }  // namespace
 
 void SampleStage::run_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
-                            const FrameParams& f, GridBuffers& grids, StageTimer& timer) {
+                            const FrameParams& f, GridBuffers& grids, StageTimer& timer,
+                            const std::function<bool()>& keep_going) {
   cl::CommandQueue& q = session_.queue();
   ensure(session_, projected_, projected_slots_, grids.slot_space(), sizeof(cl_int4), "projected grid vertices");
   // Runs of micropolygons per grid (sample_tiles.cl, MP_TILE_RUN): enough
@@ -109,18 +113,26 @@ void SampleStage::run_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint c
   k.setArg(9, tile_starts_);
   k.setArg(10, tile_entries_);
   k.setArg(11, runs_per_grid);
-  k.setArg(12, active);
-  k.setArg(13, tiles_x);
-  k.setArg(14, keys_);
-  k.setArg(15, colors_);
-  k.setArg(16, normals_);
-  k.setArg(17, totals_);
-  k.setArg(18, occlusion_dirty_);
-  k.setArg(19, occlusion_);
-  // A fixed work-group size: PoCL compiles a kernel once per size it meets.
-  cl::Event t;
-  q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(active, kTileGroup), cl::NDRange(kTileGroup), nullptr, &t);
-  timer.add(Stage::Sample, t);
+  k.setArg(13, active);
+  k.setArg(14, tiles_x);
+  k.setArg(15, keys_);
+  k.setArg(16, colors_);
+  k.setArg(17, normals_);
+  k.setArg(18, totals_);
+  k.setArg(19, occlusion_dirty_);
+  k.setArg(20, occlusion_);
+  // All tiles in one launch, or (when the caller may cancel) in parts, with
+  // a question between them. A fixed work-group size: PoCL compiles a
+  // kernel once per size it meets.
+  const cl_uint part = keep_going ? kTileChunk : active;
+  for (cl_uint first_tile = 0; first_tile < active; first_tile += part) {
+    if (first_tile > 0 && !keep_going()) break;
+    k.setArg(12, first_tile);
+    cl::Event t;
+    q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(std::min(part, active - first_tile), kTileGroup),
+                           cl::NDRange(kTileGroup), nullptr, &t);
+    timer.add(Stage::Sample, t);
+  }
   // The host lists must outlive their (asynchronous) uploads.
   q.finish();
 }
