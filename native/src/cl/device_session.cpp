@@ -119,4 +119,11 @@ cl::Buffer DeviceSession::allocate(size_t bytes, const char* what) {
   return cl::Buffer(context_, CL_MEM_READ_WRITE, std::max<size_t>(bytes, 16));
 }
 
+void DeviceSession::reserve(cl::Buffer& buffer, size_t& capacity, size_t bytes, const char* what) {
+  if (bytes <= capacity && capacity > 0) return;
+  buffer = cl::Buffer();
+  buffer = allocate(bytes, what);
+  capacity = std::max<size_t>(bytes, 16);
+}
+
 }  // namespace mp

@@ -25,6 +25,10 @@ class DeviceSession {
   // A read-write device buffer of `bytes` (at least 16); an mp::Error that
   // names `what` when the device cannot hold that much in one buffer.
   cl::Buffer allocate(size_t bytes, const char* what);
+  // Makes `buffer` (of `capacity` bytes, kept by the caller) hold at least
+  // `bytes`: a new buffer of `bytes` when it is smaller, the old released
+  // first and its contents not kept.
+  void reserve(cl::Buffer& buffer, size_t& capacity, size_t bytes, const char* what);
 
  private:
   DeviceInfo info_;

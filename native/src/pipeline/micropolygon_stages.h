@@ -157,7 +157,7 @@ class SampleStage {
   cl::Kernel project_, bound_runs_, tile_kernel_;
   bool tiles_ = false;
   cl::Buffer projected_, rects_, tile_ids_, tile_starts_, tile_entries_;
-  size_t projected_slots_ = 0, rect_slots_ = 0, tile_slots_ = 0, start_slots_ = 0, entry_slots_ = 0;
+  size_t projected_bytes_ = 0, rect_bytes_ = 0, tile_bytes_ = 0, start_bytes_ = 0, entry_bytes_ = 0;
   std::vector<cl_int> rects_host_;
   std::vector<cl_uint> tile_counts_, tile_ids_host_, tile_starts_host_, tile_entries_host_;
   cl::Buffer occlusion_dirty_;

@@ -12,12 +12,11 @@
 namespace mp {
 namespace {
 
-// Grows `buffer` to hold at least `needed` elements of `size` bytes.
-void ensure(DeviceSession& s, cl::Buffer& buffer, size_t& held, size_t needed, size_t size, const char* what) {
-  if (needed <= held && buffer()) return;
-  buffer = cl::Buffer();
-  held = std::max(needed, held + held / 2);
-  buffer = s.allocate(held * size, what);
+// Room for `count` elements of `size` bytes, and half as many again when it
+// grows (the lists' lengths vary from batch to batch).
+void ensure(DeviceSession& s, cl::Buffer& buffer, size_t& capacity, size_t count, size_t size, const char* what) {
+  if (count * size <= capacity && capacity > 0) return;
+  s.reserve(buffer, capacity, std::max(count * size, capacity + capacity / 2), what);
 }
 
 // Work-items (tiles) per work-group of the tile sampler.
@@ -34,13 +33,13 @@ void SampleStage::run_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint c
                             const FrameParams& f, GridBuffers& grids, StageTimer& timer,
                             const std::function<bool()>& keep_going) {
   cl::CommandQueue& q = session_.queue();
-  ensure(session_, projected_, projected_slots_, grids.slot_space(), sizeof(cl_int4), "projected grid vertices");
+  ensure(session_, projected_, projected_bytes_, grids.slot_space(), sizeof(cl_int4), "projected grid vertices");
   // Runs of micropolygons per grid (sample_tiles.cl, MP_TILE_RUN): enough
   // for the largest grid, (max_grid - 2)^2 + 4 max_grid micropolygons.
   const cl_uint most = cl_uint(f.max_grid > 2 ? (f.max_grid - 2) * (f.max_grid - 2) : 0) + 4u * cl_uint(f.max_grid);
   const cl_uint runs_per_grid = (most + kTileRun - 1) / kTileRun;
   const size_t runs = size_t(count) * runs_per_grid;
-  ensure(session_, rects_, rect_slots_, size_t(grids.capacity) * runs_per_grid, sizeof(cl_int4), "run tile bounds");
+  ensure(session_, rects_, rect_bytes_, size_t(grids.capacity) * runs_per_grid, sizeof(cl_int4), "run tile bounds");
   project_.setArg(0, diceable);
   project_.setArg(1, first);
   project_.setArg(2, count);
@@ -93,9 +92,9 @@ void SampleStage::run_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint c
   for (size_t k = 0; k < runs; ++k)
     for_each_tile(k, [&](cl_uint t) { tile_entries_host_[tile_counts_[t]++] = base + cl_uint(k); });
 
-  ensure(session_, tile_ids_, tile_slots_, active, sizeof(cl_uint), "tile list");
-  ensure(session_, tile_starts_, start_slots_, active + 1, sizeof(cl_uint), "tile list starts");
-  ensure(session_, tile_entries_, entry_slots_, entries, sizeof(cl_uint), "tile grid lists");
+  ensure(session_, tile_ids_, tile_bytes_, active, sizeof(cl_uint), "tile list");
+  ensure(session_, tile_starts_, start_bytes_, active + 1, sizeof(cl_uint), "tile list starts");
+  ensure(session_, tile_entries_, entry_bytes_, entries, sizeof(cl_uint), "tile grid lists");
   q.enqueueWriteBuffer(tile_ids_, CL_FALSE, 0, active * sizeof(cl_uint), tile_ids_host_.data());
   q.enqueueWriteBuffer(tile_starts_, CL_FALSE, 0, (active + 1) * sizeof(cl_uint), tile_starts_host_.data());
   q.enqueueWriteBuffer(tile_entries_, CL_FALSE, 0, entries * sizeof(cl_uint), tile_entries_host_.data());

@@ -23,13 +23,6 @@ constexpr float kMarkCoarsening = 8.0f;
 // Each marking vertex's box reaches its neighbours: one coarse micropolygon edge.
 cl_float mark_reach(const FrameParams& coarse) { return coarse.micropoly_edge; }
 
-void grow(DeviceSession& s, cl::Buffer& buffer, size_t& capacity, size_t bytes, const char* what) {
-  if (bytes <= capacity && capacity > 0) return;
-  buffer = cl::Buffer();
-  buffer = s.allocate(bytes, what);
-  capacity = std::max<size_t>(bytes, 16);
-}
-
 }  // namespace
 
 ShadowMaps::ShadowMaps(DeviceSession& session)
@@ -42,8 +35,8 @@ ShadowMaps::ShadowMaps(DeviceSession& session)
 
 void ShadowMaps::upload_records(const ShadowLayout& layout) {
   cl::CommandQueue& q = session_.queue();
-  grow(session_, inputs_.shadows, records_capacity_, layout.shadows.size() * sizeof(DeviceShadow), "shadow records");
-  grow(session_, inputs_.levels, levels_capacity_, layout.levels.size() * sizeof(DeviceShadowLevel),
+  session_.reserve(inputs_.shadows, records_capacity_, layout.shadows.size() * sizeof(DeviceShadow), "shadow records");
+  session_.reserve(inputs_.levels, levels_capacity_, layout.levels.size() * sizeof(DeviceShadowLevel),
        "shadow level records");
   q.enqueueWriteBuffer(inputs_.shadows, CL_TRUE, 0, layout.shadows.size() * sizeof(DeviceShadow),
                        layout.shadows.data());
@@ -59,7 +52,7 @@ bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, const
   const auto started = std::chrono::steady_clock::now();
   cl::CommandQueue& q = session_.queue();
   const size_t n = layout.table_entries;
-  grow(session_, requests_, requests_capacity_, n, "shadow page requests");
+  session_.reserve(requests_, requests_capacity_, n, "shadow page requests");
   q.enqueueFillBuffer(requests_, cl_uchar(0), 0, n);
   FrameParams coarse = frame.params;
   coarse.micropoly_edge *= kMarkCoarsening;
@@ -175,10 +168,10 @@ void ShadowMaps::collect_requests(const ShadowLayout& layout, std::vector<Shadow
 
 void ShadowMaps::write_table(size_t entries, const std::vector<cl_uint2>& writes) {
   cl::CommandQueue& q = session_.queue();
-  grow(session_, inputs_.pages, pages_capacity_, entries * sizeof(cl_uint), "shadow page tables");
+  session_.reserve(inputs_.pages, pages_capacity_, entries * sizeof(cl_uint), "shadow page tables");
   q.enqueueFillBuffer(inputs_.pages, cl_uint(0), 0, entries * sizeof(cl_uint));
   if (writes.empty()) return;
-  grow(session_, writes_, writes_capacity_, writes.size() * sizeof(cl_uint2), "shadow page-table writes");
+  session_.reserve(writes_, writes_capacity_, writes.size() * sizeof(cl_uint2), "shadow page-table writes");
   q.enqueueWriteBuffer(writes_, CL_TRUE, 0, writes.size() * sizeof(cl_uint2), writes.data());
   set_entries_.setArg(0, writes_);
   set_entries_.setArg(1, cl_uint(writes.size()));
@@ -201,7 +194,7 @@ bool ShadowMaps::render_views(const std::vector<FrameParams>& views, const std::
                               const FrameSetup& frame, const SceneBuffers& buffers, const ShadowPassStages& stages,
                               const BoundSplitRunner& run, StageTimer& timer, ShadowStats& stats) {
   cl::CommandQueue& q = session_.queue();
-  grow(session_, masks_, masks_capacity_, masks.size(), "shadow page masks");
+  session_.reserve(masks_, masks_capacity_, masks.size(), "shadow page masks");
   if (!masks.empty()) q.enqueueWriteBuffer(masks_, CL_TRUE, 0, masks.size(), masks.data());
   const FrameParams& f = frame.params;
   GridBuffers& grids = stages.grids;
@@ -234,7 +227,7 @@ bool ShadowMaps::render_views(const std::vector<FrameParams>& views, const std::
   };
   for (size_t first = 0; first < views.size(); first += MP_MAX_PASS_VIEWS) {
     const size_t count = std::min<size_t>(MP_MAX_PASS_VIEWS, views.size() - first);
-    grow(session_, views_, views_capacity_, MP_MAX_PASS_VIEWS * sizeof(FrameParams), "shadow views");
+    session_.reserve(views_, views_capacity_, MP_MAX_PASS_VIEWS * sizeof(FrameParams), "shadow views");
     q.enqueueWriteBuffer(views_, CL_TRUE, 0, count * sizeof(FrameParams), views.data() + first);
     PassViews pass;
     pass.views = views_;
@@ -393,7 +386,7 @@ bool ShadowMaps::allocate_and_render(const ShadowLayout& layout, const std::vect
   stats.views += views.size();
 
   StageTimer::Redirect to(timer, Stage::ShadowBoundSplit);
-  grow(session_, clear_list_, clear_capacity_, fresh.size() * sizeof(cl_uint), "shadow page list");
+  session_.reserve(clear_list_, clear_capacity_, fresh.size() * sizeof(cl_uint), "shadow page list");
   q.enqueueWriteBuffer(clear_list_, CL_TRUE, 0, fresh.size() * sizeof(cl_uint), fresh.data());
   const cl_uint texels = cl_uint(fresh.size() * MP_PAGE_TEXELS);
   clear_.setArg(0, clear_list_);
