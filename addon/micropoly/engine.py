@@ -26,7 +26,8 @@ class FinalRenderers:
         self._selector = None
         self._renderer = None
         # Seconds the last final render spent exporting, in the native
-        # renderer and writing the render result (the benchmarks read them).
+        # renderer and writing the render result, and the buckets it was
+        # rendered in (the benchmarks and tests read them).
         self.last_timings = {}
 
     def acquire(self, selector):
@@ -227,15 +228,16 @@ class MicropolyRenderEngine(bpy.types.RenderEngine):
         write_started = time.perf_counter()
         self._write_result(scene, view_layer, exported, result)
         _final_renderers.last_timings.update(native_s=native_s, native_total_s=stats["timings_ms"]["total"] / 1000.0,
-                                             write_s=time.perf_counter() - write_started)
+                                             write_s=time.perf_counter() - write_started, buckets=stats["buckets"])
         mib = stats["bound_split_peak_bytes"] / 2**20
         shadows = stats["shadows"]
         shadow_note = (f"shadow maps {shadows['pages_requested']:,} pages, {shadows['peak_bytes'] / 2**20:.0f} of "
                        f"{shadows['budget_bytes'] / 2**20:.0f} MiB | " if shadows["lights"] else "")
         hidden = (f"{stats['subpatches_occluded']:,} hidden sub-patches culled | "
                   if stats["subpatches_occluded"] else "")
+        buckets = f"{stats['buckets']} buckets | " if stats["buckets"] > 1 else ""
         self.update_stats("", f"Micropoly | {stats['device']} | {stats['micropolygons']:,} micropolygons | "
-                              f"{hidden}bound & split {mib:.1f} MiB | {shadow_note}"
+                              f"{hidden}{buckets}bound & split {mib:.1f} MiB | {shadow_note}"
                               f"{time.perf_counter() - started:.2f} s")
 
     def should_cancel(self):

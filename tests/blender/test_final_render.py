@@ -41,10 +41,15 @@ def main():
     # 640 x 360 at 64 spp: 354 MB of samples; 16 MiB of sample memory makes
     # dozens of buckets.
     whole = ru.render_passes(scene, "MICROPOLY", 640, 360, samples=64)
+    if engine._final_renderers.last_timings.get("buckets") != 1:
+        failures.append(f"the default sample memory split the frame: {engine._final_renderers.last_timings}")
     scene.micropoly.sample_memory = 16.0
     tiled = ru.render_passes(scene, "MICROPOLY", 640, 360, samples=64)
+    buckets = engine._final_renderers.last_timings.get("buckets", 0)
+    if buckets < 16:
+        failures.append(f"16 MiB of sample memory gave {buckets} buckets for 354 MB of samples")
     psnr = ru.psnr(whole["rgba"], tiled["rgba"], peak=1.0)
-    print(f"buckets against the whole frame: {psnr:.1f} dB")
+    print(f"{buckets} buckets against the whole frame: {psnr:.1f} dB")
     if psnr < 60.0:
         failures.append(f"buckets changed the image: {psnr:.1f} dB")
     if not np.array_equal(whole["rgba"][..., 3], tiled["rgba"][..., 3]):
