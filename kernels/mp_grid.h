@@ -160,6 +160,9 @@ MP_INLINE uint mp_grid_micropolygons(const MpGridShape* g) {
   return iu * iv + max(g->n[0], iu) + max(g->n[1], iv) + max(g->n[2], iu) + max(g->n[3], iv);
 }
 
+/* The most micropolygons a grid of a slot of side mg + 1 can have. */
+MP_INLINE uint mp_grid_max_micropolygons(uint mg) { return (mg > 2u ? (mg - 2u) * (mg - 2u) : 0u) + 4u * mg; }
+
 /* Step s of a strip of `steps` zipping a side of na segments to one of nb:
  * the vertex indices where the step starts and ends on each side. */
 MP_INLINE void mp_strip_step(uint s, uint steps, uint na, uint nb, uint* a0, uint* a1, uint* b0, uint* b1) {

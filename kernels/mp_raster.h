@@ -32,6 +32,11 @@ MP_INLINE long mp_to_fixed(float r) { return (long)floor(r * (float)MP_SUBPIXEL_
 /* Pixels per side of the screen tiles the CPU's sampler bins grids into
  * (sample_tiles.cl): a tile's samples belong to one work-item. */
 #define MP_RASTER_TILE 32
+/* It bins each grid's micropolygons by runs of this many (in the grid's
+ * order: rows of the interior, then the strips), whose bounds are tight
+ * where a whole grid's would put each micropolygon in front of every tile
+ * the grid touches. */
+#define MP_TILE_RUN 16
 
 MP_INLINE uint mp_sample_offset_packed(int tx, int ty, int s, FrameParams f) {
   /* Blurred, slot s is a time or lens stratum (mp_blur.h); its position
@@ -165,6 +170,13 @@ MP_INLINE float3 mp_decode_normal(uint e) {
 MP_INLINE float mp_blackman_harris(float x, float width) {
   float t = 2.0f * 3.14159265f * (x / width + 0.5f);
   return 0.35875f - 0.48829f * cos(t) + 0.14128f * cos(2.0f * t) - 0.01168f * cos(3.0f * t);
+}
+
+/* Pixels on each side whose samples a pixel filter of this full width
+ * reads (the resolve's neighbourhood; a bucket's margin). */
+MP_INLINE int mp_filter_reach(float width) {
+  int r = (int)ceil(0.5f * width - 0.5f);
+  return r > 0 ? r : 0;
 }
 
 MP_INLINE float mp_filter_weight(int type, float x, float y, float width) {

@@ -66,6 +66,26 @@ inline MpTriangle mp_setup_triangle(MpRasterVertex a, MpRasterVertex b, MpRaster
   return t;
 }
 
+/* The quad (v[0], v[1], v[2], v[3])'s triangles (v[0], v[1], v[2]) and
+ * (v[0], v[2], v[3]), each dropped unless `keep` (mp_quad_facing) keeps it. */
+inline void mp_setup_quad(const MpRasterVertex* v, uint keep, MpTriangle* tris) {
+  tris[0] = mp_setup_triangle(v[0], v[1], v[2]);
+  tris[1] = mp_setup_triangle(v[0], v[2], v[3]);
+  tris[0].e.valid &= (int)(keep & 1u);
+  tris[1].e.valid &= (int)(keep >> 1);
+}
+
+/* Which of a quad's triangles covers sample q (0 or 1, with its
+ * barycentrics), or -1: the tie rule gives a sample on the diagonal to one. */
+inline int mp_quad_covers(const MpTriangle* tris, MpFixed2 q, float* la, float* lb, float* lc) {
+  if (mp_edge_triangle_covers(&tris[0].e, q, la, lb, lc)) return 0;
+  return mp_edge_triangle_covers(&tris[1].e, q, la, lb, lc) ? 1 : -1;
+}
+
+/* A sample's visibility key: the nearest depth wins, ties go to the lower
+ * micropolygon id (positive floats order as their bits). */
+inline ulong mp_sample_key(float d, uint mp_id) { return ((ulong)as_uint(d) << 32) | (ulong)mp_id; }
+
 /* Which of the quad (v00, v10, v11, v01)'s triangles (v00, v10, v11) (bit 0)
  * and (v00, v11, v01) (bit 1) face the camera, and twice their raster area
  * in fixed-point units. Front faces run counter-clockwise on screen, i.e.

@@ -40,7 +40,7 @@ inline void mp_resolve(MP_RESOLVE_ARGS, const int lanes) {
   int px = region.x + (int)get_global_id(0), py = region.y + (int)get_global_id(1);
   if (px >= region.z || py >= region.w) return;
   int spp = f.spp_x * f.spp_y;
-  int reach = (int)ceil(0.5f * filter_width - 0.5f);
+  int reach = mp_filter_reach(filter_width);
   float4 sum = (float4)(0.0f);
   float wsum = 0.0f;
   /* Sums of the 16-lane loop, added in once at the end. */

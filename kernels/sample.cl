@@ -30,7 +30,7 @@ inline void mp_sample_write(const MpTriangle* t, float la, float lb, float lc, i
   if (!mp_triangle_depth(t, la, lb, lc, f, &d)) return;
   if (!mp_opacity_keeps(mp_id, px, py, s, opacity, f)) return;
   ulong pixel = (ulong)py * (ulong)f.width + (ulong)px, index = pixel * (ulong)spp + (ulong)s;
-  ulong key = ((ulong)as_uint(d) << 32) | (ulong)mp_id;
+  ulong key = mp_sample_key(d, mp_id);
   if (pass == MP_PASS_DEPTH) {
     if (key < keys[index]) atom_min(&keys[index], key);
   } else if (keys[index] == key) {
@@ -41,19 +41,15 @@ inline void mp_sample_write(const MpTriangle* t, float la, float lb, float lc, i
   }
 }
 
-/* Rasterises the quad's triangles (v00, v10, v11) and (v00, v11, v01) that
- * `keep` selects (bit 0 and bit 1). */
-inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVertex v11, MpRasterVertex v01, uint keep,
-                           uint mp_id, float opacity, FrameParams f, __global const ushort* offsets, uint pass,
-                           volatile __global ulong* keys, __global float* colors, __global uint* normals,
-                           uint* tests) {
+/* Rasterises the quad v[0..3]'s triangles that `keep` selects
+ * (mp_setup_quad). */
+inline void mp_raster_quad(const MpRasterVertex* v, uint keep, uint mp_id, float opacity, FrameParams f,
+                           __global const ushort* offsets, uint pass, volatile __global ulong* keys,
+                           __global float* colors, __global uint* normals, uint* tests) {
   MpTriangle tris[2];
-  tris[0] = mp_setup_triangle(v00, v10, v11);
-  tris[1] = mp_setup_triangle(v00, v11, v01);
-  tris[0].e.valid &= (int)(keep & 1u);
-  tris[1].e.valid &= (int)(keep >> 1);
-  long xmin = min(min(v00.p.x, v10.p.x), min(v11.p.x, v01.p.x)), xmax = max(max(v00.p.x, v10.p.x), max(v11.p.x, v01.p.x));
-  long ymin = min(min(v00.p.y, v10.p.y), min(v11.p.y, v01.p.y)), ymax = max(max(v00.p.y, v10.p.y), max(v11.p.y, v01.p.y));
+  mp_setup_quad(v, keep, tris);
+  long xmin = min(min(v[0].p.x, v[1].p.x), min(v[2].p.x, v[3].p.x)), xmax = max(max(v[0].p.x, v[1].p.x), max(v[2].p.x, v[3].p.x));
+  long ymin = min(min(v[0].p.y, v[1].p.y), min(v[2].p.y, v[3].p.y)), ymax = max(max(v[0].p.y, v[1].p.y), max(v[2].p.y, v[3].p.y));
   int px0 = (int)max(xmin >> MP_SUBPIXEL_BITS, (long)0), px1 = (int)min(xmax >> MP_SUBPIXEL_BITS, (long)f.width - 1);
   int py0 = (int)max(ymin >> MP_SUBPIXEL_BITS, (long)0), py1 = (int)min(ymax >> MP_SUBPIXEL_BITS, (long)f.height - 1);
   int spp = f.spp_x * f.spp_y;
@@ -64,12 +60,9 @@ inline void mp_raster_quad(MpRasterVertex v00, MpRasterVertex v10, MpRasterVerte
         if (q.x < xmin || q.x > xmax || q.y < ymin || q.y > ymax) continue;
         ++*tests;
         float la, lb, lc;
-        int k = 0;
-        if (!mp_edge_triangle_covers(&tris[0].e, q, &la, &lb, &lc)) {
-          k = 1;
-          if (!mp_edge_triangle_covers(&tris[1].e, q, &la, &lb, &lc)) continue;
-        }
-        mp_sample_write(&tris[k], la, lb, lc, px, py, s, spp, mp_id, opacity, f, pass, keys, colors, normals);
+        int k = mp_quad_covers(tris, q, &la, &lb, &lc);
+        if (k >= 0)
+          mp_sample_write(&tris[k], la, lb, lc, px, py, s, spp, mp_id, opacity, f, pass, keys, colors, normals);
       }
 }
 
@@ -153,17 +146,10 @@ inline void mp_blur_sample(int px, int py, int s, int spp, MpFixed2 sq, float4 e
     v[i].n_over_d = n[i].xyz * w;
   }
   MpTriangle tris[2];
-  tris[0] = mp_setup_triangle(v[0], v[1], v[2]);
-  tris[1] = mp_setup_triangle(v[0], v[2], v[3]);
-  tris[0].e.valid &= (int)(keep & 1u);
-  tris[1].e.valid &= (int)(keep >> 1);
+  mp_setup_quad(v, keep, tris);
   float la, lb, lc;
-  int t = 0;
-  if (!mp_edge_triangle_covers(&tris[0].e, sq, &la, &lb, &lc)) {
-    t = 1;
-    if (!mp_edge_triangle_covers(&tris[1].e, sq, &la, &lb, &lc)) return;
-  }
-  mp_sample_write(&tris[t], la, lb, lc, px, py, s, spp, mp_id, opacity, f, pass, keys, colors, normals);
+  int t = mp_quad_covers(tris, sq, &la, &lb, &lc);
+  if (t >= 0) mp_sample_write(&tris[t], la, lb, lc, px, py, s, spp, mp_id, opacity, f, pass, keys, colors, normals);
 }
 
 /* Grows the raster box by vertex i over the times [t0, t1] (its positions
@@ -353,7 +339,7 @@ inline void mp_sample(MP_SAMPLE_ARGS, __local ulong* area_sum, __local uint* cou
       mp_raster_quad_blur(vp, grid_pm, idx, motion_stride, vc, vn, keep, mp_id, opacity, f, sample_offsets, sample_table, pass,
                           keys, colors, normals, &tests);
     } else {
-      mp_raster_quad(v[0], v[1], v[2], v[3], keep, mp_id, opacity, f, sample_offsets, pass, keys, colors, normals, &tests);
+      mp_raster_quad(v, keep, mp_id, opacity, f, sample_offsets, pass, keys, colors, normals, &tests);
     }
   }
   mp_count_sampled(get_local_id(0), area2, tests, pass, totals, area_sum, count_sum, test_sum);

@@ -58,12 +58,6 @@ inline int mp_projected_micropolygon(__global const int4* projected, ulong base,
   return (r[0].w | r[1].w | r[2].w | r[3].w) == 0;
 }
 
-/* Grids are binned by runs of MP_TILE_RUN micropolygons (in the grid's
- * order: rows of the interior, then the strips), whose bounds are tight
- * where a whole grid's would put each micropolygon in front of every tile
- * the grid touches. */
-#define MP_TILE_RUN 16
-
 /* One work-item per run r of grid k (runs_per_grid per grid): the screen
  * tiles the run's micropolygons reach, (tx0, ty0, tx1, ty1), tx0 > tx1
  * where none (clipped to the frame). */
@@ -109,27 +103,21 @@ inline uint mp_sample_tile_slow(const MpTriangle* tris, long xmin, long xmax, lo
   uint tests = 0u;
   for (int py = py0; py <= py1; ++py)
     for (int px = px0; px <= px1; ++px) {
-      ulong pixel = ((ulong)py * (ulong)f.width + (ulong)px) * (ulong)spp;
+      ulong pixel = (ulong)py * (ulong)f.width + (ulong)px;
       for (int s = 0; s < spp; ++s) {
         MpFixed2 sq = mp_sample_position(px, py, s, spp, f, sample_offsets);
         if (sq.x < xmin || sq.x > xmax || sq.y < ymin || sq.y > ymax) continue;
         ++tests;
-        float la, lb, lc;
-        int t = 0;
-        if (!mp_edge_triangle_covers(&tris[0].e, sq, &la, &lb, &lc)) {
-          t = 1;
-          if (!mp_edge_triangle_covers(&tris[1].e, sq, &la, &lb, &lc)) continue;
-        }
-        float d;
-        if (!mp_triangle_depth(&tris[t], la, lb, lc, f, &d)) continue;
+        float la, lb, lc, d;
+        int t = mp_quad_covers(tris, sq, &la, &lb, &lc);
+        if (t < 0 || !mp_triangle_depth(&tris[t], la, lb, lc, f, &d)) continue;
         if (!mp_opacity_keeps(mp_id, px, py, s, opacity, f)) continue;
-        ulong key = ((ulong)as_uint(d) << 32) | (ulong)mp_id;
-        ulong index = pixel + (ulong)s;
+        ulong key = mp_sample_key(d, mp_id), index = pixel * (ulong)spp + (ulong)s;
         if (key >= keys[index]) continue;
         keys[index] = key;
         float3 col, nrm;
         mp_triangle_attributes(&tris[t], la, lb, lc, d, f, &col, &nrm);
-        mp_store_color(colors, pixel / (ulong)spp, s, spp, col, f);
+        mp_store_color(colors, pixel, s, spp, col, f);
         if (f.normal_pass) normals[index] = mp_encode_normal(normalize(nrm));
         *written = 1;
       }
@@ -274,7 +262,7 @@ inline uint mp_sample_tile_fast(const MpTriangle* tris, long xmin, long xmax, lo
           if (!cov[l]) continue;
           ulong index = pixel * (ulong)spp + (ulong)(first + l);
           if (!whole) {
-            ulong key = ((ulong)as_uint(dl[l]) << 32) | (ulong)mp_id;
+            ulong key = mp_sample_key(dl[l], mp_id);
             if (key >= keys[index]) continue;
             keys[index] = key;
             mp_store_color(colors, pixel, first + l, spp, (float3)(cx[l], cy[l], cz[l]), f);
@@ -298,9 +286,9 @@ __kernel void sample_tiles(__global const SubPatch* diceable, __global const uin
                            __global const int4* projected, __global const float4* grid_c,
                            __global const float4* grid_n, __global const ushort* sample_offsets,
                            __global const ushort* sample_soa, __global const uint* tile_ids, __global const uint* starts,
-                           __global const uint* entries, uint runs_per_grid, uint first_tile, uint active, uint tiles_x, __global ulong* keys, __global float* colors,
-                           __global uint* normals, volatile __global ulong* totals, __global uchar* occlusion_dirty,
-                           OcclusionParams occ) {
+                           __global const uint* entries, uint runs_per_grid, uint first_tile, uint active,
+                           uint tiles_x, __global ulong* keys, __global float* colors, __global uint* normals,
+                           volatile __global ulong* totals, __global uchar* occlusion_dirty, OcclusionParams occ) {
   uint a = first_tile + get_global_id(0);
   if (a >= active) return;
   uint tile = tile_ids[a];
@@ -309,7 +297,6 @@ __kernel void sample_tiles(__global const SubPatch* diceable, __global const uin
   /* The tile's samples lie in this fixed-point rectangle. */
   long fx0 = (long)tx0 << MP_SUBPIXEL_BITS, fx1 = ((long)(tx1 + 1) << MP_SUBPIXEL_BITS) - 1;
   long fy0 = (long)ty0 << MP_SUBPIXEL_BITS, fy1 = ((long)(ty1 + 1) << MP_SUBPIXEL_BITS) - 1;
-  int spp = f.spp_x * f.spp_y;
   uint stride = (uint)f.max_grid + 1u;
   ulong counted = 0u, area_sum = 0u, tests = 0u;
   int wx0 = tx1 + 1, wx1 = tx0 - 1, wy0 = ty1 + 1, wy1 = ty0 - 1; /* pixels written */
@@ -325,32 +312,26 @@ __kernel void sample_tiles(__global const SubPatch* diceable, __global const uin
       uint q[4];
       int4 r[4];
       if (!mp_projected_micropolygon(projected, base, &g, m, q, r)) continue;
-      MpFixed2 p0 = mp_projected_position(r[0]), p1 = mp_projected_position(r[1]), p2 = mp_projected_position(r[2]),
-               p3 = mp_projected_position(r[3]);
-      long xmin = min(min(p0.x, p1.x), min(p2.x, p3.x)), xmax = max(max(p0.x, p1.x), max(p2.x, p3.x));
-      long ymin = min(min(p0.y, p1.y), min(p2.y, p3.y)), ymax = max(max(p0.y, p1.y), max(p2.y, p3.y));
+      MpFixed2 p[4];
+      for (int k = 0; k < 4; ++k) p[k] = mp_projected_position(r[k]);
+      long xmin = min(min(p[0].x, p[1].x), min(p[2].x, p[3].x)), xmax = max(max(p[0].x, p[1].x), max(p[2].x, p[3].x));
+      long ymin = min(min(p[0].y, p[1].y), min(p[2].y, p[3].y)), ymax = max(max(p[0].y, p[1].y), max(p[2].y, p[3].y));
       if (xmax < fx0 || xmin > fx1 || ymax < fy0 || ymin > fy1) continue;
       long area2;
-      uint keep = mp_quad_facing(p0, p1, p2, p3, flags, f, &area2);
+      uint keep = mp_quad_facing(p[0], p[1], p[2], p[3], flags, f, &area2);
       if (!keep) continue;
       /* Counted once: in the tile of the bound's first pixel in the frame. */
-      if (clamp(xmin >> MP_SUBPIXEL_BITS, (long)0, (long)f.width - 1) >= tx0 &&
-          clamp(ymin >> MP_SUBPIXEL_BITS, (long)0, (long)f.height - 1) >= ty0 &&
-          clamp(xmin >> MP_SUBPIXEL_BITS, (long)0, (long)f.width - 1) <= tx1 &&
-          clamp(ymin >> MP_SUBPIXEL_BITS, (long)0, (long)f.height - 1) <= ty1) {
+      long hx = clamp(xmin >> MP_SUBPIXEL_BITS, (long)0, (long)f.width - 1);
+      long hy = clamp(ymin >> MP_SUBPIXEL_BITS, (long)0, (long)f.height - 1);
+      if (hx >= tx0 && hx <= tx1 && hy >= ty0 && hy <= ty1) {
         counted += area2 > 0 ? 1u : 0u;
         area_sum += (ulong)area2;
       }
       MpRasterVertex v[4];
-      v[0] = mp_raster_attributes(p0, as_float(r[0].z), grid_c[base + q[0]], grid_n[base + q[0]], f);
-      v[1] = mp_raster_attributes(p1, as_float(r[1].z), grid_c[base + q[1]], grid_n[base + q[1]], f);
-      v[2] = mp_raster_attributes(p2, as_float(r[2].z), grid_c[base + q[2]], grid_n[base + q[2]], f);
-      v[3] = mp_raster_attributes(p3, as_float(r[3].z), grid_c[base + q[3]], grid_n[base + q[3]], f);
+      for (int k = 0; k < 4; ++k)
+        v[k] = mp_raster_attributes(p[k], as_float(r[k].z), grid_c[base + q[k]], grid_n[base + q[k]], f);
       MpTriangle tris[2];
-      tris[0] = mp_setup_triangle(v[0], v[1], v[2]);
-      tris[1] = mp_setup_triangle(v[0], v[2], v[3]);
-      tris[0].e.valid &= (int)(keep & 1u);
-      tris[1].e.valid &= (int)(keep >> 1);
+      mp_setup_quad(v, keep, tris);
       uint mp_id = mp_micropolygon_id(grid_id, m);
       float opacity = grid_c[base + q[0]].w;
       int px0 = (int)max(xmin >> MP_SUBPIXEL_BITS, (long)tx0), px1 = (int)min(xmax >> MP_SUBPIXEL_BITS, (long)tx1);

@@ -209,6 +209,13 @@ TEST(RibErrors, VisibilityValues) {
   expect_error("WorldBegin\nAttribute \"visibility\" \"string transmission\" [\"opaque\"]\n", 2, "transmission");
 }
 
+TEST(RibErrors, SamplerAndSampleMemory) {
+  expect_error("Option \"micropoly\" \"string sampler\" \"fast\"\n", 1,
+               "\"sampler\" must be \"auto\", \"tiles\" or \"micropolygons\"");
+  expect_error("Option \"micropoly\"\n\"float samplememory\" [0]\n", 2, "\"samplememory\" must be");
+  expect_error("Option \"micropoly\" \"float samplememory\" [-512]\n", 1, "samplememory");
+}
+
 TEST(RibErrors, ShadowOptionsAndProgramAlpha) {
   expect_error("Option \"micropoly\" \"integer shadows\" [2]\n", 1, "\"shadows\" expects one integer in [0, 1]");
   expect_error("Option \"micropoly\" \"integer shadows\" [1]\n  \"float shadowmemory\" [0]\n", 2,

@@ -1006,6 +1006,19 @@ TEST(RibWriter, DepthOfFieldRoundTrips) {
   EXPECT_EQ(back.settings.dof_dice_factor, 0.75f);
 }
 
+TEST(RibWriter, SamplerAndSampleMemoryRoundTrip) {
+  Scene s = defocused_scene();
+  s.settings.sampler = Sampler::Micropolygons;
+  s.settings.sample_memory_mib = 96.5f;
+  const Scene back = round_trip(s);
+  EXPECT_EQ(back.settings.sampler, Sampler::Micropolygons);
+  EXPECT_EQ(back.settings.sample_memory_mib, 96.5f);
+  s.settings.sampler = Sampler::Tiles;
+  EXPECT_EQ(round_trip(s).settings.sampler, Sampler::Tiles);
+  // The defaults are left out of the file.
+  EXPECT_EQ(to_rib(defocused_scene()).find("samplememory"), std::string::npos);
+}
+
 TEST_F(RibWriterRender, DefocusedSceneRendersTheSame) {
   Scene s = defocused_scene();
   set_samples_per_pixel(s.settings, 4);

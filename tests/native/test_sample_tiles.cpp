@@ -177,6 +177,19 @@ TEST(BucketPlan, CoversTheFrameOnceWithinTheBudget) {
   EXPECT_THROW(plan_buckets(1920, 1080, 64, 1, 1000), Error);
 }
 
+TEST_F(SampleTilesTest, BadSampleMemoryIsAClearError) {
+  for (const float mib : {0.0f, 0.5f, -64.0f, std::nanf(""), INFINITY}) {
+    Scene s = test_scene(64, 48, 4);
+    s.settings.sample_memory_mib = mib;
+    try {
+      renderer_->render(s);
+      ADD_FAILURE() << "a sample memory of " << mib << " MiB rendered";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("sample memory"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST_F(SampleTilesTest, TooSmallABudgetIsAClearError) {
   Scene s = test_scene(320, 240, 1024);
   s.settings.sample_memory_mib = 1.0f;

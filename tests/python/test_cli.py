@@ -77,6 +77,9 @@ def test_usage_errors_and_device_listing(tmp_path):
     assert run(os.path.join(SCENES, "teapot.rib"), "--bound-split", "sideways").returncode == 2
     r = run(os.path.join(SCENES, "teapot.rib"), "-o", str(tmp_path / "t.png"), "--occlusion-culling", "maybe")
     assert r.returncode == 2 and "--occlusion-culling is on or off" in r.stderr
+    r = run(os.path.join(SCENES, "teapot.rib"), "-o", str(tmp_path / "t.png"), "--sampler", "fast")
+    assert r.returncode == 2 and "--sampler is auto, tiles or micropolygons" in r.stderr
+    assert run(os.path.join(SCENES, "teapot.rib"), "-o", str(tmp_path / "t.png"), "--sample-memory", "0").returncode == 2
     r = run("--list-devices")
     assert r.returncode == 0 and "[cpu]" in r.stdout
 

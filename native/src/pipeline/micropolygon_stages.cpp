@@ -250,10 +250,9 @@ void SampleStage::mark_occlusion_cells(const cl::Buffer& dirty, const OcclusionP
   occlusion_ = params;
 }
 
-void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer, const std::vector<float>& shutter_curve,
-                              bool tiles) {
+void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer, const std::vector<float>& shutter_curve) {
   mark_occlusion_cells(cl::Buffer(), OcclusionParams{});
-  tiles_ = tiles && !mp_blur_on(f);
+  tiles_ = f.planar_colors != 0;
   const int spp = f.spp_x * f.spp_y;
   size_t samples = static_cast<size_t>(f.width) * static_cast<size_t>(f.height) * static_cast<size_t>(spp);
   // The buffers only grow: the viewport alternates a small preview with the
@@ -406,7 +405,7 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, cons
   filter_width = std::max(filter_width, 1e-3f);
   const SamplePattern pattern = sample_pattern(f);
   if (type != weights_type_ || filter_width != weights_width_ || !(pattern == weights_pattern_)) {
-    const int reach = filter_reach(filter_width), side = 2 * reach + 1;
+    const int reach = mp_filter_reach(filter_width), side = 2 * reach + 1;
     const int spp = f.spp_x * f.spp_y;
     const size_t count = size_t(MP_SAMPLE_TILE) * MP_SAMPLE_TILE * side * side * spp;
     use_weights_ = count * sizeof(float) <= (size_t(64) << 20);

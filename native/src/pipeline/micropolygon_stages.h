@@ -1,11 +1,9 @@
 // The stages after bound & split, run once per batch of diceable
-// sub-patches: dice -> shade -> sample (two passes), then resolve once per
-// frame. Grids live in fixed slots of (max_grid+1)^2 vertices.
+// sub-patches: dice -> shade -> sample, then resolve once per bucket
+// (buckets.h). Grids live in fixed slots of (max_grid+1)^2 vertices.
 #pragma once
 
-#include <algorithm>
 #include <functional>
-#include <cmath>
 #include <vector>
 
 #include "cl/device_session.h"
@@ -33,10 +31,6 @@ struct SamplePattern {
 };
 SamplePattern sample_pattern(const FrameParams& f, const std::vector<float>& shutter_curve = {});
 
-// Pixels on each side whose samples a pixel filter of this width reads.
-inline int filter_reach(float filter_width) {
-  return static_cast<int>(std::ceil(0.5f * std::max(filter_width, 1e-3f) - 0.5f));
-}
 
 // A time in the shutter as a shutter curve opens it: uniform times [0, 1]
 // through the inverse of the curve's cumulative openness (piecewise linear
@@ -123,11 +117,11 @@ class SampleStage {
  public:
   explicit SampleStage(DeviceSession& session);
   // Makes the sample buffers (key, color, normal per sample) fit the frame,
-  // reusing them when the size is unchanged, and clears them. `tiles`: the
-  // frame is sampled by screen tiles (sample_tiles.cl), else one work-item
-  // per micropolygon (sample.cl); frames with blur always use the latter.
-  void begin_frame(const FrameParams& f, StageTimer& timer, const std::vector<float>& shutter_curve = {},
-                   bool tiles = false);
+  // reusing them when the size is unchanged, and clears them. A frame with
+  // planar sample colors (FrameParams.planar_colors, set by the renderer) is
+  // sampled by screen tiles (sample_tiles.cl), else one work-item per
+  // micropolygon (sample.cl).
+  void begin_frame(const FrameParams& f, StageTimer& timer, const std::vector<float>& shutter_curve = {});
   bool tiles() const { return tiles_; }
   // Samples the grids of diceable sub-patches [first, first + count).
   // `keep_going` (optional): asked between parts of the work (the tile

@@ -18,6 +18,7 @@
 #include "pipeline/shadow_maps.h"
 #include "pipeline/world_lighting.h"
 #include "mp_blur.h"
+#include "mp_raster.h"
 
 namespace mp {
 namespace {
@@ -94,12 +95,12 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     impl_->first_render = false;
   }
   FrameSetup frame = make_frame_setup(scene);
-  // The sampler (RenderSettings::sampler); blurred frames always take the
-  // per-micropolygon one. The tile sampler keeps its sample colors planar.
-  const bool tiles = (scene.settings.sampler == Sampler::Tiles ||
-                      (scene.settings.sampler == Sampler::Auto && s.info().type == "cpu")) &&
-                     !mp_blur_on(frame.params);
-  frame.params.planar_colors = tiles ? 1 : 0;
+  // The sampler (RenderSettings::sampler): the tile sampler, which keeps
+  // its sample colors planar, or (always for blurred frames) the
+  // per-micropolygon one.
+  frame.params.planar_colors = (scene.settings.sampler == Sampler::Tiles ||
+                                (scene.settings.sampler == Sampler::Auto && s.info().type == "cpu")) &&
+                               !mp_blur_on(frame.params);
   const FrameParams& f = frame.params;
   st.width = f.width;
   st.height = f.height;
@@ -165,8 +166,8 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     const size_t sample_bytes = sizeof(cl_ulong) + 3 * sizeof(cl_float) + sizeof(cl_uint);
     const size_t budget = static_cast<size_t>(double(scene.settings.sample_memory_mib) * 1048576.0);
     const size_t max_samples = std::min(budget / sample_bytes, s.max_alloc_bytes() / (3 * sizeof(cl_float)));
-    const std::vector<Bucket> buckets =
-        plan_buckets(f.width, f.height, f.spp_x * f.spp_y, filter_reach(scene.settings.filter_width), max_samples);
+    const int reach = mp_filter_reach(std::max(scene.settings.filter_width, 1e-3f));
+    const std::vector<Bucket> buckets = plan_buckets(f.width, f.height, f.spp_x * f.spp_y, reach, max_samples);
     st.buckets = buckets.size();
 
     // Cancellation: the caller's progress callback is asked between bound &
@@ -244,7 +245,7 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       const Bucket& bucket = buckets[bi];
       fb = bucket_frame(f, bucket);
       progress_base = float(bi) / float(buckets.size()), progress_scale = 1.0f / float(buckets.size());
-      sample.begin_frame(fb, timer, scene.shutter_curve, tiles);
+      sample.begin_frame(fb, timer, scene.shutter_curve);
       if (progress) {
         s.queue().finish();  // clearing a large sample buffer takes a while: look again
         keep_going(0.0f);

@@ -1,11 +1,14 @@
 // The sample stage by screen tiles (kernels/sample_tiles.cl), for CPUs: the
-// grids of a dice batch are projected and bounded on the device, sorted into
-// per-tile lists here (a counting sort over a few thousand grids: cheaper
-// than a device sort's launches, and it keeps each list in batch order, so
-// the output never depends on timing), then each non-empty tile is sampled
-// by one work-item.
+// grids of a dice batch are projected and their runs of micropolygons
+// bounded on the device, sorted into per-tile lists here (a counting sort
+// over some ten thousand runs: cheaper than a device sort's launches, and it
+// keeps each list in batch order, so the output never depends on timing),
+// then each non-empty tile is sampled by one work-item.
 #include <algorithm>
 
+#include "mp_compat.h"
+#include "mp_types.h"
+#include "mp_grid.h"
 #include "mp_raster.h"
 #include "pipeline/micropolygon_stages.h"
 
@@ -24,8 +27,6 @@ constexpr size_t kTileGroup = 1;
 // Tiles per launch when the caller may cancel: a few tens of milliseconds
 // of a 2-core CPU's work.
 constexpr cl_uint kTileChunk = 128;
-// Micropolygons per binned run (MP_TILE_RUN in sample_tiles.cl).
-constexpr cl_uint kTileRun = 16;
 
 }  // namespace
 
@@ -34,10 +35,8 @@ void SampleStage::run_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint c
                             const std::function<bool()>& keep_going) {
   cl::CommandQueue& q = session_.queue();
   ensure(session_, projected_, projected_bytes_, grids.slot_space(), sizeof(cl_int4), "projected grid vertices");
-  // Runs of micropolygons per grid (sample_tiles.cl, MP_TILE_RUN): enough
-  // for the largest grid, (max_grid - 2)^2 + 4 max_grid micropolygons.
-  const cl_uint most = cl_uint(f.max_grid > 2 ? (f.max_grid - 2) * (f.max_grid - 2) : 0) + 4u * cl_uint(f.max_grid);
-  const cl_uint runs_per_grid = (most + kTileRun - 1) / kTileRun;
+  // Runs of micropolygons per grid (MP_TILE_RUN): enough for the largest grid.
+  const cl_uint runs_per_grid = (mp_grid_max_micropolygons(cl_uint(f.max_grid)) + MP_TILE_RUN - 1) / MP_TILE_RUN;
   const size_t runs = size_t(count) * runs_per_grid;
   ensure(session_, rects_, rect_bytes_, size_t(grids.capacity) * runs_per_grid, sizeof(cl_int4), "run tile bounds");
   project_.setArg(0, diceable);

@@ -100,7 +100,8 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   warn_unknown(params,
                {"boundsplit", "boundsplitmemory", "maxgridsize", "maxsplitdepth", "backfaceculling",
                 "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate", "occlusionculling",
-                "worldshadowdirections", "apertureblades", "aperturerotation", "apertureratio", "focusfactor", "shuttercurve"},
+                "worldshadowdirections", "apertureblades", "aperturerotation", "apertureratio", "focusfactor",
+                "shuttercurve", "sampler", "samplememory"},
                [&](const std::string& name) {
                  warn_once("option-micropoly:" + name, line,
                            "Option \"micropoly\": parameter \"" + name + "\" is ignored");
