@@ -1,7 +1,7 @@
-/* Surface shading. Constant, matte and plastic follow RenderMan's standard
- * shaders (RenderMan Interface Specification 3.2, appendix A) and its light
- * shaders; principled follows Blender's Principled BSDF in physical units
- * (Lambert + GGX with Smith masking and Schlick Fresnel; Walter et al. 2007).
+/* What shading needs of lights and normals: the world's irradiance, area
+ * and sized lights' irradiance, spot cones, and the corrections Cycles
+ * makes to normals set through a BSDF's input. Surfaces are lit as
+ * closures (mp_shade_closures.h).
  * Everything is in camera space. */
 #ifndef MP_SHADING_H
 #define MP_SHADING_H
@@ -184,18 +184,6 @@ typedef struct {
   float footprint;
 } MpShadowQuery;
 
-/* GGX / Trowbridge-Reitz with Smith's separable masking-shadowing. */
-MP_INLINE float mp_ggx_specular(float3 n, float3 l, float3 v, float alpha) {
-  float3 h = normalize(l + v);
-  float nh = fmax(dot(n, h), 0.0f), nl = fmax(dot(n, l), 1e-6f), nv = fmax(dot(n, v), 1e-6f);
-  float a2 = fmax(alpha * alpha, 1e-7f);
-  float d = nh * nh * (a2 - 1.0f) + 1.0f;
-  float D = a2 / (MP_PI * d * d);
-  float gl = 2.0f * nl / (nl + sqrt(a2 + (1.0f - a2) * nl * nl));
-  float gv = 2.0f * nv / (nv + sqrt(a2 + (1.0f - a2) * nv * nv));
-  return D * gl * gv / (4.0f * nl * nv);
-}
-
 /* A shading normal n (unit, on the viewer's side of the geometric normal
  * ng; v the unit direction to the viewer) turned towards ng just enough
  * that the mirror direction of v about it stays above the surface by
@@ -258,161 +246,6 @@ MP_INLINE float mp_bump_shadowing_v4(float3 ns, float3 n, float3 l, int correcti
   float tan2_i = 1.0f / (cos_i * cos_i) - 1.0f;
   float lambda = 0.5f * (sqrt(1.0f + alpha2 * tan2_i) - 1.0f);
   return 1.0f / (1.0f + lambda);
-}
-
-/* Radiance leaving point p towards the eye, with a shading normal `n`
- * (e.g. bumped) on the side of the geometric normal `ng`: both flip together
- * when the surface is seen from behind, so a bumped normal that tilts away
- * from the viewer near a silhouette is not flipped on its own. bsdf_normal:
- * n is a BSDF's own normal, different from the surface's, which Cycles keeps
- * from reflecting the view below the surface (mp_valid_reflection_normal)
- * and whose diffuse light it shadows by the surface (mp_bump_shadowing):
- * 1 as Blender 3.x does; 2 (3 without Bump Map Correction) as 4.0 and later
- * do, where the diffuse lobe keeps the normal as it is (mp_bump_shadowing_v4)
- * and only the specular lobe is kept from reflecting below the surface.
- * faced: ng and n already face the viewer's side of the surface (smooth
- * shading normals, which the geometry faced: mp_face_shading_normal), so a
- * smooth normal turning away near a silhouette is not flipped. */
-MP_INLINE float3 mp_shade_bumped(float3 p, float3 ng, float3 n, int bsdf_normal, int faced, int ortho,
-                                 const DeviceMaterial* m, MP_GLOBAL const DeviceLight* lights, uint light_count,
-                                 MP_GLOBAL const float4* world_glossy, const MpShadowQuery* shadow) {
-  float3 cs = MP_F3(m->color[0], m->color[1], m->color[2]);
-  float3 emission = MP_F3(m->emission[0], m->emission[1], m->emission[2]);
-  int model = (int)m->color[3];
-  if (model == MP_MODEL_CONSTANT) return cs + emission;
-  float3 v = ortho ? MP_F3(0.0f, 0.0f, 1.0f) : normalize(-p);
-  int back = !faced && dot(ng, v) < 0.0f;
-  float3 ngf = back ? -ng : ng;
-  float3 nf = back ? -n : n; /* faceforward */
-  float3 nd = nf;                          /* the diffuse lobe's normal */
-  if (bsdf_normal) nf = mp_valid_reflection_normal(ngf, v, nf);
-  if (bsdf_normal <= 1) nd = nf;
-  float ka = m->coeffs[0], kd = m->coeffs[1], ks = m->coeffs[2], roughness = m->coeffs[3];
-  float inv_roughness = 1.0f / fmax(roughness, 1e-4f);
-  float metallic = m->principled[0];
-  float alpha = fmax(roughness * roughness, 1e-3f);
-  float3 f0 = (1.0f - metallic) * MP_F3(0.08f, 0.08f, 0.08f) * m->principled[1] + metallic * cs;
-  float3 ambient = MP_F3(0.0f, 0.0f, 0.0f), diffuse = ambient, specular = ambient;
-  MP_GLOBAL const DeviceLight* world = 0;
-  /* The world's visibility: its probes' shadows, weighted by the light each
-   * gives the diffuse normal and around the mirror direction. Only the
-   * MP_WORLD_PROBE_LOOKUPS probes of most weight are looked up (each lookup
-   * costs as much as a soft-shadowed light's); the others are taken to be
-   * as visible as those are, on average. */
-  float3 mirror = 2.0f * dot(nf, v) * nf - v;
-  uint probe_index[MP_WORLD_PROBE_LOOKUPS];
-  float probe_w[MP_WORLD_PROBE_LOOKUPS], probe_ws[MP_WORLD_PROBE_LOOKUPS];
-  int probes = 0;
-  for (uint k = 0; k < light_count; ++k) {
-    MP_GLOBAL const DeviceLight* lt = lights + k;
-    float3 cl = mp_light_f3(lt->color);
-    int type = (int)lt->color[3];
-    if (type == MP_LIGHT_AMBIENT) {
-      ambient += cl;
-      continue;
-    }
-    if (type == MP_LIGHT_ENVIRONMENT) world = lt;
-    if (type == MP_LIGHT_ENVIRONMENT || type == MP_LIGHT_ENVIRONMENT_DATA) continue;
-    if (type == MP_LIGHT_DISTANT && lt->axis_u[3] == MP_WORLD_PROBE) {
-      float3 lp = -mp_light_f3(lt->direction);
-      float w = (cl.x + cl.y + cl.z) * fmax(dot(nd, lp), 0.0f);
-      float ws = (cl.x + cl.y + cl.z) * fmax(dot(mirror, lp), 0.0f);
-      if (!(w + ws > 0.0f)) continue;
-      /* Kept in order of weight: insert, dropping the lightest when full. */
-      int at = probes < MP_WORLD_PROBE_LOOKUPS ? probes++ : MP_WORLD_PROBE_LOOKUPS;
-      while (at > 0 && probe_w[at - 1] + probe_ws[at - 1] < w + ws) {
-        if (at < MP_WORLD_PROBE_LOOKUPS)
-          probe_index[at] = probe_index[at - 1], probe_w[at] = probe_w[at - 1], probe_ws[at] = probe_ws[at - 1];
-        --at;
-      }
-      if (at < MP_WORLD_PROBE_LOOKUPS) probe_index[at] = k, probe_w[at] = w, probe_ws[at] = ws;
-      continue;
-    }
-    float3 l;
-    float3 e;  /* light color times cos(incidence), i.e. irradiance for physical lights */
-    float3 ed; /* the same for the diffuse lobe's normal */
-    if (type == MP_LIGHT_AREA) {
-      e = cl * mp_area_irradiance(lt, p, nf, &l);
-      ed = bsdf_normal >= 2 ? cl * mp_area_irradiance(lt, p, nd, &l) : e;
-    } else {
-      if (type == MP_LIGHT_DISTANT) {
-        l = -mp_light_f3(lt->direction);
-        e = cl * fmax(dot(nf, l), 0.0f);
-        ed = cl * fmax(dot(nd, l), 0.0f);
-      } else {
-        float3 to_light = mp_light_f3(lt->position) - p;
-        float d2 = fmax(dot(to_light, to_light), 1e-20f);
-        l = to_light / sqrt(d2);
-        if (type == MP_LIGHT_SPOT) cl *= mp_spot_mask(lt, p);
-        if (lt->cone[3] > 0.0f) {
-          e = cl * mp_sized_light_factor(lt, to_light, d2, nf);
-          ed = bsdf_normal >= 2 ? cl * mp_sized_light_factor(lt, to_light, d2, nd) : e;
-        } else {
-          e = cl * (fmax(dot(nf, l), 0.0f) / d2);
-          ed = cl * (fmax(dot(nd, l), 0.0f) / d2);
-        }
-      }
-    }
-    if (shadow && (e.x > 0.0f || e.y > 0.0f || e.z > 0.0f || ed.x > 0.0f || ed.y > 0.0f || ed.z > 0.0f)) {
-      float vis = mp_shadow_visibility(shadow->maps, k, p, shadow->normal, shadow->footprint);
-      e *= vis;
-      ed *= vis;
-    }
-    if (bsdf_normal >= 2)
-      diffuse += ed * mp_bump_shadowing_v4(ngf, nd, l, bsdf_normal == 2);
-    if (!(e.x > 0.0f || e.y > 0.0f || e.z > 0.0f)) continue;
-    if (bsdf_normal <= 1) diffuse += bsdf_normal ? e * mp_bump_shadowing(ngf, nf, l) : e;
-    if (model == MP_MODEL_PRINCIPLED) {
-      float vh = fmax(dot(v, normalize(l + v)), 0.0f);
-      float t = 1.0f - vh, t2 = t * t;
-      float3 fresnel = f0 + (MP_F3(1.0f, 1.0f, 1.0f) - f0) * (t2 * t2 * t);  /* Schlick: (1 - vh)^5 */
-      specular += e * fresnel * mp_ggx_specular(nf, l, v, alpha);
-    } else
-      specular += (e / fmax(dot(nf, l), 1e-6f)) * MP_POWR(fmax(dot(nf, normalize(l + v)), 0.0f), inv_roughness);
-  }
-  /* The world's light: its irradiance by the diffuse normal and, for the
-   * glossy lobe, its map prefiltered by the lobe around the mirror direction
-   * (mp_world.h), each darkened by the visibility its probes' shadow maps
-   * give. */
-  float3 world_d = MP_F3(0.0f, 0.0f, 0.0f), world_s = world_d;
-  float probe_lit = 0.0f, probe_total = 0.0f, probe_lit_s = 0.0f, probe_total_s = 0.0f;
-  for (int i = 0; i < probes; ++i) {
-    float vis = shadow ? mp_shadow_visibility(shadow->maps, probe_index[i], p, shadow->normal, shadow->footprint) : 1.0f;
-    probe_total += probe_w[i], probe_lit += probe_w[i] * vis;
-    probe_total_s += probe_ws[i], probe_lit_s += probe_ws[i] * vis;
-  }
-  if (world) {
-    float vis = probe_total > 0.0f ? probe_lit / probe_total : 1.0f;
-    float vis_s = probe_total_s > 0.0f ? probe_lit_s / probe_total_s : vis;
-    world_d = mp_env_irradiance(world, nd) * (vis * world->color[0]);
-    world_s = mp_world_glossy(world_glossy, mp_env_to_world(world, mirror), roughness) * (vis_s * world->color[1]);
-  }
-  if (model == MP_MODEL_PRINCIPLED) {
-    /* Lambert: albedo / pi per unit irradiance; a uniform ambient radiance A
-     * gives irradiance pi A, so the diffuse response to it is albedo * A. */
-    float3 albedo = cs * (1.0f - metallic);
-    /* Blender 4.0's layered Principled: the diffuse base gets what the
-     * dielectric specular layer lets through, 1 - its directional albedo. */
-    if (m->principled[2] > 0.0f) {
-      float2 e = mp_env_brdf(roughness, fmax(dot(nf, v), 1e-4f));
-      albedo *= fmax(1.0f - (0.08f * m->principled[1] * e.x + e.y), 0.0f);
-    }
-    /* The world's glossy light by the split sum: the prefiltered radiance
-     * times the lobe's directional albedo f0 a + b (mp_env_brdf). */
-    float2 ab = mp_env_brdf(roughness, fmax(dot(nf, v), 1e-4f));
-    return albedo * (diffuse * (1.0f / MP_PI) + ambient + world_d) + specular + f0 * ambient +
-           world_s * (f0 * ab.x + MP_F3(ab.y, ab.y, ab.y)) + emission;
-  }
-  float3 c = cs * (ka * (ambient + world_d) + kd * diffuse);
-  if (model == MP_MODEL_PLASTIC) c += MP_F3(m->specular[0], m->specular[1], m->specular[2]) * (ks * specular);
-  return c + emission;
-}
-
-/* Radiance leaving point p with normal n towards the eye. */
-MP_INLINE float3 mp_shade(float3 p, float3 n, int faced, int ortho, const DeviceMaterial* m,
-                          MP_GLOBAL const DeviceLight* lights, uint light_count, MP_GLOBAL const float4* world_glossy,
-                          const MpShadowQuery* shadow) {
-  return mp_shade_bumped(p, n, n, 0, faced, ortho, m, lights, light_count, world_glossy, shadow);
 }
 
 /* The smooth shading normal of a patch at (u, v) (mp_patch.h,

@@ -129,7 +129,7 @@ typedef struct {
   float coeffs[4];          /* ka, kd, ks, roughness */
   float specular[4];        /* specular color (plastic) */
   float emission[4];
-  float principled[4];      /* metallic, specular, layered (Blender 4.0 and later), 0 */
+  float principled[4];      /* metallic, specular, layered (Blender 4.0 and later), flags: 1 retro_diffuse + 2 multiscatter */
   float program[4];         /* compiled node program index or -1, displaces (1/0), surface program (1/0),
                                program computes the alpha (1/0) */
 } DeviceMaterial;

@@ -86,14 +86,4 @@ MP_INLINE float3 mp_world_glossy(const MP_GLOBAL float4* maps, float3 d, float r
   return (1.0f - t) * mp_world_glossy_level(maps, k, d) + t * mp_world_glossy_level(maps, k + 1, d);
 }
 
-/* The split sum's second factor, the GGX lobe's directional albedo as
- * f0 * a + b for a view at cosine nv: the analytic fit of Karis 2014
- * ("Physically Based Shading on Mobile"). */
-MP_INLINE float2 mp_env_brdf(float roughness, float nv) {
-  float rx = 1.0f - roughness, ry = 0.0425f - 0.0275f * roughness;
-  float rz = 1.04f - 0.572f * roughness, rw = 0.022f * roughness - 0.04f;
-  float a004 = fmin(rx * rx, (float)exp2(-9.28f * nv)) * rx + ry;
-  return MP_F2(rz - 1.04f * a004, rw + 1.04f * a004);
-}
-
 #endif

@@ -331,7 +331,7 @@ inline void mp_sample(MP_SAMPLE_ARGS, __local ulong* area_sum, __local uint* cou
   uint tests = 0u;
   if (keep) {
     uint mp_id = mp_micropolygon_id(mp_grid_id(&sp), m);
-    float opacity = grid_c[grid_base + q[0]].w;
+    float opacity = mp_quad_opacity(vc[0].w, vc[1].w, vc[2].w, vc[3].w);
     if (pass == MP_PASS_DEPTH && occlusion_dirty) mp_mark_occlusion_cells(occlusion_dirty, occ, f, v[0].p, v[1].p, v[2].p, v[3].p);
     if (blur) {
       ulong idx[4];

@@ -333,7 +333,8 @@ __kernel void sample_tiles(__global const SubPatch* diceable, __global const uin
       MpTriangle tris[2];
       mp_setup_quad(v, keep, tris);
       uint mp_id = mp_micropolygon_id(grid_id, m);
-      float opacity = grid_c[base + q[0]].w;
+      float opacity = mp_quad_opacity(grid_c[base + q[0]].w, grid_c[base + q[1]].w, grid_c[base + q[2]].w,
+                                      grid_c[base + q[3]].w);
       int px0 = (int)max(xmin >> MP_SUBPIXEL_BITS, (long)tx0), px1 = (int)min(xmax >> MP_SUBPIXEL_BITS, (long)tx1);
       int py0 = (int)max(ymin >> MP_SUBPIXEL_BITS, (long)ty0), py1 = (int)min(ymax >> MP_SUBPIXEL_BITS, (long)ty1);
       int written = 0;

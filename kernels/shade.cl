@@ -4,6 +4,7 @@
 #include "mp_patch.h"
 #include "mp_types.h"
 #include "mp_shading.h"
+#include "mp_shade_closures.h"
 #include "mp_grid.h"
 
 __kernel void shade_grids(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
@@ -36,6 +37,6 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
     }
   }
   if (m.program[2] > 0.0f) return; /* shaded by its node program (material_program.cl) */
-  float3 c = mp_shade(p, n, faced, f.ortho, &m, lights, light_count, world_glossy, use_shadows ? &shadow : 0);
+  float3 c = mp_shade_material(p, n, faced, f.ortho, &m, lights, light_count, world_glossy, use_shadows ? &shadow : 0);
   grid_c[index] = (float4)(c, m.opacity[3]);
 }

@@ -290,7 +290,9 @@ void shadow_sample(__global const SubPatch* diceable, uint first, uint count, __
   /* Opacity: the material's, or per vertex where its node program computes
    * one (material_program.cl, run for alpha only in shadow passes). */
   __global const DeviceMaterial* mat = materials + patch_info[4 * (ulong)sp.patch + 1];
-  float opacity = mat->program[3] > 0.0f ? grid_c[grid_base + q[0]].w : mat->opacity[3];
+  float opacity = mat->program[3] > 0.0f ? mp_quad_opacity(grid_c[grid_base + q[0]].w, grid_c[grid_base + q[1]].w,
+                                                            grid_c[grid_base + q[2]].w, grid_c[grid_base + q[3]].w)
+                                         : mat->opacity[3];
   uint mp_id = 0u;
   if (opacity < 1.0f) {
     mp_id = mp_hash32(sp.patch);

@@ -44,7 +44,9 @@ def material_parameters(material):
                       roughness=float(_input(node, "Roughness")),
                       specular=float(_input(node, "Specular IOR Level", "Specular", default=0.5)),
                       emission=[c * strength for c in list(emission)[:3]], opacity=[alpha] * 3,
-                      layered=node_compiler.blender_version() >= 400)
+                      layered=node_compiler.blender_version() >= 400,
+                      retro_diffuse=node_compiler.blender_version() < 400,
+                      multiscatter=getattr(node, "distribution", "GGX") == "MULTI_GGX")
     elif node.type == "BSDF_DIFFUSE":
         params.update(color=list(_input(node, "Color"))[:3], specular=0.0, roughness=1.0)
     elif node.type == "EMISSION":

@@ -14,6 +14,8 @@ import math
 
 import bpy
 
+from . import node_textures
+
 FLOAT, VEC = "float", "float3"
 
 MATH_OPS = ["ADD", "SUBTRACT", "MULTIPLY", "DIVIDE", "MULTIPLY_ADD", "POWER", "LOGARITHM", "SQRT", "INVERSE_SQRT",
@@ -134,6 +136,7 @@ class NodeCompiler:
         self.displacement_world = False
         self.groups = []           # the Group nodes whose trees are being compiled, outermost first
         self.world = False         # compiling a world (baked into a map) rather than a material
+        self.transparent = False   # the surface has Transparent closures (its alpha can be below 1)
 
     # ---- helpers ----------------------------------------------------------
     def warn(self, node, what):
@@ -300,8 +303,25 @@ class NodeCompiler:
         if t == "TEX_SKY":
             return self.emit_sky(node)
         if t == "NEW_GEOMETRY":
-            self.warn(node, "only Normal is supported here, in object space")
-            return {"Normal": ("g->N", VEC, None)}
+            return self.emit_geometry(node)
+        if t == "FRESNEL":
+            n = self.input(node, "Normal", VEC)[0] if node.inputs["Normal"].is_linked else "g->N"
+            return {"Fac": fn.temp(FLOAT, f"mp_fresnel_node(g, {self.input(node, 'IOR', FLOAT)[0]}, {n})",
+                                   (0.0, 1.0))}
+        if t == "LAYER_WEIGHT":
+            n = self.input(node, "Normal", VEC)[0] if node.inputs["Normal"].is_linked else "g->N"
+            facing = fn.temp(FLOAT, "0.0f", (0.0, 1.0))
+            fresnel = fn.temp(FLOAT, f"mp_layer_weight(g, {self.input(node, 'Blend', FLOAT)[0]}, {n}, &{facing[0]})",
+                              (0.0, 1.0))
+            return {"Fresnel": fresnel, "Facing": facing}
+        if t == "LIGHT_PATH":
+            return self.emit_light_path(node)
+        if t == "OBJECT_INFO":
+            for name in ("Color", "Alpha", "Object Index", "Material Index", "Random"):
+                if name in node.outputs and node.outputs[name].is_linked:
+                    self.warn(node, f"the {name} output is not supported yet; it gives its default")
+            return {"Location": ("(g->object ? (float3)(g->object->to_world[3], g->object->to_world[7], "
+                                 "g->object->to_world[11]) : (float3)(0.0f))", VEC, None)}
         if t == "VALUE":
             x = float(node.outputs[0].default_value)
             return {node.outputs[0].identifier: (_lit(x), FLOAT, (x, x))}
@@ -385,8 +405,33 @@ class NodeCompiler:
             return self.emit_normal_map(node)
         if t in TEXTURE_HEADERS:
             return self.emit_texture(node)
+        outs = node_textures.emit(self, node)
+        if outs is not None:
+            return outs
         self.warn(node, "is not supported; its outputs take their default values")
         return {}
+
+    def emit_geometry(self, node):
+        """Geometry node. Normal, True Normal, Tangent and Incoming are in
+        object space, as every vector the node programs pass on (BSDF Normal
+        inputs read them so); Position is in world space, as Cycles'."""
+        for name in ("Parametric", "Pointiness", "Random Per Island"):
+            if name in node.outputs and node.outputs[name].is_linked:
+                self.warn(node, f"the {name} output is not supported; it gives its default")
+        backfacing = self.fn.temp(FLOAT, "(float)mp_backfacing(g)", (0.0, 1.0))
+        return {"Position": ("mp_world_position(g)", VEC, None), "Normal": ("g->N", VEC, None),
+                "True Normal": ("g->N", VEC, None), "Incoming": ("mp_world_dir_to_object(g, g->I)", VEC, None),
+                "Tangent": ("normalize(mp_radial_tangent(g))", VEC, None), "Backfacing": backfacing}
+
+    def emit_light_path(self, node):
+        """Light Path: what a camera ray shading direct light sees (every
+        depth 0, no scattering), or a shadow map's ray where Micropoly
+        evaluates transparency for shadows."""
+        outs = {o.identifier: ("0.0f", FLOAT, (0.0, 0.0)) for o in node.outputs}
+        outs["Is Camera Ray"] = ("(g->shadow_ray ? 0.0f : 1.0f)", FLOAT, (0.0, 1.0))
+        outs["Is Shadow Ray"] = ("(g->shadow_ray ? 1.0f : 0.0f)", FLOAT, (0.0, 1.0))
+        outs["Ray Length"] = ("g->ray_length", FLOAT, None)
+        return outs
 
     def emit_math(self, node):
         op = node.operation
@@ -650,7 +695,7 @@ class NodeCompiler:
         self.world = True
         disp_src = "float3 mp_node_displacement(const MpNodeGlobals* g) {\n  return (float3)(0.0f);\n}\n"
         surf_src = self._function(
-            "void mp_node_surface(const MpNodeGlobals* g, MpSurfaceInputs* s)",
+            "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s)",
             lambda: f"  s->emission = {self.input(background, 'Color', VEC)[0]} * "
                     f"{self.input(background, 'Strength', FLOAT)[0]};\n")
         includes = "".join(f'#include "textures/{h}"\n' for h in sorted(self.headers))
@@ -676,21 +721,16 @@ class NodeCompiler:
         # distance 1 on the height along the normal, the way Cycles turns
         # displacement into bump) and leaves the geometry where it is.
         bump_only = disp_socket.is_linked and method == "BUMP"
-        surface_links = out.inputs["Surface"].links
-        shader = surface_links[0].from_node if surface_links else None
-        while shader is not None and shader.type == "REROUTE":
-            links = shader.inputs[0].links
-            shader = links[0].from_node if links else None
-        assigns = []
-        if shader is not None and shader.type in ("BSDF_PRINCIPLED", "BSDF_DIFFUSE", "EMISSION"):
-            assigns = self._surface_assignments(shader)
+        surface = out.inputs["Surface"]
+        shader = self._linked_node(surface)
+        constant = shader is None or _constant_shader(shader)
         bump_line = ""
-        if bump_only and not any(a[0] == "normal" for a in assigns):
+        if bump_only:
             self.uses_neighbours = True
             h = "dot(mp_node_displacement({0}), g->N)"
-            bump_line = (f"  s->normal = mp_bump(g, {h.format('g')}, g->dx ? {h.format('g->dx')} : 0.0f, "
-                         f"g->dy ? {h.format('g->dy')} : 0.0f, 1.0f, 1.0f, 0, g->N);\n  s->has_normal = MP_NORMAL_SET;\n")
-        shades = bool(assigns) or bool(bump_line)
+            bump_line = (f"  mp_surface_set_normal(s, mp_bump(g, {h.format('g')}, g->dx ? {h.format('g->dx')} : 0.0f, "
+                         f"g->dy ? {h.format('g->dy')} : 0.0f, 1.0f, 1.0f, 0, g->N));\n")
+        shades = not constant or bool(bump_line)
         if not displaces and not shades:
             return None
 
@@ -699,22 +739,245 @@ class NodeCompiler:
                                   lambda: "  return " + self.input(out, "Displacement", VEC)[0] + ";\n"
                                   if displaces or bump_only else "  return (float3)(0.0f);\n")
         bound = self._displacement_bound(displaces)
-        surf_src = self._function("void mp_node_surface(const MpNodeGlobals* g, MpSurfaceInputs* s)",
-                                  lambda: bump_line + "".join(self._assignment(shader, *a) for a in assigns))
+
+        def surface_body():
+            self.fn.lines.append(bump_line.rstrip("\n"))
+            if shader is None:
+                # No shader: Cycles renders the surface black.
+                return ""
+            self.shader_input(out, "Surface", "(float3)(1.0f)")
+            return ""
+        surf_src = self._function("void mp_node_surface(const MpNodeGlobals* g, MpSurface* s)", surface_body)
         includes = "".join(f'#include "textures/{h}"\n' for h in sorted(self.headers))
         if self.uses_neighbours:
             includes = "#define MP_NODE_USES_NEIGHBOURS 1\n" + includes
         source = includes + "".join(self.helpers) + disp_src + surf_src
         return CompiledMaterial(source, displaces, shades, bound, displaces and self.displacement_world,
-                                alpha=any(a[0] == "alpha" for a in assigns))
+                                alpha=self.transparent)
 
-    def _assignment(self, shader, field, socket, kind, strength):
-        expr = self.input(shader, socket, kind)[0]
-        if field == "normal":
-            return f"  s->normal = {expr};\n  s->has_normal = {self._normal_input_mode()};\n"
-        if strength is not None:
-            expr = f"{expr} * {self.input(shader, strength, FLOAT)[0] if strength in shader.inputs else '1.0f'}"
-        return f"  s->{field} = {expr};\n"
+    # ---- shader trees -> closures ------------------------------------------------
+    def _follow(self, socket):
+        """(node, output socket) linked into `socket` past reroutes and muted
+        links, or (None, None)."""
+        link = next((l for l in socket.links if getattr(l, "is_valid", True) and not getattr(l, "is_muted", False)),
+                    None)
+        if link is None:
+            return None, None
+        node, out = link.from_node, link.from_socket
+        while node is not None and node.type == "REROUTE":
+            inner = [l for l in node.inputs[0].links if not getattr(l, "is_muted", False)]
+            if not inner:
+                return None, None
+            node, out = inner[0].from_node, inner[0].from_socket
+        return node, out
+
+    def _linked_node(self, socket):
+        return self._follow(socket)[0]
+
+    def shader_input(self, node, key, weight):
+        """Adds the closures of the shader linked into node.inputs[key],
+        each scaled by `weight` (a float3 expression)."""
+        socket = node.inputs[key] if isinstance(key, int) else node.inputs.get(key)
+        if socket is None:
+            return
+        src, out = self._follow(socket)
+        if src is None:
+            return
+        if src.type == "GROUP_INPUT":
+            if not self.groups:
+                return
+            group = self.groups.pop()
+            try:
+                index = next((i for i, s in enumerate(group.inputs) if s.identifier == out.identifier), None)
+                if index is not None:
+                    self.shader_input(group, index, weight)
+            finally:
+                self.groups.append(group)
+            return
+        if src.type == "GROUP":
+            tree = src.node_tree
+            outputs = [n for n in tree.nodes if n.type == "GROUP_OUTPUT"] if tree is not None else []
+            active = [n for n in outputs if getattr(n, "is_active_output", False)] or outputs
+            if not active:
+                self.warn(src, "has no node tree or no Group Output; it adds nothing to the surface")
+                return
+            index = next((i for i, s in enumerate(active[0].inputs) if s.identifier == out.identifier), None)
+            if index is None:
+                return
+            self.groups.append(src)
+            try:
+                self.shader_input(active[0], index, weight)
+            finally:
+                self.groups.pop()
+            return
+        if getattr(src, "mute", False):
+            # A muted node passes its first shader input through.
+            first = next((i for i, s in enumerate(src.inputs) if s.type == "SHADER"), None)
+            if first is not None:
+                self.shader_input(src, first, weight)
+            return
+        self.emit_shader(src, weight)
+
+    def _normal_slot(self, node, key="Normal"):
+        """The normal slot of a BSDF's Normal input: 0 (the surface's) unless linked."""
+        socket = node.inputs.get(key)
+        if socket is None or not socket.is_linked:
+            return "0"
+        expr = self.input(node, key, VEC)[0]
+        return self.fn.temp("int", f"mp_surface_normal_slot(s, {expr}, {self._normal_input_mode()})")[0]
+
+    def _slot_normal(self, slot):
+        return "g->N" if slot == "0" else f"s->normal[{slot}]"
+
+    def _tangent(self, node):
+        """A BSDF's Tangent input, or the Tangent node's default: radial
+        about the object's Z axis through Generated coordinates."""
+        socket = node.inputs.get("Tangent")
+        if socket is not None and socket.is_linked:
+            return self.input(node, "Tangent", VEC)[0]
+        return "mp_radial_tangent(g)"
+
+    def _f(self, node, *names, default="0.0f"):
+        for name in names:
+            if name in node.inputs:
+                return self.input(node, name, FLOAT)[0]
+        return default
+
+    def _c(self, node, *names, default="(float3)(0.0f)"):
+        for name in names:
+            if name in node.inputs:
+                return self.input(node, name, VEC)[0]
+        return default
+
+    def _weighted(self, weight, *factors):
+        return self.fn.temp(VEC, " * ".join((weight,) + factors))[0]
+
+    def emit_shader(self, node, weight):
+        t = node.type
+        add = self.fn.lines.append
+        if t == "MIX_SHADER":
+            fac = self.fn.temp(FLOAT, f"mp_nl_clamp01({self.input(node, 0, FLOAT)[0]})")[0]
+            self.shader_input(node, 1, self._weighted(weight, f"(1.0f - {fac})"))
+            self.shader_input(node, 2, self._weighted(weight, fac))
+            return
+        if t == "ADD_SHADER":
+            self.shader_input(node, 0, weight)
+            self.shader_input(node, 1, weight)
+            return
+        if t in ("EMISSION", "BACKGROUND"):
+            add(f"  mp_add_emission(s, {weight} * {self._c(node, 'Color')} * {self._f(node, 'Strength')});")
+            return
+        if t == "BSDF_PRINCIPLED":
+            return self.emit_principled(node, weight)
+        if t == "BSDF_TRANSPARENT":
+            self.transparent = True
+            add(f"  mp_add_transparent(s, {weight} * {self._c(node, 'Color')});")
+            return
+        if t == "HOLDOUT":
+            self.warn(node, "is not supported (the rasteriser has no zero-alpha occluders); it adds nothing")
+            return
+        slot = self._normal_slot(node)
+        color = self._c(node, "Color", "Base Color", default="(float3)(0.8f)")
+        if t == "BSDF_DIFFUSE":
+            add(f"  mp_add_diffuse(s, {weight} * {color}, {slot}, {self._f(node, 'Roughness')});")
+        elif t == "BSDF_TRANSLUCENT":
+            add(f"  mp_add_translucent(s, {weight} * {color}, {slot});")
+        elif t == "SUBSURFACE_SCATTERING":
+            add(f"  mp_add_subsurface(s, {weight} * {color}, {slot}, 0.0f);")
+        elif t in ("BSDF_GLOSSY", "BSDF_ANISOTROPIC"):
+            dist = getattr(node, "distribution", "GGX")
+            if dist in ("BECKMANN", "ASHIKHMIN_SHIRLEY"):
+                self.warn(node, f"the {dist.replace('_', '-').title()} distribution is shaded as GGX")
+            rough = "0.0f" if dist == "SHARP" else self._f(node, "Roughness")
+            aniso = self._f(node, "Anisotropy")
+            rot = self._f(node, "Rotation")
+            tangent = self._tangent(node) if aniso != "0.0f" else "(float3)(0.0f)"
+            if tangent != "(float3)(0.0f)":
+                tangent = f"mp_rotate_tangent({tangent}, {self._slot_normal(slot)}, {rot})"
+            add(f"  mp_add_glossy(s, {weight} * {color}, {slot}, {rough}, {aniso}, {tangent}, MP_FRESNEL_NONE, "
+                f"(float3)(0.0f), (float3)(1.0f), {1 if dist == 'MULTI_GGX' else 0});")
+        elif t in ("BSDF_GLASS", "BSDF_REFRACTION"):
+            dist = getattr(node, "distribution", "GGX")
+            if dist == "BECKMANN":
+                self.warn(node, "the Beckmann distribution is shaded as GGX")
+            rough = "0.0f" if dist == "SHARP" else self._f(node, "Roughness")
+            ior = self._f(node, "IOR", default="1.45f")
+            if t == "BSDF_GLASS":
+                add(f"  mp_add_glass(s, {weight} * {color}, {slot}, {rough}, {ior}, {1 if dist == 'MULTI_GGX' else 0});")
+            else:
+                add(f"  mp_add_refraction(s, {weight} * {color}, {slot}, {rough}, {ior}, 0);")
+        elif t in ("BSDF_VELVET", "BSDF_SHEEN"):
+            model = "MP_SHEEN_MICROFIBER" if getattr(node, "distribution", "ASHIKHMIN") == "MICROFIBER" \
+                else "MP_SHEEN_ASHIKHMIN"
+            rough = self._f(node, "Roughness", "Sigma", default="0.5f")
+            add(f"  mp_add_sheen(s, {weight} * {color}, {slot}, {rough}, {model});")
+        elif t == "BSDF_TOON":
+            glossy = 1 if node.component == "GLOSSY" else 0
+            add(f"  mp_add_toon(s, {weight} * {color}, {slot}, {self._f(node, 'Size')}, {self._f(node, 'Smooth')}, "
+                f"{glossy});")
+        elif t == "BSDF_METALLIC":
+            if getattr(node, "fresnel_type", "F82") != "F82":
+                self.warn(node, "the Physical Conductor Fresnel is shaded with F82 tint from its IOR's reflectance")
+            aniso = self._f(node, "Anisotropy")
+            tangent = self._tangent(node) if aniso != "0.0f" else "(float3)(0.0f)"
+            add(f"  mp_add_glossy(s, {weight}, {slot}, {self._f(node, 'Roughness')}, {aniso}, {tangent}, "
+                f"MP_FRESNEL_F82, {color}, {self._c(node, 'Edge Tint', default='(float3)(1.0f)')}, "
+                f"{1 if getattr(node, 'distribution', 'GGX') == 'MULTI_GGX' else 0});")
+        else:
+            # Anything else (hair, volumes, ray portals, shaders of newer
+            # Blender): a diffuse of its Color input, and a warning.
+            self.warn(node, "is not supported; it is shaded as a Diffuse BSDF of its color")
+            add(f"  mp_add_diffuse(s, {weight} * {color}, {slot}, 0.0f);")
+
+    def emit_principled(self, node, weight):
+        """Principled BSDF: every input, in the running Blender's layout
+        (kernels/mp_principled.h)."""
+        v4 = self.version >= 400
+        f, c = self._f, self._c
+        slot = self._normal_slot(node)
+        coat_slot = self._normal_slot(node, "Coat Normal" if v4 else "Clearcoat Normal")
+        n, cn = self._slot_normal(slot), self._slot_normal(coat_slot)
+        p = f"pr{self.fn.counter}"
+        self.fn.counter += 1
+        alpha = node.inputs.get("Alpha")
+        if alpha is not None and (alpha.is_linked or float(alpha.default_value) < 1.0):
+            self.transparent = True
+        if v4:
+            thin = node.inputs.get("Thin Film Thickness")
+            if thin is not None and (thin.is_linked or float(thin.default_value) > 0.0):
+                self.warn(node, "Thin Film is not supported; it is left out")
+            if getattr(node, "subsurface_method", "RANDOM_WALK") and float(
+                    getattr(node.inputs.get("Subsurface Weight"), "default_value", 0.0)) > 0.0:
+                pass
+        fields = {
+            "base_color": c(node, "Base Color"), "metallic": f(node, "Metallic"), "roughness": f(node, "Roughness"),
+            "ior": f(node, "IOR", default="1.45f"), "alpha": f(node, "Alpha", default="1.0f"),
+            "specular": f(node, "Specular IOR Level", "Specular", default="0.5f"),
+            "specular_tint": c(node, "Specular Tint", default="(float3)(1.0f)") if v4
+            else f"(float3)({f(node, 'Specular Tint')})",
+            "anisotropy": f(node, "Anisotropic"), "anisotropic_rotation": f(node, "Anisotropic Rotation"),
+            "transmission": f(node, "Transmission Weight", "Transmission"),
+            "transmission_roughness": f(node, "Transmission Roughness"),
+            "coat": f(node, "Coat Weight", "Clearcoat"), "coat_roughness": f(node, "Coat Roughness",
+                                                                             "Clearcoat Roughness"),
+            "coat_ior": f(node, "Coat IOR", default="1.5f"), "coat_tint": c(node, "Coat Tint", default="(float3)(1.0f)"),
+            "sheen": f(node, "Sheen Weight", "Sheen"), "sheen_roughness": f(node, "Sheen Roughness", default="0.5f"),
+            "sheen_tint": c(node, "Sheen Tint", default="(float3)(1.0f)") if v4
+            else f"(float3)({f(node, 'Sheen Tint')})",
+            "subsurface": f(node, "Subsurface Weight", "Subsurface"),
+            "subsurface_color": c(node, "Subsurface Color", default="(float3)(0.0f)"),
+            "emission": f"{c(node, 'Emission Color', 'Emission')} * {f(node, 'Emission Strength', default='1.0f')}",
+            "slot": slot, "coat_slot": coat_slot, "v4": "1" if v4 else "0", "retro": "0" if v4 else "1",
+            "multiscatter": "1" if getattr(node, "distribution", "GGX") == "MULTI_GGX" else "0",
+        }
+        fields["tangent"] = self._tangent(node) if fields["anisotropy"] != "0.0f" else "(float3)(0.0f)"
+        add = self.fn.lines.append
+        add(f"  MpPrincipled {p};")
+        for k, v in fields.items():
+            add(f"  {p}.{k} = {v};")
+        add(f"  {p}.nv = mp_view_cos(g, {n});")
+        add(f"  {p}.coat_nv = mp_view_cos(g, {cn});")
+        add(f"  mp_add_principled(s, {weight}, &{p}, {n});")
 
     def _normal_input_mode(self):
         """How Cycles treats a BSDF's Normal input in the running Blender:
@@ -730,28 +993,6 @@ class NodeCompiler:
             return "MP_NORMAL_INPUT_V4"
         return "MP_NORMAL_INPUT_V4_UNCORRECTED"
 
-    def _surface_assignments(self, shader):
-        """(field, socket, kind, strength socket) for every linked Principled input."""
-        linked = lambda name: name in shader.inputs and shader.inputs[name].is_linked
-        out = []
-        if shader.type == "EMISSION":
-            if linked("Color") or linked("Strength"):
-                out.append(("emission", "Color", VEC, "Strength"))
-            return out
-        color = "Base Color" if shader.type == "BSDF_PRINCIPLED" else "Color"
-        if linked(color):
-            out.append(("base_color", color, VEC, None))
-        if shader.type == "BSDF_PRINCIPLED":
-            for field, name in (("metallic", "Metallic"), ("roughness", "Roughness"), ("alpha", "Alpha")):
-                if linked(name):
-                    out.append((field, name, FLOAT, None))
-            emission = "Emission Color" if "Emission Color" in shader.inputs else "Emission"
-            if linked(emission) or linked("Emission Strength"):
-                out.append(("emission", emission, VEC, "Emission Strength"))
-        if linked("Normal"):
-            out.append(("normal", "Normal", VEC, None))
-        return out
-
     def _displacement_bound(self, displaces):
         if not displaces:
             return 0.0
@@ -766,6 +1007,39 @@ class NodeCompiler:
                              "the node tree; 1 unit is assumed. Set Material > Micropoly > Displacement Bound if "
                              "displaced geometry is clipped")
         return 1.0
+
+
+# Principled inputs the constant material path (export_materials and
+# DeviceMaterial) has no room for: when unlinked at these values they add
+# nothing, otherwise the material needs a program.
+_PRINCIPLED_NEUTRAL = {"Subsurface Weight": 0.0, "Subsurface": 0.0, "Transmission Weight": 0.0,
+                       "Transmission": 0.0, "Coat Weight": 0.0, "Clearcoat": 0.0, "Sheen Weight": 0.0, "Sheen": 0.0,
+                       "Anisotropic": 0.0, "Thin Film Thickness": 0.0}
+
+
+def _constant_shader(node):
+    """Whether shader `node` renders as a constant material (no program)."""
+    if node.type not in ("BSDF_PRINCIPLED", "BSDF_DIFFUSE", "EMISSION"):
+        return False
+    if any(s.is_linked for s in node.inputs):
+        return False
+    if node.type == "BSDF_DIFFUSE":
+        return float(node.inputs["Roughness"].default_value) == 0.0
+    if node.type == "BSDF_PRINCIPLED":
+        for name, neutral in _PRINCIPLED_NEUTRAL.items():
+            socket = node.inputs.get(name)
+            if socket is not None and float(socket.default_value) != neutral:
+                return False
+        tint = node.inputs.get("Specular Tint")
+        if blender_version() >= 400:
+            # 4.x: a white tint, and the IOR the constant path assumes.
+            if any(float(x) != 1.0 for x in list(tint.default_value)[:3]):
+                return False
+            if abs(float(node.inputs["IOR"].default_value) - 1.5) > 1e-6:
+                return False
+        elif float(tint.default_value) != 0.0:
+            return False
+    return True
 
 
 def active_output(material):

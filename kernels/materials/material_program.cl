@@ -8,6 +8,7 @@
 #include "mp_patch.h"
 #include "mp_types.h"
 #include "mp_shading.h"
+#include "mp_shade_closures.h"
 #include "mp_patch_eval.h"
 #include "mp_surface.h"
 #include "mp_grid.h"
@@ -45,8 +46,16 @@ typedef struct {
 } MpProgramInputs;
 
 inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, float3 n, const MpProgramInputs* in,
-                                     uint patch, float2 uv) {
+                                     uint patch, float2 uv, int ortho) {
   MpNodeGlobals g;
+  /* The view direction: camera -> object -> world. */
+  float3 v = ortho ? (float3)(0.0f, 0.0f, 1.0f) : normalize(-p);
+  float3 vo = (float3)(mp_row3(o->to_object, 0, v, 0.0f), mp_row3(o->to_object, 1, v, 0.0f), mp_row3(o->to_object, 2, v, 0.0f));
+  float3 vw = (float3)(mp_row3(o->to_world, 0, vo, 0.0f), mp_row3(o->to_world, 1, vo, 0.0f), mp_row3(o->to_world, 2, vo, 0.0f));
+  float vl = length(vw);
+  g.I = vl > 0.0f ? vw / vl : (float3)(0.0f, 0.0f, 1.0f);
+  g.ray_length = length(p);
+  g.shadow_ray = 0;
   g.P = (float3)(mp_row3(o->to_object, 0, p, 1.0f), mp_row3(o->to_object, 1, p, 1.0f), mp_row3(o->to_object, 2, p, 1.0f));
   g.N = mp_camera_normal_to_object(o, n);
   g.object = o;
@@ -120,7 +129,7 @@ __kernel void displace_grids(__global const SubPatch* diceable, uint count, __gl
   __global const DeviceObject* o = objects + object;
   float3 p = grid_p[index].xyz;
   MpProgramInputs in = MP_PROGRAM_INPUTS;
-  MpNodeGlobals g = mp_node_globals(o, p, grid_n[index].xyz, &in, sp.patch, uv);
+  MpNodeGlobals g = mp_node_globals(o, p, grid_n[index].xyz, &in, sp.patch, uv, f.ortho);
   float3 d = mp_node_displacement(&g);
   if (!(isfinite(d.x) && isfinite(d.y) && isfinite(d.z))) return;
   grid_p[index] = (float4)(p + mp_object_dir_to_camera(o, d), 1.0f);
@@ -150,7 +159,7 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   float3 p = grid_p[index].xyz, n = grid_n[index].xyz;
   MpProgramInputs in = MP_PROGRAM_INPUTS;
   __global const DeviceObject* o = objects + object;
-  MpNodeGlobals g = mp_node_globals(o, p, n, &in, sp.patch, uv);
+  MpNodeGlobals g = mp_node_globals(o, p, n, &in, sp.patch, uv, f.ortho);
 #ifdef MP_NODE_USES_NEIGHBOURS
   /* Bump nodes difference their heights towards the next grid vertex along
    * u and along v (the previous one on the grid's far border), a tenth of
@@ -165,46 +174,44 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   float2 uvx = uv, uvy = uv;
   mp_slot_uv(&sp, &shape, sx % stride, sx / stride, &uvx);
   mp_slot_uv(&sp, &shape, sy % stride, sy / stride, &uvy);
-  MpNodeGlobals nx = mp_node_globals(o, grid_p[gx].xyz, grid_n[gx].xyz, &in, sp.patch, uvx);
-  MpNodeGlobals ny = mp_node_globals(o, grid_p[gy].xyz, grid_n[gy].xyz, &in, sp.patch, uvy);
+  MpNodeGlobals nx = mp_node_globals(o, grid_p[gx].xyz, grid_n[gx].xyz, &in, sp.patch, uvx, f.ortho);
+  MpNodeGlobals ny = mp_node_globals(o, grid_p[gy].xyz, grid_n[gy].xyz, &in, sp.patch, uvy, f.ortho);
   MpNodeGlobals g_dx = mp_node_globals_toward(&g, &nx, 0.1f), g_dy = mp_node_globals_toward(&g, &ny, 0.1f);
   g.dx = &g_dx;
   g.dy = &g_dy;
 #endif
-  MpSurfaceInputs s;
-  s.base_color = (float3)(m.color[0], m.color[1], m.color[2]);
-  s.metallic = m.principled[0];
-  s.specular = m.principled[1];
-  s.roughness = m.coeffs[3];
-  s.alpha = m.opacity[3];
-  s.emission = (float3)(m.emission[0], m.emission[1], m.emission[2]);
-  s.normal = g.N;
-  s.has_normal = 0;
+  g.shadow_ray = alpha_only != 0;
+  MpSurface s;
+  mp_surface_init(&s, g.N);
   mp_node_surface(&g, &s);
+  float alpha = mp_surface_alpha(&s);
   if (alpha_only) {
-    grid_c[index].w = clamp(s.alpha, 0.0f, 1.0f);
+    grid_c[index].w = alpha;
     return;
   }
-  m.color[0] = s.base_color.x, m.color[1] = s.base_color.y, m.color[2] = s.base_color.z;
-  m.principled[0] = clamp(s.metallic, 0.0f, 1.0f);
-  m.principled[1] = fmax(s.specular, 0.0f);
-  m.coeffs[3] = clamp(s.roughness, 0.0f, 1.0f);
-  m.emission[0] = s.emission.x, m.emission[1] = s.emission.y, m.emission[2] = s.emission.z;
-  int has_normal = s.has_normal && all(isfinite(s.normal)) && length(s.normal) > 1e-6f;
-  float3 ns = has_normal ? mp_object_normal_to_camera(o, s.normal) : n;
-  /* A BSDF's own normal: shaded as the running Blender's Cycles does (mp_shade_bumped). */
-  int bsdf_normal = !has_normal                                       ? 0
-                    : s.has_normal == MP_NORMAL_INPUT                 ? 1
-                    : s.has_normal == MP_NORMAL_INPUT_V4              ? 2
-                    : s.has_normal == MP_NORMAL_INPUT_V4_UNCORRECTED ? 3
-                                                                      : 0;
+  /* Normals and tangents from the program's object space to camera space;
+   * the surface's own normal is the grid's, exactly. */
+  for (int k = 0; k < s.normals; ++k) {
+    float3 nk = s.normal[k];
+    int valid = all(isfinite(nk)) && length(nk) > 1e-6f;
+    s.normal[k] = k == 0 && s.normal_mode[0] == 0 ? n : valid ? mp_object_normal_to_camera(o, nk) : n;
+    if (!valid) s.normal_mode[k] = 0;
+  }
+  for (int k = 0; k < s.count; ++k)
+    if (dot(s.c[k].tangent, s.c[k].tangent) > 0.0f) {
+      float3 t = mp_object_dir_to_camera(o, s.c[k].tangent);
+      s.c[k].tangent = all(isfinite(t)) ? t : (float3)(0.0f);
+    }
   /* Shadows compare with the surface's tangent plane (for smooth-shaded
    * polygons, which shade.cl gave their interpolated normal, that normal's). */
   MpShadowMaps maps = {shadows, shadow_levels, shadow_pages, shadow_pool};
   MpShadowQuery shadow = {&maps, n, mp_pixel_footprint(-p.z, f)};
-  float3 c = mp_shade_bumped(p, n, ns, bsdf_normal, grid_n[index].w > 0.5f, f.ortho, &m, lights, light_count,
-                             world_glossy, use_shadows ? &shadow : 0);
-  grid_c[index] = (float4)(c, clamp(s.alpha, 0.0f, 1.0f));
+  float3 c = mp_shade_closures(p, n, grid_n[index].w > 0.5f, f.ortho, &s, lights, light_count, world_glossy,
+                               use_shadows ? &shadow : 0);
+  /* Stochastic coverage multiplies by alpha: what the closures give is the
+   * covered part's colour. */
+  if (alpha > 0.0f) c = c / alpha;
+  grid_c[index] = (float4)(c, alpha);
 }
 
 /* The world's radiance towards world direction d: the world program's
@@ -223,13 +230,11 @@ float3 mp_world_radiance(float3 d, const MpProgramInputs* in) {
   g.texels = in->texels;
   g.dx = 0;
   g.dy = 0;
-  MpSurfaceInputs s;
-  s.base_color = (float3)(0.0f);
-  s.metallic = s.specular = s.roughness = 0.0f;
-  s.alpha = 1.0f;
-  s.emission = (float3)(0.0f);
-  s.normal = d;
-  s.has_normal = 0;
+  g.I = -d;
+  g.ray_length = 1e30f;
+  g.shadow_ray = 0;
+  MpSurface s;
+  mp_surface_init(&s, d);
   mp_node_surface(&g, &s);
   float3 e = s.emission;
   return (float3)(isfinite(e.x) ? fmax(e.x, 0.0f) : 0.0f, isfinite(e.y) ? fmax(e.y, 0.0f) : 0.0f,

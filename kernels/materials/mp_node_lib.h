@@ -11,6 +11,8 @@
 #include "mp_compat.h"
 #include "mp_patch.h"
 #include "mp_types.h"
+#include "mp_closures.h"
+#include "mp_principled.h"
 
 /* What the nodes can read at a shading point. Object-space position and
  * normal (Texture Coordinate > Object and Normal), Generated coordinates,
@@ -20,6 +22,9 @@ typedef struct MpNodeGlobals {
   float3 P;
   float3 N;
   float3 generated;
+  float3 I; /* unit direction towards the viewer, world space (Geometry > Incoming) */
+  float ray_length; /* distance from the camera (Light Path > Ray Length) */
+  int shadow_ray;   /* evaluated for a shadow map's transparency (Light Path > Is Shadow Ray) */
   float3 uv[MP_MAX_UV_LAYERS];
   MP_GLOBAL const DeviceObject* object; /* object <-> world (world-space nodes), or null */
   MP_GLOBAL const DeviceImage* images;
@@ -31,24 +36,6 @@ typedef struct MpNodeGlobals {
   const struct MpNodeGlobals* dy;
 } MpNodeGlobals;
 
-/* Principled BSDF inputs a surface program may set. */
-typedef struct {
-  float3 base_color;
-  float metallic, roughness, specular, alpha;
-  float3 emission; /* color times strength */
-  float3 normal;   /* shading normal, object space (Bump, bump-only displacement) */
-  int has_normal;  /* 0, or MP_NORMAL_SET, or MP_NORMAL_INPUT (a BSDF's Normal input) */
-} MpSurfaceInputs;
-
-/* How a surface program set MpSurfaceInputs.normal: as the surface's shading
- * normal (bump-only displacement) or through a BSDF's Normal input, which
- * Cycles keeps from reflecting the view direction below the surface. */
-#define MP_NORMAL_SET 1
-#define MP_NORMAL_INPUT 2
-/* The same as Blender 4.0 and later shade it (mp_shade_bumped), with and
- * without the material's Bump Map Correction. */
-#define MP_NORMAL_INPUT_V4 3
-#define MP_NORMAL_INPUT_V4_UNCORRECTED 4
 
 /* World-space vectors for nodes that work in world space: a direction from
  * world to object space, and an object-space normal to world space and back
@@ -75,6 +62,50 @@ MP_INLINE float3 mp_world_normal_to_object(const MpNodeGlobals* g, float3 n) {
   float3 o = mp_nl_columns(g->object->to_world, n);
   float len = length(o);
   return len > 0.0f ? o / len : n;
+}
+
+/* The tangent a BSDF without a Tangent input uses: the Tangent node's
+ * default, radial about the object's Z axis through Generated coordinates
+ * (object space, unnormalised). */
+MP_INLINE float3 mp_radial_tangent(const MpNodeGlobals* g) {
+  return MP_F3(-(g->generated.y - 0.5f), g->generated.x - 0.5f, 0.0f);
+}
+
+/* The cosine between the view and object-space normal n (Layer Weight,
+ * Fresnel, the Principled BSDF's layering), taken in world space. */
+MP_INLINE float mp_view_cos(const MpNodeGlobals* g, float3 n) { return dot(mp_object_normal_to_world(g, n), g->I); }
+
+/* Whether the surface faces away from the viewer (Geometry > Backfacing). */
+MP_INLINE int mp_backfacing(const MpNodeGlobals* g) { return mp_view_cos(g, g->N) < 0.0f; }
+
+/* Fresnel node: the dielectric reflectance of IOR ior (its inverse seen
+ * from behind) at the view's angle to normal n. */
+MP_INLINE float mp_fresnel_node(const MpNodeGlobals* g, float ior, float3 n) {
+  float eta = fmax(ior, 1e-5f);
+  if (mp_backfacing(g)) eta = 1.0f / eta;
+  return mp_fresnel_dielectric(mp_view_cos(g, n), eta);
+}
+
+/* Layer Weight node: Fresnel (of IOR 1 / (1 - blend)) and Facing
+ * (1 - |cos|^p, p = 2 blend below a half, 0.5 / (1 - blend) above). */
+MP_INLINE float mp_layer_weight(const MpNodeGlobals* g, float blend, float3 n, float* facing) {
+  float c = mp_view_cos(g, n);
+  float eta = fmax(1.0f - blend, 1e-5f);
+  float fresnel = mp_fresnel_dielectric(c, mp_backfacing(g) ? eta : 1.0f / eta);
+  float f = fabs(c);
+  if (blend != 0.5f) {
+    float b = clamp(blend, 0.0f, 1.0f - 1e-5f);
+    f = MP_POWR(f, b < 0.5f ? 2.0f * b : 0.5f / (1.0f - b));
+  }
+  *facing = 1.0f - f;
+  return fresnel;
+}
+
+/* This point in world space (Geometry > Position). */
+MP_INLINE float3 mp_world_position(const MpNodeGlobals* g) {
+  if (!g->object) return g->P;
+  const MP_GLOBAL float* m = g->object->to_world;
+  return mp_nl_rows(m, g->P) + MP_F3(m[3], m[7], m[11]);
 }
 
 /* This shading point in another object's space (Texture Coordinate ▸ Object

@@ -7,6 +7,17 @@ with an Emission shader fed by the texture node under test through Object
 coordinates (W from the x coordinate in 1D, from x + y in 4D). Cycles renders
 at 1 sample, pixel filter width 0.01, no denoising, to a 32-bit float EXR.
 
+Textures: Noise, Musgrave (up to 4.0), Wave, Voronoi, Checker, Brick,
+Gradient (every type), Magic (depths 0-10), White Noise (1D-4D) and Gabor
+(2D and 3D, from 4.3). Colour nodes: Blackbody, Wavelength, RGB Curves,
+Vector Curves, Float Curve (extrapolated and horizontal ends, points outside
+[0, 1]), Bright/Contrast and Gamma, fed the Object coordinates as colour or
+vector; their scalar inputs (temperature, wavelength, gamma, ...) are either
+constant or driven from one coordinate by Math nodes (multiply, add), which
+the test repeats in float32 for the probe. The curve tables and colour space
+matrices given to the probe come from the add-on's node_textures module
+(loaded from MICROPOLY_ADDON_DIR), as the generated programs embed them.
+
 The input point of a pixel is not guessed from its centre: a first render
 emits the Object coordinates themselves. Cycles' camera samples depend only
 on the pixel, sample and seed, so later renders of the same scene shade the
@@ -23,9 +34,12 @@ failure. The probe is found through MICROPOLY_TEXTURE_PROBE.
 
 Observed: every pixel of every case within 1e-3; worst differences about
 2e-5 in Blender 3.4 and 7e-5 in 4.5/5.0 (distorted or multifractal noise,
-where float rounding is amplified), medians 1e-7 or below. Runs in a few
-seconds."""
+where float rounding is amplified), medians 1e-7 or below. The pattern and
+colour nodes: worst 3e-6 in 3.4 (Brick's smoothed mortar, Float Curve) and
+7e-6 in 4.5/5.0 (Gabor), medians 6e-8 or below. Runs in a few seconds."""
 
+import importlib.util
+import math
 import os
 import subprocess
 import sys
@@ -40,7 +54,7 @@ import render_utils as ru  # noqa: E402
 
 VERSION = bpy.app.version[0] * 100 + bpy.app.version[1]
 TILE = 40  # pixels per case, square
-COLS = 12
+COLS = 12  # at least; more when there are more cases than fit in a square of 12 x 12
 TOL = 1e-3
 MIN_FRACTION = 0.995
 MAX_MEDIAN = 1e-4
@@ -52,6 +66,24 @@ VORONOI_METRICS = ["EUCLIDEAN", "MANHATTAN", "CHEBYCHEV", "MINKOWSKI"]
 WAVE_BANDS_DIRS = ["X", "Y", "Z", "DIAGONAL"]
 WAVE_RINGS_DIRS = ["X", "Y", "Z", "SPHERICAL"]
 WAVE_PROFILES = ["SIN", "SAW", "TRI"]
+GRADIENT_TYPES = ["LINEAR", "QUADRATIC", "EASING", "DIAGONAL", "SPHERICAL", "QUADRATIC_SPHERE", "RADIAL"]
+
+
+def load_node_textures():
+    """The add-on's node_textures module, loaded on its own (it computes the
+    colour space matrices and curve tables that the generated programs
+    embed; the probe is fed the same)."""
+    folder = os.environ.get("MICROPOLY_ADDON_DIR")
+    path = os.path.join(folder, "micropoly", "node_textures.py") if folder else ""
+    if not os.path.exists(path):
+        path = os.path.join(os.path.dirname(__file__), "..", "..", "addon", "micropoly", "node_textures.py")
+    spec = importlib.util.spec_from_file_location("mp_node_textures", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+NT = load_node_textures()
 
 
 # ---------------------------------------------------------------------------
@@ -137,7 +169,77 @@ def build_cases():
         voronoi(3, 3, 0, detail=1.7, roughness=0.5, lacunarity=2.3, normalize=0, label="fractal")
         voronoi(2, 2, 3, detail=0.6, roughness=0.5, lacunarity=2.0, normalize=1, smoothness=0.0,
                 label="fractal smooth0")
+    build_pattern_cases(cases)
+    build_color_cases(cases)
     return cases
+
+
+def build_pattern_cases(cases):
+    """Checker, Brick, Gradient, Magic, White Noise and (4.3+) Gabor."""
+    for scale, c1, c2 in ((3.0, (0.9, 0.3, 0.1), (0.05, 0.6, 0.8)), (7.5, (0.2, 0.25, 0.7), (1.0, 0.9, 0.4))):
+        cases.append(dict(kind="checker", label=f"checker scale {scale}", scale=scale, c1=c1, c2=c2))
+    colors = ((0.8, 0.2, 0.1), (0.3, 0.9, 0.4), (0.1, 0.1, 0.6))
+    for label, params in (
+            ("default-like", dict(scale=2.0, mortar_size=0.05, mortar_smooth=0.3, bias=0.0, brick_width=0.5,
+                                  row_height=0.25, offset=0.5, offset_frequency=2, squash=1.0, squash_frequency=2)),
+            ("hard mortar squash", dict(scale=3.3, mortar_size=0.08, mortar_smooth=0.0, bias=-0.2, brick_width=0.7,
+                                        row_height=0.3, offset=0.3, offset_frequency=3, squash=0.6,
+                                        squash_frequency=2)),
+            ("smooth 1 bias", dict(scale=2.6, mortar_size=0.1, mortar_smooth=1.0, bias=0.4, brick_width=0.45,
+                                   row_height=0.2, offset=0.7, offset_frequency=1, squash=1.5, squash_frequency=3))):
+        cases.append(dict(kind="brick", label=f"brick {label}", colors=colors, **params))
+    for gtype in range(len(GRADIENT_TYPES)):
+        cases.append(dict(kind="gradient", label=f"gradient {GRADIENT_TYPES[gtype]}", gtype=gtype))
+    for depth, scale, distortion in ((0, 1.2, 1.0), (1, 2.0, 1.5), (2, 1.5, 2.0), (3, 1.0, 0.0), (4, 1.0, 1.3),
+                                     (7, 0.8, 0.9), (10, 0.6, 0.7)):
+        cases.append(dict(kind="magic", label=f"magic depth {depth} dist {distortion}", depth=depth, scale=scale,
+                          distortion=distortion))
+    for dims in (1, 2, 3, 4):
+        cases.append(dict(kind="white_noise", label=f"white noise {DIM_NAMES[dims]}", dims=dims))
+    if VERSION >= 403:
+        for gtype, scale, freq, aniso, o2, o3 in ((0, 3.0, 2.0, 1.0, 0.785, (1.0, 1.0, 0.0)),
+                                                   (0, 4.0, 3.5, 0.3, 1.3, (1.0, 1.0, 0.0)),
+                                                   (1, 2.5, 2.0, 1.0, 0.0, (1.4142135, 1.4142135, 0.0)),
+                                                   (1, 3.0, 1.5, 0.4, 0.0, (0.3, -0.5, 0.8)),
+                                                   (1, 2.0, 2.5, 0.0, 0.0, (0.0, 1.0, 0.2))):
+            cases.append(dict(kind="gabor", label=f"gabor {'3D' if gtype else '2D'} freq {freq} aniso {aniso}",
+                              gtype=gtype, scale=scale, frequency=freq, anisotropy=aniso, o2=o2, o3=o3))
+
+
+# Curve points per curve index: (x, y) pairs replacing the default ones.
+RGB_CURVE = {3: [(-0.4, -0.2), (0.3, 0.55), (1.2, 0.9)], 0: [(0.0, 0.0), (0.5, 0.7), (1.0, 1.0)],
+             1: [(0.0, 0.1), (0.3, 0.1), (1.0, 0.95)]}
+VECTOR_CURVE = {0: [(-1.0, -1.0), (0.0, 0.4), (1.0, 1.0)], 1: [(-1.0, -0.8), (-0.5, 0.3), (0.6, -0.2), (1.0, 0.7)]}
+FLOAT_CURVE = {0: [(0.0, 0.0), (0.3, 0.8), (0.7, 0.2), (1.0, 1.0)]}
+
+
+def build_color_cases(cases):
+    """Blackbody, Wavelength, the curves, Bright/Contrast and Gamma. `drive`
+    sets an input to coordinate[axis] * mul + add (Math nodes in the scene,
+    the same float operations here); `const` sets an input's value; the
+    nodes' colour or vector input is the Object coordinate."""
+    cases.append(dict(kind="blackbody", label="blackbody 200-11800 K", drive={"Temperature": (0, 5800.0, 6000.0)}))
+    cases.append(dict(kind="blackbody", label="blackbody 7000-15000 K", drive={"Temperature": (1, 4000.0, 11000.0)}))
+    cases.append(dict(kind="wavelength", label="wavelength 365-795 nm", drive={"Wavelength": (0, 215.0, 580.0)}))
+    cases.append(dict(kind="wavelength", label="wavelength 380-780 nm (y)", drive={"Wavelength": (1, 200.0, 580.0)}))
+    cases.append(dict(kind="curves", label="rgb curves extrapolated", curve="RGB", points=RGB_CURVE,
+                      extend="EXTRAPOLATED", const={"Fac": 1.0}))
+    cases.append(dict(kind="curves", label="rgb curves horizontal fac 0.85", curve="RGB", points=RGB_CURVE,
+                      extend="HORIZONTAL", const={"Fac": 0.85}))
+    cases.append(dict(kind="curves", label="vector curves extrapolated", curve="VECTOR", points=VECTOR_CURVE,
+                      extend="EXTRAPOLATED", const={"Fac": 1.0}))
+    cases.append(dict(kind="curves", label="vector curves horizontal fac 0.6", curve="VECTOR", points=VECTOR_CURVE,
+                      extend="HORIZONTAL", const={"Fac": 0.6}))
+    cases.append(dict(kind="float_curve", label="float curve extrapolated", curve="FLOAT", points=FLOAT_CURVE,
+                      extend="EXTRAPOLATED", const={"Factor": 1.0}, drive={"Value": (0, 0.8, 0.5)}))
+    cases.append(dict(kind="float_curve", label="float curve horizontal fac 0.7", curve="FLOAT", points=FLOAT_CURVE,
+                      extend="HORIZONTAL", const={"Factor": 0.7}, drive={"Value": (0, 0.8, 0.5)}))
+    cases.append(dict(kind="bright_contrast", label="bright/contrast 0.2 0.5", const={"Bright": 0.2, "Contrast": 0.5}))
+    cases.append(dict(kind="bright_contrast", label="bright/contrast driven",
+                      drive={"Bright": (1, 0.5, 0.0), "Contrast": (0, 0.8, -0.2)}))
+    cases.append(dict(kind="gamma", label="gamma 2.2", const={"Gamma": 2.2}))
+    cases.append(dict(kind="gamma", label="gamma 0.33-1.98 (z)", drive={"Gamma": (2, 1.5, 1.0)}))
+    cases.append(dict(kind="gamma", label="gamma 0", const={"Gamma": 0.0}))
 
 
 # Output groups rendered per kind: (name, probe columns).
@@ -147,7 +249,69 @@ OUTPUT_GROUPS = {
     "musgrave": [("fac", (0, 0, 0))],
     "wave": [("fac", (0, 0, 0)), ("color", (1, 2, 3))],
     "voronoi": [("color", (1, 2, 3)), ("position", (4, 5, 6)), ("distance,w,radius", (0, 7, 8))],
+    # Probe columns: checker/brick/gradient/magic: fac r g b; white_noise: value r g b;
+    # gabor: value phase intensity; float_curve: value; the colour nodes: r g b.
+    "checker": [("fac", (0, 0, 0)), ("color", (1, 2, 3))],
+    "brick": [("fac", (0, 0, 0)), ("color", (1, 2, 3))],
+    "gradient": [("fac", (0, 0, 0)), ("color", (1, 2, 3))],
+    "magic": [("fac", (0, 0, 0)), ("color", (1, 2, 3))],
+    "white_noise": [("value", (0, 0, 0)), ("color", (1, 2, 3))],
+    "gabor": [("value,phase,intensity", (0, 1, 2))],
+    "blackbody": [("color", (0, 1, 2))],
+    "wavelength": [("color", (0, 1, 2))],
+    "curves": [("color", (0, 1, 2))],
+    "float_curve": [("value", (0, 0, 0))],
+    "bright_contrast": [("color", (0, 1, 2))],
+    "gamma": [("color", (0, 1, 2))],
 }
+NEW_KINDS = {"checker", "brick", "gradient", "magic", "white_noise", "gabor", "blackbody", "wavelength", "curves",
+             "float_curve", "bright_contrast", "gamma"}
+
+
+def g(x):
+    return f"{float(x):.9g}"
+
+
+def gs(values):
+    return " ".join(g(v) for v in values)
+
+
+def new_probe_line(case, x, y, z, w, d):
+    """The probe query of a pattern or colour case at (x, y, z, w); d: the
+    driven inputs' values."""
+    k, xyz = case["kind"], f"{g(x)} {g(y)} {g(z)}"
+    if k == "checker":
+        return f"checker {g(case['scale'])} {gs(case['c1'])} {gs(case['c2'])} {VERSION} {xyz}"
+    if k == "brick":
+        p = case
+        return (f"brick {gs(p[n] for n in ('scale', 'mortar_size', 'mortar_smooth', 'bias', 'brick_width'))} "
+                f"{g(p['row_height'])} {g(p['offset'])} {p['offset_frequency']} {g(p['squash'])} "
+                f"{p['squash_frequency']} {gs(sum(p['colors'], ()))} {VERSION} {xyz}")
+    if k == "gradient":
+        return f"gradient {case['gtype']} {VERSION} {xyz}"
+    if k == "magic":
+        return f"magic {case['depth']} {g(case['scale'])} {g(case['distortion'])} {VERSION} {xyz}"
+    if k == "white_noise":
+        return f"white_noise {case['dims']} {VERSION} {xyz} {g(w)}"
+    if k == "gabor":
+        return (f"gabor {case['gtype']} {g(case['scale'])} {g(case['frequency'])} {g(case['anisotropy'])} "
+                f"{g(case['o2'])} {gs(case['o3'])} {VERSION} {xyz}")
+    if k == "blackbody":
+        rows = case["_rows"]
+        flat = sum(rows, []) if rows is not None else [1, 0, 0, 0, 1, 0, 0, 0, 1]
+        return f"blackbody {0 if rows is None else 1} {gs(flat)} {VERSION} {g(d['Temperature'])}"
+    if k == "wavelength":
+        return f"wavelength {gs(sum(case['_rows'], []))} {VERSION} {g(d['Wavelength'])}"
+    if k in ("curves", "float_curve"):
+        lo, hi, extrapolate, _ = case["_table"]
+        fac = case["const"]["Fac" if k == "curves" else "Factor"]
+        head = f"{k} {case['_table_id']} {g(lo)} {g(hi)} {int(extrapolate)} {g(fac)} {VERSION}"
+        return f"{head} {xyz}" if k == "curves" else f"{head} {g(d['Value'])}"
+    if k == "bright_contrast":
+        c = dict(case.get("const", {}), **d)
+        return f"bright_contrast {g(c['Bright'])} {g(c['Contrast'])} {VERSION} {xyz}"
+    c = dict(case.get("const", {}), **d)
+    return f"gamma {g(c['Gamma'])} {VERSION} {xyz}"
 
 
 def probe_line(case, x, y, z, w):
@@ -192,8 +356,116 @@ def set_input(node, name, value):
     sock.default_value = value
 
 
-def texture_node(nt, case):
+def set_input_id(node, identifier, value):
+    sock = next((s for s in node.inputs if s.identifier == identifier), None)
+    if sock is None:
+        raise KeyError(f"{node.bl_idname} has no input {identifier!r} in Blender {bpy.app.version_string}")
+    sock.default_value = value
+
+
+def set_curve(mapping, points, extend):
+    """Replaces the given curves' points; the mapping is unclipped so that
+    points may lie outside [0, 1] (and the table's range with them)."""
+    mapping.use_clip = False
+    for index, pts in points.items():
+        curve = mapping.curves[index]
+        while len(curve.points) > 2:
+            curve.points.remove(curve.points[1])
+        curve.points[0].location = pts[0]
+        curve.points[-1].location = pts[-1]
+        for x, y in pts[1:-1]:
+            curve.points.new(x, y)
+    mapping.extend = extend
+    mapping.update()
+
+
+def drive_input(nt, coords, node, identifier, axis, mul, add):
+    """Input = coordinate[axis] * mul + add, by Math nodes."""
+    sep = nt.nodes.new("ShaderNodeSeparateXYZ")
+    nt.links.new(coords, sep.inputs[0])
+    m = nt.nodes.new("ShaderNodeMath")
+    m.operation = "MULTIPLY"
+    nt.links.new(sep.outputs[axis], m.inputs[0])
+    m.inputs[1].default_value = mul
+    a = nt.nodes.new("ShaderNodeMath")
+    a.operation = "ADD"
+    nt.links.new(m.outputs[0], a.inputs[0])
+    a.inputs[1].default_value = add
+    sock = next(s for s in node.inputs if s.identifier == identifier)
+    nt.links.new(a.outputs[0], sock)
+
+
+COLOR_NODES = {"blackbody": "ShaderNodeBlackbody", "wavelength": "ShaderNodeWavelength",
+               "bright_contrast": "ShaderNodeBrightContrast", "gamma": "ShaderNodeGamma",
+               "float_curve": "ShaderNodeFloatCurve"}
+
+
+def new_texture_node(nt, case, coords):
+    """Node and outputs of a pattern or colour case."""
     k = case["kind"]
+    if k == "checker":
+        n = nt.nodes.new("ShaderNodeTexChecker")
+        set_input_id(n, "Scale", case["scale"])
+        set_input_id(n, "Color1", case["c1"] + (1.0,))
+        set_input_id(n, "Color2", case["c2"] + (1.0,))
+        return n, {"fac": n.outputs["Fac"], "color": n.outputs["Color"]}
+    if k == "brick":
+        n = nt.nodes.new("ShaderNodeTexBrick")
+        for ident, key in (("Scale", "scale"), ("Mortar Size", "mortar_size"), ("Mortar Smooth", "mortar_smooth"),
+                           ("Bias", "bias"), ("Brick Width", "brick_width"), ("Row Height", "row_height")):
+            set_input_id(n, ident, case[key])
+        for ident, color in zip(("Color1", "Color2", "Mortar"), case["colors"]):
+            set_input_id(n, ident, color + (1.0,))
+        n.offset, n.offset_frequency = case["offset"], case["offset_frequency"]
+        n.squash, n.squash_frequency = case["squash"], case["squash_frequency"]
+        return n, {"fac": n.outputs["Fac"], "color": n.outputs["Color"]}
+    if k == "gradient":
+        n = nt.nodes.new("ShaderNodeTexGradient")
+        n.gradient_type = GRADIENT_TYPES[case["gtype"]]
+        return n, {"fac": n.outputs["Fac"], "color": n.outputs["Color"]}
+    if k == "magic":
+        n = nt.nodes.new("ShaderNodeTexMagic")
+        n.turbulence_depth = case["depth"]
+        set_input_id(n, "Scale", case["scale"])
+        set_input_id(n, "Distortion", case["distortion"])
+        return n, {"fac": n.outputs["Fac"], "color": n.outputs["Color"]}
+    if k == "white_noise":
+        n = nt.nodes.new("ShaderNodeTexWhiteNoise")
+        n.noise_dimensions = DIM_NAMES[case["dims"]]
+        return n, {"value": n.outputs["Value"], "color": n.outputs["Color"]}
+    if k == "gabor":
+        n = nt.nodes.new("ShaderNodeTexGabor")
+        n.gabor_type = "3D" if case["gtype"] else "2D"
+        for ident, key in (("Scale", "scale"), ("Frequency", "frequency"), ("Anisotropy", "anisotropy"),
+                           ("Orientation 2D", "o2"), ("Orientation 3D", "o3")):
+            set_input_id(n, ident, case[key])
+        combine = nt.nodes.new("ShaderNodeCombineXYZ")
+        for i, name in enumerate(("Value", "Phase", "Intensity")):
+            nt.links.new(n.outputs[name], combine.inputs[i])
+        return n, {"value,phase,intensity": combine.outputs[0]}
+    if k == "curves":
+        n = nt.nodes.new("ShaderNodeRGBCurve" if case["curve"] == "RGB" else "ShaderNodeVectorCurve")
+        set_curve(n.mapping, case["points"], case["extend"])
+        if case["curve"] == "RGB":
+            nt.links.new(coords, n.inputs["Color"])  # the Vector one is linked by build_scene
+    else:
+        n = nt.nodes.new(COLOR_NODES[k])
+        if k == "float_curve":
+            set_curve(n.mapping, case["points"], case["extend"])
+        if k in ("bright_contrast", "gamma"):
+            nt.links.new(coords, n.inputs["Color"])
+    for ident, value in case.get("const", {}).items():
+        set_input_id(n, ident, value)
+    for ident, (axis, mul, add) in case.get("drive", {}).items():
+        drive_input(nt, coords, n, ident, axis, mul, add)
+    key = "value" if k == "float_curve" else "color"
+    return n, {key: n.outputs[0]}
+
+
+def texture_node(nt, case, coords):
+    k = case["kind"]
+    if k in NEW_KINDS:
+        return new_texture_node(nt, case, coords)
     if k == "noise":
         n = nt.nodes.new("ShaderNodeTexNoise")
         n.noise_dimensions = DIM_NAMES[case["dims"]]
@@ -259,6 +531,9 @@ def tilted_quad(name):
 
 
 def build_scene(cases):
+    global COLS
+    # The camera's ortho scale spans the wider side of the image: keep it the width.
+    COLS = max(COLS, math.ceil(math.sqrt(len(cases))))
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     rows = (len(cases) + COLS - 1) // COLS
@@ -268,7 +543,7 @@ def build_scene(cases):
         mat, emission = ru.emission_material(f"case{i}")
         nt = mat.node_tree
         coords = nt.nodes.new("ShaderNodeTexCoord")
-        tex, outs = texture_node(nt, case)
+        tex, outs = texture_node(nt, case, coords.outputs["Object"])
         if available(tex.inputs, "Vector") is not None:
             nt.links.new(coords.outputs["Object"], tex.inputs["Vector"])
         if available(tex.inputs, "W") is not None:
@@ -399,6 +674,21 @@ def main():
     for img in images:
         covered &= img[..., 3] == 1.0
 
+    # What the add-on embeds in a program: curve tables, colour space matrices.
+    prefix = []
+    xyz_rows = NT.xyz_to_scene_rows()
+    for i, case in enumerate(cases):
+        if case["kind"] in ("curves", "float_curve"):
+            node = next(n for n in case["_material"].node_tree.nodes if hasattr(n, "mapping"))
+            case["_table"] = NT.curve_table(node.mapping, case["curve"], VERSION)
+            case["_table_id"] = i
+            values = case["_table"][3]
+            prefix.append(f"table {i} {len(values)} {gs(values)}")
+        elif case["kind"] == "wavelength":
+            case["_rows"] = xyz_rows
+        elif case["kind"] == "blackbody":
+            case["_rows"] = NT.rec709_to_scene_rows()
+
     failures = []
     # Sanity: the coordinate render is the Object coordinate of the pixel's
     # centre to well within a pixel (a wrong colour transform would show here).
@@ -421,11 +711,19 @@ def main():
         y = xyz[:, 1].astype(np.float32)
         z = xyz[:, 2].astype(np.float32)
         w = x if case.get("dims") == 1 else (x + y).astype(np.float32)  # the Math node's float add
+        driven = {}
+        for ident, (axis, mul, add) in case.get("drive", {}).items():
+            c = (x, y, z)[axis]
+            driven[ident] = ((c * np.float32(mul)).astype(np.float32) + np.float32(add)).astype(np.float32)
         for k in range(len(ys)):
-            lines.append(probe_line(case, float(x[k]), float(y[k]), float(z[k]), float(w[k])))
+            if case["kind"] in NEW_KINDS:
+                d = {ident: float(v[k]) for ident, v in driven.items()}
+                lines.append(new_probe_line(case, float(x[k]), float(y[k]), float(z[k]), float(w[k]), d))
+            else:
+                lines.append(probe_line(case, float(x[k]), float(y[k]), float(z[k]), float(w[k])))
         where.append((i, y0 + ys, x0 + xs))
     t_probe0 = time.time()
-    answers = run_probe(lines)
+    answers = run_probe(prefix + lines)[len(prefix):]
     t_probe = time.time() - t_probe0
 
     print(f"\nBlender {bpy.app.version_string} (version code {VERSION}): {len(cases)} cases, "

@@ -21,7 +21,7 @@ namespace {
 
 class MaterialProgramTest : public SharedRendererTest {};
 
-const char* kNoSurface = "void mp_node_surface(const MpNodeGlobals* g, MpSurfaceInputs* s) {}\n";
+const char* kNoSurface = "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {}\n";
 const char* kNoDisplacement = "float3 mp_node_displacement(const MpNodeGlobals* g) { return (float3)(0.0f); }\n";
 
 // A 6 x 6 plane at z = 0 facing a camera at z = 5 (45 degree field of view).
@@ -58,8 +58,8 @@ TEST_F(MaterialProgramTest, SurfaceProgramColorsByGeneratedCoordinates) {
   Scene s = facing_plane(static_cast<int>(Material::Model::Constant));
   s.material_programs.push_back(
       {"ramp", std::string(kNoDisplacement) +
-                   "void mp_node_surface(const MpNodeGlobals* g, MpSurfaceInputs* s) {"
-                   " s->base_color = (float3)(g->generated.x, 0.0f, 0.0f); }\n"});
+                   "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {"
+                   " mp_add_emission(s, (float3)(g->generated.x, 0.0f, 0.0f)); }\n"});
   s.materials[0].program_shades = true;
   RenderResult r = renderer_->render(s);
   // Generated x = (x + 3) / 6 across the plane's texture space (its bounding
@@ -98,8 +98,8 @@ void expect_affine_uv_colours(const RenderResult& r, const char* what) {
 
 TEST_F(MaterialProgramTest, SurfaceProgramReadsUVLayers) {
   const std::string program = std::string(kNoDisplacement) +
-                              "void mp_node_surface(const MpNodeGlobals* g, MpSurfaceInputs* s) {"
-                              " s->base_color = (float3)(g->uv[1].x, g->uv[1].y, 0.0f); }\n";
+                              "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {"
+                              " mp_add_emission(s, (float3)(g->uv[1].x, g->uv[1].y, 0.0f)); }\n";
   Scene s = facing_plane(static_cast<int>(Material::Model::Constant));
   s.meshes[0] = polygon({{-4, -3, 0}, {3, -4, 0}, {5, 1, 0}, {0, 4, 0}, {-5, 2, 0}});
   set_affine_uvs(s.meshes[0]);
@@ -134,9 +134,9 @@ TEST_F(MaterialProgramTest, ProgramsSurviveARibRoundTrip) {
 // index, which renders magenta.
 TEST_F(MaterialProgramTest, ImagesAreFilteredThenDecodedAndMissingOnesAreMagenta) {
   const std::string lookup =
-      "void mp_node_surface(const MpNodeGlobals* g, MpSurfaceInputs* s) {"
+      "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {"
       " float4 c = mp_tex_image(g->images, g->image_count, g->texels, INDEX, g->uv[0].x, 0.5f, 0, 1);"
-      " s->base_color = c.xyz; }\n";
+      " mp_add_emission(s, c.xyz); }\n";
   Scene s = facing_plane(static_cast<int>(Material::Model::Constant));
   std::vector<glm::vec2> uvs;
   for (int v : s.meshes[0].face_vertex_indices) uvs.push_back((glm::vec2(s.meshes[0].points[size_t(v)]) + 3.0f) / 6.0f);

@@ -144,7 +144,7 @@ TEST_F(OcclusionTest, DisplacedSurfacesRenderTheSame) {
        "float3 mp_node_displacement(const MpNodeGlobals* g) {\n"
        "  float h = 0.6f * sin(9.0f * g->P.x) * sin(7.0f * g->P.y);\n"
        "  return (float3)(0.0f, 0.0f, h);\n}\n"
-       "void mp_node_surface(const MpNodeGlobals* g, MpSurfaceInputs* s) {}\n"});
+       "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {}\n"});
   Material bumpy = colored({0.8f, 0.7f, 0.2f});
   bumpy.program = 0;
   bumpy.program_displaces = true;

@@ -116,6 +116,8 @@ void expect_same_material(const Material& a, const Material& b) {
       EXPECT_EQ(a.roughness, b.roughness);
       EXPECT_EQ(a.specular, b.specular);
       EXPECT_EQ(a.layered, b.layered);
+      EXPECT_EQ(a.retro_diffuse, b.retro_diffuse);
+      EXPECT_EQ(a.multiscatter, b.multiscatter);
       break;
   }
   EXPECT_EQ(a.program, b.program);
@@ -312,6 +314,7 @@ Scene full_scene() {
   Material principled = material("gold", Material::Model::Principled, {1.0f, 0.766f, 0.336f});
   principled.metallic = 0.9f, principled.roughness = 0.35f, principled.specular = 0.45f;
   principled.layered = true;
+  principled.multiscatter = true;
   principled.opacity = glm::vec3(0.75f);
   s.materials.push_back(principled);
   Material glow = material("glow", Material::Model::Constant, {0.2f, 0.3f, 0.4f});
@@ -466,10 +469,10 @@ Scene full_scene() {
       {"textured",
        "#include \"textures/mp_tex_image.h\"\n"
        "float3 mp_node_displacement(const MpNodeGlobals* g) { return (float3)(0.0f); }\n"
-       "void mp_node_surface(const MpNodeGlobals* g, MpSurfaceInputs* s) {\n"
+       "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {\n"
        "  float4 a = mp_tex_image(g->images, g->image_count, g->texels, 0, g->uv[0].x, g->uv[0].y, 0, 0);\n"
        "  float4 b = mp_tex_image(g->images, g->image_count, g->texels, 1, g->uv[1].x, g->uv[1].y, 1, 1);\n"
-       "  s->base_color = a.xyz * 0.6f + b.xyz * 0.2f + g->generated * 0.2f; }\n"});
+       "  mp_add_emission(s, a.xyz * 0.6f + b.xyz * 0.2f + g->generated * 0.2f); }\n"});
   Material textured = material("textured", Material::Model::Principled, glm::vec3(0.5f));
   textured.program = 0;
   textured.program_shades = true;

@@ -447,7 +447,7 @@ TEST_F(ShadowRenderTest, DisplacementMovesTheShadow) {
   Scene s = floor_scene(sun);
   s.material_programs.push_back(
       {"lift", "float3 mp_node_displacement(const MpNodeGlobals* g) { return (float3)(0.0f, 0.0f, 1.0f); }\n"
-               "void mp_node_surface(const MpNodeGlobals* g, MpSurfaceInputs* s) {}\n"});
+               "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {}\n"});
   Material lifted = s.materials[0];
   lifted.program = 0;
   lifted.program_displaces = true;

@@ -88,6 +88,11 @@ struct Material {
   // Principled only: Blender 4.0's layered Principled BSDF, whose diffuse
   // base lies under the specular layer and gets the light it lets through.
   bool layered = false;
+  // Principled only: the diffuse lobe is Disney's with retro-reflection
+  // (Blender 3.x's Principled BSDF) rather than Lambert (a Diffuse BSDF, or
+  // 4.x), and the glossy lobes compensate multiple scattering (Multiscatter GGX).
+  bool retro_diffuse = false;
+  bool multiscatter = false;
   glm::vec3 emission{0.0f};
   // A node tree compiled to a material program (Scene::material_programs),
   // or -1. The program may displace the surface (displacement_bound is then

@@ -30,6 +30,7 @@ DeviceMaterial to_device(const Material& m) {
   d.principled[0] = std::clamp(m.metallic, 0.0f, 1.0f);
   d.principled[1] = std::max(m.specular, 0.0f);
   d.principled[2] = m.layered ? 1.0f : 0.0f;
+  d.principled[3] = (m.retro_diffuse ? 1.0f : 0.0f) + (m.multiscatter ? 2.0f : 0.0f);
   d.program[0] = static_cast<float>(m.program);
   d.program[1] = m.program >= 0 && m.program_displaces ? 1.0f : 0.0f;
   d.program[2] = m.program >= 0 && m.program_shades ? 1.0f : 0.0f;

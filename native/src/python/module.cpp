@@ -272,9 +272,11 @@ PYBIND11_MODULE(_native, m) {
              std::vector<float> opacity, float ka, float kd, float ks, float roughness, std::vector<float> specular_color,
              std::vector<float> emission, float metallic, float specular, int program, bool program_displaces,
              bool program_shades, float displacement_bound, bool displacement_bound_world, bool program_alpha,
-             bool layered) {
+             bool layered, bool retro_diffuse, bool multiscatter) {
             Material mat;
             mat.layered = layered;
+            mat.retro_diffuse = retro_diffuse;
+            mat.multiscatter = multiscatter;
             mat.program_alpha = program_alpha;
             mat.displacement_bound_world = displacement_bound_world;
             mat.program = program;
@@ -303,7 +305,7 @@ PYBIND11_MODULE(_native, m) {
           py::arg("emission") = std::vector<float>{0, 0, 0}, py::arg("metallic") = 0.0f, py::arg("specular") = 0.5f,
           py::arg("program") = -1, py::arg("program_displaces") = false, py::arg("program_shades") = false,
           py::arg("displacement_bound") = 0.0f, py::arg("displacement_bound_world") = false,
-          py::arg("program_alpha") = false, py::arg("layered") = false,
+          py::arg("program_alpha") = false, py::arg("layered") = false, py::arg("retro_diffuse") = false, py::arg("multiscatter") = false,
           "Adds a material (constant, matte, plastic or principled; see scene.h); returns its index.")
       .def(
           "add_material_program",

@@ -63,7 +63,7 @@ std::vector<float> Parser::material_key(const Material& m) {
           m.metallic, m.specular, static_cast<float>(m.program), m.displacement_bound,
           static_cast<float>(m.program_displaces), static_cast<float>(m.program_shades),
           static_cast<float>(m.displacement_bound_world), static_cast<float>(m.program_alpha),
-          static_cast<float>(m.layered)};
+          static_cast<float>(m.layered), static_cast<float>(m.retro_diffuse), static_cast<float>(m.multiscatter)};
 }
 
 int Parser::material_index(const Attributes& attrs) {
@@ -131,8 +131,13 @@ void Parser::req_surface(ArgReader& args) {
     int layered = 0;
     params.get_int("layered", 0, 1, &layered);
     m.layered = layered != 0;
+    int retro = 0, multiscatter = 0;
+    params.get_int("retrodiffuse", 0, 1, &retro);
+    params.get_int("multiscatter", 0, 1, &multiscatter);
+    m.retro_diffuse = retro != 0;
+    m.multiscatter = multiscatter != 0;
     read_emission();
-    warn_unknown_params(params, {"metallic", "roughness", "specular", "layered", "emission"},
+    warn_unknown_params(params, {"metallic", "roughness", "specular", "layered", "retrodiffuse", "multiscatter", "emission"},
                         "Surface \"micropoly_principled\"", warn_param);
   } else {
     // plastic, and the fallback for any other shader with plastic's defaults.

@@ -425,6 +425,8 @@ void write_material(std::string& o, const Material& m, int index, const char* in
       param(o, "roughness", m.roughness);
       param(o, "float specular", m.specular);
       if (m.layered) param(o, "integer layered", static_cast<long long>(1));
+      if (m.retro_diffuse) param(o, "integer retrodiffuse", static_cast<long long>(1));
+      if (m.multiscatter) param(o, "integer multiscatter", static_cast<long long>(1));
       break;
   }
   // Emission is a Micropoly extension on every surface; omitted when black

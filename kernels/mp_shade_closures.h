@@ -1,0 +1,369 @@
+/* Lighting a sum of closures (mp_closures.h) at a grid vertex: every lamp
+ * with its shadow, the world's irradiance and its prefiltered glossy maps,
+ * the way mp_shade_bumped lights a Principled material, for each closure.
+ * Everything in camera space. Compiles as OpenCL C and C++. */
+#ifndef MP_SHADE_CLOSURES_H
+#define MP_SHADE_CLOSURES_H
+
+#include "mp_compat.h"
+#include "mp_bsdf.h"
+#include "mp_closures.h"
+#include "mp_principled.h"
+#include "mp_shading.h"
+
+/* A closure reads its normal slot as a diffuse lobe (the normal as it is,
+ * shadowed by the smooth surface) or as a glossy one (kept from reflecting
+ * below the surface). */
+MP_INLINE int mp_closure_is_glossy(int kind) {
+  return kind == MP_CLOSURE_GLOSSY || kind == MP_CLOSURE_REFRACTION || kind == MP_CLOSURE_TOON_GLOSSY ||
+         kind == MP_CLOSURE_CLEARCOAT || kind == MP_CLOSURE_PHONG;
+}
+
+/* The light a lamp gives a surface of normal n at p, as a factor of its
+ * colour (irradiance per unit colour); `l` is the direction to it. */
+MP_INLINE float mp_lamp_factor(MP_GLOBAL const DeviceLight* lt, int type, float3 p, float3 n, float3 to_light,
+                               float d2, float3* l) {
+  if (type == MP_LIGHT_AREA) return mp_area_irradiance(lt, p, n, l);
+  if (type == MP_LIGHT_DISTANT) return fmax(dot(n, *l), 0.0f);
+  if (lt->cone[3] > 0.0f) return mp_sized_light_factor(lt, to_light, d2, n);
+  return fmax(dot(n, *l), 0.0f) / d2;
+}
+
+/* The glossy closure's Fresnel term at the cosine c between the view and
+ * the half vector. */
+MP_INLINE float3 mp_closure_fresnel(const MpClosure* c, float cos_vh) {
+  float3 one = MP_F3(1.0f, 1.0f, 1.0f);
+  if (c->fresnel == MP_FRESNEL_SCHLICK) return c->f0 + (one - c->f0) * mp_schlick_weight(cos_vh);
+  if (c->fresnel == MP_FRESNEL_DIELECTRIC) return c->f82 * mp_fresnel_dielectric(cos_vh, c->f0.x);
+  if (c->fresnel == MP_FRESNEL_GENERALIZED) {
+    /* The dielectric curve of IOR f82.x remapped to run from f0 (a colour:
+     * its reflectance at normal incidence times the specular tint) to 1
+     * (Cycles' generalised Schlick with a negative exponent). */
+    float f0 = mp_f0_from_ior(c->f82.x);
+    float t = f0 < 1.0f ? clamp((mp_fresnel_dielectric(cos_vh, c->f82.x) - f0) / (1.0f - f0), 0.0f, 1.0f) : 1.0f;
+    return c->f0 + (one - c->f0) * t;
+  }
+  if (c->fresnel == MP_FRESNEL_F82) {
+    /* Hoffman's F82-tint: Schlick minus a term that dips at 82 degrees to
+     * f82 times Schlick's value there. */
+    const float mu82 = 1.0f / 7.0f;
+    float3 schlick82 = c->f0 + (one - c->f0) * mp_schlick_weight(mu82);
+    float denom = mu82 * 0.3348979f; /* (1 - mu82)^6 at mu82 = 1/7 */
+    float3 b = (schlick82 * (one - c->f82)) / denom;
+    float t = 1.0f - cos_vh, t6 = t * t * t;
+    t6 *= t6;
+    float3 f = c->f0 + (one - c->f0) * mp_schlick_weight(cos_vh) - b * (cos_vh * t6);
+    return MP_F3(clamp(f.x, 0.0f, 1.0f), clamp(f.y, 0.0f, 1.0f), clamp(f.z, 0.0f, 1.0f));
+  }
+  return one;
+}
+
+/* The glossy closure's directional albedo against the world, for the split
+ * sum: the Fresnel term at the view's cosine times the lobe's albedo
+ * (mp_ggx_albedo's table), with multiple scattering where asked (the single
+ * scattering albedo's missing energy, tinted by the Fresnel term). */
+MP_INLINE float3 mp_closure_glossy_albedo(const MpClosure* c, float nv) {
+  float r = sqrt(0.5f * (c->a + c->b));
+  float2 ab = mp_ggx_albedo(r, fmax(nv, 1e-4f));
+  float e = fmax(ab.x + ab.y, 1e-3f);
+  float3 albedo = MP_F3(e, e, e);
+  if (c->fresnel != MP_FRESNEL_NONE) {
+    /* Schlick's split: f0 a + b; for the exact and rescaled dielectric curves
+     * the same with their value at normal incidence. */
+    float3 f0 = c->fresnel == MP_FRESNEL_DIELECTRIC ? c->f82 * mp_f0_from_ior(c->f0.x) : c->f0;
+    float3 f90 = c->fresnel == MP_FRESNEL_DIELECTRIC ? c->f82 : MP_F3(1.0f, 1.0f, 1.0f);
+    albedo = f0 * ab.x + f90 * ab.y;
+  }
+  if (c->multiscatter) albedo = albedo * (1.0f + (1.0f - e) / e);
+  return albedo;
+}
+
+/* Multiple scattering's gain on a glossy lobe's single scattering (the
+ * same compensation, for lamps). */
+MP_INLINE float mp_closure_multiscatter(const MpClosure* c, float nv) {
+  if (!c->multiscatter) return 1.0f;
+  float r = sqrt(0.5f * (c->a + c->b));
+  float2 ab = mp_ggx_albedo(r, fmax(nv, 1e-4f));
+  return 1.0f / fmax(ab.x + ab.y, 1e-3f);
+}
+
+/* A sheen closure's lobe (f cos) and its directional albedo. */
+MP_INLINE float mp_sheen_albedo(const MpClosure* c, float nv) {
+  /* Principled 3.x: (1 - l.h)^5 nl integrated over the hemisphere is
+   * 0.0003 at normal view and grows towards grazing; Schlick's weight of
+   * the view stands in for that growth. The microfiber table stands in
+   * for the velvet lobe as well. */
+  if (c->fresnel == MP_SHEEN_PRINCIPLED_V1) return 0.0003f + 0.1f * mp_schlick_weight(nv);
+  return mp_microfiber_sheen_albedo(nv, c->a);
+}
+MP_INLINE float mp_closure_sheen(const MpClosure* c, float3 n, float3 l, float3 v) {
+  if (c->fresnel == MP_SHEEN_PRINCIPLED_V1) {
+    float3 h = normalize(l + v);
+    return mp_schlick_weight(fmax(dot(l, h), 0.0f)) * fmax(dot(n, l), 0.0f);
+  }
+  if (c->fresnel == MP_SHEEN_ASHIKHMIN) return mp_velvet(n, l, v, c->a);
+  return mp_microfiber_sheen(n, l, v, c->a);
+}
+
+/* The direction the view leaves a closed object refracting it (relative
+ * IOR ior; `back`: seen from inside): refracted in, and out again as
+ * through a sphere, whose far side bends the ray by as much again in the
+ * same sense; from inside, one interface. Also the share that passes:
+ * (1 - F) at each side for glass (fresnel), everything otherwise. Returns 0
+ * under total internal reflection. */
+MP_INLINE int mp_refracted_exit(float3 n, float3 v, float ior, int back, int fresnel, float3* out, float* through) {
+  float eta = back ? ior : 1.0f / ior;
+  float cos_i = dot(n, v), k2 = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
+  if (!(k2 > 0.0f)) return 0;
+  float3 d = -v, t = -eta * v + (eta * cos_i - sqrt(k2)) * n;
+  float fr = fresnel ? mp_fresnel_dielectric(cos_i, back ? 1.0f / ior : ior) : 0.0f;
+  *through = 1.0f - fr;
+  if (!back) {
+    float ct = clamp(dot(t, d), -1.0f, 1.0f);
+    float3 u = t - ct * d;
+    float ul = length(u);
+    if (ul > 1e-6f) {
+      float dev = acos(ct);
+      t = cos(2.0f * dev) * d + sin(2.0f * dev) * (u / ul);
+    }
+    *through *= 1.0f - fr;
+  }
+  *out = t;
+  return 1;
+}
+
+/* Outgoing radiance at p towards the viewer from surface s (camera space,
+ * normals already facing the viewer's side as ng does when `faced`). */
+MP_INLINE float3 mp_shade_closures(float3 p, float3 ng, int faced, int ortho, const MpSurface* s,
+                                   MP_GLOBAL const DeviceLight* lights, uint light_count,
+                                   MP_GLOBAL const float4* world_glossy, const MpShadowQuery* shadow) {
+  float3 zero = MP_F3(0.0f, 0.0f, 0.0f);
+  float3 v = ortho ? MP_F3(0.0f, 0.0f, 1.0f) : normalize(-p);
+  int back = !faced && dot(ng, v) < 0.0f;
+  float3 ngf = back ? -ng : ng;
+  /* Each slot's normals: nf for glossy lobes, nd for diffuse ones. */
+  float3 nf[MP_MAX_CLOSURE_NORMALS], nd[MP_MAX_CLOSURE_NORMALS];
+  int used = 0, backlit = 0;
+  for (int k = 0; k < s->normals; ++k) {
+    int mode = s->normal_mode[k];
+    float3 n = back ? -s->normal[k] : s->normal[k];
+    nd[k] = n;
+    nf[k] = mode >= MP_NORMAL_INPUT ? mp_valid_reflection_normal(ngf, v, n) : n;
+    if (mode == MP_NORMAL_INPUT) nd[k] = nf[k];
+  }
+  for (int i = 0; i < s->count; ++i) {
+    used |= 1 << s->c[i].slot;
+    if (s->c[i].kind == MP_CLOSURE_TRANSLUCENT) backlit |= 1 << s->c[i].slot;
+  }
+  float3 out = zero, ambient = zero;
+  MP_GLOBAL const DeviceLight* world = 0;
+  float3 mirror0 = 2.0f * dot(nf[0], v) * nf[0] - v;
+  /* Probes weigh towards the mirror direction by a power that narrows with
+   * the sharpest glossy lobe (the probes' soft shadows are as wide as their
+   * regions: a sharp lobe should read the one it points into). */
+  float sharp = 1.0f;
+  for (int i = 0; i < s->count; ++i)
+    if (s->c[i].kind == MP_CLOSURE_GLOSSY || s->c[i].kind == MP_CLOSURE_REFRACTION)
+      sharp = fmax(sharp, fmin(1.0f / fmax(s->c[i].kind == MP_CLOSURE_GLOSSY ? 0.5f * (s->c[i].a + s->c[i].b)
+                                                                              : s->c[i].a, 1e-3f), 32.0f));
+  uint probe_index[MP_WORLD_PROBE_LOOKUPS];
+  float probe_w[MP_WORLD_PROBE_LOOKUPS], probe_ws[MP_WORLD_PROBE_LOOKUPS], probe_wb[MP_WORLD_PROBE_LOOKUPS];
+  int probes = 0;
+  for (uint k = 0; k < light_count && s->count > 0; ++k) {
+    MP_GLOBAL const DeviceLight* lt = lights + k;
+    float3 cl = mp_light_f3(lt->color);
+    int type = (int)lt->color[3];
+    if (type == MP_LIGHT_AMBIENT) {
+      ambient += cl;
+      continue;
+    }
+    if (type == MP_LIGHT_ENVIRONMENT) world = lt;
+    if (type == MP_LIGHT_ENVIRONMENT || type == MP_LIGHT_ENVIRONMENT_DATA) continue;
+    if (type == MP_LIGHT_DISTANT && lt->axis_u[3] == MP_WORLD_PROBE) {
+      float3 lp = -mp_light_f3(lt->direction);
+      float w = (cl.x + cl.y + cl.z) * fmax(dot(nd[0], lp), 0.0f);
+      float ws = (cl.x + cl.y + cl.z) * MP_POWR(fmax(dot(mirror0, lp), 0.0f), sharp);
+      /* Translucent closures take light from behind. */
+      float wb = backlit ? (cl.x + cl.y + cl.z) * fmax(-dot(nd[0], lp), 0.0f) : 0.0f;
+      if (!(w + ws + wb > 0.0f)) continue;
+      int at = probes < MP_WORLD_PROBE_LOOKUPS ? probes++ : MP_WORLD_PROBE_LOOKUPS;
+      while (at > 0 && probe_w[at - 1] + probe_ws[at - 1] + probe_wb[at - 1] < w + ws + wb) {
+        if (at < MP_WORLD_PROBE_LOOKUPS)
+          probe_index[at] = probe_index[at - 1], probe_w[at] = probe_w[at - 1], probe_ws[at] = probe_ws[at - 1],
+          probe_wb[at] = probe_wb[at - 1];
+        --at;
+      }
+      if (at < MP_WORLD_PROBE_LOOKUPS) probe_index[at] = k, probe_w[at] = w, probe_ws[at] = ws, probe_wb[at] = wb;
+      continue;
+    }
+    float3 to_light = zero, l = zero;
+    float d2 = 1.0f;
+    if (type == MP_LIGHT_DISTANT)
+      l = -mp_light_f3(lt->direction);
+    else if (type != MP_LIGHT_AREA) {
+      to_light = mp_light_f3(lt->position) - p;
+      d2 = fmax(dot(to_light, to_light), 1e-20f);
+      l = to_light / sqrt(d2);
+      if (type == MP_LIGHT_SPOT) cl *= mp_spot_mask(lt, p);
+    }
+    float ef[MP_MAX_CLOSURE_NORMALS], ed[MP_MAX_CLOSURE_NORMALS], eb[MP_MAX_CLOSURE_NORMALS];
+    float any = 0.0f;
+    for (int j = 0; j < s->normals; ++j) {
+      ef[j] = ed[j] = eb[j] = 0.0f;
+      if (!(used & (1 << j))) continue;
+      ef[j] = mp_lamp_factor(lt, type, p, nf[j], to_light, d2, &l);
+      ed[j] = s->normal_mode[j] >= MP_NORMAL_INPUT_V4 ? mp_lamp_factor(lt, type, p, nd[j], to_light, d2, &l) : ef[j];
+      if (backlit & (1 << j)) eb[j] = mp_lamp_factor(lt, type, p, -nd[j], to_light, d2, &l);
+      any += ef[j] + ed[j] + eb[j];
+    }
+    if (!(any > 0.0f) || !(cl.x > 0.0f || cl.y > 0.0f || cl.z > 0.0f)) continue;
+    if (shadow) cl *= mp_shadow_visibility(shadow->maps, k, p, shadow->normal, shadow->footprint);
+    for (int i = 0; i < s->count; ++i) {
+      const MpClosure* c = &s->c[i];
+      int j = c->slot, mode = s->normal_mode[j];
+      float3 n = mp_closure_is_glossy(c->kind) ? nf[j] : nd[j];
+      float e = mp_closure_is_glossy(c->kind) ? ef[j] : ed[j];
+      float nl = dot(n, l);
+      /* A BSDF's own normal: its diffuse light shadowed by the surface. */
+      float shadowing = 1.0f;
+      if (!mp_closure_is_glossy(c->kind) && mode == MP_NORMAL_INPUT) shadowing = mp_bump_shadowing(ngf, n, l);
+      if (!mp_closure_is_glossy(c->kind) && mode >= MP_NORMAL_INPUT_V4)
+        shadowing = mp_bump_shadowing_v4(ngf, n, l, mode == MP_NORMAL_INPUT_V4);
+      float f = 0.0f; /* f cos / cos: the response per unit irradiance */
+      float3 tint = MP_F3(1.0f, 1.0f, 1.0f);
+      if (c->kind == MP_CLOSURE_TRANSLUCENT) {
+        out += c->weight * (cl * (eb[j] * (1.0f / MP_PI)));
+        continue;
+      }
+      if (!(e > 0.0f) || !(nl > 0.0f)) continue;
+      float nv = fmax(dot(n, v), 1e-6f);
+      if (c->kind == MP_CLOSURE_DIFFUSE)
+        f = c->fresnel ? mp_disney_diffuse(n, l, v, c->b) / nl
+            : c->a > 0.0f ? mp_oren_nayar(n, l, v, c->a) / nl : 1.0f / MP_PI;
+      else if (c->kind == MP_CLOSURE_SUBSURFACE)
+        f = 1.0f / MP_PI;
+      else if (c->kind == MP_CLOSURE_GLOSSY) {
+        float3 tx, ty;
+        mp_frame(n, c->tangent, &tx, &ty);
+        f = mp_ggx_reflect(n, tx, ty, l, v, c->a, c->b) * mp_closure_multiscatter(c, nv);
+        tint = mp_closure_fresnel(c, fmax(dot(v, normalize(l + v)), 0.0f));
+      } else if (c->kind == MP_CLOSURE_PHONG)
+        f = MP_POWR(fmax(dot(n, normalize(l + v)), 0.0f), 1.0f / fmax(c->a, 1e-4f)) / nl;
+      else if (c->kind == MP_CLOSURE_CLEARCOAT)
+        f = mp_clearcoat(n, l, v, c->a);
+      else if (c->kind == MP_CLOSURE_SHEEN)
+        f = mp_closure_sheen(c, n, l, v) / nl;
+      else if (c->kind == MP_CLOSURE_TOON_DIFFUSE)
+        f = mp_toon(nl, c->a, c->b) / nl;
+      else if (c->kind == MP_CLOSURE_TOON_GLOSSY)
+        f = mp_toon(dot(2.0f * dot(n, v) * n - v, l), c->a, c->b) / nl;
+      out += c->weight * tint * (cl * (e * f * shadowing));
+    }
+  }
+  /* The world: irradiance for diffuse lobes, the prefiltered maps for
+   * glossy ones, darkened by what its probes' shadows let through. */
+  float vis = 1.0f, vis_s = 1.0f, vis_b = 1.0f;
+  if (world) {
+    float lit = 0.0f, total = 0.0f, lit_s = 0.0f, total_s = 0.0f, lit_b = 0.0f, total_b = 0.0f;
+    for (int i = 0; i < probes; ++i) {
+      float pv = shadow ? mp_shadow_visibility(shadow->maps, probe_index[i], p, shadow->normal, shadow->footprint)
+                        : 1.0f;
+      total += probe_w[i], lit += probe_w[i] * pv;
+      total_s += probe_ws[i], lit_s += probe_ws[i] * pv;
+      total_b += probe_wb[i], lit_b += probe_wb[i] * pv;
+    }
+    vis_b = total_b > 0.0f ? lit_b / total_b : 1.0f;
+    vis = total > 0.0f ? lit / total : 1.0f;
+    vis_s = total_s > 0.0f ? lit_s / total_s : vis;
+  }
+  for (int i = 0; i < s->count; ++i) {
+    const MpClosure* c = &s->c[i];
+    int j = c->slot;
+    float3 n = mp_closure_is_glossy(c->kind) ? nf[j] : nd[j];
+    float nv = fmax(dot(n, v), 1e-4f);
+    float3 diffuse_world = zero, glossy_world = zero;
+    if (c->kind == MP_CLOSURE_GLOSSY || c->kind == MP_CLOSURE_TOON_GLOSSY || c->kind == MP_CLOSURE_CLEARCOAT) {
+      float3 r = 2.0f * dot(n, v) * n - v;
+      float rough = c->kind == MP_CLOSURE_TOON_GLOSSY ? sqrt(c->a) : sqrt(0.5f * (c->a + c->b));
+      float3 albedo = c->kind == MP_CLOSURE_TOON_GLOSSY ? MP_F3(1.0f, 1.0f, 1.0f) : mp_closure_glossy_albedo(c, nv);
+      if (world) glossy_world = mp_world_glossy(world_glossy, mp_env_to_world(world, r), rough) * (vis_s * world->color[1]);
+      out += c->weight * albedo * (glossy_world + ambient);
+    } else if (c->kind == MP_CLOSURE_REFRACTION) {
+      /* The world through the object, as environment-mapped refraction
+       * did before ray tracing (mp_refracted_exit). */
+      float3 t;
+      float through;
+      if (world && mp_refracted_exit(n, v, c->b, back, c->fresnel, &t, &through)) {
+        glossy_world = mp_world_glossy(world_glossy, mp_env_to_world(world, t), sqrt(c->a)) * world->color[1];
+        out += c->weight * through * glossy_world;
+      }
+    } else if (c->kind != MP_CLOSURE_PHONG) {
+      float3 dn = c->kind == MP_CLOSURE_TRANSLUCENT ? -n : n;
+      if (world)
+        diffuse_world = mp_env_irradiance(world, dn) * ((c->kind == MP_CLOSURE_TRANSLUCENT ? vis_b : vis) * world->color[0]);
+      float albedo = 1.0f;
+      if (c->kind == MP_CLOSURE_SHEEN) albedo = mp_sheen_albedo(c, nv);
+      out += (c->kind == MP_CLOSURE_DIFFUSE ? c->f0 : c->weight) * albedo * (diffuse_world + ambient);
+    }
+  }
+  return out + s->emission;
+}
+
+/* A material without a program (DeviceMaterial), as closures: Principled
+ * ones as those of their constant inputs (their opacity is the
+ * rasteriser's coverage); RenderMan's matte and plastic (RenderMan
+ * Interface Specification 3.2, appendix A) as a diffuse closure whose lamp
+ * light is Kd times the irradiance and whose ambient and world light is Ka
+ * times theirs, plus for plastic a Phong lobe of Ks times the specular
+ * colour; constant as its colour. */
+MP_INLINE float3 mp_shade_material(float3 p, float3 n, int faced, int ortho, const DeviceMaterial* m,
+                                   MP_GLOBAL const DeviceLight* lights, uint light_count,
+                                   MP_GLOBAL const float4* world_glossy, const MpShadowQuery* shadow) {
+  float3 zero = MP_F3(0.0f, 0.0f, 0.0f), one = MP_F3(1.0f, 1.0f, 1.0f);
+  float3 cs = MP_F3(m->color[0], m->color[1], m->color[2]);
+  float3 emission = MP_F3(m->emission[0], m->emission[1], m->emission[2]);
+  int model = (int)m->color[3];
+  if (model == MP_MODEL_CONSTANT) return cs + emission;
+  MpSurface s;
+  mp_surface_init(&s, n);
+  if (model != MP_MODEL_PRINCIPLED) {
+    MpClosure d = mp_closure(MP_CLOSURE_DIFFUSE, cs * (m->coeffs[1] * MP_PI), 0, 0.0f, 0.0f);
+    d.f0 = cs * m->coeffs[0];
+    mp_surface_add(&s, d);
+    if (model == MP_MODEL_PLASTIC)
+      mp_surface_add(&s, mp_closure(MP_CLOSURE_PHONG, MP_F3(m->specular[0], m->specular[1], m->specular[2]) *
+                                                          m->coeffs[2], 0, m->coeffs[3], 0.0f));
+    mp_add_emission(&s, emission);
+    return mp_shade_closures(p, n, faced, ortho, &s, lights, light_count, world_glossy, shadow);
+  }
+  float3 v = ortho ? MP_F3(0.0f, 0.0f, 1.0f) : normalize(-p);
+  MpPrincipled pr;
+  pr.base_color = cs;
+  pr.metallic = m->principled[0];
+  pr.roughness = m->coeffs[3];
+  pr.ior = 1.5f;
+  pr.alpha = 1.0f;
+  pr.specular = m->principled[1];
+  pr.specular_tint = m->principled[2] > 0.0f ? one : zero;
+  pr.anisotropy = pr.anisotropic_rotation = 0.0f;
+  pr.tangent = zero;
+  pr.transmission = pr.transmission_roughness = 0.0f;
+  pr.coat = pr.coat_roughness = 0.0f;
+  pr.coat_ior = 1.5f;
+  pr.coat_tint = one;
+  pr.sheen = pr.sheen_roughness = 0.0f;
+  pr.sheen_tint = one;
+  pr.subsurface = 0.0f;
+  pr.subsurface_color = zero;
+  pr.emission = emission;
+  pr.slot = pr.coat_slot = 0;
+  pr.nv = pr.coat_nv = fabs(dot(n, v));
+  pr.v4 = m->principled[2] > 0.0f;
+  int flags = (int)m->principled[3];
+  pr.retro = flags & 1;
+  pr.multiscatter = (flags >> 1) & 1;
+  mp_add_principled(&s, one, &pr, n);
+  return mp_shade_closures(p, n, faced, ortho, &s, lights, light_count, world_glossy, shadow);
+}
+
+#endif

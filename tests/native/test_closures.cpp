@@ -1,0 +1,199 @@
+// The closures' BSDFs (kernels/mp_bsdf.h), the Principled BSDF's layers
+// (kernels/mp_principled.h) and closure lighting (kernels/mp_shade_closures.h)
+// on the host, against quadrature and textbook identities.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "mp_compat.h"
+#include "mp_types.h"
+#include "mp_shade_closures.h"
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+float3 spherical(double theta, double phi) {
+  return MP_F3(float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)), float(std::cos(theta)));
+}
+
+// Integrates f(l) over the hemisphere about +z with a midpoint rule.
+template <class F>
+double hemisphere(F f, int n = 256) {
+  double sum = 0.0;
+  const double dt = 0.5 * kPi / n, dp = 2.0 * kPi / (2 * n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < 2 * n; ++j) {
+      const double t = (i + 0.5) * dt, p = (j + 0.5) * dp;
+      sum += f(spherical(t, p)) * std::sin(t) * dt * dp;
+    }
+  return sum;
+}
+
+// The unpolarised dielectric reflectance from Snell's law and the two
+// polarisations (Born & Wolf), a different route to mp_fresnel_dielectric's.
+double fresnel_reference(double cos_i, double eta) {
+  const double sin_t2 = (1.0 - cos_i * cos_i) / (eta * eta);
+  if (sin_t2 >= 1.0) return 1.0;
+  const double cos_t = std::sqrt(1.0 - sin_t2);
+  const double rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+  const double rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+  return 0.5 * (rs * rs + rp * rp);
+}
+
+TEST(Closures, DielectricFresnelMatchesSnellAndBornWolf) {
+  for (double eta : {1.1, 1.33, 1.5, 2.4, 1.0 / 1.5})
+    for (int k = 1; k <= 100; ++k) {
+      const double c = k / 100.0;
+      EXPECT_NEAR(mp_fresnel_dielectric(float(c), float(eta)), fresnel_reference(c, eta), 2e-5) << eta << " " << c;
+    }
+  EXPECT_NEAR(mp_fresnel_dielectric(1.0f, 1.5f), 0.04f, 1e-6f);
+  EXPECT_NEAR(mp_f0_from_ior(mp_ior_from_f0(0.08f)), 0.08f, 1e-6f);
+}
+
+// The anisotropic GGX distribution's projected area is one: int D (n.h) dh = 1.
+TEST(Closures, GgxDistributionIsNormalised) {
+  for (float ax : {0.05f, 0.2f, 0.6f})
+    for (float ay : {0.05f, 0.3f, 0.9f}) {
+      const double total = hemisphere([&](float3 h) { return double(mp_ggx_d(h, ax, ay)) * h.z; }, 512);
+      EXPECT_NEAR(total, 1.0, 0.02) << ax << " " << ay;
+    }
+}
+
+// GGX with height-correlated Smith shadowing reflects at most what arrives,
+// and nearly all of it while the lobe is narrow (white furnace).
+TEST(Closures, GgxReflectionConservesEnergy) {
+  const float3 n = MP_F3(0.0f, 0.0f, 1.0f), tx = MP_F3(1.0f, 0.0f, 0.0f), ty = MP_F3(0.0f, 1.0f, 0.0f);
+  for (float r : {0.2f, 0.5f, 1.0f})
+    for (float nv : {0.2f, 0.6f, 1.0f}) {
+      const float3 v = MP_F3(std::sqrt(1.0f - nv * nv), 0.0f, nv);
+      const float a = r * r;
+      const double e = hemisphere([&](float3 l) { return double(mp_ggx_reflect(n, tx, ty, l, v, a, a)) * l.z; }, 512);
+      EXPECT_LE(e, 1.01) << r << " " << nv;
+      if (r <= 0.2f && nv >= 0.6f) EXPECT_GT(e, 0.95) << r << " " << nv;
+      // The albedo table (scripts/ggx_albedo_table.py, integrating over half
+      // vectors) agrees with this quadrature of the kernel's lobe.
+      const float2 ab = mp_ggx_albedo(r, nv);
+      EXPECT_NEAR(e, ab.x + ab.y, 0.02) << r << " " << nv;
+    }
+}
+
+TEST(Closures, OrenNayarWithoutRoughnessIsLambert) {
+  const float3 n = MP_F3(0.0f, 0.0f, 1.0f), v = normalize(MP_F3(0.3f, 0.1f, 0.8f));
+  for (int k = 0; k < 50; ++k) {
+    const float3 l = spherical(1.5 * k / 50.0, 0.7 * k);
+    EXPECT_NEAR(mp_oren_nayar(n, l, v, 0.0f), l.z / kPi, 1e-6);
+  }
+  // Rough surfaces keep their albedo below one.
+  const double e = hemisphere([&](float3 l) { return double(mp_oren_nayar(n, l, v, 1.0f)); });
+  EXPECT_LT(e, 1.0);
+  EXPECT_GT(e, 0.7);
+}
+
+// A toon lobe with a hard edge reflects exactly what arrives within its cone.
+TEST(Closures, ToonIsNormalisedOverItsCone) {
+  for (float size : {0.2f, 0.5f, 0.9f}) {
+    const double e = hemisphere([&](float3 l) { return double(mp_toon(l.z, size, 0.0f)); }, 512);
+    EXPECT_NEAR(e, 1.0, 0.02) << size;
+  }
+}
+
+// The microfiber sheen's albedo table against quadrature of its lobe.
+TEST(Closures, MicrofiberSheenAlbedoTableMatchesItsLobe) {
+  const float3 n = MP_F3(0.0f, 0.0f, 1.0f);
+  for (float r : {0.25f, 0.5f, 1.0f})
+    for (float nv : {0.25f, 0.5f, 1.0f}) {
+      const float3 v = MP_F3(std::sqrt(1.0f - nv * nv), 0.0f, nv);
+      const double e = hemisphere([&](float3 l) { return double(mp_microfiber_sheen(n, l, v, r)); });
+      EXPECT_NEAR(mp_microfiber_sheen_albedo(nv, r), std::min(e, 1.0), 0.01) << r << " " << nv;
+    }
+}
+
+MpPrincipled principled_defaults() {
+  MpPrincipled p{};
+  p.base_color = MP_F3(0.8f, 0.8f, 0.8f);
+  p.roughness = 0.5f;
+  p.ior = 1.5f;
+  p.alpha = 1.0f;
+  p.specular = 0.5f;
+  p.specular_tint = MP_F3(1.0f, 1.0f, 1.0f);
+  p.coat_ior = 1.5f;
+  p.coat_tint = p.sheen_tint = MP_F3(1.0f, 1.0f, 1.0f);
+  p.nv = p.coat_nv = 1.0f;
+  p.v4 = 1;
+  p.retro = 0;
+  return p;
+}
+
+// Blender 4.x's layers: the diffuse base gets what the specular layer does
+// not reflect; metal replaces both; alpha moves weight to transparency.
+TEST(Closures, PrincipledLayersShareTheWeight) {
+  const float3 one = MP_F3(1.0f, 1.0f, 1.0f);
+  MpSurface s;
+  mp_surface_init(&s, MP_F3(0.0f, 0.0f, 1.0f));
+  MpPrincipled p = principled_defaults();
+  mp_add_principled(&s, one, &p, MP_F3(0.0f, 0.0f, 1.0f));
+  ASSERT_EQ(s.count, 2);
+  EXPECT_EQ(s.c[0].kind, MP_CLOSURE_GLOSSY);
+  EXPECT_EQ(s.c[1].kind, MP_CLOSURE_DIFFUSE);
+  const float below = 1.0f - mp_layer_albedo(MP_F3(0.04f, 0.04f, 0.04f), 0.5f, 1.0f).x;
+  EXPECT_NEAR(s.c[1].weight.x, 0.8f * below, 1e-5f);
+  EXPECT_GT(below, 0.9f);
+
+  mp_surface_init(&s, MP_F3(0.0f, 0.0f, 1.0f));
+  p.metallic = 1.0f;
+  mp_add_principled(&s, one, &p, MP_F3(0.0f, 0.0f, 1.0f));
+  ASSERT_EQ(s.count, 1);
+  EXPECT_EQ(s.c[0].fresnel, MP_FRESNEL_F82);
+
+  mp_surface_init(&s, MP_F3(0.0f, 0.0f, 1.0f));
+  p = principled_defaults();
+  p.alpha = 0.25f;
+  mp_add_principled(&s, one, &p, MP_F3(0.0f, 0.0f, 1.0f));
+  EXPECT_NEAR(mp_surface_alpha(&s), 0.25f, 1e-6f);
+  EXPECT_NEAR(s.c[0].weight.x, 0.25f, 1e-6f);
+}
+
+TEST(Closures, ClosuresPastTheLimitAreCountedAndZeroWeightsCostNothing) {
+  MpSurface s;
+  mp_surface_init(&s, MP_F3(0.0f, 0.0f, 1.0f));
+  mp_add_diffuse(&s, MP_F3(0.0f, 0.0f, 0.0f), 0, 0.0f);
+  EXPECT_EQ(s.count, 0);
+  for (int i = 0; i < MP_MAX_CLOSURES + 3; ++i) mp_add_diffuse(&s, MP_F3(0.1f, 0.1f, 0.1f), 0, 0.0f);
+  EXPECT_EQ(s.count, MP_MAX_CLOSURES);
+  EXPECT_EQ(s.dropped, 3);
+  // Equal normals share a slot; slots run out into the surface's.
+  const float3 a = MP_F3(0.0f, 1.0f, 0.0f), b = MP_F3(1.0f, 0.0f, 0.0f);
+  const int sa = mp_surface_normal_slot(&s, a, MP_NORMAL_INPUT_V4);
+  EXPECT_EQ(mp_surface_normal_slot(&s, a, MP_NORMAL_INPUT_V4), sa);
+  EXPECT_NE(mp_surface_normal_slot(&s, b, MP_NORMAL_INPUT_V4), sa);
+}
+
+// One closure of each kind lit by a distant light from the normal: each
+// gives its own lobe's response, and a Mix of two is the mix of their colours.
+TEST(Closures, ShadingSumsTheClosuresItIsGiven) {
+  DeviceLight sun{};
+  sun.color[0] = sun.color[1] = sun.color[2] = 3.0f;
+  sun.color[3] = float(MP_LIGHT_DISTANT);
+  sun.direction[2] = -1.0f;  // travelling down -z: light from +z
+  const float3 p = MP_F3(0.0f, 0.0f, -5.0f), n = MP_F3(0.0f, 0.0f, 1.0f);
+  auto shade = [&](const MpSurface& s) { return mp_shade_closures(p, n, 0, 0, &s, &sun, 1, nullptr, nullptr); };
+  MpSurface d;
+  mp_surface_init(&d, n);
+  mp_add_diffuse(&d, MP_F3(0.5f, 0.5f, 0.5f), 0, 0.0f);
+  EXPECT_NEAR(shade(d).x, 3.0 * 0.5 / kPi, 1e-5);
+  MpSurface t;
+  mp_surface_init(&t, n);
+  mp_add_translucent(&t, MP_F3(0.5f, 0.5f, 0.5f), 0);
+  EXPECT_NEAR(shade(t).x, 0.0, 1e-6);  // lit from the front only
+  MpSurface m;
+  mp_surface_init(&m, n);
+  mp_add_diffuse(&m, MP_F3(0.5f, 0.5f, 0.5f) * 0.25f, 0, 0.0f);
+  mp_add_emission(&m, MP_F3(0.2f, 0.0f, 0.0f) * 0.75f);
+  const float3 c = shade(m);
+  EXPECT_NEAR(c.x, 0.25 * 3.0 * 0.5 / kPi + 0.15, 1e-5);
+  EXPECT_NEAR(c.y, 0.25 * 3.0 * 0.5 / kPi, 1e-5);
+}
+
+}  // namespace
