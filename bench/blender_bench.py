@@ -41,10 +41,38 @@ SHADOWS = "--shadows" in args
 # --deep: the Suzannes in five rows one behind the other (30 of them, each
 # row hiding most of the next): high depth complexity.
 DEEP = "--deep" in args
+# --material mix|principled: every Suzanne wears a Mix Shader of a Diffuse
+# and a Glossy BSDF (factor 0.5), or a Principled BSDF of the same colour
+# (the closure benchmark: shade time of two closures against one Principled).
+MATERIAL = args[args.index("--material") + 1] if "--material" in args else None
 # --engines A,B: only these engines (default: Micropoly, Cycles and EEVEE).
 ENGINES = args[args.index("--engines") + 1].split(",") if "--engines" in args else None
 W, H = (480, 270) if QUICK else (1920, 1080)
 SAMPLES = 16
+
+
+def bench_material(mat, kind):
+    """Replaces the diffuse material's shader by a Mix(Diffuse, Glossy) or a Principled BSDF."""
+    nt = mat.node_tree
+    out = next(n for n in nt.nodes if n.type == "OUTPUT_MATERIAL")
+    old = out.inputs["Surface"].links[0].from_node
+    color = tuple(old.inputs["Color"].default_value)
+    nt.nodes.remove(old)
+    if kind == "principled":
+        p = nt.nodes.new("ShaderNodeBsdfPrincipled")
+        p.inputs["Base Color"].default_value = color
+        p.inputs["Roughness"].default_value = 0.3
+        nt.links.new(p.outputs[0], out.inputs["Surface"])
+        return
+    d = nt.nodes.new("ShaderNodeBsdfDiffuse")
+    d.inputs["Color"].default_value = color
+    g = nt.nodes.new("ShaderNodeBsdfGlossy")
+    g.inputs["Roughness"].default_value = 0.3
+    mix = nt.nodes.new("ShaderNodeMixShader")
+    mix.inputs[0].default_value = 0.5
+    nt.links.new(d.outputs[0], mix.inputs[1])
+    nt.links.new(g.outputs[0], mix.inputs[2])
+    nt.links.new(mix.outputs[0], out.inputs["Surface"])
 
 
 def build_scene():
@@ -59,6 +87,8 @@ def build_scene():
         mat = ru.diffuse_material(f"m{i}", (0.2 + 0.12 * (i % 6), 0.5, 0.8 - 0.1 * (i % 6)))
         if DISPLACED:
             ru.add_noise_displacement(mat, 4.0, 0.15)
+        if MATERIAL:
+            bench_material(mat, MATERIAL)
         obj.data.materials.append(mat)
     bpy.ops.mesh.primitive_plane_add(size=30.0, location=(0, 0, -1.0))
     for kind, energy, loc in (("SUN", 3.0, (3, -3, 6)), ("POINT", 1000.0, (-4, -4, 4)), ("AREA", 500.0, (0, -6, 5))):
@@ -206,7 +236,7 @@ def shadow_stats(scene):
 def main():
     if "--rib-only" in args:
         export_rib("shadow_suzannes" if SHADOWS else "displaced_suzannes" if DISPLACED else
-                   "deep_suzannes" if DEEP else "suzannes")
+                   "deep_suzannes" if DEEP else f"suzannes_{MATERIAL}" if MATERIAL else "suzannes")
         return
     if SHADOWS:
         shadow_bench()
