@@ -64,20 +64,21 @@ MP_INLINE void mp_frame(float3 n, float3 t, float3* x, float3* y) {
 }
 
 /* GGX reflection D G / (4 nl nv) with the height-correlated Smith term,
- * without Fresnel; nl, nv > 0 assumed. */
+ * without Fresnel; 0 unless both directions are above the surface. */
 MP_INLINE float mp_ggx_reflect(float3 n, float3 tx, float3 ty, float3 l, float3 v, float ax, float ay) {
   ax = fmax(ax, 1e-4f), ay = fmax(ay, 1e-4f);
   float3 h = normalize(l + v);
   float3 hl = MP_F3(dot(h, tx), dot(h, ty), dot(h, n));
   if (!(hl.z > 0.0f)) return 0.0f;
   float3 ll = MP_F3(dot(l, tx), dot(l, ty), dot(l, n)), vl = MP_F3(dot(v, tx), dot(v, ty), dot(v, n));
+  if (!(vl.z > 0.0f && ll.z > 0.0f)) return 0.0f;
   float g = 1.0f / (1.0f + mp_ggx_lambda(ll, ax, ay) + mp_ggx_lambda(vl, ax, ay));
   return mp_ggx_d(hl, ax, ay) * g / (4.0f * ll.z * vl.z);
 }
 
 /* Principled 3.x's clearcoat (Burley 2012): the GTR1 distribution of
  * alpha a, Smith shadowing of a GGX of fixed alpha 0.25 taken separately
- * for view and light, and the Fresnel term of IOR 1.5; f / cos. */
+ * for view and light, and the Fresnel term of IOR 1.5; f. */
 MP_INLINE float mp_clearcoat(float3 n, float3 l, float3 v, float a) {
   float nl = dot(n, l), nv = dot(n, v);
   if (!(nl > 0.0f && nv > 0.0f)) return 0.0f;

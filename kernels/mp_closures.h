@@ -26,13 +26,13 @@
 #define MP_CLOSURE_SHEEN 5        /* a = roughness; fresnel: MP_SHEEN_* */
 #define MP_CLOSURE_TOON_DIFFUSE 6 /* a = size, b = smooth */
 #define MP_CLOSURE_TOON_GLOSSY 7
-#define MP_CLOSURE_SUBSURFACE 8   /* diffusion approximated by wrapped Lambert, a = wrap */
+#define MP_CLOSURE_SUBSURFACE 8   /* diffusion approximated by Lambert */
 #define MP_CLOSURE_CLEARCOAT 9    /* Principled 3.x's clearcoat: GTR1, IOR 1.5; a = b = alpha */
 #define MP_CLOSURE_PHONG 10       /* RenderMan's plastic specular, (n.h)^(1/a) per unit irradiance */
 
 /* How a glossy closure's Fresnel term is computed. */
 #define MP_FRESNEL_NONE 0       /* weight as it is (Glossy BSDF) */
-#define MP_FRESNEL_SCHLICK 1    /* f0 + (1 - f0)(1 - cos)^5 (Principled before 4.0) */
+#define MP_FRESNEL_SCHLICK 1    /* f0 + (1 - f0)(1 - cos)^5 (Principled before 4.0, in place of its rescaled dielectric curve) */
 #define MP_FRESNEL_DIELECTRIC 2 /* exact dielectric of IOR f0.x, scaled by tint = f82 (weight) */
 #define MP_FRESNEL_F82 3        /* conductor: Schlick from f0 with Hoffman's F82 tint (Principled 4.x metal) */
 #define MP_FRESNEL_GENERALIZED 4 /* dielectric of IOR f82.x remapped to run from f0 (a colour) to 1 */
@@ -145,16 +145,16 @@ MP_INLINE void mp_add_diffuse(MpSurface* s, float3 w, int slot, float roughness)
 MP_INLINE void mp_add_translucent(MpSurface* s, float3 w, int slot) {
   mp_surface_add(s, mp_closure(MP_CLOSURE_TRANSLUCENT, mp_clamp_weight(w), slot, 0.0f, 0.0f));
 }
-MP_INLINE void mp_add_subsurface(MpSurface* s, float3 w, int slot, float wrap) {
-  mp_surface_add(s, mp_closure(MP_CLOSURE_SUBSURFACE, mp_clamp_weight(w), slot, clamp(wrap, 0.0f, 1.0f), 0.0f));
+MP_INLINE void mp_add_subsurface(MpSurface* s, float3 w, int slot) {
+  mp_surface_add(s, mp_closure(MP_CLOSURE_SUBSURFACE, mp_clamp_weight(w), slot, 0.0f, 0.0f));
 }
 MP_INLINE void mp_add_emission(MpSurface* s, float3 w) { s->emission += w; }
 MP_INLINE void mp_add_transparent(MpSurface* s, float3 w) { s->transparent += mp_clamp_weight(w); }
 
 /* GGX reflection of roughness r (alpha = r^2) stretched by anisotropy
  * along `tangent`, as Cycles' Glossy BSDF maps them (4.0 and later; 3.x's
- * Anisotropic BSDF the same): alpha_x = alpha / (1 - a), alpha_y =
- * alpha (1 - a) for a >= 0, and the other way round for a < 0. */
+ * Anisotropic BSDF the same): alpha_x = alpha (1 - a), alpha_y =
+ * alpha / (1 - a) for a >= 0, and alpha / (1 + a), alpha (1 + a) for a < 0. */
 MP_INLINE void mp_add_glossy(MpSurface* s, float3 w, int slot, float roughness, float anisotropy, float3 tangent,
                              int fresnel, float3 f0, float3 f82, int multiscatter) {
   float r = clamp(roughness, 0.0f, 1.0f);

@@ -32,7 +32,7 @@ typedef std::uint16_t ushort;
 typedef std::uint8_t uchar;
 #define MP_INLINE inline
 #define MP_GLOBAL
-#define MP_CONSTANT
+#define MP_CONSTANT inline constexpr
 #define MP_F2(x, y) (glm::vec2((x), (y)))
 #define MP_F3(x, y, z) (glm::vec3((x), (y), (z)))
 #define MP_F4(x, y, z, w) (glm::vec4((x), (y), (z), (w)))

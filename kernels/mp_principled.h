@@ -29,9 +29,18 @@ typedef struct {
   float nv, coat_nv;    /* cosines between the view and those normals */
   int v4, multiscatter;
   int retro;            /* 3.x: Disney's diffuse with retro-reflection (a Diffuse BSDF's is Lambert) */
+  float diffuse_roughness; /* 4.3 and later: Oren-Nayar's sigma for the diffuse base */
 } MpPrincipled;
 
 MP_INLINE float mp_luminance(float3 c) { return 0.212671f * c.x + 0.71516f * c.y + 0.072169f * c.z; }
+
+/* A conductor's reflectance at normal incidence from its IOR n and
+ * extinction k, per channel. */
+MP_INLINE float3 mp_conductor_f0(float3 n, float3 k) {
+  float3 one = MP_F3(1.0f, 1.0f, 1.0f);
+  float3 a = (n - one) * (n - one) + k * k, b = (n + one) * (n + one) + k * k;
+  return MP_F3(b.x > 0.0f ? a.x / b.x : 0.0f, b.y > 0.0f ? a.y / b.y : 0.0f, b.z > 0.0f ? a.z / b.z : 0.0f);
+}
 
 /* The tangent turned about normal n by a fraction `rotation` of a turn. */
 MP_INLINE float3 mp_rotate_tangent(float3 t, float3 n, float rotation) {
@@ -54,6 +63,22 @@ MP_INLINE float3 mp_layer_albedo(float3 f0, float roughness, float nv) {
 MP_INLINE float mp_below(float3 a) { return clamp(1.0f - fmax(a.x, fmax(a.y, a.z)), 0.0f, 1.0f); }
 
 MP_INLINE float3 mp_min3(float3 c, float m) { return MP_F3(fmin(c.x, m), fmin(c.y, m), fmin(c.z, m)); }
+
+/* A GGX lobe with the Principled BSDF's (and Metallic BSDF's) anisotropy:
+ * a in [0, 1], aspect sqrt(1 - 0.9 a), alpha_x = r^2 / aspect, alpha_y =
+ * r^2 aspect, along `tangent`. */
+MP_INLINE void mp_add_glossy_aspect(MpSurface* s, float3 w, int slot, float roughness, float anisotropy, float3 tangent,
+                                    int fresnel, float3 f0, float3 f82, int multiscatter) {
+  float r = clamp(roughness, 0.0f, 1.0f), r2 = r * r;
+  float an = clamp(anisotropy, 0.0f, 1.0f), aspect = sqrt(1.0f - 0.9f * an);
+  MpClosure c = mp_closure(MP_CLOSURE_GLOSSY, mp_clamp_weight(w), slot, r2 / aspect, r2 * aspect);
+  c.tangent = an > 0.0f ? tangent : MP_F3(0.0f, 0.0f, 0.0f);
+  c.fresnel = fresnel;
+  c.f0 = f0;
+  c.f82 = f82;
+  c.multiscatter = multiscatter;
+  mp_surface_add(s, c);
+}
 
 /* Blender 4.x, top to bottom: sheen, coat (with its tint), emission, metal,
  * glass, specular, then subsurface and diffuse. */
@@ -89,8 +114,8 @@ MP_INLINE void mp_add_principled_v4(MpSurface* s, float3 w, const MpPrincipled* 
   }
   mp_add_emission(s, w * p->emission);
   if (metallic > 1e-5f)
-    mp_add_glossy(s, w * metallic, p->slot, roughness, p->anisotropy, tangent, MP_FRESNEL_F82, base1,
-                  mp_min3(tint, 1.0f), p->multiscatter);
+    mp_add_glossy_aspect(s, w * metallic, p->slot, roughness, p->anisotropy, tangent, MP_FRESNEL_F82, base1,
+                         mp_min3(tint, 1.0f), p->multiscatter);
   w = w * (1.0f - metallic);
   float ior = fmax(p->ior, 1e-5f);
   if (transmission > 1e-5f) {
@@ -116,20 +141,13 @@ MP_INLINE void mp_add_principled_v4(MpSurface* s, float3 w, const MpPrincipled* 
   }
   if (eta != 1.0f) {
     float3 f0c = MP_F3(clamp(f0 * tint.x, 0.0f, 1.0f), clamp(f0 * tint.y, 0.0f, 1.0f), clamp(f0 * tint.z, 0.0f, 1.0f));
-    float r2 = roughness * roughness;
-    float an = clamp(p->anisotropy, 0.0f, 1.0f), aspect = sqrt(1.0f - 0.9f * an);
-    MpClosure c = mp_closure(MP_CLOSURE_GLOSSY, w, p->slot, r2 / aspect, r2 * aspect);
-    c.tangent = an > 0.0f ? tangent : zero;
-    c.fresnel = MP_FRESNEL_GENERALIZED;
-    c.f0 = f0c;
-    c.f82 = MP_F3(eta, 0.0f, 0.0f);
-    c.multiscatter = p->multiscatter;
-    mp_surface_add(s, c);
+    mp_add_glossy_aspect(s, w, p->slot, roughness, p->anisotropy, tangent, MP_FRESNEL_GENERALIZED, f0c,
+                         MP_F3(eta, 0.0f, 0.0f), p->multiscatter);
     w = w * mp_below(mp_layer_albedo(f0c, roughness, p->nv));
   }
   float sss = clamp(p->subsurface, 0.0f, 1.0f);
-  mp_add_subsurface(s, w * sss * base1, p->slot, 0.0f);
-  mp_add_diffuse(s, w * (1.0f - sss) * base, p->slot, 0.0f);
+  mp_add_subsurface(s, w * sss * base1, p->slot);
+  mp_add_diffuse(s, w * (1.0f - sss) * base, p->slot, p->diffuse_roughness);
 }
 
 MP_INLINE void mp_add_principled_v3(MpSurface* s, float3 w, const MpPrincipled* p, float3 normal) {

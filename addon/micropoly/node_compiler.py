@@ -17,6 +17,8 @@ import bpy
 from . import node_textures
 
 FLOAT, VEC = "float", "float3"
+# Closures a shading point holds (MP_MAX_CLOSURES, kernels/mp_closures.h).
+MAX_CLOSURES = 10
 
 MATH_OPS = ["ADD", "SUBTRACT", "MULTIPLY", "DIVIDE", "MULTIPLY_ADD", "POWER", "LOGARITHM", "SQRT", "INVERSE_SQRT",
             "ABSOLUTE", "EXPONENT", "MINIMUM", "MAXIMUM", "LESS_THAN", "GREATER_THAN", "SIGN", "COMPARE",
@@ -137,6 +139,7 @@ class NodeCompiler:
         self.groups = []           # the Group nodes whose trees are being compiled, outermost first
         self.world = False         # compiling a world (baked into a map) rather than a material
         self.transparent = False   # the surface has Transparent closures (its alpha can be below 1)
+        self.closures = 0          # closures the surface adds at most (MP_MAX_CLOSURES per vertex)
 
     # ---- helpers ----------------------------------------------------------
     def warn(self, node, what):
@@ -748,6 +751,9 @@ class NodeCompiler:
             self.shader_input(out, "Surface", "(float3)(1.0f)")
             return ""
         surf_src = self._function("void mp_node_surface(const MpNodeGlobals* g, MpSurface* s)", surface_body)
+        if self.closures > MAX_CLOSURES:
+            self.warnings.append(f"material '{self.material.name}': its shader tree can add up to {self.closures} "
+                                 f"closures at a point; past {MAX_CLOSURES} the last are left out")
         includes = "".join(f'#include "textures/{h}"\n' for h in sorted(self.headers))
         if self.uses_neighbours:
             includes = "#define MP_NODE_USES_NEIGHBOURS 1\n" + includes
@@ -783,6 +789,12 @@ class NodeCompiler:
         src, out = self._follow(socket)
         if src is None:
             return
+        if getattr(src, "mute", False):
+            # A muted node passes its first shader input through.
+            first = next((i for i, s in enumerate(src.inputs) if s.type == "SHADER"), None)
+            if first is not None:
+                self.shader_input(src, first, weight)
+            return
         if src.type == "GROUP_INPUT":
             if not self.groups:
                 return
@@ -809,12 +821,6 @@ class NodeCompiler:
                 self.shader_input(active[0], index, weight)
             finally:
                 self.groups.pop()
-            return
-        if getattr(src, "mute", False):
-            # A muted node passes its first shader input through.
-            first = next((i for i, s in enumerate(src.inputs) if s.type == "SHADER"), None)
-            if first is not None:
-                self.shader_input(src, first, weight)
             return
         self.emit_shader(src, weight)
 
@@ -868,6 +874,7 @@ class NodeCompiler:
             add(f"  mp_add_emission(s, {weight} * {self._c(node, 'Color')} * {self._f(node, 'Strength')});")
             return
         if t == "BSDF_PRINCIPLED":
+            self.closures += 5  # its most layers at once (coat, sheen, metal, glass, specular; diffuse replaces one)
             return self.emit_principled(node, weight)
         if t == "BSDF_TRANSPARENT":
             self.transparent = True
@@ -876,6 +883,7 @@ class NodeCompiler:
         if t == "HOLDOUT":
             self.warn(node, "is not supported (the rasteriser has no zero-alpha occluders); it adds nothing")
             return
+        self.closures += 2 if t == "BSDF_GLASS" else 1
         slot = self._normal_slot(node)
         color = self._c(node, "Color", "Base Color", default="(float3)(0.8f)")
         if t == "BSDF_DIFFUSE":
@@ -883,7 +891,7 @@ class NodeCompiler:
         elif t == "BSDF_TRANSLUCENT":
             add(f"  mp_add_translucent(s, {weight} * {color}, {slot});")
         elif t == "SUBSURFACE_SCATTERING":
-            add(f"  mp_add_subsurface(s, {weight} * {color}, {slot}, 0.0f);")
+            add(f"  mp_add_subsurface(s, {weight} * {color}, {slot});")
         elif t in ("BSDF_GLOSSY", "BSDF_ANISOTROPIC"):
             dist = getattr(node, "distribution", "GGX")
             if dist in ("BECKMANN", "ASHIKHMIN_SHIRLEY"):
@@ -916,13 +924,25 @@ class NodeCompiler:
             add(f"  mp_add_toon(s, {weight} * {color}, {slot}, {self._f(node, 'Size')}, {self._f(node, 'Smooth')}, "
                 f"{glossy});")
         elif t == "BSDF_METALLIC":
-            if getattr(node, "fresnel_type", "F82") != "F82":
-                self.warn(node, "the Physical Conductor Fresnel is shaded with F82 tint from its IOR's reflectance")
+            if getattr(node, "distribution", "GGX") == "BECKMANN":
+                self.warn(node, "the Beckmann distribution is shaded as GGX")
+            if getattr(node, "fresnel_type", "F82") == "F82":
+                f0 = f"mp_nl_clamp01_3({color})"
+                tint = f"mp_nl_clamp01_3({self._c(node, 'Edge Tint', default='(float3)(1.0f)')})"
+            else:
+                # Physical Conductor: its reflectance at normal incidence
+                # from IOR n and extinction k, ((n-1)^2 + k^2) / ((n+1)^2 + k^2),
+                # with no dip towards grazing.
+                self.warn(node, "the Physical Conductor Fresnel is shaded as F82 tint from its reflectance at "
+                                "normal incidence")
+                f0 = self.fn.temp(VEC, f"mp_conductor_f0({self._c(node, 'IOR')}, {self._c(node, 'Extinction')})")[0]
+                tint = "(float3)(1.0f)"
             aniso = self._f(node, "Anisotropy")
             tangent = self._tangent(node) if aniso != "0.0f" else "(float3)(0.0f)"
-            add(f"  mp_add_glossy(s, {weight}, {slot}, {self._f(node, 'Roughness')}, {aniso}, {tangent}, "
-                f"MP_FRESNEL_F82, {color}, {self._c(node, 'Edge Tint', default='(float3)(1.0f)')}, "
-                f"{1 if getattr(node, 'distribution', 'GGX') == 'MULTI_GGX' else 0});")
+            if tangent != "(float3)(0.0f)":
+                tangent = f"mp_rotate_tangent({tangent}, {self._slot_normal(slot)}, {self._f(node, 'Rotation')})"
+            add(f"  mp_add_glossy_aspect(s, {weight}, {slot}, {self._f(node, 'Roughness')}, {aniso}, {tangent}, "
+                f"MP_FRESNEL_F82, {f0}, {tint}, {1 if getattr(node, 'distribution', 'GGX') == 'MULTI_GGX' else 0});")
         else:
             # Anything else (hair, volumes, ray portals, shaders of newer
             # Blender): a diffuse of its Color input, and a warning.
@@ -946,9 +966,6 @@ class NodeCompiler:
             thin = node.inputs.get("Thin Film Thickness")
             if thin is not None and (thin.is_linked or float(thin.default_value) > 0.0):
                 self.warn(node, "Thin Film is not supported; it is left out")
-            if getattr(node, "subsurface_method", "RANDOM_WALK") and float(
-                    getattr(node.inputs.get("Subsurface Weight"), "default_value", 0.0)) > 0.0:
-                pass
         fields = {
             "base_color": c(node, "Base Color"), "metallic": f(node, "Metallic"), "roughness": f(node, "Roughness"),
             "ior": f(node, "IOR", default="1.45f"), "alpha": f(node, "Alpha", default="1.0f"),
@@ -965,6 +982,7 @@ class NodeCompiler:
             "sheen_tint": c(node, "Sheen Tint", default="(float3)(1.0f)") if v4
             else f"(float3)({f(node, 'Sheen Tint')})",
             "subsurface": f(node, "Subsurface Weight", "Subsurface"),
+            "diffuse_roughness": f(node, "Diffuse Roughness") if v4 else "0.0f",
             "subsurface_color": c(node, "Subsurface Color", default="(float3)(0.0f)"),
             "emission": f"{c(node, 'Emission Color', 'Emission')} * {f(node, 'Emission Strength', default='1.0f')}",
             "slot": slot, "coat_slot": coat_slot, "v4": "1" if v4 else "0", "retro": "0" if v4 else "1",
@@ -975,8 +993,8 @@ class NodeCompiler:
         add(f"  MpPrincipled {p};")
         for k, v in fields.items():
             add(f"  {p}.{k} = {v};")
-        add(f"  {p}.nv = mp_view_cos(g, {n});")
-        add(f"  {p}.coat_nv = mp_view_cos(g, {cn});")
+        add(f"  {p}.nv = fabs(mp_view_cos(g, {n}));")
+        add(f"  {p}.coat_nv = fabs(mp_view_cos(g, {cn}));")
         add(f"  mp_add_principled(s, {weight}, &{p}, {n});")
 
     def _normal_input_mode(self):
@@ -1012,7 +1030,7 @@ class NodeCompiler:
 # Principled inputs the constant material path (export_materials and
 # DeviceMaterial) has no room for: when unlinked at these values they add
 # nothing, otherwise the material needs a program.
-_PRINCIPLED_NEUTRAL = {"Subsurface Weight": 0.0, "Subsurface": 0.0, "Transmission Weight": 0.0,
+_PRINCIPLED_NEUTRAL = {"Diffuse Roughness": 0.0, "Subsurface Weight": 0.0, "Subsurface": 0.0, "Transmission Weight": 0.0,
                        "Transmission": 0.0, "Coat Weight": 0.0, "Clearcoat": 0.0, "Sheen Weight": 0.0, "Sheen": 0.0,
                        "Anisotropic": 0.0, "Thin Film Thickness": 0.0}
 

@@ -54,8 +54,9 @@ inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, f
   float3 vw = (float3)(mp_row3(o->to_world, 0, vo, 0.0f), mp_row3(o->to_world, 1, vo, 0.0f), mp_row3(o->to_world, 2, vo, 0.0f));
   float vl = length(vw);
   g.I = vl > 0.0f ? vw / vl : (float3)(0.0f, 0.0f, 1.0f);
-  g.ray_length = length(p);
+  g.ray_length = ortho ? -p.z : length(p);
   g.shadow_ray = 0;
+  g.backfacing = dot(n, v) < 0.0f;
   g.P = (float3)(mp_row3(o->to_object, 0, p, 1.0f), mp_row3(o->to_object, 1, p, 1.0f), mp_row3(o->to_object, 2, p, 1.0f));
   g.N = mp_camera_normal_to_object(o, n);
   g.object = o;
@@ -160,6 +161,10 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   MpProgramInputs in = MP_PROGRAM_INPUTS;
   __global const DeviceObject* o = objects + object;
   MpNodeGlobals g = mp_node_globals(o, p, n, &in, sp.patch, uv, f.ortho);
+  /* Smooth shading normals already face the viewer (shade.cl); w = 2 says
+   * the surface itself faced away. */
+  if (grid_n[index].w > 0.5f) g.backfacing = grid_n[index].w > 1.5f;
+  g.shadow_ray = alpha_only != 0;
 #ifdef MP_NODE_USES_NEIGHBOURS
   /* Bump nodes difference their heights towards the next grid vertex along
    * u and along v (the previous one on the grid's far border), a tenth of
@@ -180,7 +185,6 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   g.dx = &g_dx;
   g.dy = &g_dy;
 #endif
-  g.shadow_ray = alpha_only != 0;
   MpSurface s;
   mp_surface_init(&s, g.N);
   mp_node_surface(&g, &s);
@@ -233,6 +237,7 @@ float3 mp_world_radiance(float3 d, const MpProgramInputs* in) {
   g.I = -d;
   g.ray_length = 1e30f;
   g.shadow_ray = 0;
+  g.backfacing = 0;
   MpSurface s;
   mp_surface_init(&s, d);
   mp_node_surface(&g, &s);

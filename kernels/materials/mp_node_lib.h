@@ -25,6 +25,7 @@ typedef struct MpNodeGlobals {
   float3 I; /* unit direction towards the viewer, world space (Geometry > Incoming) */
   float ray_length; /* distance from the camera (Light Path > Ray Length) */
   int shadow_ray;   /* evaluated for a shadow map's transparency (Light Path > Is Shadow Ray) */
+  int backfacing;   /* the surface faces away from the viewer (Geometry > Backfacing) */
   float3 uv[MP_MAX_UV_LAYERS];
   MP_GLOBAL const DeviceObject* object; /* object <-> world (world-space nodes), or null */
   MP_GLOBAL const DeviceImage* images;
@@ -76,7 +77,7 @@ MP_INLINE float3 mp_radial_tangent(const MpNodeGlobals* g) {
 MP_INLINE float mp_view_cos(const MpNodeGlobals* g, float3 n) { return dot(mp_object_normal_to_world(g, n), g->I); }
 
 /* Whether the surface faces away from the viewer (Geometry > Backfacing). */
-MP_INLINE int mp_backfacing(const MpNodeGlobals* g) { return mp_view_cos(g, g->N) < 0.0f; }
+MP_INLINE int mp_backfacing(const MpNodeGlobals* g) { return g->backfacing; }
 
 /* Fresnel node: the dielectric reflectance of IOR ior (its inverse seen
  * from behind) at the view's angle to normal n. */

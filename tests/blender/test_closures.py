@@ -152,6 +152,12 @@ def m_principled_specular_tint(nt):
     return principled(nt, **{"Specular Tint": tint, "Roughness": 0.25, "Metallic": 0.3}).outputs[0]
 
 
+def m_metallic(nt):
+    m = node(nt, "ShaderNodeBsdfMetallic", **{"Base Color": rgba(0.9, 0.6, 0.2), "Edge Tint": rgba(1.0, 0.8, 0.6),
+                                              "Roughness": 0.3, "Anisotropy": 0.5})
+    return m.outputs[0]
+
+
 def m_translucent(nt):
     return node(nt, "ShaderNodeBsdfTranslucent", Color=rgba(0.3, 0.8, 0.3)).outputs[0]
 
@@ -379,6 +385,8 @@ CASES = {
     "principled_sheen": lambda: case_material("principled_sheen", m_principled_sheen),
     "principled_specular_tint": lambda: case_material("principled_specular_tint", m_principled_specular_tint),
     "translucent": lambda: case_material("translucent", m_translucent),
+    # The Metallic BSDF (F82 tint, anisotropy along the default tangent) came with 4.2.
+    "metallic": lambda: case_material("metallic", m_metallic) if VERSION >= 402 else report("metallic", [], "skipped: no Metallic BSDF before 4.2"),
     "toon_diffuse": lambda: case_material("toon_diffuse", m_toon("DIFFUSE")),
     "toon_glossy": lambda: case_material("toon_glossy", m_toon("GLOSSY")),
     "leaf": case_leaf,

@@ -123,6 +123,7 @@ MpPrincipled principled_defaults() {
   p.nv = p.coat_nv = 1.0f;
   p.v4 = 1;
   p.retro = 0;
+  p.diffuse_roughness = 0.0f;
   return p;
 }
 
