@@ -1,10 +1,12 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Blender materials -> native Principled materials.
+"""Blender materials -> native materials.
 
-The node connected to the active Material Output's Surface socket decides:
-Principled BSDF (its Alpha as opacity) and Diffuse BSDF give their constant inputs, an Emission
-shader gives emission; anything else falls back to the material's viewport
-color, metallic and roughness."""
+The node connected to the active Material Output's Surface socket decides
+the constant material: Principled BSDF (its Alpha as opacity) and Diffuse
+BSDF give their constant inputs, an Emission shader gives emission; other
+shader trees are material programs (node_compiler), whose closures replace
+the constant material's shading; a material without a Surface link uses its
+viewport color, metallic and roughness."""
 
 from . import export_images, node_compiler
 
@@ -22,8 +24,7 @@ def _input(node, *names, default=None):
 
 def _surface_node(material):
     out = node_compiler.active_output(material)
-    links = out.inputs["Surface"].links if out is not None else ()
-    return links[0].from_node if links else None
+    return node_compiler.linked_from(out.inputs["Surface"])[0] if out is not None else None
 
 
 def material_parameters(material):

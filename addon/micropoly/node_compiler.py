@@ -762,23 +762,12 @@ class NodeCompiler:
                                 alpha=self.transparent)
 
     # ---- shader trees -> closures ------------------------------------------------
-    def _follow(self, socket):
-        """(node, output socket) linked into `socket` past reroutes and muted
-        links, or (None, None)."""
-        link = next((l for l in socket.links if getattr(l, "is_valid", True) and not getattr(l, "is_muted", False)),
-                    None)
-        if link is None:
-            return None, None
-        node, out = link.from_node, link.from_socket
-        while node is not None and node.type == "REROUTE":
-            inner = [l for l in node.inputs[0].links if not getattr(l, "is_muted", False)]
-            if not inner:
-                return None, None
-            node, out = inner[0].from_node, inner[0].from_socket
-        return node, out
+    @staticmethod
+    def _follow(socket):
+        return linked_from(socket)
 
     def _linked_node(self, socket):
-        return self._follow(socket)[0]
+        return linked_from(socket)[0]
 
     def shader_input(self, node, key, weight):
         """Adds the closures of the shader linked into node.inputs[key],
@@ -1058,6 +1047,22 @@ def _constant_shader(node):
         elif float(tint.default_value) != 0.0:
             return False
     return True
+
+
+def linked_from(socket):
+    """(node, output socket) linked into `socket` past reroutes and muted
+    links, or (None, None)."""
+    link = next((l for l in socket.links if getattr(l, "is_valid", True) and not getattr(l, "is_muted", False)),
+                None)
+    if link is None:
+        return None, None
+    node, out = link.from_node, link.from_socket
+    while node is not None and node.type == "REROUTE":
+        inner = [l for l in node.inputs[0].links if not getattr(l, "is_muted", False)]
+        if not inner:
+            return None, None
+        node, out = inner[0].from_node, inner[0].from_socket
+    return node, out
 
 
 def active_output(material):

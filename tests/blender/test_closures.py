@@ -158,6 +158,14 @@ def m_metallic(nt):
     return m.outputs[0]
 
 
+def m_rerouted_principled(nt):
+    """A constant Principled BSDF reaching the output through a reroute."""
+    p = principled(nt, **{"Base Color": rgba(0.2, 0.5, 0.3), "Roughness": 0.35})
+    reroute = nt.nodes.new("NodeReroute")
+    nt.links.new(p.outputs[0], reroute.inputs[0])
+    return reroute.outputs[0]
+
+
 def m_translucent(nt):
     return node(nt, "ShaderNodeBsdfTranslucent", Color=rgba(0.3, 0.8, 0.3)).outputs[0]
 
@@ -385,6 +393,7 @@ CASES = {
     "principled_sheen": lambda: case_material("principled_sheen", m_principled_sheen),
     "principled_specular_tint": lambda: case_material("principled_specular_tint", m_principled_specular_tint),
     "translucent": lambda: case_material("translucent", m_translucent),
+    "rerouted_principled": lambda: case_material("rerouted_principled", m_rerouted_principled),
     # The Metallic BSDF (F82 tint, anisotropy along the default tangent) came with 4.2.
     "metallic": lambda: case_material("metallic", m_metallic) if VERSION >= 402 else report("metallic", [], "skipped: no Metallic BSDF before 4.2"),
     "toon_diffuse": lambda: case_material("toon_diffuse", m_toon("DIFFUSE")),
