@@ -94,6 +94,16 @@ class MaterialTable:
             return -1, -1
         return tuple(self.uv_layer(("tangent", name, k)) for k in (0, 1))
 
+    def attribute_layers(self, name):
+        """Two layers holding attribute `name`'s RGBA per face corner ("":
+        the active render color attribute; export_mesh), or (-1, -1) when
+        the layers run out."""
+        if len(self.uv_names) + sum(("attribute", name, k) not in self.uv_names for k in (0, 1)) > MAX_UV_LAYERS:
+            self.warnings.append(f"more than {MAX_UV_LAYERS} UV layers and attributes are used; attribute "
+                                 f"'{name or 'the active color attribute'}' reads zero")
+            return -1, -1
+        return tuple(self.uv_layer(("attribute", name, k)) for k in (0, 1))
+
     def image(self, image, warn):
         return self.images.get(image, warn)
 

@@ -146,14 +146,66 @@ def _tangents(mesh, layer, n_loops, counts):
     return out
 
 
+def _attribute_corners(mesh, name, n_loops):
+    """(n_loops, 4) per face corner: attribute `name` ("" the active render
+    color attribute) as RGBA (a float as (x, x, x, 1), a vector as (x, y, z, 1)),
+    from the point, corner or face domain; None if the mesh lacks it."""
+    attrs = getattr(mesh, "attributes", None)
+    if attrs is None:
+        return None
+    if not name:
+        colors = getattr(mesh, "color_attributes", None)
+        if colors is None or not len(colors):
+            return None
+        index = getattr(colors, "render_color_index", getattr(colors, "active_color_index", 0))
+        layer = colors[index] if 0 <= index < len(colors) else colors[0]
+    else:
+        layer = attrs.get(name)
+    if layer is None or layer.domain not in ("POINT", "CORNER", "FACE"):
+        return None
+    sizes = {"FLOAT_COLOR": ("color", 4), "BYTE_COLOR": ("color", 4), "FLOAT_VECTOR": ("vector", 3),
+             "FLOAT2": ("vector", 2), "FLOAT": ("value", 1), "INT": ("value", 1), "BOOLEAN": ("value", 1)}
+    if layer.data_type not in sizes:
+        return None
+    prop, size = sizes[layer.data_type]
+    count = len(layer.data)
+    flat = np.empty(count * size, dtype=np.float32 if layer.data_type not in ("INT", "BOOLEAN") else
+                    (np.int32 if layer.data_type == "INT" else bool))
+    layer.data.foreach_get(prop, flat)
+    values = flat.astype(np.float32).reshape(count, size)
+    rgba = np.zeros((count, 4), dtype=np.float32)
+    rgba[:, 3] = 1.0
+    if size == 1:
+        rgba[:, :3] = values
+    else:
+        rgba[:, :size] = values
+    if layer.domain == "CORNER":
+        return rgba
+    if layer.domain == "POINT":
+        vertex = np.empty(n_loops, dtype=np.int32)
+        mesh.loops.foreach_get("vertex_index", vertex)
+        return rgba[vertex]
+    counts = np.empty(len(mesh.polygons), dtype=np.int32)
+    mesh.polygons.foreach_get("loop_total", counts)
+    return np.repeat(rgba, counts, axis=0)
+
+
 def _uv_layers(mesh, names, n_loops, counts):
     """(len(names), n_loops, 2) per face corner: a name is a UV map ("" the
-    active render one), or ("tangent", map, k) for half k of that map's
-    tangents (xy, then z and the bitangent sign). A map the mesh lacks reads
-    zero, as in Cycles."""
+    active render one), ("tangent", map, k) for half k of that map's
+    tangents (xy, then z and the bitangent sign), or ("attribute", name, k)
+    for half k of an attribute's RGBA (_attribute_corners). A map or
+    attribute the mesh lacks reads zero, as in Cycles."""
     out = np.zeros((len(names), n_loops, 2), dtype=np.float32)
     tangents = {}
+    attributes = {}
     for k, name in enumerate(names):
+        if isinstance(name, tuple) and name[0] == "attribute":
+            if name[1] not in attributes:
+                attributes[name[1]] = _attribute_corners(mesh, name[1], n_loops)
+            if attributes[name[1]] is not None:
+                out[k] = attributes[name[1]][:, 2 * name[2]:2 * name[2] + 2]
+            continue
         if isinstance(name, tuple):
             layer = _uv_layer(mesh, name[1])
             if layer is None:

@@ -114,6 +114,9 @@ class NoResources:
     def tangent_layers(self, name):
         return -1, -1
 
+    def attribute_layers(self, name):
+        return -1, -1
+
     def image(self, image, warn):
         return -1, False
 
@@ -317,6 +320,8 @@ class NodeCompiler:
             fresnel = fn.temp(FLOAT, f"mp_layer_weight(g, {self.input(node, 'Blend', FLOAT)[0]}, {n}, &{facing[0]})",
                               (0.0, 1.0))
             return {"Fresnel": fresnel, "Facing": facing}
+        if t in ("ATTRIBUTE", "VERTEX_COLOR"):
+            return self.emit_attribute(node)
         if t == "LIGHT_PATH":
             return self.emit_light_path(node)
         if t == "OBJECT_INFO":
@@ -425,6 +430,26 @@ class NodeCompiler:
         return {"Position": ("mp_world_position(g)", VEC, None), "Normal": ("g->N", VEC, None),
                 "True Normal": ("g->N", VEC, None), "Incoming": ("mp_world_dir_to_object(g, g->I)", VEC, None),
                 "Tangent": ("normalize(mp_radial_tangent(g))", VEC, None), "Backfacing": backfacing}
+
+    def emit_attribute(self, node):
+        """Attribute (Geometry type) and Color Attribute: a mesh attribute's
+        value per face corner, interpolated over the surface as UVs are
+        (two layers: RG and BA)."""
+        if node.type == "VERTEX_COLOR":
+            name = node.layer_name
+        else:
+            if getattr(node, "attribute_type", "GEOMETRY") != "GEOMETRY":
+                self.warn(node, f"{node.attribute_type.title()} attributes are not supported; it gives zero")
+                return {}
+            name = node.attribute_name
+        ka, kb = self.resources.attribute_layers(name)
+        if ka < 0:
+            return {}
+        rgba = self.fn.temp("float4", f"(float4)(g->uv[{ka}].x, g->uv[{ka}].y, g->uv[{kb}].x, g->uv[{kb}].y)")[0]
+        color = (f"{rgba}.xyz", VEC, None)
+        # Fac: a float attribute's value, a colour's or vector's average (Cycles).
+        return {"Color": color, "Vector": color, "Fac": (f"dot({rgba}.xyz, (float3)(1.0f / 3.0f))", FLOAT, None),
+                "Alpha": (f"{rgba}.w", FLOAT, None)}
 
     def emit_light_path(self, node):
         """Light Path: what a camera ray shading direct light sees (every

@@ -381,6 +381,55 @@ def case_unsupported_warning():
     return report("unsupported_warning", failures, f"{len(warnings)} warnings")
 
 
+def case_attributes():
+    """A grid whose colour comes from a point colour attribute (Color
+    Attribute node) mixed by a float attribute (Attribute node) into a
+    Diffuse BSDF; a grey in their place must fail."""
+    def build(nt):
+        col = nt.nodes.new("ShaderNodeVertexColor")
+        col.layer_name = "paint"
+        weight = nt.nodes.new("ShaderNodeAttribute")
+        weight.attribute_name = "weight"
+        mix = nt.nodes.new("ShaderNodeMixRGB")
+        mix.inputs["Color2"].default_value = rgba(0.1, 0.2, 0.8)
+        nt.links.new(weight.outputs["Fac"], mix.inputs["Fac"])
+        nt.links.new(col.outputs["Color"], mix.inputs["Color1"])
+        d = node(nt, "ShaderNodeBsdfDiffuse")
+        nt.links.new(mix.outputs["Color"], d.inputs["Color"])
+        return d.outputs[0]
+    scene = scene_with("attributes", build, floor=False)
+    mat = bpy.data.materials["attributes"]
+    bpy.data.objects.remove(next(o for o in scene.objects if o.name.startswith("Suzanne")))
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=24, y_subdivisions=24, size=4.0, location=(0.0, 0.0, -0.3),
+                                    rotation=(math.radians(60), 0.0, 0.0))
+    obj = bpy.context.object
+    obj.data.materials.append(mat)
+    mesh = obj.data
+    co = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+    mesh.vertices.foreach_get("co", co)
+    co = co.reshape(-1, 3)
+    paint = mesh.attributes.new("paint", "FLOAT_COLOR", "POINT")
+    colors = np.stack([0.5 + 0.4 * np.sin(2.0 * co[:, 0]), 0.5 + 0.4 * np.cos(1.5 * co[:, 1]),
+                       np.full(len(co), 0.3), np.ones(len(co))], -1).astype(np.float32)
+    paint.data.foreach_set("color", colors.reshape(-1))
+    weight = mesh.attributes.new("weight", "FLOAT", "POINT")
+    weight.data.foreach_set("value", np.clip(0.5 + 0.25 * co[:, 0], 0.0, 1.0).astype(np.float32))
+    cycles, micro = render_pair(scene, "attributes")
+    db, covered = covered_psnr(cycles, micro)
+    mesh.attributes.remove(mesh.attributes["paint"])
+    mesh.attributes.remove(mesh.attributes["weight"])
+    wrong = ru.render_passes(scene, "MICROPOLY", W, H, samples=16)["rgba"]
+    db_wrong, _ = covered_psnr(cycles, wrong)
+    failures = []
+    if db < 30.0:
+        failures.append(f"PSNR {db:.2f} dB < 30")
+    if db_wrong >= 30.0:
+        failures.append(f"without the attributes Micropoly still reaches {db_wrong:.2f} dB: the case cannot tell")
+    if covered < 0.3 * W * H:
+        failures.append(f"only {covered} covered pixels")
+    return report("attributes", failures, f"PSNR {db:.2f} dB over {covered} px, without the attributes {db_wrong:.2f} dB")
+
+
 CASES = {
     "mix_diffuse_glossy": lambda: case_material("mix_diffuse_glossy", m_mix_diffuse_glossy),
     "add_diffuse_emission": lambda: case_material("add_diffuse_emission", m_add_diffuse_emission, emissive=True),
@@ -402,6 +451,7 @@ CASES = {
     "glass": lambda: case_through_glass("glass", m_glass),
     "refraction": lambda: case_through_glass("refraction", m_refraction),
     "unsupported_warning": case_unsupported_warning,
+    "attributes": case_attributes,
 }
 
 
