@@ -17,6 +17,7 @@
  * precision, where PoCL's pow and powr go through double-precision log and
  * exp (a fifth of a diffuse-and-plastic frame's time on the CPU). */
 #define MP_POWR(x, y) exp2((y) * log2(x))
+#define MP_FMOD(x, y) fmod((x), (y))
 #else
 #include <cmath>
 #include <cstdint>
@@ -38,6 +39,7 @@ typedef std::uint8_t uchar;
 #define MP_F4(x, y, z, w) (glm::vec4((x), (y), (z), (w)))
 #define MP_XYZ(v) (glm::vec3(v))
 #define MP_POWR(x, y) (std::pow((x), (y)))
+#define MP_FMOD(x, y) (std::fmod((x), (y)))
 namespace mp_compat {
 inline float dot(glm::vec3 a, glm::vec3 b) { return glm::dot(a, b); }
 inline glm::vec3 cross(glm::vec3 a, glm::vec3 b) { return glm::cross(a, b); }

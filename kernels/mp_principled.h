@@ -1,5 +1,5 @@
 /* The Principled BSDF as the closures Cycles splits it into (mp_closures.h),
- * in Blender 4.x's layered form (v4 = 1: coat over sheen over metal,
+ * in Blender 4.x's layered form (v4 = 1: sheen over coat over metal,
  * glass, specular and diffuse, each layer passing down what its albedo
  * leaves) or 3.x's (v4 = 0: the Disney weights). Compiles as OpenCL C and C++. */
 #ifndef MP_PRINCIPLED_H

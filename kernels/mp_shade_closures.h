@@ -1,7 +1,7 @@
 /* Lighting a sum of closures (mp_closures.h) at a grid vertex: every lamp
- * with its shadow, the world's irradiance and its prefiltered glossy maps,
- * the way mp_shade_bumped lights a Principled material, for each closure.
- * Everything in camera space. Compiles as OpenCL C and C++. */
+ * with its shadow, and the world's irradiance and prefiltered glossy maps
+ * with its probes' shadows, for each closure. Everything in camera space.
+ * Compiles as OpenCL C and C++. */
 #ifndef MP_SHADE_CLOSURES_H
 #define MP_SHADE_CLOSURES_H
 
@@ -60,10 +60,19 @@ MP_INLINE float3 mp_closure_fresnel(const MpClosure* c, float cos_vh, int back) 
   return one;
 }
 
+/* Multiple scattering's gain on a glossy lobe of single scattering: 1 / E,
+ * E its albedo for a Fresnel term of 1 (the energy compensation Cycles
+ * applies to Multiscatter GGX, without its Fresnel-tinted share). */
+MP_INLINE float mp_closure_multiscatter(const MpClosure* c, float nv) {
+  if (!c->multiscatter) return 1.0f;
+  float r = sqrt(0.5f * (c->a + c->b));
+  float2 ab = mp_ggx_albedo(r, fmax(nv, 1e-4f));
+  return 1.0f / fmax(ab.x + ab.y, 1e-3f);
+}
+
 /* The glossy closure's directional albedo against the world, for the split
- * sum: the Fresnel term at the view's cosine times the lobe's albedo
- * (mp_ggx_albedo's table), with multiple scattering where asked (the single
- * scattering albedo's missing energy, tinted by the Fresnel term). */
+ * sum: the lobe's albedo split for the Fresnel term (mp_ggx_albedo's
+ * table), with multiple scattering's gain where asked. */
 MP_INLINE float3 mp_closure_glossy_albedo(const MpClosure* c, float nv) {
   float r = sqrt(0.5f * (c->a + c->b));
   float2 ab = mp_ggx_albedo(r, fmax(nv, 1e-4f));
@@ -76,17 +85,7 @@ MP_INLINE float3 mp_closure_glossy_albedo(const MpClosure* c, float nv) {
     float3 f90 = c->fresnel == MP_FRESNEL_DIELECTRIC ? c->f82 : MP_F3(1.0f, 1.0f, 1.0f);
     albedo = f0 * ab.x + f90 * ab.y;
   }
-  if (c->multiscatter) albedo = albedo * (1.0f + (1.0f - e) / e);
-  return albedo;
-}
-
-/* Multiple scattering's gain on a glossy lobe's single scattering (the
- * same compensation, for lamps). */
-MP_INLINE float mp_closure_multiscatter(const MpClosure* c, float nv) {
-  if (!c->multiscatter) return 1.0f;
-  float r = sqrt(0.5f * (c->a + c->b));
-  float2 ab = mp_ggx_albedo(r, fmax(nv, 1e-4f));
-  return 1.0f / fmax(ab.x + ab.y, 1e-3f);
+  return albedo * mp_closure_multiscatter(c, nv);
 }
 
 /* A sheen closure's lobe (f cos) and its directional albedo. */

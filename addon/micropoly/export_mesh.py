@@ -146,8 +146,8 @@ def _tangents(mesh, layer, n_loops, counts):
     return out
 
 
-def _attribute_corners(mesh, name, n_loops):
-    """(n_loops, 4) per face corner: attribute `name` ("" the active render
+def _attribute_corners(mesh, name, n_loops, counts):
+    """(n_loops, 4) per face corner (`counts`: corners per face): attribute `name` ("" the active render
     color attribute) as RGBA (a float as (x, x, x, 1), a vector as (x, y, z, 1)),
     from the point, corner or face domain; None if the mesh lacks it."""
     attrs = getattr(mesh, "attributes", None)
@@ -185,8 +185,6 @@ def _attribute_corners(mesh, name, n_loops):
         vertex = np.empty(n_loops, dtype=np.int32)
         mesh.loops.foreach_get("vertex_index", vertex)
         return rgba[vertex]
-    counts = np.empty(len(mesh.polygons), dtype=np.int32)
-    mesh.polygons.foreach_get("loop_total", counts)
     return np.repeat(rgba, counts, axis=0)
 
 
@@ -202,7 +200,7 @@ def _uv_layers(mesh, names, n_loops, counts):
     for k, name in enumerate(names):
         if isinstance(name, tuple) and name[0] == "attribute":
             if name[1] not in attributes:
-                attributes[name[1]] = _attribute_corners(mesh, name[1], n_loops)
+                attributes[name[1]] = _attribute_corners(mesh, name[1], n_loops, counts)
             if attributes[name[1]] is not None:
                 out[k] = attributes[name[1]][:, 2 * name[2]:2 * name[2] + 2]
             continue

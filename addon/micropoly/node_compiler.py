@@ -857,6 +857,14 @@ class NodeCompiler:
             return self.input(node, "Tangent", VEC)[0]
         return "mp_radial_tangent(g)"
 
+    def _anisotropy_tangent(self, node, aniso, slot):
+        """The tangent an anisotropic lobe stretches along (zero while the
+        anisotropy is the constant 0), turned about its normal by the node's
+        Rotation."""
+        if aniso == "0.0f":
+            return "(float3)(0.0f)"
+        return f"mp_rotate_tangent({self._tangent(node)}, {self._slot_normal(slot)}, {self._f(node, 'Rotation')})"
+
     def _f(self, node, *names, default="0.0f"):
         for name in names:
             if name in node.inputs:
@@ -912,10 +920,7 @@ class NodeCompiler:
                 self.warn(node, f"the {dist.replace('_', '-').title()} distribution is shaded as GGX")
             rough = "0.0f" if dist == "SHARP" else self._f(node, "Roughness")
             aniso = self._f(node, "Anisotropy")
-            rot = self._f(node, "Rotation")
-            tangent = self._tangent(node) if aniso != "0.0f" else "(float3)(0.0f)"
-            if tangent != "(float3)(0.0f)":
-                tangent = f"mp_rotate_tangent({tangent}, {self._slot_normal(slot)}, {rot})"
+            tangent = self._anisotropy_tangent(node, aniso, slot)
             add(f"  mp_add_glossy(s, {weight} * {color}, {slot}, {rough}, {aniso}, {tangent}, MP_FRESNEL_NONE, "
                 f"(float3)(0.0f), (float3)(1.0f), {1 if dist == 'MULTI_GGX' else 0});")
         elif t in ("BSDF_GLASS", "BSDF_REFRACTION"):
@@ -952,9 +957,7 @@ class NodeCompiler:
                 f0 = self.fn.temp(VEC, f"mp_conductor_f0({self._c(node, 'IOR')}, {self._c(node, 'Extinction')})")[0]
                 tint = "(float3)(1.0f)"
             aniso = self._f(node, "Anisotropy")
-            tangent = self._tangent(node) if aniso != "0.0f" else "(float3)(0.0f)"
-            if tangent != "(float3)(0.0f)":
-                tangent = f"mp_rotate_tangent({tangent}, {self._slot_normal(slot)}, {self._f(node, 'Rotation')})"
+            tangent = self._anisotropy_tangent(node, aniso, slot)
             add(f"  mp_add_glossy_aspect(s, {weight}, {slot}, {self._f(node, 'Roughness')}, {aniso}, {tangent}, "
                 f"MP_FRESNEL_F82, {f0}, {tint}, {1 if getattr(node, 'distribution', 'GGX') == 'MULTI_GGX' else 0});")
         else:

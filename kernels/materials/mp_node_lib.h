@@ -112,11 +112,7 @@ MP_INLINE float3 mp_world_position(const MpNodeGlobals* g) {
 /* This shading point in another object's space (Texture Coordinate ▸ Object
  * with an object set): world -> that object given as the rows of a 3x4. */
 MP_INLINE float3 mp_point_in_space(const MpNodeGlobals* g, float4 r0, float4 r1, float4 r2) {
-  float3 w = g->P;
-  if (g->object) {
-    const MP_GLOBAL float* m = g->object->to_world;
-    w = mp_nl_rows(m, g->P) + MP_F3(m[3], m[7], m[11]);
-  }
+  float3 w = mp_world_position(g);
   return MP_F3(r0.x * w.x + r0.y * w.y + r0.z * w.z + r0.w, r1.x * w.x + r1.y * w.y + r1.z * w.z + r1.w,
                r2.x * w.x + r2.y * w.y + r2.z * w.z + r2.w);
 }

@@ -25,14 +25,6 @@
 
 MP_INLINE float mp_tx_mix(float a, float b, float t) { return a + t * (b - a); }
 
-MP_INLINE float mp_tx_fmod(float a, float b) {
-#ifdef __OPENCL_VERSION__
-  return fmod(a, b);
-#else
-  return std::fmod(a, b);
-#endif
-}
-
 MP_INLINE int mp_tx_isfinite(float x) { return (as_uint(x) & 0x7f800000u) != 0x7f800000u; }
 
 MP_INLINE float mp_tx_saturate(float x) { return x < 0.0f ? 0.0f : (x > 1.0f ? 1.0f : x); }
@@ -168,7 +160,7 @@ MP_INLINE float mp_tx_snoise(const float* p, int dims, int blender_version) {
     q[i] = p[i];
     if (blender_version >= 400) {
       float correction = fabs(q[i]) >= 1000000.0f ? 0.5f : 0.0f;
-      q[i] = mp_tx_fmod(q[i], 100000.0f) + correction;
+      q[i] = MP_FMOD(q[i], 100000.0f) + correction;
     }
   }
   float r, scale;

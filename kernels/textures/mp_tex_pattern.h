@@ -34,14 +34,6 @@
 
 MP_INLINE float mp_pt_saturate(float x) { return fmin(fmax(x, 0.0f), 1.0f); }
 
-MP_INLINE float mp_pt_fmod(float a, float b) {
-#ifdef __OPENCL_VERSION__
-  return fmod(a, b);
-#else
-  return std::fmod(a, b);
-#endif
-}
-
 MP_INLINE int mp_pt_iabs(int v) { return v < 0 ? -v : v; }
 
 MP_INLINE float3 mp_pt_select3(int first, float3 a, float3 b) { return first ? a : b; }
@@ -162,9 +154,9 @@ MP_INLINE float mp_tex_gradient(float3 p, int type) {
 /* Magic Texture Color at point p (unscaled); depth 0-10. Coordinates are
  * first reduced modulo 2 pi, as Blender does to keep sines accurate. */
 MP_INLINE float3 mp_tex_magic(float3 p, float scale, int depth, float distortion) {
-  float px = mp_pt_fmod(p.x, MP_PT_2PI);
-  float py = mp_pt_fmod(p.y, MP_PT_2PI);
-  float pz = mp_pt_fmod(p.z, MP_PT_2PI);
+  float px = MP_FMOD(p.x, MP_PT_2PI);
+  float py = MP_FMOD(p.y, MP_PT_2PI);
+  float pz = MP_FMOD(p.z, MP_PT_2PI);
   float x = sin((px + py + pz) * 5.0f * scale);
   float y = cos((-px + py - pz) * 5.0f * scale);
   float z = -cos((-px - py + pz) * 5.0f * scale);

@@ -228,6 +228,13 @@ TEST(RibErrors, ShadowOptionsAndProgramAlpha) {
                3, "\"programalpha\" expects one integer in [0, 1]");
 }
 
+TEST(RibErrors, PrincipledFlags) {
+  expect_error("WorldBegin\nSurface \"micropoly_principled\" \"integer multiscatter\" [2]\n", 2,
+               "\"multiscatter\" expects one integer in [0, 1]");
+  expect_error("WorldBegin\nSurface \"micropoly_principled\"\n  \"integer retrodiffuse\" [-1]\n", 3,
+               "\"retrodiffuse\" expects one integer in [0, 1]");
+}
+
 TEST(RibErrors, Archives) {
   expect_error("WorldBegin\nReadArchive \"does_not_exist.rib\"\n", 2, "cannot read");
   expect_error("ReadArchive \"/dev/zero\"\n", 1, "not a regular file");
