@@ -33,7 +33,7 @@ __kernel void clear_samples(__global ulong* keys, ulong n) {
       cam_to_world_z, rgba, depth, normal_out, want_passes, region, origin, out_width
 
 /* `lanes` (a constant in each kernel below): planar sample colors
- * (FrameParams.planar_colors, the tile sampler's) summed 16 at a time; the
+ * (FrameParams.planar_colors, the tile sampler's) summed 8 at a time; the
  * other kernel carries none of that code, whose registers cost GPUs
  * occupancy. */
 inline void mp_resolve(MP_RESOLVE_ARGS, const int lanes) {
@@ -43,9 +43,10 @@ inline void mp_resolve(MP_RESOLVE_ARGS, const int lanes) {
   int reach = mp_filter_reach(filter_width);
   float4 sum = (float4)(0.0f);
   float wsum = 0.0f;
-  /* Sums of the 16-lane loop, added in once at the end. */
-  float16 r16 = (float16)(0.0f), g16 = (float16)(0.0f), b16 = (float16)(0.0f), a16 = (float16)(0.0f),
-          w16 = (float16)(0.0f);
+  /* Sums of the 8-lane loop, added in once at the end. Eight lanes, not
+   * sixteen: the x86 backend of LLVM 14 (in the PoCL that the extension
+   * carries, docs/install.md) aborts on this loop's 16-wide compares. */
+  float8 r8 = (float8)(0.0f), g8 = (float8)(0.0f), b8 = (float8)(0.0f), a8 = (float8)(0.0f), w8 = (float8)(0.0f);
   float cx = (float)px + 0.5f, cy = (float)py + 0.5f;
   int side = 2 * reach + 1;
   int tile = ((py + f.crop_y0) & (MP_SAMPLE_TILE - 1)) * MP_SAMPLE_TILE + ((px + f.crop_x0) & (MP_SAMPLE_TILE - 1));
@@ -55,22 +56,22 @@ inline void mp_resolve(MP_RESOLVE_ARGS, const int lanes) {
                                               (ulong)((qy - py + reach) * side + (qx - px + reach))) * (ulong)spp;
       ulong q = (ulong)qy * (ulong)f.width + (ulong)qx;
       int s = 0;
-      if (lanes && use_weights && spp >= 16) {
-        /* 16 samples at a time (the weights and each color channel of a
+      if (lanes && use_weights && spp >= 8) {
+        /* 8 samples at a time (the weights and each color channel of a
          * pixel's samples lie together, mp_sample.h). */
         __global const ulong* k = keys + q * (ulong)spp;
         __global const float* c = colors + mp_color_index(q, spp, 0);
-        for (; s + 16 <= spp; s += 16) {
-          float16 w = vload16(0, wrow + s);
-          w = select((float16)(0.0f), w, w > (float16)(0.0f));
+        for (; s + 8 <= spp; s += 8) {
+          float8 w = vload8(0, wrow + s);
+          w = select((float8)(0.0f), w, w > (float8)(0.0f));
           /* Empty samples' colors are whatever the buffer held: selected
            * away, not multiplied by 0 (which keeps a NaN). */
-          int16 covered = convert_int16(vload16(0, k + s) != (ulong16)0xffffffffffffffffUL);
-          w16 += w;
-          a16 += select((float16)(0.0f), w, covered);
-          r16 += select((float16)(0.0f), w * vload16(0, c + s), covered);
-          g16 += select((float16)(0.0f), w * vload16(0, c + spp + s), covered);
-          b16 += select((float16)(0.0f), w * vload16(0, c + 2 * spp + s), covered);
+          int8 covered = convert_int8(vload8(0, k + s) != (ulong8)0xffffffffffffffffUL);
+          w8 += w;
+          a8 += select((float8)(0.0f), w, covered);
+          r8 += select((float8)(0.0f), w * vload8(0, c + s), covered);
+          g8 += select((float8)(0.0f), w * vload8(0, c + spp + s), covered);
+          b8 += select((float8)(0.0f), w * vload8(0, c + 2 * spp + s), covered);
         }
       }
       for (; s < spp; ++s) {
@@ -88,13 +89,12 @@ inline void mp_resolve(MP_RESOLVE_ARGS, const int lanes) {
         if (keys[index] != (ulong)0xffffffffffffffffUL) sum += w * (float4)(mp_load_color(colors, q, s, spp, f), 1.0f);
       }
     }
-#define MP_SUM16(v) (((v).s0 + (v).s1) + ((v).s2 + (v).s3) + ((v).s4 + (v).s5) + ((v).s6 + (v).s7) + \
-                     ((v).s8 + (v).s9) + ((v).sa + (v).sb) + ((v).sc + (v).sd) + ((v).se + (v).sf))
-  if (lanes && spp >= 16) {
-    wsum += MP_SUM16(w16);
-    sum += (float4)(MP_SUM16(r16), MP_SUM16(g16), MP_SUM16(b16), MP_SUM16(a16));
+#define MP_SUM8(v) ((((v).s0 + (v).s1) + ((v).s2 + (v).s3)) + (((v).s4 + (v).s5) + ((v).s6 + (v).s7)))
+  if (lanes && spp >= 8) {
+    wsum += MP_SUM8(w8);
+    sum += (float4)(MP_SUM8(r8), MP_SUM8(g8), MP_SUM8(b8), MP_SUM8(a8));
   }
-#undef MP_SUM16
+#undef MP_SUM8
   ulong pixel = (ulong)py * (ulong)f.width + (ulong)px;
   ulong out = (ulong)(py + origin.y) * (ulong)out_width + (ulong)(px + origin.x);
   rgba[out] = wsum > 0.0f ? sum / wsum : (float4)(0.0f);

@@ -12,6 +12,9 @@
  * watertight) and the same arithmetic for depth and attributes
  * (mp_sample.h). On a GPU one work-item per tile leaves most lanes idle,
  * so GPUs keep sample.cl. */
+/* Left out where the device's compiler cannot build it
+ * (DeviceSession::tile_sampler). */
+#ifndef MP_NO_TILE_SAMPLER
 #include "mp_compat.h"
 #include "mp_patch.h"
 #include "mp_types.h"
@@ -354,3 +357,5 @@ __kernel void sample_tiles(__global const SubPatch* diceable, __global const uin
     atom_add(&totals[2], tests);
   }
 }
+
+#endif /* MP_NO_TILE_SAMPLER */

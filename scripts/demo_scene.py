@@ -5,6 +5,7 @@
 """
 
 import math
+import os
 import sys
 
 import bpy
@@ -16,7 +17,9 @@ check = "--check" in args
 bpy.ops.wm.read_factory_settings(use_empty=True)
 import addon_utils  # noqa: E402
 
-addon_utils.enable("micropoly", default_set=True)
+# The add-on's module: "micropoly" as a legacy add-on (the developer build),
+# "bl_ext.user_default.micropoly" once installed from the extension zip.
+addon_utils.enable(os.environ.get("MICROPOLY_ADDON_MODULE", "micropoly"), default_set=True)
 scene = bpy.context.scene
 
 

@@ -15,7 +15,7 @@ packages=(
   ocl-icd-opencl-dev opencl-headers pocl-opencl-icd clinfo
   libglm-dev pybind11-dev libosd-dev libgtest-dev libgmock-dev
   libpng-dev libopenexr-dev
-  python3 python3-dev python3-numpy python3-pytest python3-venv
+  python3 python3-dev python3-numpy python3-pytest python3-venv python3-pil util-linux
   blender xvfb xauth libgl1-mesa-dri
 )
 missing=()

@@ -17,6 +17,10 @@ bl_info = {
     "category": "Render",
 }
 
+from . import native_module  # noqa: E402
+
+native_module.alias_wheel_module(__package__)
+
 _MODULES = ("properties", "preferences", "engine", "ui", "operators")
 
 

@@ -95,3 +95,31 @@ TEST(DeviceChoice, UnknownSelectorsAreRejected) {
 
 }  // namespace
 }  // namespace mp
+
+// Which devices get the tile sampler: PoCL on LLVM 14 or older aborts the
+// process compiling it (the pocl-binary-distribution 3.0 wheel the
+// extension carries reports LLVM 14.0.6); other platforms always get it.
+TEST(TileSamplerGate, FollowsPoclsLlvm) {
+  EXPECT_FALSE(mp::compiles_tile_sampler(
+      "OpenCL 3.0 PoCL 3.0-rc2  Linux, Release, RELOC, LLVM 14.0.6, SLEEF, DISTRO, POCL_DEBUG"));
+  EXPECT_TRUE(mp::compiles_tile_sampler(
+      "OpenCL 3.0 PoCL 3.1+debian  Linux, None+Asserts, RELOC, SPIR, LLVM 15.0.6, SLEEF, DISTRO, POCL_DEBUG"));
+  EXPECT_TRUE(mp::compiles_tile_sampler("OpenCL 3.0 CUDA 12.8.90"));
+  EXPECT_TRUE(mp::compiles_tile_sampler("OpenCL 3.0 PoCL 6.0 Linux, Release, LLVM 18.1.8"));
+}
+
+// The gate reads the platform of the device a session runs on: the tile
+// sampler's kernels exist exactly where it says they compile.
+TEST(TileSamplerGate, SessionProgramHoldsTheTileSamplerWhereAllowed) {
+  mp::DeviceSession session("cpu");
+  const std::string version =
+      cl::Platform(session.device().getInfo<CL_DEVICE_PLATFORM>()).getInfo<CL_PLATFORM_VERSION>();
+  EXPECT_EQ(session.tile_sampler(), mp::compiles_tile_sampler(version));
+  bool found = true;
+  try {
+    cl::Kernel kernel(session.program(), "sample_tiles");
+  } catch (const cl::Error&) {
+    found = false;
+  }
+  EXPECT_EQ(found, session.tile_sampler()) << version;
+}

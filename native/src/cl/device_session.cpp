@@ -85,6 +85,15 @@ FoundDevice choose(const std::string& requested) {
 
 }  // namespace
 
+bool compiles_tile_sampler(const std::string& platform_version) {
+  // PoCL names its LLVM in the platform version: "OpenCL 3.0 PoCL 3.0-rc2
+  // Linux, Release, RELOC, LLVM 14.0.6, ...".
+  if (platform_version.find("PoCL") == std::string::npos) return true;
+  const size_t at = platform_version.find("LLVM ");
+  if (at == std::string::npos) return true;
+  return std::atoi(platform_version.c_str() + at + 5) >= 15;
+}
+
 std::vector<DeviceInfo> list_devices() {
   std::vector<DeviceInfo> out;
   for (auto& d : enumerate()) out.push_back(d.info);
@@ -102,7 +111,9 @@ DeviceSession::DeviceSession(const std::string& selector) {
     context_ = cl::Context(device_);
     queue_ = cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE);
     max_alloc_ = device_.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
-    auto built = build_program_cached(context_, device_, assemble_program_source(), "-cl-std=CL1.2");
+    tile_sampler_ = compiles_tile_sampler(cl::Platform(device_.getInfo<CL_DEVICE_PLATFORM>()).getInfo<CL_PLATFORM_VERSION>());
+    auto built = build_program_cached(context_, device_, assemble_program_source(),
+                                      tile_sampler_ ? "-cl-std=CL1.2" : "-cl-std=CL1.2 -DMP_NO_TILE_SAMPLER");
     program_ = built.program;
     build_ms_ = built.build_ms;
     cache_hit_ = built.from_cache;

@@ -10,6 +10,10 @@
 
 namespace mp {
 
+// Whether a device of this CL_PLATFORM_VERSION compiles the tile sampler
+// (DeviceSession::tile_sampler).
+bool compiles_tile_sampler(const std::string& platform_version);
+
 class DeviceSession {
  public:
   explicit DeviceSession(const std::string& selector);
@@ -22,6 +26,12 @@ class DeviceSession {
   double program_build_ms() const { return build_ms_; }
   bool program_cache_hit() const { return cache_hit_; }
   size_t max_alloc_bytes() const { return max_alloc_; }
+  // Whether the program holds the tile sampler (sample_tiles.cl). PoCL
+  // built on LLVM 14 or older (the PoCL binary distribution that CPU-only
+  // installs carry) aborts the process compiling its 16-wide vector code,
+  // so on such a device it is left out and the per-micropolygon sampler
+  // runs instead.
+  bool tile_sampler() const { return tile_sampler_; }
   // A read-write device buffer of `bytes` (at least 16); an mp::Error that
   // names `what` when the device cannot hold that much in one buffer.
   cl::Buffer allocate(size_t bytes, const char* what);
@@ -38,6 +48,7 @@ class DeviceSession {
   cl::Program program_;
   double build_ms_ = 0;
   bool cache_hit_ = false;
+  bool tile_sampler_ = true;
   size_t max_alloc_ = 0;
 };
 

@@ -199,9 +199,9 @@ SampleStage::SampleStage(DeviceSession& session)
       kernel_(session.program(), "sample_micropolygons"),
       blur_kernel_(session.program(), "sample_micropolygons_blur"),
       clear_(session.program(), "clear_samples"),
-      project_(session.program(), "project_grids"),
-      bound_runs_(session.program(), "bound_runs"),
-      tile_kernel_(session.program(), "sample_tiles") {
+      project_(session.tile_sampler() ? cl::Kernel(session.program(), "project_grids") : cl::Kernel()),
+      bound_runs_(session.tile_sampler() ? cl::Kernel(session.program(), "bound_runs") : cl::Kernel()),
+      tile_kernel_(session.tile_sampler() ? cl::Kernel(session.program(), "sample_tiles") : cl::Kernel()) {
   totals_ = cl::Buffer(session.context(), CL_MEM_READ_WRITE, 3 * sizeof(cl_ulong));
 }
 

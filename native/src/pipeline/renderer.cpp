@@ -97,10 +97,11 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
   FrameSetup frame = make_frame_setup(scene);
   // The sampler (RenderSettings::sampler): the tile sampler, which keeps
   // its sample colors planar, or (always for blurred frames) the
-  // per-micropolygon one.
+  // per-micropolygon one, and always where the device cannot build the
+  // tile sampler (DeviceSession::tile_sampler).
   frame.params.planar_colors = (scene.settings.sampler == Sampler::Tiles ||
                                 (scene.settings.sampler == Sampler::Auto && s.info().type == "cpu")) &&
-                               !mp_blur_on(frame.params);
+                               !mp_blur_on(frame.params) && s.tile_sampler();
   const FrameParams& f = frame.params;
   st.width = f.width;
   st.height = f.height;

@@ -1,0 +1,21 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Micropoly's native renderer as the micropoly_native wheel.
+
+The wheel carries every shared library the module needs (auditwheel), the
+OpenCL ICD loader among them; drivers are not in it. Before the module
+loads, opencl_vendors.register() points that loader at the system's
+drivers plus, where the system has no PoCL of its own, the CPU device of
+the pocl-binary-distribution wheel installed beside this one, so a machine
+without any OpenCL driver still renders on its CPU (docs/install.md).
+"""
+
+from . import opencl_vendors
+
+embedded_cpu_device = opencl_vendors.register()
+
+from . import _native  # noqa: E402  (after the loader knows its drivers)
+
+
+def devices():
+    """The OpenCL devices the module sees, as (name, type) pairs."""
+    return [(d["name"], d["type"]) for d in _native.list_devices()]

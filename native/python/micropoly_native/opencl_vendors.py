@@ -1,0 +1,98 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Which OpenCL drivers the wheel's ICD loader (ocl-icd) loads.
+
+The loader reads its drivers from /etc/OpenCL/vendors, or from the folder
+that OCL_ICD_VENDORS names. A machine with no OpenCL driver has nothing
+there; one with an NVIDIA or AMD driver has that driver's file. So this
+module writes a folder of its own holding the system's files plus one for
+the CPU device of pocl-binary-distribution (PyOpenCL's PoCL build, a
+relocatable PoCL with its LLVM linked in), and names it in OCL_ICD_VENDORS
+before the native module first calls the loader.
+
+Left alone: an OCL_ICD_VENDORS the user set, and a system that has a PoCL
+of its own (two CPU platforms would only compete for the same cores), unless
+MICROPOLY_EMBEDDED_POCL=1 asks for the carried one anyway.
+"""
+
+import glob
+import hashlib
+import importlib.util
+import os
+import tempfile
+
+SYSTEM_VENDORS = "/etc/OpenCL/vendors"
+
+
+def carried_pocl():
+    """The path of the PoCL library that pocl-binary-distribution installed,
+    or None. Its wheel puts the library under pyopencl/.libs beside its own
+    package, where PoCL finds its kernel library by a relative path."""
+    spec = importlib.util.find_spec("pocl_binary_distribution")
+    if spec is None or not spec.submodule_search_locations:
+        return None
+    site = os.path.dirname(os.path.abspath(list(spec.submodule_search_locations)[0]))
+    found = sorted(glob.glob(os.path.join(site, "pyopencl", ".libs", "libpocl*.so*")))
+    return found[0] if found else None
+
+
+def _system_icds():
+    return sorted(glob.glob(os.path.join(SYSTEM_VENDORS, "*.icd")))
+
+
+def _cache_root():
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return os.path.join(base, "micropoly")
+
+
+def _write_vendors(entries):
+    """A folder holding one .icd file per (name, library) entry, named by its
+    content so that processes with the same drivers share it and never see
+    a half-written one."""
+    digest = hashlib.sha256(repr(entries).encode()).hexdigest()[:16]
+    for root in (_cache_root(), tempfile.gettempdir()):
+        folder = os.path.join(root, f"opencl-vendors-{digest}")
+        if os.path.isdir(folder):
+            return folder
+        try:
+            os.makedirs(root, exist_ok=True)
+            staging = tempfile.mkdtemp(prefix="opencl-vendors-", dir=root)
+            for name, library in entries:
+                with open(os.path.join(staging, name), "w") as f:
+                    f.write(library + "\n")
+            try:
+                os.rename(staging, folder)
+            except OSError:  # another process got there first
+                for name, _ in entries:
+                    os.remove(os.path.join(staging, name))
+                os.rmdir(staging)
+            return folder
+        except OSError:
+            continue
+    return None
+
+
+def register():
+    """Points the ICD loader at the system's drivers plus the carried PoCL.
+    Returns the carried PoCL's path when it was added, else None."""
+    if "OCL_ICD_VENDORS" in os.environ:
+        return None
+    pocl = carried_pocl()
+    if pocl is None:
+        return None
+    system = _system_icds()
+    if os.environ.get("MICROPOLY_EMBEDDED_POCL") != "1":
+        if any("pocl" in os.path.basename(icd).lower() for icd in system):
+            return None
+    entries = []
+    for icd in system:
+        try:
+            with open(icd) as f:
+                entries.append((os.path.basename(icd), f.read().strip()))
+        except OSError:
+            continue
+    entries.append(("micropoly-carried-pocl.icd", pocl))
+    folder = _write_vendors(entries)
+    if folder is None:
+        return None
+    os.environ["OCL_ICD_VENDORS"] = folder
+    return pocl
