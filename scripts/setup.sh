@@ -45,6 +45,15 @@ if [ "$mode" = test ]; then
         { echo "bpy $v did not install" >&2; rm -rf "$venv"; exit 1; }
     fi
   done
+  # openjd-cli runs the farm job template locally (tests/farm/test_openjd.py).
+  if ! build/openjd-venv/bin/openjd --version >/dev/null 2>&1; then
+    echo "== installing openjd-cli into build/openjd-venv"
+    rm -rf build/openjd-venv
+    /usr/bin/python3 -m venv build/openjd-venv
+    build/openjd-venv/bin/python3 -m pip install -q --disable-pip-version-check \
+      "openjd-cli==0.8.0" "openjd-model==0.13.0" "openjd-sessions==0.13.0" ||
+      { echo "openjd-cli did not install" >&2; rm -rf build/openjd-venv; exit 1; }
+  fi
 fi
 
 jobs=$(nproc)
