@@ -63,6 +63,7 @@ typedef struct {
   int normals;
   float3 emission;
   float3 transparent; /* Transparent BSDF weight: 1 - its average is the alpha */
+  float holdout;      /* Holdout weight (average): the part of the alpha cut out of the image */
   int dropped;        /* closures beyond MP_MAX_CLOSURES */
 } MpSurface;
 
@@ -83,6 +84,7 @@ MP_INLINE void mp_surface_init(MpSurface* s, float3 n) {
   s->normal_mode[0] = 0;
   s->emission = MP_F3(0.0f, 0.0f, 0.0f);
   s->transparent = MP_F3(0.0f, 0.0f, 0.0f);
+  s->holdout = 0.0f;
   s->dropped = 0;
 }
 
@@ -150,6 +152,13 @@ MP_INLINE void mp_add_subsurface(MpSurface* s, float3 w, int slot) {
 }
 MP_INLINE void mp_add_emission(MpSurface* s, float3 w) { s->emission += w; }
 MP_INLINE void mp_add_transparent(MpSurface* s, float3 w) { s->transparent += mp_clamp_weight(w); }
+/* Holdout: as Cycles, its weight's average leaves the image transparent
+ * there (alpha and colour 0) while the surface still hides what lies
+ * behind it. */
+MP_INLINE void mp_add_holdout(MpSurface* s, float3 w) {
+  float3 c = mp_clamp_weight(w);
+  s->holdout += (c.x + c.y + c.z) * (1.0f / 3.0f);
+}
 
 /* GGX reflection of roughness r (alpha = r^2) stretched by anisotropy
  * along `tangent`, as Cycles' Glossy BSDF maps them (4.0 and later; 3.x's
@@ -208,6 +217,14 @@ MP_INLINE void mp_add_toon(MpSurface* s, float3 w, int slot, float size, float s
 MP_INLINE float mp_surface_alpha(const MpSurface* s) {
   float t = (s->transparent.x + s->transparent.y + s->transparent.z) * (1.0f / 3.0f);
   return clamp(1.0f - t, 0.0f, 1.0f);
+}
+
+/* The share of a surface's covered samples that are held out: Cycles'
+ * alpha is 1 - transparent - holdout, and a covered sample stays in the
+ * image with probability alpha (stochastic opacity), so held out among those
+ * with probability holdout / alpha. */
+MP_INLINE float mp_surface_holdout_share(const MpSurface* s, float alpha) {
+  return alpha > 0.0f ? clamp(s->holdout / alpha, 0.0f, 1.0f) : 0.0f;
 }
 
 #endif

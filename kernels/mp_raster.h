@@ -22,7 +22,8 @@ typedef struct {
 } MpFixed2;
 
 /* A micropolygon's opacity: the mean of its corners' (a cut-out's edge
- * then falls where its alpha crosses, not on one corner's side). */
+ * then falls where its alpha crosses, not on one corner's side). Its
+ * held-out share (Holdout, grid normals' w after shading) is the same mean. */
 MP_INLINE float mp_quad_opacity(float a, float b, float c, float d) { return 0.25f * (a + b + c + d); }
 
 MP_INLINE long mp_to_fixed(float r) { return (long)floor(r * (float)MP_SUBPIXEL_ONE + 0.5f); }

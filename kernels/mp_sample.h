@@ -132,6 +132,24 @@ inline int mp_opacity_keeps(uint mp_id, int px, int py, int s, float opacity, Fr
   return mp_hash_unit(h) < opacity;
 }
 
+/* Holdout (mp_closures.h): a sample's held-out share h travels in the 8
+ * lowest mantissa bits of its blue (changing blue by at most 2^-15 of
+ * itself), so samples need no fourth channel; its colour is stored times
+ * 1 - h, and the resolve counts 1 - h of it in the alpha. Samples of
+ * micropolygons with no holdout store h = 0. */
+inline float mp_pack_holdout(float blue, float h) {
+  uint q = (uint)(clamp(h, 0.0f, 1.0f) * 255.0f + 0.5f);
+  return as_float((as_uint(blue) & ~0xffu) | q);
+}
+inline float mp_unpack_holdout(float blue) { return (float)(as_uint(blue) & 0xffu) * (1.0f / 255.0f); }
+
+/* The colour a sample stores, its held-out share h packed in. */
+inline float3 mp_sample_color(float3 col, float h) {
+  col *= 1.0f - h;
+  col.z = mp_pack_holdout(col.z, h);
+  return col;
+}
+
 /* Color and normal at a covered sample of depth d. */
 inline void mp_triangle_attributes(const MpTriangle* t, float la, float lb, float lc, float d, FrameParams f,
                                    float3* col, float3* nrm) {

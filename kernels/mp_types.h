@@ -105,6 +105,10 @@ typedef struct {
   /* Sample colors per pixel channel by channel (the tile sampler's layout,
    * for 16-lane loads and stores) or sample by sample (mp_sample.h). */
   int planar_colors;
+  /* Held-out samples (Holdout) count as covered in the alpha: an opaque
+   * film, whose background is laid behind by alpha, shows none through
+   * them. 0 leaves them transparent (Film > Transparent, the CLI). */
+  int holdout_covers;
 } FrameParams;
 
 /* The camera view's occlusion pyramid (mp_occlusion.h): level 0 has a cell

@@ -67,11 +67,16 @@ inline void mp_resolve(MP_RESOLVE_ARGS, const int lanes) {
           /* Empty samples' colors are whatever the buffer held: selected
            * away, not multiplied by 0 (which keeps a NaN). */
           int8 covered = convert_int8(vload8(0, k + s) != (ulong8)0xffffffffffffffffUL);
+          /* A sample's held-out share (mp_sample.h) is left out of its
+           * alpha, unless f.holdout_covers; its colour has it already. */
+          float8 blue = vload8(0, c + 2 * spp + s);
+          float8 shown = f.holdout_covers ? w
+                                          : w * (1.0f - convert_float8(as_uint8(blue) & (uint8)(0xffu)) * (1.0f / 255.0f));
           w8 += w;
-          a8 += select((float8)(0.0f), w, covered);
+          a8 += select((float8)(0.0f), shown, covered);
           r8 += select((float8)(0.0f), w * vload8(0, c + s), covered);
           g8 += select((float8)(0.0f), w * vload8(0, c + spp + s), covered);
-          b8 += select((float8)(0.0f), w * vload8(0, c + 2 * spp + s), covered);
+          b8 += select((float8)(0.0f), w * blue, covered);
         }
       }
       for (; s < spp; ++s) {
@@ -86,7 +91,9 @@ inline void mp_resolve(MP_RESOLVE_ARGS, const int lanes) {
         if (w <= 0.0f) continue;
         ulong index = q * (ulong)spp + (ulong)s;
         wsum += w;
-        if (keys[index] != (ulong)0xffffffffffffffffUL) sum += w * (float4)(mp_load_color(colors, q, s, spp, f), 1.0f);
+        if (keys[index] == (ulong)0xffffffffffffffffUL) continue;
+        float3 col = mp_load_color(colors, q, s, spp, f);
+        sum += w * (float4)(col, f.holdout_covers ? 1.0f : 1.0f - mp_unpack_holdout(col.z));
       }
     }
 #define MP_SUM8(v) ((((v).s0 + (v).s1) + ((v).s2 + (v).s3)) + (((v).s4 + (v).s5) + ((v).s6 + (v).s7)))

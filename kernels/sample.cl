@@ -22,13 +22,14 @@
 
 /* Sample s of pixel (px, py), covered by triangle t at barycentrics (la,
  * lb, lc): within the clip range and the stochastic opacity, the depth pass
- * keeps the nearest key and the attribute pass lets its owner write. */
+ * keeps the nearest key and the attribute pass lets its owner write.
+ * cover: the micropolygon's opacity and its held-out share (Holdout). */
 inline void mp_sample_write(const MpTriangle* t, float la, float lb, float lc, int px, int py, int s, int spp,
-                            uint mp_id, float opacity, FrameParams f, uint pass, volatile __global ulong* keys,
+                            uint mp_id, float2 cover, FrameParams f, uint pass, volatile __global ulong* keys,
                             __global float* colors, __global uint* normals) {
   float d;
   if (!mp_triangle_depth(t, la, lb, lc, f, &d)) return;
-  if (!mp_opacity_keeps(mp_id, px, py, s, opacity, f)) return;
+  if (!mp_opacity_keeps(mp_id, px, py, s, cover.x, f)) return;
   ulong pixel = (ulong)py * (ulong)f.width + (ulong)px, index = pixel * (ulong)spp + (ulong)s;
   ulong key = mp_sample_key(d, mp_id);
   if (pass == MP_PASS_DEPTH) {
@@ -36,14 +37,14 @@ inline void mp_sample_write(const MpTriangle* t, float la, float lb, float lc, i
   } else if (keys[index] == key) {
     float3 col, nrm;
     mp_triangle_attributes(t, la, lb, lc, d, f, &col, &nrm);
-    mp_store_color(colors, pixel, s, spp, col, f);
+    mp_store_color(colors, pixel, s, spp, mp_sample_color(col, cover.y), f);
     if (f.normal_pass) normals[index] = mp_encode_normal(normalize(nrm));
   }
 }
 
 /* Rasterises the quad v[0..3]'s triangles that `keep` selects
  * (mp_setup_quad). */
-inline void mp_raster_quad(const MpRasterVertex* v, uint keep, uint mp_id, float opacity, FrameParams f,
+inline void mp_raster_quad(const MpRasterVertex* v, uint keep, uint mp_id, float2 cover, FrameParams f,
                            __global const ushort* offsets, uint pass, volatile __global ulong* keys,
                            __global float* colors, __global uint* normals, uint* tests) {
   MpTriangle tris[2];
@@ -62,7 +63,7 @@ inline void mp_raster_quad(const MpRasterVertex* v, uint keep, uint mp_id, float
         float la, lb, lc;
         int k = mp_quad_covers(tris, q, &la, &lb, &lc);
         if (k >= 0)
-          mp_sample_write(&tris[k], la, lb, lc, px, py, s, spp, mp_id, opacity, f, pass, keys, colors, normals);
+          mp_sample_write(&tris[k], la, lb, lc, px, py, s, spp, mp_id, cover, f, pass, keys, colors, normals);
       }
 }
 
@@ -109,7 +110,7 @@ inline float3 mp_blur_position(int i, float t, int steps, const float4* p, float
  * lens position, a cheap box rejection, then the fixed-point edge tests. */
 inline void mp_blur_sample(int px, int py, int s, int spp, MpFixed2 sq, float4 e, int steps, const float4* p,
                            float4 ps[4][MP_BLUR_LOCAL_STEPS], __global const float4* pm, const ulong* idx, ulong stride,
-                           float8* still, const float4* c, const float4* n, uint keep, uint mp_id, float opacity,
+                           float8* still, const float4* c, const float4* n, uint keep, uint mp_id, float2 cover,
                            FrameParams f, uint pass, volatile __global ulong* keys, __global float* colors,
                            __global uint* normals) {
   float3 q[4];
@@ -149,7 +150,7 @@ inline void mp_blur_sample(int px, int py, int s, int spp, MpFixed2 sq, float4 e
   mp_setup_quad(v, keep, tris);
   float la, lb, lc;
   int t = mp_quad_covers(tris, sq, &la, &lb, &lc);
-  if (t >= 0) mp_sample_write(&tris[t], la, lb, lc, px, py, s, spp, mp_id, opacity, f, pass, keys, colors, normals);
+  if (t >= 0) mp_sample_write(&tris[t], la, lb, lc, px, py, s, spp, mp_id, cover, f, pass, keys, colors, normals);
 }
 
 /* Grows the raster box by vertex i over the times [t0, t1] (its positions
@@ -181,7 +182,7 @@ inline int mp_blur_path_box(int i, float t0, float t1, float2 bx, float2 by, int
  * centre's culling (`keep`); attributes are the centre's (shading once per
  * grid vertex). Motion positions: pm[idx[i] + k * stride] for step k. */
 inline void mp_raster_quad_blur(const float4* p, __global const float4* pm, const ulong* idx, ulong stride,
-                                const float4* c, const float4* n, uint keep, uint mp_id, float opacity, FrameParams f,
+                                const float4* c, const float4* n, uint keep, uint mp_id, float2 cover, FrameParams f,
                                 __global const ushort* offsets, __global const float4* table, uint pass,
                                 volatile __global ulong* keys, __global float* colors, __global uint* normals,
                                 uint* tests) {
@@ -234,7 +235,7 @@ inline void mp_raster_quad_blur(const float4* p, __global const float4* pm, cons
           if (sq.x < fx0 || sq.x > fx1 || sq.y < fy0 || sq.y > fy1) continue;
           ++*tests;
           mp_blur_sample(px, py, k, spp, sq, table[(ty * MP_SAMPLE_TILE + tx) * spp + k], steps, p, ps, pm, idx,
-                         stride, still, c, n, keep, mp_id, opacity, f, pass, keys, colors, normals);
+                         stride, still, c, n, keep, mp_id, cover, f, pass, keys, colors, normals);
         }
       }
   }
@@ -331,15 +332,16 @@ inline void mp_sample(MP_SAMPLE_ARGS, __local ulong* area_sum, __local uint* cou
   uint tests = 0u;
   if (keep) {
     uint mp_id = mp_micropolygon_id(mp_grid_id(&sp), m);
-    float opacity = mp_quad_opacity(vc[0].w, vc[1].w, vc[2].w, vc[3].w);
+    float2 cover = (float2)(mp_quad_opacity(vc[0].w, vc[1].w, vc[2].w, vc[3].w),
+                            mp_quad_opacity(vn[0].w, vn[1].w, vn[2].w, vn[3].w));
     if (pass == MP_PASS_DEPTH && occlusion_dirty) mp_mark_occlusion_cells(occlusion_dirty, occ, f, v[0].p, v[1].p, v[2].p, v[3].p);
     if (blur) {
       ulong idx[4];
       for (int k = 0; k < 4; ++k) idx[k] = grid_base + q[k];
-      mp_raster_quad_blur(vp, grid_pm, idx, motion_stride, vc, vn, keep, mp_id, opacity, f, sample_offsets, sample_table, pass,
+      mp_raster_quad_blur(vp, grid_pm, idx, motion_stride, vc, vn, keep, mp_id, cover, f, sample_offsets, sample_table, pass,
                           keys, colors, normals, &tests);
     } else {
-      mp_raster_quad(v, keep, mp_id, opacity, f, sample_offsets, pass, keys, colors, normals, &tests);
+      mp_raster_quad(v, keep, mp_id, cover, f, sample_offsets, pass, keys, colors, normals, &tests);
     }
   }
   mp_count_sampled(get_local_id(0), area2, tests, pass, totals, area_sum, count_sum, test_sum);

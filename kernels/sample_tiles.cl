@@ -97,9 +97,10 @@ inline MpFixed2 mp_projected_position(int4 v) {
 }
 
 /* The same samples one at a time in 64-bit arithmetic (mp_edge_triangle_covers),
- * for micropolygons too large for the int32 path or not opaque. */
+ * for micropolygons too large for the int32 path, not opaque or held out
+ * (cover: opacity, held-out share). */
 inline uint mp_sample_tile_slow(const MpTriangle* tris, long xmin, long xmax, long ymin, long ymax, int px0, int px1,
-                                int py0, int py1, uint mp_id, float opacity, FrameParams f,
+                                int py0, int py1, uint mp_id, float2 cover, FrameParams f,
                                 __global const ushort* sample_offsets, __global ulong* keys, __global float* colors,
                                 __global uint* normals, int* written) {
   int spp = f.spp_x * f.spp_y;
@@ -114,13 +115,13 @@ inline uint mp_sample_tile_slow(const MpTriangle* tris, long xmin, long xmax, lo
         float la, lb, lc, d;
         int t = mp_quad_covers(tris, sq, &la, &lb, &lc);
         if (t < 0 || !mp_triangle_depth(&tris[t], la, lb, lc, f, &d)) continue;
-        if (!mp_opacity_keeps(mp_id, px, py, s, opacity, f)) continue;
+        if (!mp_opacity_keeps(mp_id, px, py, s, cover.x, f)) continue;
         ulong key = mp_sample_key(d, mp_id), index = pixel * (ulong)spp + (ulong)s;
         if (key >= keys[index]) continue;
         keys[index] = key;
         float3 col, nrm;
         mp_triangle_attributes(&tris[t], la, lb, lc, d, f, &col, &nrm);
-        mp_store_color(colors, pixel, s, spp, col, f);
+        mp_store_color(colors, pixel, s, spp, mp_sample_color(col, cover.y), f);
         if (f.normal_pass) normals[index] = mp_encode_normal(normalize(nrm));
         *written = 1;
       }
@@ -168,7 +169,8 @@ inline int16 mp_inside16(const MpEdge16* g, int sx, int sy, int16 ox, int16 oy, 
  * vectors; keys and colors of a whole chunk of a pixel's samples are
  * stored as vectors, a partial chunk's (the lanes past the pixel's samples
  * belong to other pixels) and normals one by one. Opaque micropolygons
- * only (the stochastic opacity is per sample: mp_sample_tile_slow). */
+ * only, none held out (the stochastic opacity and holdout are per sample:
+ * mp_sample_tile_slow). */
 inline uint mp_sample_tile_fast(const MpTriangle* tris, long xmin, long xmax, long ymin, long ymax, int px0, int px1,
                                 int py0, int py1, uint mp_id, FrameParams f, __global const ushort* soa,
                                 __global ulong* keys, __global float* colors, __global uint* normals, int* written) {
@@ -243,6 +245,8 @@ inline uint mp_sample_tile_fast(const MpTriangle* tris, long xmin, long xmax, lo
     lb * select((float16)tris[1].b.field.comp, (float16)tris[0].b.field.comp, in0) +                     \
     lc * select((float16)tris[1].c.field.comp, (float16)tris[0].c.field.comp, in0)) * w)
         float16 r = MP_ATTRIBUTE16(c_over_d, x), gr = MP_ATTRIBUTE16(c_over_d, y), bl = MP_ATTRIBUTE16(c_over_d, z);
+        /* No holdout here: a held-out share of 0 in blue's low bits (mp_sample.h). */
+        bl = as_float16(as_uint16(bl) & (uint16)(~0xffu));
         if (whole) {
           __global float* cp = colors + mp_color_index(pixel, spp, 0) + (ulong)first;
           vstore16(select(vload16(0, cp), r, covered), 0, cp);
@@ -336,16 +340,18 @@ __kernel void sample_tiles(__global const SubPatch* diceable, __global const uin
       MpTriangle tris[2];
       mp_setup_quad(v, keep, tris);
       uint mp_id = mp_micropolygon_id(grid_id, m);
-      float opacity = mp_quad_opacity(grid_c[base + q[0]].w, grid_c[base + q[1]].w, grid_c[base + q[2]].w,
-                                      grid_c[base + q[3]].w);
+      float2 cover = (float2)(mp_quad_opacity(grid_c[base + q[0]].w, grid_c[base + q[1]].w, grid_c[base + q[2]].w,
+                                              grid_c[base + q[3]].w),
+                              mp_quad_opacity(grid_n[base + q[0]].w, grid_n[base + q[1]].w, grid_n[base + q[2]].w,
+                                              grid_n[base + q[3]].w));
       int px0 = (int)max(xmin >> MP_SUBPIXEL_BITS, (long)tx0), px1 = (int)min(xmax >> MP_SUBPIXEL_BITS, (long)tx1);
       int py0 = (int)max(ymin >> MP_SUBPIXEL_BITS, (long)ty0), py1 = (int)min(ymax >> MP_SUBPIXEL_BITS, (long)ty1);
       int written = 0;
-      if (xmax - xmin <= MP_FAST_SPAN && ymax - ymin <= MP_FAST_SPAN && opacity >= 1.0f)
+      if (xmax - xmin <= MP_FAST_SPAN && ymax - ymin <= MP_FAST_SPAN && cover.x >= 1.0f && !(cover.y > 0.0f))
         tests += mp_sample_tile_fast(tris, xmin, xmax, ymin, ymax, px0, px1, py0, py1, mp_id, f, sample_soa, keys,
                                      colors, normals, &written);
       else
-        tests += mp_sample_tile_slow(tris, xmin, xmax, ymin, ymax, px0, px1, py0, py1, mp_id, opacity, f,
+        tests += mp_sample_tile_slow(tris, xmin, xmax, ymin, ymax, px0, px1, py0, py1, mp_id, cover, f,
                                      sample_offsets, keys, colors, normals, &written);
       if (written) wx0 = min(wx0, px0), wx1 = max(wx1, px1), wy0 = min(wy0, py0), wy1 = max(wy1, py1);
     }

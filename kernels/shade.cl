@@ -32,9 +32,12 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
   if ((patch_info[4 * (ulong)sp.patch + 2] & MP_PATCH_SMOOTH_NORMALS) && !(m.program[1] > 0.0f)) {
     float3 ns = mp_face_shading_normal(patch_normals, sp.patch, uv.x, uv.y, n, p, f.ortho);
     if (dot(ns, ns) > 0.0f) {
-      /* w: 1 faced, 2 faced and the surface itself faces away (Backfacing). */
+      /* w, for node programs: 1 faced, 2 faced and the surface itself faces
+       * away (Backfacing). They replace it by the held-out share the sampler
+       * reads (material_program.cl); for other materials it stays 0. */
       float3 view = f.ortho ? (float3)(0.0f, 0.0f, 1.0f) : -p;
-      grid_n[index] = (float4)(ns, dot(n, view) < 0.0f ? 2.0f : 1.0f);
+      float flag = dot(n, view) < 0.0f ? 2.0f : 1.0f;
+      grid_n[index] = (float4)(ns, m.program[2] > 0.0f ? flag : 0.0f);
       n = ns, faced = 1;
     }
   }

@@ -161,6 +161,9 @@ def export_settings(native_scene, scene, width, height):
     settings.bound_split = getattr(_native.BoundSplitMethod, mp.bound_split_method)
     settings.bound_split_memory_mib = mp.bound_split_memory
     settings.occlusion_culling = mp.use_occlusion_culling
+    # An opaque film lays the world behind by alpha: held-out samples count
+    # as covered so it shows nowhere through a Holdout, as in Cycles.
+    settings.holdout_covers = not r.film_transparent
     settings.shadows = mp.use_shadows
     settings.shadow_memory_mib = mp.shadow_memory
     settings.shadow_shading_rate = mp.shadow_shading_rate

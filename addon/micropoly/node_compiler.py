@@ -903,7 +903,7 @@ class NodeCompiler:
             add(f"  mp_add_transparent(s, {weight} * {self._c(node, 'Color')});")
             return
         if t == "HOLDOUT":
-            self.warn(node, "is not supported (the rasteriser has no zero-alpha occluders); it adds nothing")
+            add(f"  mp_add_holdout(s, {weight});")
             return
         self.closures += 2 if t == "BSDF_GLASS" else 1
         slot = self._normal_slot(node)

@@ -140,7 +140,7 @@ __kernel void displace_grids(__global const SubPatch* diceable, uint count, __gl
 __kernel void shade_program_grids(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
                                   __global const DeviceMaterial* materials, __global const DeviceObject* objects,
                                   FrameParams f, int program, __global const float4* grid_p,
-                                  __global const float4* grid_n, MP_PROGRAM_INPUT_ARGS,
+                                  __global float4* grid_n, MP_PROGRAM_INPUT_ARGS,
                                   __global const DeviceLight* lights, uint light_count, __global float4* grid_c,
                                   __global const uint* vertex_offsets, uint use_shadows,
                                   __global const DeviceShadow* shadows, __global const DeviceShadowLevel* shadow_levels,
@@ -212,10 +212,14 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   MpShadowQuery shadow = {&maps, n, mp_pixel_footprint(-p.z, f)};
   float3 c = mp_shade_closures(p, n, grid_n[index].w > 0.5f, f.ortho, &s, lights, light_count, world_glossy,
                                use_shadows ? &shadow : 0);
-  /* Stochastic coverage multiplies by alpha: what the closures give is the
-   * covered part's colour. */
-  if (alpha > 0.0f) c = c / alpha;
+  /* Stochastic coverage multiplies by alpha, and by 1 - the held-out share
+   * of it: what the closures give is the kept samples' colour. */
+  float held = mp_surface_holdout_share(&s, alpha), kept = alpha * (1.0f - held);
+  c = kept > 1e-6f ? c / kept : (float3)(0.0f);
   grid_c[index] = (float4)(c, alpha);
+  /* The faced flag (read above) has served: w now carries the held-out
+   * share to the sampler (mp_raster.h). */
+  grid_n[index].w = held;
 }
 
 /* The world's radiance towards world direction d: the world program's

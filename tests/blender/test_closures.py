@@ -13,7 +13,9 @@ fully (alpha > 0.999). Glass and Refraction are shown in front of a textured
 world (Cycles with transmission bounces, so its rays leave the glass) and
 need >= 25 dB; the same scene with the glass replaced by a grey diffuse
 must miss that (the case can tell). An alpha-cut leaf (Principled Alpha from
-a texture): silhouette IoU >= 0.97 against Cycles.
+a texture): silhouette IoU >= 0.97 against Cycles. A Holdout mixed in by a
+texture: premultiplied RGBA >= 30 dB over Suzanne (a black Diffuse in its
+place must miss).
 
 Cases in SHORT_OF_TARGET miss their threshold in some Blender version; they
 are left out of the default run and their figures are in docs/blender.md.
@@ -86,6 +88,26 @@ def m_mix_diffuse_glossy(nt):
     nt.links.new(noise_fac(nt), mix.inputs[0])
     nt.links.new(d.outputs[0], mix.inputs[1])
     nt.links.new(g.outputs[0], mix.inputs[2])
+    return mix.outputs[0]
+
+
+def m_holdout_mix(nt, hold=True):
+    """Mix(Diffuse, Holdout) by a noise factor: Suzanne partly cut out of
+    the image. hold=False puts a black Diffuse where the Holdout was (what
+    a renderer that ignores Holdout would show)."""
+    d = node(nt, "ShaderNodeBsdfDiffuse", Color=rgba(0.7, 0.3, 0.2))
+    h = nt.nodes.new("ShaderNodeHoldout") if hold else node(nt, "ShaderNodeBsdfDiffuse", Color=rgba(0.0, 0.0, 0.0))
+    mix = nt.nodes.new("ShaderNodeMixShader")
+    ramp = node(nt, "ShaderNodeMath")
+    ramp.operation = "MULTIPLY_ADD"
+    ramp.inputs[1].default_value = 2.5
+    ramp.inputs[2].default_value = -0.3
+    nt.links.new(noise_fac(nt, scale=2.0), ramp.inputs[0])
+    clamp = node(nt, "ShaderNodeClamp")
+    nt.links.new(ramp.outputs[0], clamp.inputs[0])
+    nt.links.new(clamp.outputs[0], mix.inputs[0])
+    nt.links.new(d.outputs[0], mix.inputs[1])
+    nt.links.new(h.outputs[0], mix.inputs[2])
     return mix.outputs[0]
 
 
@@ -343,6 +365,43 @@ def case_leaf():
     return report("leaf", failures, f"IoU {i:.4f} over {covered} px (the uncut frame: {full:.3f})")
 
 
+def case_holdout():
+    """Mix(Diffuse, Holdout) by a texture on Suzanne in front of the floor:
+    premultiplied RGBA against Cycles over Suzanne's pixels, with a
+    transparent film (alpha 0 and colour 0 where held out) and an opaque
+    one (Cycles keeps the colour black there: no world behind; Micropoly's
+    alpha stays 1 there, docs/blender.md). A black Diffuse in the Holdout's
+    place must fail."""
+    scene = scene_with("holdout", m_holdout_mix)
+    obj = next(o for o in scene.objects if o.name.startswith("Suzanne"))
+    failures, shown = [], []
+    # Suzanne's pixels: where she covers the frame with the holdout gone.
+    cycles_t, micro_t = render_pair(scene, "holdout")
+    obj.data.materials[0] = material("holdout_off", lambda nt: m_holdout_mix(nt, hold=False))
+    plain = ru.render_passes(scene, "MICROPOLY", W, H, samples=16, transparent=True)["rgba"]
+    mask = plain[..., 3] > 0.999
+    obj.data.materials[0] = bpy.data.materials["holdout"]
+    held = float((1.0 - cycles_t[..., 3])[mask].mean())
+    if held < 0.1:
+        failures.append(f"Cycles holds out only {held:.3f} of Suzanne: the case cannot tell")
+    def rgba_psnr(ref, got):
+        return ru.psnr(ref[mask], got[mask], peak=float(ref[mask].max()))
+    db_t = rgba_psnr(cycles_t, micro_t)
+    db_wrong = rgba_psnr(cycles_t, plain)
+    shown.append(f"transparent film RGBA {db_t:.2f} dB (held out {held:.2f} of {int(mask.sum())} px), "
+                 f"black Diffuse instead {db_wrong:.2f} dB")
+    if db_t < 30.0:
+        failures.append(f"transparent film: RGBA PSNR {db_t:.2f} dB < 30")
+    if db_wrong >= 30.0:
+        failures.append(f"a black Diffuse in the Holdout's place reaches {db_wrong:.2f} dB: the case cannot tell")
+    cycles_o, micro_o = render_pair(scene, "holdout_opaque", transparent=False)
+    db_o = ru.psnr(cycles_o[mask][:, :3], micro_o[mask][:, :3], peak=float(cycles_o[mask][:, :3].max()))
+    shown.append(f"opaque film RGB {db_o:.2f} dB")
+    if db_o < 30.0:
+        failures.append(f"opaque film: RGB PSNR {db_o:.2f} dB < 30")
+    return report("holdout", failures, "; ".join(shown))
+
+
 def case_unsupported_warning():
     """A shader Micropoly cannot run, reached twice in one material and once
     in another: exactly one warning per material naming both it and the node."""
@@ -451,6 +510,7 @@ CASES = {
     "glass": lambda: case_through_glass("glass", m_glass),
     "refraction": lambda: case_through_glass("refraction", m_refraction),
     "unsupported_warning": case_unsupported_warning,
+    "holdout": case_holdout,
     "attributes": case_attributes,
 }
 

@@ -66,6 +66,7 @@ void expect_same_settings(const RenderSettings& a, const RenderSettings& b) {
   EXPECT_EQ(a.shadow_memory_mib, b.shadow_memory_mib);
   EXPECT_EQ(a.shadow_shading_rate, b.shadow_shading_rate);
   EXPECT_EQ(a.occlusion_culling, b.occlusion_culling);
+  EXPECT_EQ(a.holdout_covers, b.holdout_covers);
 }
 
 void expect_same_camera(const Camera& a, const Camera& b) {
@@ -296,6 +297,7 @@ Scene full_scene() {
   st.shadow_memory_mib = 100.3f;  // shadows stay on, so that the render tests see them
   st.shadow_shading_rate = 2.7f;
   st.occlusion_culling = false;
+  st.holdout_covers = true;
 
   s.camera = look_at({1.3f, 2.1f, 7.7f}, {0.1f, 0.2f, 0.0f}, 47.3f);
   s.camera.screen_left = -1.4f, s.camera.screen_right = 1.3f;
@@ -798,7 +800,7 @@ TEST(RibWriterExtensions, PngTexturesAreSrgbAndBottomRowFirst) {
 TEST(RibWriterExtensions, ShadowOptionsAndProgramAlpha) {
   const RibResult r = read_rib_string(
       "Option \"micropoly\" \"integer shadows\" [0] \"float shadowmemory\" [32.5] \"float shadowshadingrate\" [0.5]\n"
-      "Option \"micropoly\" \"integer occlusionculling\" [0]\n"
+      "Option \"micropoly\" \"integer occlusionculling\" [0] \"integer holdoutcovers\" [1]\n"
       "WorldBegin\n"
       "Attribute \"micropoly\" \"integer material\" 1 \"string program\" \"a\" \"integer programalpha\" 1\n"
       "Attribute \"micropoly\" \"integer material\" 2 \"string program\" \"a\" \"integer programshades\" 1\n"
@@ -810,6 +812,7 @@ TEST(RibWriterExtensions, ShadowOptionsAndProgramAlpha) {
   EXPECT_EQ(s.settings.shadow_memory_mib, 32.5f);
   EXPECT_EQ(s.settings.shadow_shading_rate, 0.5f);
   EXPECT_FALSE(s.settings.occlusion_culling);
+  EXPECT_TRUE(s.settings.holdout_covers);
   ASSERT_EQ(s.materials.size(), 3u);
   EXPECT_TRUE(s.materials[1].program_alpha);
   EXPECT_FALSE(s.materials[2].program_alpha);  // the default
@@ -821,6 +824,7 @@ TEST(RibWriterExtensions, ShadowOptionsAndProgramAlpha) {
   EXPECT_EQ(plain.settings.shadow_memory_mib, def.shadow_memory_mib);
   EXPECT_EQ(plain.settings.shadow_shading_rate, def.shadow_shading_rate);
   EXPECT_EQ(plain.settings.occlusion_culling, def.occlusion_culling);
+  EXPECT_EQ(plain.settings.holdout_covers, def.holdout_covers);
 }
 
 TEST(RibWriterExtensions, BadValuesAreErrors) {

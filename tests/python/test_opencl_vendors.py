@@ -21,7 +21,10 @@ def vendors(tmp_path, monkeypatch):
     system.mkdir()
     monkeypatch.setattr(module, "SYSTEM_VENDORS", str(system))
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
-    monkeypatch.delenv("OCL_ICD_VENDORS", raising=False)
+    # register() sets OCL_ICD_VENDORS itself: setting it through monkeypatch
+    # first makes the teardown restore whatever the process had.
+    monkeypatch.setenv("OCL_ICD_VENDORS", "")
+    monkeypatch.delenv("OCL_ICD_VENDORS")
     monkeypatch.delenv("MICROPOLY_EMBEDDED_POCL", raising=False)
     return module, system, tmp_path
 

@@ -275,6 +275,11 @@ struct RenderSettings {
   // the Normal pass): a frame that needs more is rendered in buckets that
   // fit, each with the pixel filter's reach of samples around it.
   float sample_memory_mib = 2048.0f;
+  // Held-out samples (Holdout shaders) count as covered in the alpha, so a
+  // background laid behind by alpha shows nowhere through them (Blender's
+  // opaque film; Cycles keeps their colour black there too). Off: they are
+  // transparent, alpha 0 (Film > Transparent, and the CLI's images).
+  bool holdout_covers = false;
 };
 
 struct Scene {

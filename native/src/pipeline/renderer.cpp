@@ -102,6 +102,7 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
   frame.params.planar_colors = (scene.settings.sampler == Sampler::Tiles ||
                                 (scene.settings.sampler == Sampler::Auto && s.info().type == "cpu")) &&
                                !mp_blur_on(frame.params) && s.tile_sampler();
+  frame.params.holdout_covers = scene.settings.holdout_covers ? 1 : 0;
   const FrameParams& f = frame.params;
   st.width = f.width;
   st.height = f.height;

@@ -193,6 +193,7 @@ PYBIND11_MODULE(_native, m) {
       .def_readwrite("keep_shadow_pages", &RenderSettings::keep_shadow_pages)
       .def_readwrite("soft_shadow_pages", &RenderSettings::soft_shadow_pages)
       .def_readwrite("occlusion_culling", &RenderSettings::occlusion_culling)
+      .def_readwrite("holdout_covers", &RenderSettings::holdout_covers)
       .def_readwrite("world_probes", &RenderSettings::world_probes)
       .def_readwrite("dof_dice_factor", &RenderSettings::dof_dice_factor)
       .def_readwrite("sampler", &RenderSettings::sampler)

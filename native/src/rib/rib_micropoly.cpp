@@ -65,6 +65,9 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   flag = s.occlusion_culling ? 1 : 0;
   params.get_int("occlusionculling", 0, 1, &flag);
   s.occlusion_culling = flag != 0;
+  flag = s.holdout_covers ? 1 : 0;
+  params.get_int("holdoutcovers", 0, 1, &flag);
+  s.holdout_covers = flag != 0;
   auto positive = [](float v) { return v > 0.0f && std::isfinite(v); };
   const std::string sampler = params.get_string("sampler", "");
   if (sampler == "auto")
@@ -99,7 +102,7 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   const int line = args.request().line;
   warn_unknown(params,
                {"boundsplit", "boundsplitmemory", "maxgridsize", "maxsplitdepth", "backfaceculling",
-                "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate", "occlusionculling",
+                "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate", "occlusionculling", "holdoutcovers",
                 "worldshadowdirections", "apertureblades", "aperturerotation", "apertureratio", "focusfactor",
                 "shuttercurve", "sampler", "samplememory"},
                [&](const std::string& name) {

@@ -239,6 +239,8 @@ void write_options(std::string& o, const RenderSettings& s, const Camera& c) {
     param(o, "float shadowshadingrate", s.shadow_shading_rate);
   if (s.occlusion_culling != def.occlusion_culling)
     param(o, "integer occlusionculling", static_cast<long long>(s.occlusion_culling ? 1 : 0));
+  if (s.holdout_covers != def.holdout_covers)
+    param(o, "integer holdoutcovers", static_cast<long long>(s.holdout_covers ? 1 : 0));
   if (s.world_probes != def.world_probes)
     param(o, "integer worldshadowdirections", static_cast<long long>(s.world_probes));
   if (differs(s.dof_dice_factor, def.dof_dice_factor)) param(o, "float focusfactor", s.dof_dice_factor);
