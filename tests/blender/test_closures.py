@@ -192,6 +192,14 @@ def m_translucent(nt):
     return node(nt, "ShaderNodeBsdfTranslucent", Color=rgba(0.3, 0.8, 0.3)).outputs[0]
 
 
+def m_subsurface(nt):
+    """Subsurface Scattering of a skin-like colour and radius (scale 0.1 on a
+    Suzanne of size 2)."""
+    sss = node(nt, "ShaderNodeSubsurfaceScattering", Color=rgba(0.8, 0.45, 0.35), Scale=0.1)
+    sss.inputs["Radius"].default_value = (1.0, 0.35, 0.2)
+    return sss.outputs[0]
+
+
 def m_toon(component):
     def build(nt):
         t = node(nt, "ShaderNodeBsdfToon", Color=rgba(0.8, 0.5, 0.3), Size=0.5, Smooth=0.1)
@@ -501,6 +509,7 @@ CASES = {
     "principled_sheen": lambda: case_material("principled_sheen", m_principled_sheen),
     "principled_specular_tint": lambda: case_material("principled_specular_tint", m_principled_specular_tint),
     "translucent": lambda: case_material("translucent", m_translucent),
+    "subsurface": lambda: case_material("subsurface", m_subsurface),
     "rerouted_principled": lambda: case_material("rerouted_principled", m_rerouted_principled),
     # The Metallic BSDF (F82 tint, anisotropy along the default tangent) came with 4.2.
     "metallic": lambda: case_material("metallic", m_metallic) if VERSION >= 402 else report("metallic", [], "skipped: no Metallic BSDF before 4.2"),
