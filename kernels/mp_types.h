@@ -150,6 +150,8 @@ typedef struct {
   float texspace_size[4];
   float to_world[12];   /* object -> world (rows of a 3x4) */
   float from_world[12]; /* world -> object */
+  float color[4];       /* Object Info: the object's colour (RGBA) */
+  float info[4];        /* Object Info: pass index, random number, 0, 0 */
 } DeviceObject;
 
 /* A texture image (scene.h Image): its texels are width * height float4

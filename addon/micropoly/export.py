@@ -228,7 +228,8 @@ def export_scene(depsgraph, view=None, meshes=None, motion=None):
         if obj.type == "MESH":
             try:
                 if export_mesh.export_object(native_scene, materials, meshes, obj, _matrix(inst.matrix_world),
-                                             out.warnings, is_instance=inst.is_instance, depsgraph=depsgraph):
+                                             out.warnings, is_instance=inst.is_instance, depsgraph=depsgraph,
+                                             random_id=inst.random_id if inst.is_instance else None):
                     out.objects += 1
                     if motion is not None and not inst.is_instance:
                         motion.apply_to_mesh(native_scene, obj.name)

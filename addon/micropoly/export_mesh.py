@@ -283,7 +283,47 @@ def ray_visibility(obj):
     return bool(getattr(obj, "visible_camera", True)), bool(getattr(obj, "visible_shadow", True))
 
 
-def export_object(native_scene, materials, cache, obj, matrix, warnings, is_instance=False, depsgraph=None):
+def _hash_string(name):
+    """Cycles' string hash (util/hash.h): i = i * 37 + byte, 32-bit."""
+    i = 0
+    for c in name.encode("utf-8"):
+        i = (i * 37 + c) & 0xFFFFFFFF
+    return i
+
+
+def _hash_uint2(kx, ky):
+    """Cycles' hash_uint2: Bob Jenkins' lookup3 final mix of two words."""
+    m = 0xFFFFFFFF
+
+    def rot(x, k):
+        return ((x << k) | (x >> (32 - k))) & m
+    a = b = c = (0xDEADBEEF + (2 << 2) + 13) & m
+    a, b = (a + kx) & m, (b + ky) & m
+    c ^= b
+    c = (c - rot(b, 14)) & m
+    a ^= c
+    a = (a - rot(c, 11)) & m
+    b ^= a
+    b = (b - rot(a, 25)) & m
+    c ^= b
+    c = (c - rot(b, 16)) & m
+    a ^= c
+    a = (a - rot(c, 4)) & m
+    b ^= a
+    b = (b - rot(a, 14)) & m
+    c ^= b
+    return (c - rot(b, 24)) & m
+
+
+def object_random(name, random_id=None):
+    """Object Info's Random as Cycles gives it: an instance's random id, or
+    for an object of its own the hash of its name, over 0xFFFFFFFF (float)."""
+    rid = (random_id & 0xFFFFFFFF) if random_id is not None else _hash_uint2(_hash_string(name), 0)
+    return float(np.float32(rid) * np.float32(1.0 / 0xFFFFFFFF))
+
+
+def export_object(native_scene, materials, cache, obj, matrix, warnings, is_instance=False, depsgraph=None,
+                  random_id=None):
     """Adds one mesh instance; returns False when it has no faces or nothing
     it would be seen in (neither the camera nor shadows). `depsgraph` gives
     the cage's shape keys their values at its time."""
@@ -338,7 +378,8 @@ def export_object(native_scene, materials, cache, obj, matrix, warnings, is_inst
         corner_vertices=arrays.get("corner_vertices", empty_i), corner_sharpness=arrays.get("corner_sharpness", empty_f),
         boundary=boundary, double_sided=double_sided, uv_layers=arrays.get("uv_layers", empty_f),
         corner_normals=arrays.get("corner_normals", empty_f), visible_camera=visible_camera,
-        cast_shadows=cast_shadows, **_texture_space(obj.original.data))
+        cast_shadows=cast_shadows, object_color=list(obj.color), pass_index=float(obj.pass_index),
+        random=object_random(obj.name, random_id if is_instance else None), **_texture_space(obj.original.data))
     return True
 
 

@@ -325,11 +325,18 @@ class NodeCompiler:
         if t == "LIGHT_PATH":
             return self.emit_light_path(node)
         if t == "OBJECT_INFO":
-            for name in ("Color", "Alpha", "Object Index", "Material Index", "Random"):
-                if name in node.outputs and node.outputs[name].is_linked:
-                    self.warn(node, f"the {name} output is not supported yet; it gives its default")
-            return {"Location": ("(g->object ? (float3)(g->object->to_world[3], g->object->to_world[7], "
-                                 "g->object->to_world[11]) : (float3)(0.0f))", VEC, None)}
+            # Per object (DeviceObject: its colour, pass index and random
+            # number, export_mesh.py); the material's pass index is a constant.
+            index = float(getattr(self.material, "pass_index", 0))
+            outs = {"Location": ("(g->object ? (float3)(g->object->to_world[3], g->object->to_world[7], "
+                                 "g->object->to_world[11]) : (float3)(0.0f))", VEC, None),
+                    "Color": ("(g->object ? (float3)(g->object->color[0], g->object->color[1], g->object->color[2])"
+                              " : (float3)(1.0f))", VEC, None),
+                    "Alpha": ("(g->object ? g->object->color[3] : 1.0f)", FLOAT, None),
+                    "Object Index": ("(g->object ? g->object->info[0] : 0.0f)", FLOAT, None),
+                    "Random": ("(g->object ? g->object->info[1] : 0.0f)", FLOAT, None),
+                    "Material Index": (_lit(index), FLOAT, (index, index))}
+            return {node.outputs[name].identifier: value for name, value in outs.items() if name in node.outputs}
         if t == "VALUE":
             x = float(node.outputs[0].default_value)
             return {node.outputs[0].identifier: (_lit(x), FLOAT, (x, x))}

@@ -410,6 +410,64 @@ def case_holdout():
     return report("holdout", failures, "; ".join(shown))
 
 
+def case_object_info():
+    """Object Info's Random, Object Index, Material Index and Color as
+    emission on four cubes (names, pass indices and colours of their own):
+    >= 40 dB against Cycles over the cubes; the same with the per-object
+    values zeroed (what a renderer without them shows) must miss."""
+    def by_numbers(nt):
+        info = nt.nodes.new("ShaderNodeObjectInfo")
+        rgb = nt.nodes.new("ShaderNodeCombineXYZ")
+        index = node(nt, "ShaderNodeMath")
+        index.operation = "MULTIPLY"
+        index.inputs[1].default_value = 0.1
+        nt.links.new(info.outputs["Object Index"], index.inputs[0])
+        mat_index = node(nt, "ShaderNodeMath")
+        mat_index.operation = "MULTIPLY"
+        mat_index.inputs[1].default_value = 0.1
+        nt.links.new(info.outputs["Material Index"], mat_index.inputs[0])
+        nt.links.new(info.outputs["Random"], rgb.inputs[0])
+        nt.links.new(index.outputs[0], rgb.inputs[1])
+        nt.links.new(mat_index.outputs[0], rgb.inputs[2])
+        e = node(nt, "ShaderNodeEmission", Strength=1.0)
+        nt.links.new(rgb.outputs[0], e.inputs["Color"])
+        return e.outputs[0]
+
+    def by_color(nt):
+        info = nt.nodes.new("ShaderNodeObjectInfo")
+        e = node(nt, "ShaderNodeEmission", Strength=1.0)
+        nt.links.new(info.outputs["Color"], e.inputs["Color"])
+        return e.outputs[0]
+    scene = scene_with("object_info", by_numbers, floor=False)
+    bpy.data.objects.remove(next(o for o in scene.objects if o.name.startswith("Suzanne")))
+    numbers = bpy.data.materials["object_info"]
+    numbers.pass_index = 4
+    colored = material("object_color", by_color)
+    for k, (name, x, z) in enumerate((("Crate", -2.2, 0.6), ("Barrel.001", 0.0, 0.6), ("tree_oak", 2.2, 0.6),
+                                      ("Painted", 0.0, -1.2))):
+        bpy.ops.mesh.primitive_cube_add(size=1.2, location=(x, 0.0, z))
+        obj = bpy.context.object
+        obj.name = name
+        obj.pass_index = 2 + 3 * k
+        obj.color = (0.9, 0.3 + 0.1 * k, 0.2, 1.0)
+        obj.data.materials.append(colored if name == "Painted" else numbers)
+    cycles, micro = render_pair(scene, "object_info")
+    db, covered = covered_psnr(cycles, micro)
+    for obj in scene.objects:
+        if obj.type == "MESH":
+            obj.pass_index, obj.color = 0, (1.0, 1.0, 1.0, 1.0)  # names kept: Random stays
+    plain = ru.render_passes(scene, "MICROPOLY", W, H, samples=16)["rgba"]
+    db_plain, _ = covered_psnr(cycles, plain)
+    failures = []
+    if covered < 2000:
+        failures.append(f"only {covered} covered pixels")
+    if db < 40.0:
+        failures.append(f"PSNR {db:.2f} dB < 40")
+    if db_plain >= 40.0:
+        failures.append(f"without the objects' colours and indices {db_plain:.2f} dB: the case cannot tell")
+    return report("object_info", failures, f"PSNR {db:.2f} dB over {covered} px (indices and colours reset: {db_plain:.2f} dB)")
+
+
 def case_unsupported_warning():
     """A shader Micropoly cannot run, reached twice in one material and once
     in another: exactly one warning per material naming both it and the node."""
@@ -520,6 +578,7 @@ CASES = {
     "refraction": lambda: case_through_glass("refraction", m_refraction),
     "unsupported_warning": case_unsupported_warning,
     "holdout": case_holdout,
+    "object_info": case_object_info,
     "attributes": case_attributes,
 }
 

@@ -199,6 +199,7 @@ void expect_same_mesh(const Mesh& a, const Mesh& b) {
   EXPECT_EQ(a.double_sided, b.double_sided);
   EXPECT_EQ(a.visible_camera, b.visible_camera);
   EXPECT_EQ(a.cast_shadows, b.cast_shadows);
+  EXPECT_TRUE(a.info == b.info) << a.name;
   EXPECT_EQ(a.uv_layers, b.uv_layers);
   EXPECT_EQ(a.corner_normals, b.corner_normals);
   EXPECT_EQ(a.texspace_location, b.texspace_location);
@@ -253,6 +254,7 @@ void expect_same_scene(const Scene& a, const Scene& b) {
     EXPECT_EQ(p.double_sided, q.double_sided);
     EXPECT_EQ(p.visible_camera, q.visible_camera);
     EXPECT_EQ(p.cast_shadows, q.cast_shadows);
+    EXPECT_TRUE(p.info == q.info) << p.name;
   }
 }
 
@@ -408,6 +410,7 @@ Scene full_scene() {
   mirrored.double_sided = false;
   mirrored.object_to_world = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(-1.8f, 0.3f, 0.5f)), glm::vec3(-0.3f, 0.4f, 0.35f));
   mirrored.cast_shadows = false;
+  mirrored.info = {{0.9f, 0.4f, 0.3f, 1.0f}, 7.0f, 0.25f};  // Object Info's values
   s.meshes.push_back(mirrored);
 
   // Catmull-Clark with the other boundary modes and a pentagon.
@@ -454,6 +457,7 @@ Scene full_scene() {
   mirrored_patch.object_to_world = glm::scale(glm::translate(glm::mat4(1.0f), glm::vec3(0.3f, 1.8f, 0.0f)), glm::vec3(-0.5f, 0.5f, 0.5f));
   mirrored_patch.visible_camera = false;
   mirrored_patch.cast_shadows = false;
+  mirrored_patch.info = {{0.2f, 0.7f, 0.1f, 0.5f}, 3.0f, 0.8125f};  // Object Info's values
   s.bezier_patches.push_back(mirrored_patch);
 
   // Texturing: a material program reads two UV layers, two images (one sRGB

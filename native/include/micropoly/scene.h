@@ -12,6 +12,18 @@ namespace mp {
 enum class SubdivScheme { None, CatmullClark };  // None: flat polygons
 enum class BoundaryInterpolation { None, EdgeOnly, EdgeAndCorner };
 
+// What Blender's Object Info node reads of an object: its Object Color
+// (RGBA), Pass Index and random number (Cycles': a hash of the object's
+// name, or the instance's random id, over 0xFFFFFFFF).
+struct ObjectInfo {
+  glm::vec4 color{1.0f};
+  float pass_index = 0.0f;
+  float random = 0.0f;
+  bool operator==(const ObjectInfo& o) const {
+    return color == o.color && pass_index == o.pass_index && random == o.random;
+  }
+};
+
 // A polygon or Catmull-Clark mesh. Faces may have any number (>= 3) of vertices.
 struct Mesh {
   std::string name;
@@ -50,6 +62,7 @@ struct Mesh {
   // casting shadows (in the lights' shadow maps).
   bool visible_camera = true;
   bool cast_shadows = true;
+  ObjectInfo info;
   // Motion blur (Scene::motion_steps): the points (deformation) and the
   // transform at each motion step, or empty where they do not move; the
   // fields above are the shutter centre's.
@@ -67,6 +80,7 @@ struct BezierPatches {
   bool double_sided = true;
   bool visible_camera = true;  // as Mesh
   bool cast_shadows = true;
+  ObjectInfo info;
 };
 
 // Materials. Constant, Matte and Plastic follow RenderMan's shaders (Cs,

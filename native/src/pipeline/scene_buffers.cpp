@@ -40,7 +40,7 @@ DeviceMaterial to_device(const Material& m) {
 
 // Camera <-> object transforms and texture space of one surface.
 DeviceObject to_device_object(const glm::mat4& to_camera, const glm::mat4& to_world, glm::vec3 texspace_location,
-                              glm::vec3 texspace_size, const std::vector<glm::vec3>& points) {
+                              glm::vec3 texspace_size, const std::vector<glm::vec3>& points, const ObjectInfo& info) {
   if (texspace_size == glm::vec3(0.0f) && !points.empty()) {
     glm::vec3 lo(3e38f), hi(-3e38f);
     for (const glm::vec3& p : points) lo = glm::min(lo, p), hi = glm::max(hi, p);
@@ -59,6 +59,9 @@ DeviceObject to_device_object(const glm::mat4& to_camera, const glm::mat4& to_wo
     }
   put(o.texspace_location, texspace_location, 0.0f);
   put(o.texspace_size, texspace_size, 0.0f);
+  for (int k = 0; k < 4; ++k) o.color[k] = info.color[k];
+  o.info[0] = info.pass_index;
+  o.info[1] = info.random;
   return o;
 }
 
@@ -304,8 +307,9 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
     place_shape(*shapes[i], to_camera, mesh, set, uint32_t(out.objects.size()), scene, out.patches);
     const glm::mat4& to_world = mesh ? mesh->object_to_world : set->object_to_world;
     out.objects.push_back(mesh ? to_device_object(to_camera, to_world, mesh->texspace_location, mesh->texspace_size,
-                                                  mesh->points)
-                               : to_device_object(to_camera, to_world, glm::vec3(0.0f), glm::vec3(0.0f), set->control_points));
+                                                  mesh->points, mesh->info)
+                               : to_device_object(to_camera, to_world, glm::vec3(0.0f), glm::vec3(0.0f),
+                                                  set->control_points, set->info));
   }
   if (scene.motion_steps >= 2) place_motion(scene, surfaces, cache ? cache : &local, out);
   if (scene.materials.empty()) out.materials.push_back(to_device(Material{}));

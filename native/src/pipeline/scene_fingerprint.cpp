@@ -94,6 +94,7 @@ void hash_surfaces(Hasher& h, const Scene& scene) {
     h.value(m.texspace_size);
     h.value(m.visible_camera);
     h.value(m.cast_shadows);
+    h.value(m.info.color), h.value(m.info.pass_index), h.value(m.info.random);
     h.value(m.motion_points.size());
     for (const std::vector<glm::vec3>& step : m.motion_points) h.values(step);
     h.values(m.motion_object_to_world);
@@ -109,6 +110,7 @@ void hash_surfaces(Hasher& h, const Scene& scene) {
     h.value(b.double_sided);
     h.value(b.visible_camera);
     h.value(b.cast_shadows);
+    h.value(b.info.color), h.value(b.info.pass_index), h.value(b.info.random);
   }
   h.value(scene.materials.size());
   for (const Material& m : scene.materials) {

@@ -360,8 +360,12 @@ PYBIND11_MODULE(_native, m) {
              const Array<int>& corner_vertices, const Array<float>& corner_sharpness, const Array<int>& hole_faces,
              const std::string& boundary, bool double_sided, std::vector<float> texspace_location,
              std::vector<float> texspace_size, const Array<float>& uv_layers, const Array<float>& corner_normals,
-             bool visible_camera, bool cast_shadows) {
+             bool visible_camera, bool cast_shadows, std::vector<float> object_color, float pass_index, float random) {
             Mesh mesh;
+            if (object_color.size() != 4) throw Error("mesh '" + name + "': object_color must have 4 values (RGBA)");
+            mesh.info.color = glm::vec4(object_color[0], object_color[1], object_color[2], object_color[3]);
+            mesh.info.pass_index = pass_index;
+            mesh.info.random = random;
             mesh.visible_camera = visible_camera;
             mesh.cast_shadows = cast_shadows;
             mesh.corner_normals = to_points(corner_normals, "corner_normals");
@@ -406,6 +410,8 @@ PYBIND11_MODULE(_native, m) {
           py::arg("texspace_location") = std::vector<float>{0, 0, 0},
           py::arg("texspace_size") = std::vector<float>{0, 0, 0}, py::arg("uv_layers") = Array<float>(),
           py::arg("corner_normals") = Array<float>(), py::arg("visible_camera") = true, py::arg("cast_shadows") = true,
+          py::arg("object_color") = std::vector<float>{1, 1, 1, 1}, py::arg("pass_index") = 0.0f,
+          py::arg("random") = 0.0f,
           "Adds a mesh; uv_layers is (layers, face corners, 2): UV layer k is what material programs read as "
           "UV layer k; corner_normals (face corners, 3), object space, shade a polygon mesh smooth.")
       .def(

@@ -186,10 +186,22 @@ void Parser::read_environment_light(ArgReader& args, const ParamList& params) {
 void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
   const int line = args.request().line;
   warn_unknown(params, {"material", "materialname", "program", "programdisplaces", "programshades",
-                        "programalpha", "displacementbound", "displacementworld"}, [&](const std::string& name) {
+                        "programalpha", "displacementbound", "displacementworld", "objectcolor", "objectalpha",
+                        "objectindex", "objectrandom"}, [&](const std::string& name) {
     warn_once("attribute-micropoly:" + name, line,
               "Attribute \"micropoly\": parameter \"" + name + "\" is ignored");
   });
+  // What Object Info reads of the following objects.
+  ObjectInfo& info = attrs_.object_info;
+  glm::vec3 rgb(info.color);
+  params.get_floats("objectcolor", &rgb.x, 3);
+  auto finite = [](float v) { return std::isfinite(v); };
+  info.color = glm::vec4(rgb, params.get_float_checked("objectalpha", info.color.w, finite, "a finite number"));
+  info.pass_index = params.get_float_checked("objectindex", info.pass_index, finite, "a finite number");
+  info.random = params.get_float_checked("objectrandom", info.random,
+                                         [](float v) { return v >= 0.0f && v <= 1.0f; }, "a number in [0, 1]");
+  if (!std::isfinite(rgb.x) || !std::isfinite(rgb.y) || !std::isfinite(rgb.z))
+    args.fail("\"objectcolor\" must be finite");
   if (!params.find("material")) {
     if (params.find("materialname"))
       warn_once("attribute-micropoly:materialname", line,

@@ -137,7 +137,7 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
                      merge_.object_to_world == object_to_world && merge_.material == material &&
                      merge_.double_sided == attrs.double_sided &&
                      merge_.visible_camera == attrs.visible_camera &&
-                     merge_.cast_shadows == attrs.cast_shadows &&
+                     merge_.cast_shadows == attrs.cast_shadows && merge_.object_info == attrs.object_info &&
                      merge_.identifier == attrs.identifier &&
                      merge_.has_identifier == attrs.has_identifier;
   if (prim.kind == Primitive::Kind::Mesh) {
@@ -163,6 +163,7 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
     mesh.double_sided = attrs.double_sided;
     mesh.visible_camera = attrs.visible_camera;
     mesh.cast_shadows = attrs.cast_shadows;
+    mesh.info = attrs.object_info;
     for (const glm::mat4& m : attrs.motion_ctm) mesh.motion_object_to_world.push_back(m * prim.local);
     if (flip) reverse_faces(mesh, 0, 0);
     scene.meshes.push_back(std::move(mesh));
@@ -185,6 +186,7 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
     set.double_sided = attrs.double_sided;
     set.visible_camera = attrs.visible_camera;
     set.cast_shadows = attrs.cast_shadows;
+    set.info = attrs.object_info;
     if (flip) mirror_patches_u(set.control_points, 0);
     scene.bezier_patches.push_back(std::move(set));
   }
@@ -198,6 +200,7 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
     merge_.double_sided = attrs.double_sided;
     merge_.visible_camera = attrs.visible_camera;
     merge_.cast_shadows = attrs.cast_shadows;
+    merge_.object_info = attrs.object_info;
     merge_.identifier = attrs.identifier;
     merge_.has_identifier = attrs.has_identifier;
   }

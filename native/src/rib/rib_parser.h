@@ -68,6 +68,9 @@ struct Attributes {
   // Scene material chosen by Attribute "micropoly" "integer material"; -1:
   // none (the shading state above picks one). Surface, Color and Opacity reset it.
   int material_slot = -1;
+  // Attribute "micropoly" "color objectcolor" / "float objectalpha" /
+  // "float objectindex" / "float objectrandom": what Object Info reads.
+  ObjectInfo object_info;
 };
 
 // A primitive before it is placed: geometry in its own object space, vertex
@@ -130,6 +133,7 @@ class Parser {
     bool double_sided;
     bool visible_camera;
     bool cast_shadows;
+    ObjectInfo object_info;
     std::string identifier;
     bool has_identifier;
   };

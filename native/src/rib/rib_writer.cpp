@@ -471,6 +471,14 @@ void write_object_state(std::string& o, const Object& object, const std::vector<
   write_transform(o, object.object_to_world, motion_transforms(object), "  ");
   o += object.double_sided ? "  Sides 2\n" : "  Sides 1\n";
   write_visibility(o, object.visible_camera, object.cast_shadows);
+  if (!(object.info == ObjectInfo{})) {
+    o += "  Attribute \"micropoly\"";
+    param(o, "color objectcolor", glm::vec3(object.info.color));
+    param(o, "float objectalpha", object.info.color.w);
+    param(o, "float objectindex", object.info.pass_index);
+    param(o, "float objectrandom", object.info.random);
+    o += '\n';
+  }
   const int material = object.material;
   write_material(o, materials[static_cast<size_t>(material)], material, "  ", programs);
 }
