@@ -92,13 +92,13 @@ MP_INLINE float3 mp_closure_glossy_albedo(const MpClosure* c, float nv) {
 MP_INLINE float mp_sheen_albedo(const MpClosure* c, float nv) {
   /* Principled 3.x: (1 - l.h)^5 nl integrated over the hemisphere is
    * 0.0003 at normal view, 0.016 at nv = 0.5 and 0.048 at 0.2; 0.125 (1 -
-   * nv)^3 follows that within a third. The microfiber table stands in for
-   * the velvet lobe as well. */
+   * nv)^3 follows that within a third. The Charlie lobe's albedo stands in
+   * for the velvet lobe's. */
   if (c->fresnel == MP_SHEEN_PRINCIPLED_V1) {
     float t = 1.0f - clamp(nv, 0.0f, 1.0f);
     return 0.125f * t * t * t;
   }
-  return mp_microfiber_sheen_albedo(nv, c->a);
+  return c->fresnel == MP_SHEEN_ASHIKHMIN ? mp_charlie_sheen_albedo(nv, c->a) : mp_microfiber_sheen_albedo(nv, c->a);
 }
 MP_INLINE float mp_closure_sheen(const MpClosure* c, float3 n, float3 l, float3 v) {
   if (c->fresnel == MP_SHEEN_PRINCIPLED_V1) {

@@ -588,7 +588,6 @@ CASES = {
 # (Shaders ▸ Against Cycles). Name them after "--" to run them.
 SHORT_OF_TARGET = {
     "glossy_0.1": "the world's occlusion of a sharp lobe comes from 16 wide probe shadows",
-    "principled_sheen": "4.x's microfiber sheen is approximated by the Charlie lobe",
     "glass": "3.4, 5.0: one lookup along a sphere's exit direction stands in for paths through the object",
     "refraction": "one environment lookup cannot follow a ray through two interfaces",
 }
