@@ -109,6 +109,9 @@ typedef struct {
    * film, whose background is laid behind by alpha, shows none through
    * them. 0 leaves them transparent (Film > Transparent, the CLI). */
   int holdout_covers;
+  /* Some material can hold out (its program calls mp_add_holdout): else
+   * the resolve skips reading the held-out share. */
+  int holdouts;
 } FrameParams;
 
 /* The camera view's occlusion pyramid (mp_occlusion.h): level 0 has a cell

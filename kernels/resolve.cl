@@ -70,8 +70,9 @@ inline void mp_resolve(MP_RESOLVE_ARGS, const int lanes) {
           /* A sample's held-out share (mp_sample.h) is left out of its
            * alpha, unless f.holdout_covers; its colour has it already. */
           float8 blue = vload8(0, c + 2 * spp + s);
-          float8 shown = f.holdout_covers ? w
-                                          : w * (1.0f - convert_float8(as_uint8(blue) & (uint8)(0xffu)) * (1.0f / 255.0f));
+          float8 shown = f.holdout_covers || !f.holdouts
+                             ? w
+                             : w * (1.0f - convert_float8(as_uint8(blue) & (uint8)(0xffu)) * (1.0f / 255.0f));
           w8 += w;
           a8 += select((float8)(0.0f), shown, covered);
           r8 += select((float8)(0.0f), w * vload8(0, c + s), covered);
@@ -93,7 +94,7 @@ inline void mp_resolve(MP_RESOLVE_ARGS, const int lanes) {
         wsum += w;
         if (keys[index] == (ulong)0xffffffffffffffffUL) continue;
         float3 col = mp_load_color(colors, q, s, spp, f);
-        sum += w * (float4)(col, f.holdout_covers ? 1.0f : 1.0f - mp_unpack_holdout(col.z));
+        sum += w * (float4)(col, f.holdout_covers || !f.holdouts ? 1.0f : 1.0f - mp_unpack_holdout(col.z));
       }
     }
 #define MP_SUM8(v) ((((v).s0 + (v).s1) + ((v).s2 + (v).s3)) + (((v).s4 + (v).s5) + ((v).s6 + (v).s7)))

@@ -103,6 +103,14 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
                                 (scene.settings.sampler == Sampler::Auto && s.info().type == "cpu")) &&
                                !mp_blur_on(frame.params) && s.tile_sampler();
   frame.params.holdout_covers = scene.settings.holdout_covers ? 1 : 0;
+  // Whether any material can hold out (mp_closures.h's mp_add_holdout in its
+  // program): only then does the resolve read samples' held-out shares.
+  frame.params.holdouts = std::any_of(scene.material_programs.begin(), scene.material_programs.end(),
+                                      [](const MaterialProgram& p) {
+                                        return p.source.find("mp_add_holdout") != std::string::npos;
+                                      })
+                              ? 1
+                              : 0;
   const FrameParams& f = frame.params;
   st.width = f.width;
   st.height = f.height;
