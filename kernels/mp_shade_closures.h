@@ -29,6 +29,30 @@ MP_INLINE float mp_lamp_factor(MP_GLOBAL const DeviceLight* lt, int type, float3
   return fmax(dot(n, *l), 0.0f) / d2;
 }
 
+/* Geometric specular antialiasing (Kaplanyan, Hill, Patney and Lefohn
+ * 2016; Tokuyoshi and Kaplanyan 2019): a highlight narrower than a
+ * micropolygon, shaded at its vertices and interpolated between them,
+ * would alias; the spread of the normal across the micropolygon (n to its
+ * neighbours one step along u and v) is added to a sharp lobe's alpha^2
+ * instead, as the pixel filter would have blurred it: variance
+ * 1/(2 pi) (|dn_u|^2 + |dn_v|^2), at most 0.18. */
+MP_INLINE float mp_normal_spread2(float3 n, float3 nu, float3 nv) {
+  float3 du = nu - n, dv = nv - n;
+  float variance = (0.5f / MP_PI) * (dot(du, du) + dot(dv, dv));
+  return isfinite(variance) ? fmin(2.0f * variance, 0.18f) : 0.0f;
+}
+
+/* Widens the surface's GGX lobes by a normal spread^2 (mp_normal_spread2). */
+MP_INLINE void mp_surface_filter_roughness(MpSurface* s, float spread2) {
+  if (!(spread2 > 0.0f)) return;
+  for (int i = 0; i < s->count; ++i) {
+    MpClosure* c = &s->c[i];
+    if (c->kind != MP_CLOSURE_GLOSSY && c->kind != MP_CLOSURE_CLEARCOAT) continue;
+    c->a = fmin(sqrt(c->a * c->a + spread2), 1.0f);
+    c->b = fmin(sqrt(c->b * c->b + spread2), 1.0f);
+  }
+}
+
 /* The glossy closure's Fresnel term at the cosine c between the view and
  * the half vector; `back`: seen from inside, where a dielectric's relative
  * IOR is inverted. */
@@ -320,10 +344,11 @@ MP_INLINE float3 mp_shade_closures(float3 p, float3 ng, int faced, int ortho, co
  * Interface Specification 3.2, appendix A) as a diffuse closure whose lamp
  * light is Kd times the irradiance and whose ambient and world light is Ka
  * times theirs, plus for plastic a Phong lobe of Ks times the specular
- * colour; constant as its colour. */
+ * colour; constant as its colour. spread2: the normal's spread across the
+ * micropolygon (mp_normal_spread2). */
 MP_INLINE float3 mp_shade_material(float3 p, float3 n, int faced, int ortho, const DeviceMaterial* m,
                                    MP_GLOBAL const DeviceLight* lights, uint light_count,
-                                   MP_GLOBAL const float4* world_glossy, const MpShadowQuery* shadow) {
+                                   MP_GLOBAL const float4* world_glossy, const MpShadowQuery* shadow, float spread2) {
   float3 zero = MP_F3(0.0f, 0.0f, 0.0f), one = MP_F3(1.0f, 1.0f, 1.0f);
   float3 cs = MP_F3(m->color[0], m->color[1], m->color[2]);
   float3 emission = MP_F3(m->emission[0], m->emission[1], m->emission[2]);
@@ -369,6 +394,7 @@ MP_INLINE float3 mp_shade_material(float3 p, float3 n, int faced, int ortho, con
   pr.retro = flags & 1;
   pr.multiscatter = (flags >> 1) & 1;
   mp_add_principled(&s, one, &pr, n);
+  mp_surface_filter_roughness(&s, spread2);
   return mp_shade_closures(p, n, faced, ortho, &s, lights, light_count, world_glossy, shadow);
 }
 

@@ -42,6 +42,25 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
     }
   }
   if (m.program[2] > 0.0f) return; /* shaded by its node program (material_program.cl) */
-  float3 c = mp_shade_material(p, n, faced, f.ortho, &m, lights, light_count, world_glossy, use_shadows ? &shadow : 0);
+  /* The normal one step along u and v (mp_normal_spread2). Smooth-shaded
+   * polygons take their neighbours' interpolated normals from the patch
+   * (their grid normals are being replaced by this kernel), the rest the
+   * grid's, which this kernel leaves alone. */
+  MpGridShape shape = mp_grid_shape(&sp, (uint)f.max_grid);
+  uint here = mp_slot(&shape, i, j), sx, sy;
+  mp_grid_steps(&shape, i, j, &sx, &sy);
+  ulong gx = index - here + sx, gy = index - here + sy;
+  float3 nx = grid_n[gx].xyz, ny = grid_n[gy].xyz;
+  if (faced) {
+    uint stride = (uint)f.max_grid + 1u;
+    float2 uvx = uv, uvy = uv;
+    mp_slot_uv(&sp, &shape, sx % stride, sx / stride, &uvx);
+    mp_slot_uv(&sp, &shape, sy % stride, sy / stride, &uvy);
+    nx = mp_face_shading_normal(patch_normals, sp.patch, uvx.x, uvx.y, shadow.normal, grid_p[gx].xyz, f.ortho);
+    ny = mp_face_shading_normal(patch_normals, sp.patch, uvy.x, uvy.y, shadow.normal, grid_p[gy].xyz, f.ortho);
+  }
+  float spread2 = mp_normal_spread2(n, nx, ny);
+  float3 c = mp_shade_material(p, n, faced, f.ortho, &m, lights, light_count, world_glossy, use_shadows ? &shadow : 0,
+                               spread2);
   grid_c[index] = (float4)(c, m.opacity[3]);
 }

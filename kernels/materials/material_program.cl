@@ -210,6 +210,14 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
    * polygons, which shade.cl gave their interpolated normal, that normal's). */
   MpShadowMaps maps = {shadows, shadow_levels, shadow_pages, shadow_pool};
   MpShadowQuery shadow = {&maps, n, mp_pixel_footprint(-p.z, f)};
+  /* Sharp lobes widened by the normal's spread across the micropolygon
+   * (mp_normal_spread2): the grid's normals, final since shade.cl. */
+  {
+    MpGridShape gs = mp_grid_shape(&sp, (uint)f.max_grid);
+    uint at = mp_slot(&gs, i, j), ax, ay;
+    mp_grid_steps(&gs, i, j, &ax, &ay);
+    mp_surface_filter_roughness(&s, mp_normal_spread2(n, grid_n[index - at + ax].xyz, grid_n[index - at + ay].xyz));
+  }
   float3 c = mp_shade_closures(p, n, grid_n[index].w > 0.5f, f.ortho, &s, lights, light_count, world_glossy,
                                use_shadows ? &shadow : 0);
   /* Stochastic coverage multiplies by alpha, and by 1 - the held-out share
