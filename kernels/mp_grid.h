@@ -236,18 +236,6 @@ MP_INLINE uint mp_across_slot(const MpGridShape* g, uint e, uint k) {
 
 /* Neighbouring vertex slots of slot (i, j) towards -u, +u, -v and +v (the
  * vertex itself where there is none), for differences across the grid. */
-MP_INLINE void mp_grid_neighbours(const MpGridShape* g, uint i, uint j, uint* xm, uint* xp, uint* ym, uint* yp);
-
-/* One step along u and one along v from slot (i, j): towards +u and +v,
- * or -u and -v on the far border. */
-MP_INLINE void mp_grid_steps(const MpGridShape* g, uint i, uint j, uint* sx, uint* sy) {
-  uint here = mp_slot(g, i, j), xm, xp, ym, yp;
-  mp_grid_neighbours(g, i, j, &xm, &xp, &ym, &yp);
-  *sx = xp != here ? xp : xm;
-  *sy = yp != here ? yp : ym;
-}
-
-/* Neighbouring vertex slots of slot (i, j) (see above). */
 MP_INLINE void mp_grid_neighbours(const MpGridShape* g, uint i, uint j, uint* xm, uint* xp, uint* ym, uint* yp) {
   uint self = mp_slot(g, i, j), mg = g->mg;
   *xm = *xp = *ym = *yp = self;
@@ -274,6 +262,15 @@ MP_INLINE void mp_grid_neighbours(const MpGridShape* g, uint i, uint j, uint* xm
   *xp = i + 1u < g->nu ? mp_slot(g, i + 1u, j) : mp_edge_slot(g, 1u, mp_round_ratio(j, g->n[1], g->nv));
   *ym = j > 1u ? mp_slot(g, i, j - 1u) : mp_edge_slot(g, 0u, mp_round_ratio(i, g->n[0], g->nu));
   *yp = j + 1u < g->nv ? mp_slot(g, i, j + 1u) : mp_edge_slot(g, 2u, mp_round_ratio(i, g->n[2], g->nu));
+}
+
+/* One step along u and one along v from slot (i, j): towards +u and +v,
+ * or -u and -v on the far border. */
+MP_INLINE void mp_grid_steps(const MpGridShape* g, uint i, uint j, uint* sx, uint* sy) {
+  uint here = mp_slot(g, i, j), xm, xp, ym, yp;
+  mp_grid_neighbours(g, i, j, &xm, &xp, &ym, &yp);
+  *sx = xp != here ? xp : xm;
+  *sy = yp != here ? yp : ym;
 }
 
 #endif

@@ -29,7 +29,8 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
    * for shading, node programs and the Normal pass (w = 1: already faced).
    * Displaced surfaces keep the normal of their displaced grid. */
   int faced = 0;
-  if ((patch_info[4 * (ulong)sp.patch + 2] & MP_PATCH_SMOOTH_NORMALS) && !(m.program[1] > 0.0f)) {
+  int smooth = (patch_info[4 * (ulong)sp.patch + 2] & MP_PATCH_SMOOTH_NORMALS) && !(m.program[1] > 0.0f);
+  if (smooth) {
     float3 ns = mp_face_shading_normal(patch_normals, sp.patch, uv.x, uv.y, n, p, f.ortho);
     if (dot(ns, ns) > 0.0f) {
       /* w, for node programs: 1 faced, 2 faced and the surface itself faces
@@ -50,14 +51,18 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
   uint here = mp_slot(&shape, i, j), sx, sy;
   mp_grid_steps(&shape, i, j, &sx, &sy);
   ulong gx = index - here + sx, gy = index - here + sy;
-  float3 nx = grid_n[gx].xyz, ny = grid_n[gy].xyz;
-  if (faced) {
+  float3 nx, ny;
+  if (!smooth) {
+    nx = grid_n[gx].xyz, ny = grid_n[gy].xyz;
+  } else {
     uint stride = (uint)f.max_grid + 1u;
     float2 uvx = uv, uvy = uv;
     mp_slot_uv(&sp, &shape, sx % stride, sx / stride, &uvx);
     mp_slot_uv(&sp, &shape, sy % stride, sy / stride, &uvy);
     nx = mp_face_shading_normal(patch_normals, sp.patch, uvx.x, uvx.y, shadow.normal, grid_p[gx].xyz, f.ortho);
     ny = mp_face_shading_normal(patch_normals, sp.patch, uvy.x, uvy.y, shadow.normal, grid_p[gy].xyz, f.ortho);
+    if (!(dot(nx, nx) > 0.0f)) nx = n; /* a patch without smooth normals there */
+    if (!(dot(ny, ny) > 0.0f)) ny = n;
   }
   float spread2 = mp_normal_spread2(n, nx, ny);
   float3 c = mp_shade_material(p, n, faced, f.ortho, &m, lights, light_count, world_glossy, use_shadows ? &shadow : 0,

@@ -165,17 +165,18 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
    * the surface itself faced away. */
   if (grid_n[index].w > 0.5f) g.backfacing = grid_n[index].w > 1.5f;
   g.shadow_ray = alpha_only != 0;
-#ifdef MP_NODE_USES_NEIGHBOURS
-  /* Bump nodes difference their heights towards the next grid vertex along
-   * u and along v (the previous one on the grid's far border), a tenth of
-   * the way: a small step keeps the difference first-order even where a
-   * micropolygon spans much of a texture's feature (grazing views). */
-  uint stride = (uint)f.max_grid + 1u;
+  /* The next grid vertex along u and along v (the previous one on the
+   * grid's far border): bump nodes difference towards them, and sharp lobes
+   * widen by the normal's spread to them. */
   MpGridShape shape = mp_grid_shape(&sp, (uint)f.max_grid);
-  uint here = mp_slot(&shape, i, j), xm, xp, ym, yp;
-  mp_grid_neighbours(&shape, i, j, &xm, &xp, &ym, &yp);
-  uint sx = xp != here ? xp : xm, sy = yp != here ? yp : ym;
+  uint here = mp_slot(&shape, i, j), sx, sy;
+  mp_grid_steps(&shape, i, j, &sx, &sy);
   ulong gx = index - here + sx, gy = index - here + sy;
+#ifdef MP_NODE_USES_NEIGHBOURS
+  /* Bump nodes go a tenth of the way: a small step keeps the difference
+   * first-order even where a micropolygon spans much of a texture's feature
+   * (grazing views). */
+  uint stride = (uint)f.max_grid + 1u;
   float2 uvx = uv, uvy = uv;
   mp_slot_uv(&sp, &shape, sx % stride, sx / stride, &uvx);
   mp_slot_uv(&sp, &shape, sy % stride, sy / stride, &uvy);
@@ -212,12 +213,7 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   MpShadowQuery shadow = {&maps, n, mp_pixel_footprint(-p.z, f)};
   /* Sharp lobes widened by the normal's spread across the micropolygon
    * (mp_normal_spread2): the grid's normals, final since shade.cl. */
-  {
-    MpGridShape gs = mp_grid_shape(&sp, (uint)f.max_grid);
-    uint at = mp_slot(&gs, i, j), ax, ay;
-    mp_grid_steps(&gs, i, j, &ax, &ay);
-    mp_surface_filter_roughness(&s, mp_normal_spread2(n, grid_n[index - at + ax].xyz, grid_n[index - at + ay].xyz));
-  }
+  mp_surface_filter_roughness(&s, mp_normal_spread2(n, grid_n[gx].xyz, grid_n[gy].xyz));
   float3 c = mp_shade_closures(p, n, grid_n[index].w > 0.5f, f.ortho, &s, lights, light_count, world_glossy,
                                use_shadows ? &shadow : 0);
   /* Stochastic coverage multiplies by alpha, and by 1 - the held-out share

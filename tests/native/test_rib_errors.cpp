@@ -235,6 +235,18 @@ TEST(RibErrors, PrincipledFlags) {
                "\"retrodiffuse\" expects one integer in [0, 1]");
 }
 
+// Object Info's values and the holdout option: out of range, not numbers,
+// not finite.
+TEST(RibErrors, ObjectInfoAndHoldout) {
+  expect_error("WorldBegin\nAttribute \"micropoly\" \"float objectrandom\" [1.5]\n", 2,
+               "\"objectrandom\" must be a number in [0, 1]");
+  expect_error("WorldBegin\nAttribute \"micropoly\" \"float objectindex\" [\"two\"]\n", 2, "objectindex");
+  // Non-finite numbers never reach it: the lexer refuses them.
+  expect_error("WorldBegin\nAttribute \"micropoly\" \"color objectcolor\" [1 1e999 0]\n", 2, "out of range");
+  expect_error("Option \"micropoly\" \"integer holdoutcovers\" [3]\n", 1,
+               "\"holdoutcovers\" expects one integer in [0, 1]");
+}
+
 TEST(RibErrors, Archives) {
   expect_error("WorldBegin\nReadArchive \"does_not_exist.rib\"\n", 2, "cannot read");
   expect_error("ReadArchive \"/dev/zero\"\n", 1, "not a regular file");

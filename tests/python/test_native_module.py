@@ -76,6 +76,9 @@ def test_bad_input_raises_a_clear_error(renderer):
     scene.add_mesh("bad_index", points, np.array([3], dtype=np.int32), np.array([0, 1, 7], dtype=np.int32))
     with pytest.raises(RuntimeError, match="out of range"):
         renderer.render(scene)
+    with pytest.raises(_native.Error, match="object_color"):
+        scene.add_mesh("odd_colour", points, np.array([3], dtype=np.int32), np.arange(3, dtype=np.int32),
+                       object_color=[1.0, 0.5, 0.2])
     with pytest.raises(_native.Error):
         scene.add_light("laser")
     with pytest.raises(_native.Error):

@@ -200,8 +200,6 @@ void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
   info.pass_index = params.get_float_checked("objectindex", info.pass_index, finite, "a finite number");
   info.random = params.get_float_checked("objectrandom", info.random,
                                          [](float v) { return v >= 0.0f && v <= 1.0f; }, "a number in [0, 1]");
-  if (!std::isfinite(rgb.x) || !std::isfinite(rgb.y) || !std::isfinite(rgb.z))
-    args.fail("\"objectcolor\" must be finite");
   if (!params.find("material")) {
     if (params.find("materialname"))
       warn_once("attribute-micropoly:materialname", line,
