@@ -2,7 +2,9 @@
 # Installs what Micropoly needs on Debian 12, builds it, and then
 #   demo: renders the demo scene through headless Blender to demo.png
 #         (and the Utah teapot RIB through micropoly-render to teapot.png)
-#   test: runs every test (ctest: GoogleTest, pytest, Blender tests)
+#   test: runs every test (ctest: GoogleTest, pytest, Blender tests), then
+#         the sanitized build's tests and the fuzz targets' short runs
+#         (scripts/check_sanitized.sh, docs/reliability.md)
 #   build: stops after building (and installing into build/install)
 # Usage: scripts/setup.sh [demo|test|build]   (as root, or through sudo)
 set -euo pipefail
@@ -16,6 +18,7 @@ packages=(
   libglm-dev pybind11-dev libosd-dev libgtest-dev libgmock-dev
   libpng-dev libopenexr-dev
   python3 python3-dev python3-numpy python3-pytest python3-venv python3-pil util-linux
+  clang libclang-rt-14-dev llvm
   blender xvfb xauth libgl1-mesa-dri
 )
 missing=()
@@ -76,8 +79,9 @@ case "$mode" in
     ;;
   test)
     echo "== running tests"
-    cd build
-    ctest --output-on-failure -j 1
+    (cd build && ctest --output-on-failure -j 1)
+    echo "== sanitizers (AddressSanitizer, UndefinedBehaviorSanitizer) and fuzzing"
+    bash scripts/check_sanitized.sh build-sanitize
     ;;
   *) echo "unknown mode '$mode' (demo, test or build)" >&2; exit 2 ;;
 esac

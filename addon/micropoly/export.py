@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _native, export_lights, export_materials, export_mesh, export_motion
+from . import _native, camera_view, export_lights, export_materials, export_mesh, export_motion
 
 
 class ExportError(Exception):
@@ -78,7 +78,11 @@ def export_camera(native_scene, scene, camera_object, width, height):
     if cam.type not in ("PERSP", "ORTHO"):
         raise ExportError(f"camera '{camera_object.name}' is {cam.type.lower()}; Micropoly renders "
                           "perspective and orthographic cameras")
-    native_scene.set_camera(_matrix(camera_object.matrix_world.inverted()), orthographic=cam.type == "ORTHO",
+    try:
+        view = camera_view.view_matrix(camera_object)
+    except ValueError as e:
+        raise ExportError(str(e)) from None
+    native_scene.set_camera(view, orthographic=cam.type == "ORTHO",
                             fov_degrees=90.0, clip_near=max(cam.clip_start, 1e-6), clip_far=cam.clip_end,
                             screen_window=window)
     export_depth_of_field(native_scene, camera_object)

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import export_mesh
+from . import camera_view, export_mesh
 
 
 def shutter_position(scene):
@@ -114,7 +114,7 @@ def sample(setter, depsgraph, times):
     for time in times:
         frame_set(setter, time)
         scene = depsgraph.scene
-        camera.append(np.array(scene.camera.evaluated_get(depsgraph).matrix_world.inverted(), dtype=np.float32))
+        camera.append(camera_view.view_matrix(scene.camera.evaluated_get(depsgraph)))
         for inst in depsgraph.object_instances:
             obj = inst.object
             if inst.is_instance or obj.type != "MESH" or not _object_blurs(obj):

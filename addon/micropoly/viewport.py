@@ -20,7 +20,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from . import export
+from . import camera_view, export
 
 
 def refinement_passes(samples, shading_rate):
@@ -120,7 +120,7 @@ def view_from_camera(scene, depsgraph, width, height):
     """The scene camera as a ViewCamera (what the viewport shows in camera
     view with the frame filling the region): for benchmarks and tests."""
     cam = scene.camera.evaluated_get(depsgraph)
-    view = np.array(cam.matrix_world.inverted(), dtype=np.float32)
+    view = camera_view.view_matrix(cam)
     proj = cam.calc_matrix_camera(depsgraph, x=width, y=height)
     return view_from_matrices(view, proj, cam.data.type == "ORTHO", width, height, lens_camera=cam)
 

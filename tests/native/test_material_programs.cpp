@@ -214,6 +214,30 @@ TEST_F(MaterialProgramTest, ProgramThatDoesNotCompileNamesTheMaterial) {
   }
 }
 
+// Node values are constants in a program's source, so an animated value
+// builds a program per frame: the renderer keeps those the scene uses and a
+// few spare (MaterialPrograms::kSparePrograms), not every one it ever built.
+TEST_F(MaterialProgramTest, ProgramsNoLongerUsedAreReleasedBeyondAFewSpare) {
+  auto emitting = [](int value) {
+    Scene s = facing_plane(static_cast<int>(Material::Model::Constant));
+    s.material_programs.push_back(
+        {"animated", std::string(kNoDisplacement) + "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {"
+                                                    " mp_add_emission(s, (float3)(" + std::to_string(value) +
+                         ".0f / 64.0f)); }\n"});
+    s.materials[0].program_shades = true;
+    return s;
+  };
+  renderer_->render(emitting(0));
+  EXPECT_EQ(renderer_->render(emitting(0)).stats.program_build_ms, 0.0) << "held programs are not rebuilt";
+  for (int v = 1; v <= 8; ++v) renderer_->render(emitting(v));  // 8 others: program 0 is still a spare
+  EXPECT_EQ(renderer_->render(emitting(0)).stats.program_build_ms, 0.0);
+  for (int v = 1; v <= 9; ++v) renderer_->render(emitting(v));  // 9 others: program 0 is the oldest spare
+  RenderResult r = renderer_->render(emitting(0));
+  EXPECT_GT(r.stats.program_build_ms, 0.0) << "the least recently used program is released";
+  EXPECT_NEAR(r.rgba[4 * (32 * 64 + 32)], 0.0f, 1e-6f);
+  EXPECT_NEAR(renderer_->render(emitting(9)).rgba[4 * (32 * 64 + 32)], 9.0f / 64.0f, 1e-5f);
+}
+
 TEST_F(MaterialProgramTest, BadProgramReferencesAndBoundsAreRejected) {
   Scene s = facing_plane(static_cast<int>(Material::Model::Matte));  // program 0 of none
   EXPECT_THROW(validate_scene(s), Error);

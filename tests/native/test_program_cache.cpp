@@ -73,8 +73,23 @@ TEST(ProgramCache, KernelBuildFailureIsAClearError) {
   } catch (const Error& e) {
     std::string msg = e.what();
     EXPECT_NE(msg.find("failed to build"), std::string::npos) << msg;
-    EXPECT_NE(msg.find("y"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("line 1:"), std::string::npos) << msg;  // where, in the source as built
+    EXPECT_NE(msg.find("'y'"), std::string::npos) << msg;     // what: the undeclared name
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line for Blender's report: " << msg;
   }
+}
+
+TEST(ProgramCache, FirstBuildErrorIsOneLineWithoutTheTemporaryFileName) {
+  const std::string log =
+      "/tmp/pocl-abc/input.cl:12:7: warning: unused variable 'q'\n"
+      "/tmp/pocl-abc/input.cl:40:3: error: use of undeclared identifier 'y'\n  x = y;\n    ^\n"
+      "/tmp/pocl-abc/input.cl:41:1: error: expected ';'\n2 errors generated.\n";
+  EXPECT_EQ(first_build_error(log), "line 40:3: error: use of undeclared identifier 'y' (and 1 more)");
+  // PoCL's order: "error:" first.
+  EXPECT_EQ(first_build_error("error: /root/.cache/pocl/kcache/tempfile_x.cl:1:50: use of undeclared identifier 'y'\n"),
+            "error: line 1:50: use of undeclared identifier 'y'");
+  EXPECT_EQ(first_build_error("ptxas fatal: out of registers\nmore\n"), "ptxas fatal: out of registers");
+  EXPECT_EQ(first_build_error(""), "no compiler log");
 }
 
 TEST(ProgramCache, EmbeddedSourcesResolveEveryInclude) {

@@ -6,6 +6,9 @@
 #include <cmath>
 #include <memory>
 #include <numeric>
+#include <utility>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "micropoly/error.h"
 #include "micropoly/renderer.h"
@@ -265,6 +268,29 @@ TEST_F(RenderTest, InvalidSceneIsRejectedWithTheObjectName) {
     FAIL() << "expected an error";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("broken"), std::string::npos) << e.what();
+  }
+}
+
+// Finite but enormous coordinates (single-precision bounds overflow) are
+// refused by validation, by world position: the object's transform counts.
+TEST_F(RenderTest, CoordinatesBeyondTheWorldLimitAreRefused) {
+  auto render_with = [&](float reach, float scale) {
+    Scene s = base_scene(32, 32, 1);
+    Mesh m = polygon({{-reach, -reach, 0}, {reach, -reach, 0}, {0, reach, 0}});
+    m.name = "far";
+    m.object_to_world = glm::scale(glm::mat4(1.0f), glm::vec3(scale));
+    s.meshes.push_back(m);
+    renderer_->render(s);
+  };
+  render_with(1e14f, 1.0f);
+  for (auto [reach, scale] : {std::pair{3e38f, 1.0f}, std::pair{1e25f, 1.0f}, std::pair{1e13f, 1e3f}}) {
+    try {
+      render_with(reach, scale);
+      FAIL() << "expected an error for " << reach << " x " << scale;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("mesh 'far': point 0 lies"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("beyond 1e15"), std::string::npos) << e.what();
+    }
   }
 }
 

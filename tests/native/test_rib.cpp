@@ -718,6 +718,30 @@ TEST(RibMotion, TransformsMoveObjectsOverTheShutter) {
   EXPECT_TRUE(r.warnings.empty());
 }
 
+TEST(RibMotion, BlocksThatMoveNothingLeaveAStillScene) {
+  // No shape follows the moving transform, or it moves only an object
+  // definition that is never placed: nothing moves, so no motion steps.
+  EXPECT_EQ(parse_world("MotionBegin [0 1]\nTranslate 0 0 0\nTranslate 5 0 0\nMotionEnd\n").scene.motion_steps, 0);
+  EXPECT_EQ(parse_world("ObjectBegin 1\nMotionBegin [0 1]\nTranslate 0 0 0\nTranslate 5 0 0\nMotionEnd\n"
+                        "ObjectEnd\nPolygon \"P\" [0 0 0 1 0 0 0 1 0]\n")
+                .scene.motion_steps,
+            0);
+}
+
+TEST(RibPrograms, ProgramsNoMaterialUsesAreDropped) {
+  // Material 1 redefined without its program: the program is unused.
+  const mp::RibResult r = parse_world(
+      "Attribute \"micropoly\" \"integer material\" [1] \"string program\" [\"first\"]\n"
+      "Attribute \"micropoly\" \"integer material\" [1]\n"
+      "Attribute \"micropoly\" \"integer material\" [2] \"string program\" [\"second\"]\n"
+      "Polygon \"P\" [0 0 0 1 0 0 0 1 0]\n");
+  ASSERT_EQ(r.scene.material_programs.size(), 1u);
+  EXPECT_EQ(r.scene.material_programs[0].source, "second");
+  int users = 0;
+  for (const mp::Material& m : r.scene.materials) users += m.program == 0;
+  EXPECT_EQ(users, 1);
+}
+
 TEST(RibMotion, ShutterCameraAndDeformation) {
   const mp::RibResult r = parse(
       "Shutter 0 0.5\nMotionBegin [0 0.25 0.5]\nTranslate 0 0 5\nTranslate 0 0 6\nTranslate 0 0 7\nMotionEnd\n"

@@ -36,7 +36,9 @@ std::string to_rib(const Scene& scene) {
 // means something was dropped).
 Scene round_trip(const Scene& scene) {
   const std::string text = to_rib(scene);
-  RibResult r = read_rib_string(text, "written.rib");
+  RibReadOptions options;  // the textures are written to an absolute temporary folder
+  options.allowed_roots = {::testing::TempDir() + "/rib_writer_textures"};
+  RibResult r = read_rib_string(text, "written.rib", ".", options);
   for (const std::string& w : r.warnings) ADD_FAILURE() << "warning: " << w << "\n" << text;
   return std::move(r.scene);
 }
@@ -640,9 +642,12 @@ TEST(RibWriter, ShadowExtensionsOnlyWhereNotDefault) {
 
 TEST(RibWriter, FloatsReadBackExactly) {
   // Awkward values: many digits, tiny, huge, denormal, negative zero.
+  // (Points stop at 1e15, validation's world limit; the largest finite
+  // float goes through the camera's far clipping distance.)
   const float values[] = {0.1f, 1.0f / 3.0f, 2.0f / 3.0f, 3.14159274f, 1e-7f, 1.17549435e-38f,
-                          1e-40f, 3.0e38f, -123456.789f, 16777217.0f, -0.0f, 0.30000001f};
+                          1e-40f, 9.99999987e14f, -123456.789f, 16777217.0f, -0.0f, 0.30000001f};
   Scene s;
+  s.camera.clip_far = 3.40282347e38f;
   Mesh m = polygon({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}});
   for (float v : values) m.points.push_back({v, -v, v * 0.5f});
   for (int i = 0; i < 1000; ++i) {
@@ -651,7 +656,9 @@ TEST(RibWriter, FloatsReadBackExactly) {
     m.points.push_back({v, 1.0f / (v + 1.0f), -v * 7.0f});
   }
   s.meshes.push_back(m);
-  EXPECT_EQ(round_trip(s).meshes.at(0).points, m.points);
+  const Scene back = round_trip(s);
+  EXPECT_EQ(back.meshes.at(0).points, m.points);
+  EXPECT_EQ(back.camera.clip_far, s.camera.clip_far);
 }
 
 TEST(RibWriter, NamesAreEscaped) {

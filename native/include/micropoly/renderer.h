@@ -128,6 +128,13 @@ class Renderer {
   // of one size pays for allocating (and faulting in) the image only once.
   void render(const Scene& scene, RenderResult& out, const ProgressCallback& progress = {});
 
+  // For tests of device-failure handling only: plants one OpenCL failure
+  // in the coming frames, as the MICROPOLY_CL_FAULT environment variable
+  // does when the renderer is created. `plan` is "KIND:N:CODE[:lost][@PHASE]"
+  // (native/src/cl/device_faults.h; docs/reliability.md); throws mp::Error
+  // when it is malformed.
+  void inject_device_fault(const std::string& plan);
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <exception>
+#include <iterator>
 #include <mutex>
 
 #include "cl/program_cache.h"
@@ -101,6 +103,15 @@ std::vector<DeviceInfo> list_devices() {
 }
 
 DeviceSession::DeviceSession(const std::string& selector) {
+  if (const char* plan = std::getenv("MICROPOLY_CL_FAULT"); plan && *plan) faults_.arm(parse_fault_plan(plan));
+  open(selector);
+}
+
+DeviceSession::DeviceSession(const std::string& selector, const FaultInjector& faults) : faults_(faults) {
+  open(selector);
+}
+
+void DeviceSession::open(const std::string& selector) {
   FoundDevice found = choose(selector);
   info_ = found.info;
   device_ = found.device;
@@ -109,7 +120,7 @@ DeviceSession::DeviceSession(const std::string& selector) {
     if (ext.find("cl_khr_int64_extended_atomics") == std::string::npos)
       throw Error("OpenCL device '" + info_.name + "' lacks cl_khr_int64_extended_atomics, which the rasteriser needs");
     context_ = cl::Context(device_);
-    queue_ = cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE);
+    queue_ = DeviceQueue(cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE), faults_, activities_);
     max_alloc_ = device_.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
     tile_sampler_ = compiles_tile_sampler(cl::Platform(device_.getInfo<CL_DEVICE_PLATFORM>()).getInfo<CL_PLATFORM_VERSION>());
     auto built = build_program_cached(context_, device_, assemble_program_source(),
@@ -122,19 +133,54 @@ DeviceSession::DeviceSession(const std::string& selector) {
   }
 }
 
-cl::Buffer DeviceSession::allocate(size_t bytes, const char* what) {
+cl::Buffer DeviceSession::allocate(size_t bytes, const char* what, cl_mem_flags flags) {
   if (bytes > max_alloc_)
     throw Error(std::string("the ") + what + " needs " + std::to_string(bytes >> 20) + " MiB in one buffer but the device '" +
                 info_.name + "' allows " + std::to_string(max_alloc_ >> 20) +
                 " MiB: lower the resolution or the samples per pixel");
-  return cl::Buffer(context_, CL_MEM_READ_WRITE, std::max<size_t>(bytes, 16));
+  if (faults_.armed()) faults_.hit(DeviceOp::Alloc, "clCreateBuffer", activities_.empty() ? "" : activities_.back());
+  return cl::Buffer(context_, flags, std::max<size_t>(bytes, 16));
 }
 
 void DeviceSession::reserve(cl::Buffer& buffer, size_t& capacity, size_t bytes, const char* what) {
   if (bytes <= capacity && capacity > 0) return;
+  // Released first, and the capacity forgotten until the new one exists:
+  // a failed allocation must not leave a capacity that an empty buffer
+  // seems to have.
   buffer = cl::Buffer();
+  capacity = 0;
   buffer = allocate(bytes, what);
   capacity = std::max<size_t>(bytes, 16);
+}
+
+DeviceSession::Activity::Activity(DeviceSession& session, const char* name)
+    : session_(session), uncaught_(std::uncaught_exceptions()) {
+  session.activities_.push_back(name);
+}
+
+DeviceSession::Activity::~Activity() {
+  // Innermost first: the first phase an exception leaves is where it arose.
+  if (std::uncaught_exceptions() > uncaught_ && session_.failed_activity_.empty()) {
+    for (const char* name : session_.activities_) {
+      if (!session_.failed_activity_.empty()) session_.failed_activity_ += '/';
+      session_.failed_activity_ += name;
+    }
+  }
+  session_.activities_.pop_back();
+}
+
+bool DeviceSession::responds() {
+  try {
+    const cl_uint sent[4] = {0x9e3779b9u, 1u, 2u, 3u};
+    cl_uint back[4] = {};
+    cl::Buffer probe = allocate(sizeof sent, "device probe");
+    queue_.enqueueWriteBuffer(probe, CL_TRUE, 0, sizeof sent, sent);
+    queue_.enqueueReadBuffer(probe, CL_TRUE, 0, sizeof back, back);
+    queue_.finish();
+    return std::equal(std::begin(sent), std::end(sent), std::begin(back));
+  } catch (const cl::Error&) {
+    return false;
+  }
 }
 
 }  // namespace mp

@@ -4,8 +4,11 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "cl/cl.h"
+#include "cl/device_faults.h"
+#include "cl/device_queue.h"
 #include "micropoly/renderer.h"
 
 namespace mp {
@@ -16,11 +19,18 @@ bool compiles_tile_sampler(const std::string& platform_version);
 
 class DeviceSession {
  public:
+  // Arms the fault injector from MICROPOLY_CL_FAULT when it is set
+  // (device_faults.h; tests only).
   explicit DeviceSession(const std::string& selector);
+  // A session that carries on `faults` (FaultInjector::reopened) instead of
+  // reading the environment: the renderer reopening a lost device.
+  DeviceSession(const std::string& selector, const FaultInjector& faults);
+  DeviceSession(const DeviceSession&) = delete;
+  DeviceSession& operator=(const DeviceSession&) = delete;
 
   const DeviceInfo& info() const { return info_; }
   cl::Context& context() { return context_; }
-  cl::CommandQueue& queue() { return queue_; }
+  DeviceQueue& queue() { return queue_; }
   cl::Program& program() { return program_; }
   cl::Device& device() { return device_; }
   double program_build_ms() const { return build_ms_; }
@@ -34,17 +44,47 @@ class DeviceSession {
   bool tile_sampler() const { return tile_sampler_; }
   // A read-write device buffer of `bytes` (at least 16); an mp::Error that
   // names `what` when the device cannot hold that much in one buffer.
-  cl::Buffer allocate(size_t bytes, const char* what);
+  cl::Buffer allocate(size_t bytes, const char* what, cl_mem_flags flags = CL_MEM_READ_WRITE);
   // Makes `buffer` (of `capacity` bytes, kept by the caller) hold at least
   // `bytes`: a new buffer of `bytes` when it is smaller, the old released
   // first and its contents not kept.
   void reserve(cl::Buffer& buffer, size_t& capacity, size_t bytes, const char* what);
 
+  // A named phase of a frame ("upload", "dice", ...) for as long as it
+  // lives; phases nest. When an exception leaves the innermost phase, its
+  // path ("shadows/bound_split") is kept as failed_activity() for the error
+  // message, and fault plans can target a phase by name.
+  class Activity {
+   public:
+    Activity(DeviceSession& session, const char* name);
+    ~Activity();
+    Activity(const Activity&) = delete;
+    Activity& operator=(const Activity&) = delete;
+
+   private:
+    DeviceSession& session_;
+    int uncaught_;
+  };
+  const std::string& failed_activity() const { return failed_activity_; }
+  void clear_failed_activity() { failed_activity_.clear(); }
+
+  // Whether the device still answers: a small write, read back and
+  // compared, after a frame failed with an error that may have been a
+  // device fault in disguise (cl_error_means_out_of_memory).
+  bool responds();
+
+  FaultInjector& faults() { return faults_; }
+
  private:
+  void open(const std::string& selector);
+
   DeviceInfo info_;
   cl::Device device_;
   cl::Context context_;
-  cl::CommandQueue queue_;
+  FaultInjector faults_;
+  std::vector<const char*> activities_;
+  std::string failed_activity_;
+  DeviceQueue queue_;
   cl::Program program_;
   double build_ms_ = 0;
   bool cache_hit_ = false;

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <regex>
 #include <sstream>
 #include <unistd.h>
 
@@ -62,6 +63,27 @@ std::string build_log(const cl::Program& program, const cl::Device& device) {
 }
 
 }  // namespace
+
+std::string first_build_error(const std::string& log) {
+  // Compilers name the place as "FILE:LINE:COL:" (clang puts "error:" after
+  // it, PoCL before it); FILE is a temporary name that means nothing to the
+  // reader, so it becomes "line LINE:COL:".
+  static const std::regex place(R"(([^\s:]+):(\d+):(\d+):)");
+  std::string first;
+  size_t errors = 0;
+  std::istringstream lines(log);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find("error:") == std::string::npos) continue;
+    if (errors++ == 0) first = std::regex_replace(line, place, "line $2:$3:", std::regex_constants::format_first_only);
+  }
+  if (errors == 0) {
+    first = log.substr(0, log.find('\n'));
+    if (first.empty()) return "no compiler log";
+  }
+  if (first.size() > 300) first = first.substr(0, 300) + "...";
+  if (errors > 1) first += " (and " + std::to_string(errors - 1) + " more)";
+  return first;
+}
 
 std::map<std::string, std::string> embedded_files() {
   std::map<std::string, std::string> files;
@@ -124,9 +146,20 @@ BuiltProgram build_program_cached(const cl::Context& context, const cl::Device& 
   try {
     program.build(devices, options.c_str());
   } catch (const cl::Error& e) {
-    std::string log = build_log(program, device);
-    if (log.size() > 4000) log = log.substr(0, 4000) + "\n...";
-    throw Error("the OpenCL kernels failed to build on " + device.getInfo<CL_DEVICE_NAME>() + ": " + log);
+    // One line for the artist (Blender's report, the CLI): the compiler's
+    // first error; the whole log goes next to the cached binaries.
+    const std::string log = build_log(program, device);
+    std::string where;
+    if (!file.empty()) {
+      std::error_code ec;
+      fs::create_directories(dir, ec);
+      fs::path log_file = dir / (std::string(key) + ".log");
+      std::ofstream out(log_file);
+      out << log;
+      if (out) where = " (compiler log: " + log_file.string() + ")";
+    }
+    throw Error("the OpenCL kernels failed to build on " + device.getInfo<CL_DEVICE_NAME>() + ": " +
+                first_build_error(log) + where);
   }
   if (!file.empty()) {
     try {

@@ -18,6 +18,11 @@ std::string assemble_program_source();
 // add-on's generated node functions in place of its marker.
 std::string assemble_material_program_source(const std::string& generated);
 
+// The first error of an OpenCL compiler log as one line ("line L:C: error:
+// ...", with a count of the others), for messages; the whole log is kept in
+// the cache folder.
+std::string first_build_error(const std::string& log);
+
 struct BuiltProgram {
   cl::Program program;
   bool from_cache = false;

@@ -20,8 +20,12 @@ const char* kUsage =
     "                        [--bound-split-memory MIB] [--shadows on|off] [--shadow-memory MIB]\n"
     "                        [--fresh-shadows] [--occlusion-culling on|off] [--stats FILE.json]\n"
     "                        [--sampler auto|tiles|micropolygons] [--sample-memory MIB]\n"
-    "                        [--repeat N]\n"
-    "       micropoly-render --list-devices\n";
+    "                        [--repeat N] [--allow-path DIR]... [--allow-any-path]\n"
+    "       micropoly-render --list-devices\n"
+    "A scene may read archives and textures only inside its own folder and the\n"
+    "folders given with --allow-path, and its material programs may not include\n"
+    "files or use inline assembly; --allow-any-path trusts the scene file and lifts\n"
+    "both rules (docs/rib.md, \"Untrusted scene files\").\n";
 
 struct Options {
   std::string scene, output, device, stats, bound_split, shadows, occlusion, sampler;
@@ -29,6 +33,7 @@ struct Options {
   float shading_rate = 0, memory_mib = 0, shadow_memory_mib = 0, sample_memory_mib = 0;
   bool list_devices = false;
   bool fresh_shadows = false;  // every --repeat frame renders its shadow maps anew
+  mp::RibReadOptions rib;      // --allow-path, --allow-any-path
 };
 
 [[noreturn]] void usage_error(const std::string& why) {
@@ -80,6 +85,8 @@ Options parse(int argc, char** argv) {
     else if (a == "--stats") o.stats = value();
     else if (a == "--repeat") o.repeat = static_cast<int>(parse_number(a, value(), 1, 10000));
     else if (a == "--list-devices") o.list_devices = true;
+    else if (a == "--allow-path") o.rib.allowed_roots.push_back(value());
+    else if (a == "--allow-any-path") o.rib.allow_any_path = true;
     else if (!a.empty() && a[0] == '-') usage_error("unknown option " + a);
     else if (o.scene.empty()) o.scene = a;
     else usage_error("more than one scene file given");
@@ -102,7 +109,7 @@ int main(int argc, char** argv) {
     if (o.scene.empty()) usage_error("no scene file given");
     mp::RibResult rib;
     try {
-      rib = mp::read_rib_file(o.scene);
+      rib = mp::read_rib_file(o.scene, o.rib);
     } catch (const mp::Error& e) {
       std::fprintf(stderr, "micropoly-render: %s\n", e.what());
       return 2;

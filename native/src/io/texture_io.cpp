@@ -13,6 +13,7 @@
 #include <memory>
 #include <vector>
 
+#include "io/image_bounds.h"
 #include "micropoly/error.h"
 
 namespace mp {
@@ -41,6 +42,9 @@ void flip_rows(Image& im) {
 }
 
 Image read_exr(const std::string& path, size_t max_pixels) {
+  // The header's claim is checked against the file's size before OpenEXR
+  // sizes its tables from it.
+  check_exr_claim(path, image_file_bytes(path));
   Image im;
   try {
     Imf::InputFile file(path.c_str());
@@ -71,24 +75,27 @@ Image read_exr(const std::string& path, size_t max_pixels) {
 }
 
 Image read_png(const std::string& path, size_t max_pixels) {
+  const uint64_t file_bytes = image_file_bytes(path);
   png_image png;
   std::memset(&png, 0, sizeof(png));
   png.version = PNG_IMAGE_VERSION;
   if (!png_image_begin_read_from_file(&png, path.c_str()))
     throw Error("cannot read texture '" + path + "': " + png.message);
+  Image im;
+  std::vector<png_byte> data;
   try {
+    check_png_claim(path, file_bytes, png.width, png.height);
     check_size(path, png.width, png.height, max_pixels);
+    im.width = static_cast<int>(png.width);
+    im.height = static_cast<int>(png.height);
+    data.resize(static_cast<size_t>(png.width) * png.height * 4);
   } catch (...) {
-    png_image_free(&png);
+    png_image_free(&png);  // png_image_finish_read frees it on every other path
     throw;
   }
-  Image im;
-  im.width = static_cast<int>(png.width);
-  im.height = static_cast<int>(png.height);
   const size_t n = static_cast<size_t>(im.width) * static_cast<size_t>(im.height);
   // 8-bit RGBA as stored (16-bit files are reduced to 8-bit sRGB by libpng).
   png.format = PNG_FORMAT_RGBA;
-  std::vector<png_byte> data(n * 4);
   if (!png_image_finish_read(&png, nullptr, data.data(), 0, nullptr))
     throw Error("cannot read texture '" + path + "': " + png.message);
   im.pixels.resize(n);

@@ -47,12 +47,13 @@ class TalliedBuffer {
   TalliedBuffer(const TalliedBuffer&) = delete;
   TalliedBuffer& operator=(const TalliedBuffer&) = delete;
   // Makes the buffer hold at least `bytes` (contents are not kept).
-  void reserve(cl::Context& context, size_t bytes) {
+  void reserve(DeviceSession& session, size_t bytes) {
     if (bytes <= bytes_ && bytes_ > 0) return;
     tally_->remove(bytes_);
     buffer_ = cl::Buffer();
+    bytes_ = 0;  // until the new buffer exists
+    buffer_ = session.allocate(bytes, "bound & split queue");
     bytes_ = std::max<size_t>(bytes, 16);
-    buffer_ = cl::Buffer(context, CL_MEM_READ_WRITE, bytes_);
     tally_->add(bytes_);
   }
   void swap_with(TalliedBuffer& other) {

@@ -46,10 +46,11 @@ constexpr size_t kMaxWorkers = size_t(1) << 20;
 constexpr size_t kWorthwhile = 64;
 constexpr cl_uint kMinWave = 64;
 
-void ensure(cl::Context& context, cl::Buffer& buffer, size_t& held, size_t bytes) {
+void ensure(DeviceSession& s, cl::Buffer& buffer, size_t& held, size_t bytes) {
   if (held == bytes) return;
   buffer = cl::Buffer();
-  buffer = cl::Buffer(context, CL_MEM_READ_WRITE, bytes);
+  held = 0;  // until the new buffer exists
+  buffer = s.allocate(bytes, "bound & split workspace");
   held = bytes;
 }
 
@@ -58,8 +59,7 @@ void ensure(cl::Context& context, cl::Buffer& buffer, size_t& held, size_t bytes
 BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes, cl_uint dice_capacity,
                                      BoundedWorkspace& ws) {
   DeviceSession& s = ctx.session;
-  cl::Context& context = s.context();
-  cl::CommandQueue& queue = s.queue();
+  DeviceQueue& queue = s.queue();
   const size_t rec = sizeof(SubPatch);
   const cl_uint stack_depth = static_cast<cl_uint>(ctx.frame.max_depth) + 2;
   const size_t fixed = static_cast<size_t>(dice_capacity) * rec + kCounters * sizeof(cl_uint);
@@ -75,11 +75,11 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
 
   BoundSplitResult result;
   {
-    ensure(context, ws.stacks, ws.stacks_bytes, workers * stack_depth * rec);
-    ensure(context, ws.sizes, ws.sizes_bytes, workers * sizeof(cl_uint));
-    ensure(context, ws.ring, ws.ring_bytes, static_cast<size_t>(ring_capacity) * rec);
-    ensure(context, ws.diceable, ws.diceable_bytes, static_cast<size_t>(dice_capacity) * rec);
-    ensure(context, ws.counters, ws.counters_bytes, kCounters * sizeof(cl_uint));
+    ensure(s, ws.stacks, ws.stacks_bytes, workers * stack_depth * rec);
+    ensure(s, ws.sizes, ws.sizes_bytes, workers * sizeof(cl_uint));
+    ensure(s, ws.ring, ws.ring_bytes, static_cast<size_t>(ring_capacity) * rec);
+    ensure(s, ws.diceable, ws.diceable_bytes, static_cast<size_t>(dice_capacity) * rec);
+    ensure(s, ws.counters, ws.counters_bytes, kCounters * sizeof(cl_uint));
     result.peak_bytes = ws.stacks_bytes + ws.sizes_bytes + ws.ring_bytes + ws.diceable_bytes + ws.counters_bytes;
     cl_uint zero = 0;
     queue.enqueueFillBuffer(ws.sizes, zero, 0, workers * sizeof(cl_uint));

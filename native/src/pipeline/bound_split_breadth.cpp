@@ -12,8 +12,7 @@ namespace mp {
 
 BoundSplitResult bound_split_breadth(BoundSplitContext& ctx, cl_uint dice_capacity) {
   DeviceSession& s = ctx.session;
-  cl::Context& context = s.context();
-  cl::CommandQueue& queue = s.queue();
+  DeviceQueue& queue = s.queue();
   MemoryTally tally;
   BoundSplitResult result;
   {
@@ -27,11 +26,11 @@ BoundSplitResult bound_split_breadth(BoundSplitContext& ctx, cl_uint dice_capaci
     // levels before it sampled (the roots, all taken at once, against none).
     const PassOcclusion& occ = ctx.occlusion;
     TalliedBuffer occluded(tally);
-    occluded.reserve(context, sizeof(cl_uint));
+    occluded.reserve(s, sizeof(cl_uint));
     queue.enqueueFillBuffer(occluded.get(), cl_uint(0), 0, sizeof(cl_uint));
     cl_uint n = ctx.root_count();
     const size_t rec = sizeof(SubPatch);
-    queue_in.reserve(context, n * rec);
+    queue_in.reserve(s, n * rec);
     init.setArg(0, queue_in.get());
     init.setArg(1, n);
     init.setArg(2, ctx.scene.patch_count);
@@ -41,9 +40,9 @@ BoundSplitResult bound_split_breadth(BoundSplitContext& ctx, cl_uint dice_capaci
     ctx.timer.add(Stage::BoundSplit, e0);
 
     for (int depth = 0; n > 0; ++depth) {
-      decision.reserve(context, n * sizeof(cl_uint));
-      dice_flag.reserve(context, (n + 1) * sizeof(cl_uint));
-      split_flag.reserve(context, (n + 1) * sizeof(cl_uint));
+      decision.reserve(s, n * sizeof(cl_uint));
+      dice_flag.reserve(s, (n + 1) * sizeof(cl_uint));
+      split_flag.reserve(s, (n + 1) * sizeof(cl_uint));
       classify.setArg(0, queue_in.get());
       classify.setArg(1, n);
       classify.setArg(2, ctx.scene.points);
@@ -68,8 +67,8 @@ BoundSplitResult bound_split_breadth(BoundSplitContext& ctx, cl_uint dice_capaci
 
       cl_uint dice_total = scan.exclusive_scan(dice_flag.get(), n, ctx.timer);
       cl_uint split_total = scan.exclusive_scan(split_flag.get(), n, ctx.timer);
-      queue_out.reserve(context, static_cast<size_t>(split_total) * 2 * rec);
-      diceable.reserve(context, static_cast<size_t>(dice_total) * rec);
+      queue_out.reserve(s, static_cast<size_t>(split_total) * 2 * rec);
+      diceable.reserve(s, static_cast<size_t>(dice_total) * rec);
 
       scatter.setArg(0, queue_in.get());
       scatter.setArg(1, n);
@@ -88,7 +87,7 @@ BoundSplitResult bound_split_breadth(BoundSplitContext& ctx, cl_uint dice_capaci
         if (first == 0 && count == dice_total) {
           ctx.sink(diceable.get(), count);
         } else {
-          batch.reserve(context, static_cast<size_t>(dice_capacity) * rec);
+          batch.reserve(s, static_cast<size_t>(dice_capacity) * rec);
           queue.enqueueCopyBuffer(diceable.get(), batch.get(), first * rec, 0, count * rec);
           ctx.sink(batch.get(), count);
         }

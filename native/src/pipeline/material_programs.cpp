@@ -8,6 +8,7 @@
 namespace mp {
 
 void MaterialPrograms::prepare(const Scene& scene, RenderStats& stats) {
+  ++generation_;
   active_.clear();
   displaces_ = false;
   std::vector<bool> displaces(scene.material_programs.size(), false), shades(displaces), alpha(displaces);
@@ -27,11 +28,26 @@ void MaterialPrograms::prepare(const Scene& scene, RenderStats& stats) {
   world_ = w >= 0 && size_t(w) < scene.material_programs.size()
                ? build(scene.material_programs[size_t(w)], "world '", stats)
                : nullptr;
+  evict_unused();
+}
+
+void MaterialPrograms::evict_unused() {
+  std::vector<std::pair<unsigned long long, const std::string*>> spare;
+  for (const auto& [source, built] : built_)
+    if (built->used != generation_) spare.emplace_back(built->used, &source);
+  if (spare.size() <= kSparePrograms) return;
+  std::sort(spare.begin(), spare.end());  // least recently used first
+  std::vector<std::string> evict;
+  for (size_t i = 0; i + kSparePrograms < spare.size(); ++i) evict.push_back(*spare[i].second);
+  for (const std::string& source : evict) built_.erase(source);
 }
 
 MaterialPrograms::Built* MaterialPrograms::build(const MaterialProgram& mp, const char* owner, RenderStats& stats) {
   auto it = built_.find(mp.source);
-  if (it != built_.end()) return it->second.get();
+  if (it != built_.end()) {
+    it->second->used = generation_;
+    return it->second.get();
+  }
   BuiltProgram b;
   try {
     b = build_program_cached(session_.context(), session_.device(), assemble_material_program_source(mp.source),
@@ -46,6 +62,7 @@ MaterialPrograms::Built* MaterialPrograms::build(const MaterialProgram& mp, cons
   built->shade = cl::Kernel(built->program, "shade_program_grids");
   built->bake_world = cl::Kernel(built->program, "bake_world");
   built->world_pixels = cl::Kernel(built->program, "world_pixels");
+  built->used = generation_;
   return built_.emplace(mp.source, std::move(built)).first->second.get();
 }
 
@@ -75,7 +92,7 @@ WorldMap MaterialPrograms::bake_world(const Scene& scene, const SceneBuffers& bu
   k.setArg(1, cl_uint(map.height));
   set_program_input_args(k, 2, buffers);
   k.setArg(8, out);
-  cl::CommandQueue& q = session_.queue();
+  DeviceQueue& q = session_.queue();
   q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(cl_uint(texels)), cl::NDRange(64));
   std::vector<cl_float4> host(texels);
   q.enqueueReadBuffer(out, CL_TRUE, 0, texels * sizeof(cl_float4), host.data());
@@ -97,7 +114,7 @@ std::vector<float> MaterialPrograms::world_background(const Scene& scene, const 
     k.setArg(cl_uint(1 + r), cl_float4{{to_world[0][r], to_world[1][r], to_world[2][r], 0.0f}});
   set_program_input_args(k, 4, buffers);
   k.setArg(10, out);
-  cl::CommandQueue& q = session_.queue();
+  DeviceQueue& q = session_.queue();
   q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(cl_uint(pixels)), cl::NDRange(64));
   std::vector<float> host(pixels * 3);
   q.enqueueReadBuffer(out, CL_TRUE, 0, host.size() * sizeof(float), host.data());

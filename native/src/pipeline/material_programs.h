@@ -49,7 +49,16 @@ class MaterialPrograms {
   struct Built {
     cl::Program program;
     cl::Kernel displace, shade, bake_world, world_pixels;
+    unsigned long long used = 0;  // the last prepare() that used it
   };
+  // Programs kept beyond those the current scene uses: node values are
+  // constants in a program's source, so an animated value or a dragged
+  // slider builds a new program per frame, and keeping them all would grow
+  // without limit (about 8 MiB each on PoCL). A few are kept for scenes
+  // that switch back and forth; the rest are rebuilt from the on-disk
+  // binary cache when they return.
+  static constexpr size_t kSparePrograms = 8;
+  void evict_unused();
   struct Active {
     Built* built;
     cl_int index;  // the scene's program index, as DeviceMaterial.program[0]
@@ -62,6 +71,7 @@ class MaterialPrograms {
 
   DeviceSession& session_;
   std::unordered_map<std::string, std::unique_ptr<Built>> built_;  // by source
+  unsigned long long generation_ = 0;                               // prepare() calls
   std::vector<Active> active_;
   Built* world_ = nullptr;  // the scene's world program, if any
   bool displaces_ = false;

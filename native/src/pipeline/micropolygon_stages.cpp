@@ -102,7 +102,7 @@ void GridBuffers::ensure_motion(DeviceSession& session, int steps) {
 void DiceStage::run_motion(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
                            GridBuffers& grids, StageTimer& timer) {
   grids.ensure_motion(session_, int(scene.motion_steps));
-  cl::CommandQueue& q = session_.queue();
+  DeviceQueue& q = session_.queue();
   // The centre's positions before displacement (for `displaced`).
   q.enqueueCopyBuffer(grids.p, grids.rest_p, 0, 0, size_t(count) * grids.vertices_per_slot * sizeof(cl_float4));
   for (cl_uint k = 0; k < scene.motion_steps; ++k) {
@@ -202,7 +202,7 @@ SampleStage::SampleStage(DeviceSession& session)
       project_(session.tile_sampler() ? cl::Kernel(session.program(), "project_grids") : cl::Kernel()),
       bound_runs_(session.tile_sampler() ? cl::Kernel(session.program(), "bound_runs") : cl::Kernel()),
       tile_kernel_(session.tile_sampler() ? cl::Kernel(session.program(), "sample_tiles") : cl::Kernel()) {
-  totals_ = cl::Buffer(session.context(), CL_MEM_READ_WRITE, 3 * sizeof(cl_ulong));
+  totals_ = session.allocate(3 * sizeof(cl_ulong), "sample totals");
 }
 
 void SampleStage::sampled_totals(size_t& micropolygons, double& area_px, size_t& tests) {
@@ -304,11 +304,11 @@ void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer, const std
         chunk[s % 16] = o & 0xffu;
         chunk[16 + s % 16] = o >> 8;
       }
-    offsets_soa_ = cl::Buffer(session_.context(), CL_MEM_READ_ONLY, soa.size() * sizeof(cl_ushort));
+    offsets_soa_ = session_.allocate(soa.size() * sizeof(cl_ushort), "sample pattern", CL_MEM_READ_ONLY);
     session_.queue().enqueueWriteBuffer(offsets_soa_, CL_TRUE, 0, soa.size() * sizeof(cl_ushort), soa.data());
-    offsets_ = cl::Buffer(session_.context(), CL_MEM_READ_ONLY, offsets.size() * sizeof(cl_ushort));
+    offsets_ = session_.allocate(offsets.size() * sizeof(cl_ushort), "sample pattern", CL_MEM_READ_ONLY);
     session_.queue().enqueueWriteBuffer(offsets_, CL_TRUE, 0, offsets.size() * sizeof(cl_ushort), offsets.data());
-    blur_ = cl::Buffer(session_.context(), CL_MEM_READ_ONLY, table.size() * sizeof(cl_float4));
+    blur_ = session_.allocate(table.size() * sizeof(cl_float4), "sample times and lens positions", CL_MEM_READ_ONLY);
     session_.queue().enqueueWriteBuffer(blur_, CL_TRUE, 0, table.size() * sizeof(cl_float4), table.data());
     pattern_ = pattern;
   }
@@ -425,7 +425,7 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, cons
               }
             }
     }
-    weights_ = cl::Buffer(session_.context(), CL_MEM_READ_ONLY, w.size() * sizeof(float));
+    weights_ = session_.allocate(w.size() * sizeof(float), "pixel filter weights", CL_MEM_READ_ONLY);
     session_.queue().enqueueWriteBuffer(weights_, CL_TRUE, 0, w.size() * sizeof(float), w.data());
     weights_type_ = type, weights_width_ = filter_width, weights_pattern_ = pattern;
   }
@@ -467,7 +467,7 @@ void ResolveStage::read_back(const FrameSetup& frame, bool passes, RenderResult&
   if (use_pinned_) {
     if (pinned_bytes_ != rgba_bytes) {
       if (pinned_ptr_) session_.queue().enqueueUnmapMemObject(pinned_, pinned_ptr_);
-      pinned_ = cl::Buffer(session_.context(), CL_MEM_READ_WRITE | CL_MEM_ALLOC_HOST_PTR, rgba_bytes);
+      pinned_ = session_.allocate(rgba_bytes, "image readback buffer", CL_MEM_READ_WRITE | CL_MEM_ALLOC_HOST_PTR);
       pinned_ptr_ = static_cast<float*>(
           session_.queue().enqueueMapBuffer(pinned_, CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0, rgba_bytes));
       pinned_bytes_ = rgba_bytes;

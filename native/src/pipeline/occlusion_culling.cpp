@@ -23,7 +23,7 @@ OcclusionCulling::OcclusionCulling(DeviceSession& session)
     : session_(session),
       base_(session.program(), "occlusion_base"),
       reduce_(session.program(), "occlusion_reduce"),
-      covered_(session.context(), CL_MEM_READ_WRITE, sizeof(cl_uint)) {}
+      covered_(session.allocate(sizeof(cl_uint), "covered pixel count")) {}
 
 void OcclusionCulling::size_for(const FrameParams& f) {
   OcclusionParams o{};
@@ -38,8 +38,8 @@ void OcclusionCulling::size_for(const FrameParams& f) {
     cells += size_t((o.base_w + (1 << k) - 1) >> k) * size_t((o.base_h + (1 << k) - 1) >> k);
   if (cells > cells_held_) {
     pyramid_ = dirty_ = cl::Buffer();
-    pyramid_ = cl::Buffer(session_.context(), CL_MEM_READ_WRITE, cells * sizeof(cl_uint));
-    dirty_ = cl::Buffer(session_.context(), CL_MEM_READ_WRITE, cells);
+    pyramid_ = session_.allocate(cells * sizeof(cl_uint), "occlusion pyramid");
+    dirty_ = session_.allocate(cells, "occlusion cells");
     cells_held_ = cells;
   }
   cells_ = cells;
@@ -57,7 +57,7 @@ void OcclusionCulling::begin_frame(const FrameParams& f, StageTimer& timer) {
 
 void OcclusionCulling::build_base(const cl::Buffer& keys, const FrameParams& f, bool all, StageTimer& timer,
                                   const cl_int4& count_region) {
-  cl::CommandQueue& q = session_.queue();
+  DeviceQueue& q = session_.queue();
   q.enqueueFillBuffer(covered_, cl_uint(0), 0, sizeof(cl_uint));
   base_.setArg(0, keys);
   base_.setArg(1, f);
@@ -103,7 +103,8 @@ const cl::Buffer& OcclusionCulling::root_order(const std::vector<glm::vec4>& box
   if (order_() && key == order_key_) return order_;
   const std::vector<cl_uint> order = near_to_far_order(boxes, f, &overlap_);
   order_ = cl::Buffer();
-  order_ = cl::Buffer(session_.context(), CL_MEM_READ_ONLY, std::max<size_t>(order.size(), 1) * sizeof(cl_uint));
+  order_ = session_.allocate(std::max<size_t>(order.size(), 1) * sizeof(cl_uint), "occlusion patch order",
+                             CL_MEM_READ_ONLY);
   if (!order.empty()) session_.queue().enqueueWriteBuffer(order_, CL_TRUE, 0, order.size() * sizeof(cl_uint), order.data());
   order_key_ = key;
   return order_;

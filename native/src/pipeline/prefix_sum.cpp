@@ -12,7 +12,7 @@ void PrefixSum::scan_level(const cl::Buffer& data, cl_uint n, size_t level, Stag
   cl_uint groups = (n + kBlock - 1) / kBlock;
   while (sums_.size() <= level) sums_.push_back(std::make_unique<TalliedBuffer>(tally_));
   // One extra slot past the block sums holds the level's grand total.
-  sums_[level]->reserve(session_.context(), (groups + 1) * sizeof(cl_uint));
+  sums_[level]->reserve(session_, (groups + 1) * sizeof(cl_uint));
   const cl::Buffer& sums = sums_[level]->get();
   blocks_.setArg(0, data);
   blocks_.setArg(1, n);

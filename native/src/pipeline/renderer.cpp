@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
+#include <utility>
 
 #include "cl/device_session.h"
 #include "micropoly/error.h"
@@ -30,12 +32,13 @@ constexpr cl_uint kSampleChunk = 256;
 
 }  // namespace
 
-// Everything that outlives one frame: the device session, the stages' kernels
-// and the buffers whose size does not depend on the scene.
-struct Renderer::Impl {
-  explicit Impl(const std::string& selector)
-      : session(selector),
-        layout(session, kDiceBatch),
+// Everything built on one device session that outlives a frame: the stages'
+// kernels, the buffers whose size does not depend on the scene, and the last
+// scene uploaded. A frame that fails drops all of it (Renderer::Impl::recover),
+// so nothing a failed frame left half-built is seen again.
+struct DeviceStages {
+  explicit DeviceStages(DeviceSession& session)
+      : layout(session, kDiceBatch),
         dice(session),
         shade(session),
         sample(session),
@@ -43,7 +46,6 @@ struct Renderer::Impl {
         programs(session),
         shadow_maps(session),
         occlusion(session) {}
-  DeviceSession session;
   GridLayoutStage layout;
   DiceStage dice;
   ShadeStage shade;
@@ -54,27 +56,98 @@ struct Renderer::Impl {
   OcclusionCulling occlusion;
   std::unique_ptr<GridBuffers> grids;
   BoundedWorkspace bounded;
-  bool first_render = true;
   // The last scene uploaded, kept for the next render of the same content
   // (scene_fingerprint.h): progressive passes and repeated frames skip
-  // building and uploading patches.
+  // building and uploading patches. scene_key is set only once the scene,
+  // its lights and its world are all on the device.
   std::unique_ptr<SceneBuffers> scene_buffers;
   uint64_t scene_key = 0;
+};
+
+// What a failed frame says about its device session.
+enum class SessionHealth {
+  Good,     // the last frame succeeded (or none failed)
+  Suspect,  // an error that can also mean a faulted device: ask it before use
+  Lost,     // a device-lost error: open the device anew
+};
+
+struct Renderer::Impl {
+  explicit Impl(const std::string& device_selector)
+      : selector(device_selector), session(std::make_unique<DeviceSession>(selector)), info(session->info()) {}
+  // The session and stages ready for a frame: after a failed frame, the
+  // session is asked whether it still works (or, lost, reopened) and the
+  // stages are built anew.
+  DeviceSession& ready_session();
+  void render_frame(const Scene& scene, RenderResult& out, const ProgressCallback& progress);
+  // After a frame failed: waits for what the queue still holds (it may point
+  // into host memory that is about to go), then frees the frame's device
+  // state. `health` decides what the next render does with the session.
+  void recover(SessionHealth health);
+
+  std::string selector;
+  std::unique_ptr<DeviceSession> session;
+  std::unique_ptr<DeviceStages> stages;
+  DeviceInfo info;  // the session's, kept while it is being reopened
+  SessionHealth health = SessionHealth::Good;
+  bool first_render = true;
   // The world's map and the lights derived from it (world-space, so a
-  // moving camera keeps them), kept while the world stays the same.
+  // moving camera keeps them), kept while the world stays the same. Host
+  // memory only, and world_key is set once all three are complete.
   WorldMap world_map;
   std::vector<Light> world_lights;
   std::vector<glm::vec4> world_glossy;
   uint64_t world_key = 0;
   // Object-space patches of the last scenes' shapes: a moved camera or
-  // object re-places them instead of rebuilding (patch_cache.h).
+  // object re-places them instead of rebuilding (patch_cache.h). Host
+  // memory, filled before anything is uploaded.
   PatchCache patch_cache;
 };
+
+DeviceSession& Renderer::Impl::ready_session() {
+  if (session && health == SessionHealth::Suspect && !session->responds()) health = SessionHealth::Lost;
+  if (!session || health == SessionHealth::Lost) {
+    // The old context goes first: a driver may hold the lost device's
+    // memory until it is released. The fault plan carries over so a test's
+    // one fault is not planted again by the new session.
+    const FaultInjector faults = session ? session->faults().reopened() : FaultInjector();
+    stages.reset();
+    session.reset();
+    try {
+      session = std::make_unique<DeviceSession>(selector, faults);
+    } catch (const Error& e) {
+      throw Error("the OpenCL device '" + info.name + "' stopped responding and could not be opened again (" +
+                  e.what() + "): check the driver (dmesg lists GPU faults), or choose another device");
+    }
+    info = session->info();
+    first_render = true;
+  }
+  health = SessionHealth::Good;
+  session->clear_failed_activity();
+  if (!stages) {
+    DeviceSession::Activity activity(*session, "setup");
+    stages = std::make_unique<DeviceStages>(*session);
+  }
+  return *session;
+}
+
+void Renderer::Impl::recover(SessionHealth failed) {
+  if (session) session->queue().drain();
+  stages.reset();
+  health = failed;
+}
 
 Renderer::Renderer(const std::string& selector) : impl_(std::make_unique<Impl>(selector)) {}
 Renderer::~Renderer() = default;
 
-const DeviceInfo& Renderer::device() const { return impl_->session.info(); }
+const DeviceInfo& Renderer::device() const { return impl_->info; }
+
+void Renderer::inject_device_fault(const std::string& plan) {
+  const FaultPlan parsed = parse_fault_plan(plan);
+  // Armed on the session the next frame uses; stages a failed frame dropped
+  // are not built here, so a plan can target their setup.
+  if (!impl_->session || impl_->health == SessionHealth::Lost) impl_->ready_session();
+  impl_->session->faults().arm(parsed);
+}
 
 RenderResult Renderer::render(const Scene& scene, const ProgressCallback& progress) {
   RenderResult out;
@@ -84,15 +157,41 @@ RenderResult Renderer::render(const Scene& scene, const ProgressCallback& progre
 
 void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallback& progress) {
   validate_scene(scene);
+  Impl& impl = *impl_;
+  try {
+    impl.ready_session();
+    impl.render_frame(scene, out, progress);
+  } catch (const cl::Error& e) {
+    // A device error mid-frame: the frame's device state goes, and the
+    // session is reopened (device lost) or tested (an out-of-resources
+    // error, which some drivers also return for a faulted kernel) before the
+    // next frame. The message names the phase of the frame that failed.
+    const bool lost = cl_error_means_device_lost(e.err());
+    impl.recover(lost ? SessionHealth::Lost : SessionHealth::Suspect);
+    const std::string phase = impl.session ? impl.session->failed_activity() : std::string();
+    const std::string where = phase.empty() ? "" : " (" + phase + ")";
+    throw Error("rendering on '" + impl.info.name + "' failed" + where + ": " + describe_cl_error(e) +
+                (lost ? "; the next render reopens the device" : "; the frame's device memory was freed"));
+  } catch (...) {
+    // Any other failure (a buffer larger than the device allows, host
+    // memory, a progress callback that raised) may also leave stages half
+    // set up: the next frame builds them anew on the same session.
+    impl.recover(SessionHealth::Good);
+    throw;
+  }
+}
+
+void Renderer::Impl::render_frame(const Scene& scene, RenderResult& out, const ProgressCallback& progress) {
   auto t_start = std::chrono::steady_clock::now();
-  DeviceSession& s = impl_->session;
+  DeviceSession& s = *session;
+  DeviceStages& d = *stages;
   out.stats = RenderStats{};
   RenderStats& st = out.stats;
   st.device = s.info().name;
-  if (impl_->first_render) {
+  if (first_render) {
     st.program_build_ms = s.program_build_ms();
     st.program_cache_hit = s.program_cache_hit();
-    impl_->first_render = false;
+    first_render = false;
   }
   FrameSetup frame = make_frame_setup(scene);
   // The sampler (RenderSettings::sampler): the tile sampler, which keeps
@@ -115,17 +214,18 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
   st.width = f.width;
   st.height = f.height;
   st.spp = f.spp_x * f.spp_y;
-  try {
+  {
     StageTimer timer;
     auto t_upload = std::chrono::steady_clock::now();
-    impl_->programs.prepare(scene, st);
+    std::optional<DeviceSession::Activity> upload_activity(std::in_place, s, "upload");
+    d.programs.prepare(scene, st);
     const uint64_t key = scene_fingerprint(scene);
-    const bool fresh = !impl_->scene_buffers || impl_->scene_key != key;
+    const bool fresh = !d.scene_buffers || d.scene_key != key;
     if (fresh) {
-      impl_->scene_buffers.reset();  // free the old scene's device memory first
-      HostSceneData host = prepare_scene_data(scene, &impl_->patch_cache);
-      impl_->scene_buffers = std::make_unique<SceneBuffers>(upload_scene_data(s.context(), s.queue(), host));
-      impl_->scene_key = key;
+      d.scene_buffers.reset();  // free the old scene's device memory first
+      d.scene_key = 0;          // and forget it until the new one is complete
+      HostSceneData host = prepare_scene_data(scene, &patch_cache);
+      d.scene_buffers = std::make_unique<SceneBuffers>(upload_scene_data(s, host));
     } else {
       st.scene_reused = true;
     }
@@ -137,34 +237,36 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     if (scene.world.present()) {
       if (fresh) {
         const uint64_t wkey = world_fingerprint(scene);
-        if (wkey != impl_->world_key) {
-          impl_->world_map = scene.world.program >= 0 ? impl_->programs.bake_world(scene, *impl_->scene_buffers)
-                                                      : given_world_map(scene.world);
-          impl_->world_lights = world_lights(impl_->world_map, scene.world, scene.settings.world_probes);
-          impl_->world_glossy = world_glossy_maps(impl_->world_map);
-          impl_->world_key = wkey;
+        if (wkey != world_key) {
+          world_map = scene.world.program >= 0 ? d.programs.bake_world(scene, *d.scene_buffers)
+                                               : given_world_map(scene.world);
+          world_lights = mp::world_lights(world_map, scene.world, scene.settings.world_probes);
+          world_glossy = world_glossy_maps(world_map);
+          world_key = wkey;
         }
       }
-      lights.insert(lights.end(), impl_->world_lights.begin(), impl_->world_lights.end());
+      lights.insert(lights.end(), world_lights.begin(), world_lights.end());
       if (fresh) {
-        upload_lights(s.context(), s.queue(), lights, scene.camera.world_to_camera, *impl_->scene_buffers);
-        upload_world_glossy(s.context(), s.queue(), impl_->world_glossy, *impl_->scene_buffers);
+        upload_lights(s, lights, scene.camera.world_to_camera, *d.scene_buffers);
+        upload_world_glossy(s, world_glossy, *d.scene_buffers);
       }
     }
-    const SceneBuffers& buffers = *impl_->scene_buffers;
+    if (fresh) d.scene_key = key;
+    upload_activity.reset();
+    const SceneBuffers& buffers = *d.scene_buffers;
     st.timings_ms.upload = ms_since(t_upload);
     st.patches = buffers.patch_count;
 
-    if (!impl_->grids || impl_->grids->vertices_per_slot != static_cast<size_t>(f.max_grid + 1) * (f.max_grid + 1)) {
-      impl_->grids.reset();
-      impl_->grids = std::make_unique<GridBuffers>(s, kDiceBatch, f.max_grid);
+    if (!d.grids || d.grids->vertices_per_slot != static_cast<size_t>(f.max_grid + 1) * (f.max_grid + 1)) {
+      d.grids.reset();
+      d.grids = std::make_unique<GridBuffers>(s, kDiceBatch, f.max_grid);
     }
-    GridBuffers& grids = *impl_->grids;
+    GridBuffers& grids = *d.grids;
     const cl_uint capacity = grids.capacity;
-    DiceStage& dice = impl_->dice;
-    ShadeStage& shade = impl_->shade;
-    SampleStage& sample = impl_->sample;
-    ResolveStage& resolve = impl_->resolve;
+    DiceStage& dice = d.dice;
+    ShadeStage& shade = d.shade;
+    SampleStage& sample = d.sample;
+    ResolveStage& resolve = d.resolve;
     if (progress && !progress(0.0f)) {  // cancelled before the frame's buffers are set up
       st.cancelled = true;
       out.width = out.height = 0;
@@ -201,9 +303,10 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       BoundSplitContext ctx{s, buffers, pass_frame, timer, pass_sink, keep_going, views, *pass_occlusion};
       BoundSplitResult r;
       if (buffers.patch_count == 0 || cancelled) return r;
+      DeviceSession::Activity activity(s, "bound_split");
       if (scene.settings.bound_split == BoundSplitMethod::Bounded) {
         size_t budget = static_cast<size_t>(std::max(0.0f, scene.settings.bound_split_memory_mib) * 1048576.0);
-        r = bound_split_bounded(ctx, budget, capacity, impl_->bounded);
+        r = bound_split_bounded(ctx, budget, capacity, d.bounded);
       } else {
         r = bound_split_breadth(ctx, capacity);
       }
@@ -215,23 +318,28 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     };
     // The shadow maps first: shading the camera's view reads them.
     auto t_shadows = std::chrono::steady_clock::now();
-    const bool shadows_done = impl_->shadow_maps.render(scene, lights, frame, buffers, {impl_->layout, dice, impl_->programs, grids},
+    std::optional<DeviceSession::Activity> shadows_activity(std::in_place, s, "shadows");
+    const bool shadows_done = d.shadow_maps.render(scene, lights, frame, buffers, {d.layout, dice, d.programs, grids},
                                                         run_pass, timer, st.shadows);
+    shadows_activity.reset();
     st.timings_ms.shadows_wall = ms_since(t_shadows);
-    const ShadowInputs& shadows = impl_->shadow_maps.inputs();
-    impl_->layout.begin_frame();
+    const ShadowInputs& shadows = d.shadow_maps.inputs();
+    d.layout.begin_frame();
     FrameParams fb = f;  // the bucket being rendered
     DiceSink sink = [&](const cl::Buffer& diceable, cl_uint count) {
       if (cancelled) return;
-      impl_->layout.run(diceable, count, fb, grids, timer);
+      std::optional<DeviceSession::Activity> activity(std::in_place, s, "dice");
+      d.layout.run(diceable, count, fb, grids, timer);
       dice.run(diceable, count, buffers, fb, grids, timer);
       if (mp_motion_on(fb)) dice.run_motion(diceable, count, buffers, fb, grids, timer);
-      impl_->programs.displace(diceable, count, buffers, fb, grids, timer);
+      d.programs.displace(diceable, count, buffers, fb, grids, timer);
       if (mp_motion_on(fb)) dice.displaced(diceable, count, fb, grids, timer);
+      activity.emplace(s, "shade");
       shade.run(diceable, count, buffers, fb, grids, shadows, timer);
-      impl_->programs.shade(diceable, count, buffers, fb, grids, shadows, timer);
+      d.programs.shade(diceable, count, buffers, fb, grids, shadows, timer);
       // The tile sampler takes a batch at once (its lists cover the batch)
       // and asks between parts of its tiles.
+      activity.emplace(s, "sample");
       const cl_uint chunk = progress && !sample.tiles() ? kSampleChunk : count;
       std::function<bool()> ask;
       if (progress)
@@ -255,6 +363,7 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       const Bucket& bucket = buckets[bi];
       fb = bucket_frame(f, bucket);
       progress_base = float(bi) / float(buckets.size()), progress_scale = 1.0f / float(buckets.size());
+      std::optional<DeviceSession::Activity> activity(std::in_place, s, "sample");
       sample.begin_frame(fb, timer, scene.shutter_curve);
       if (progress) {
         s.queue().finish();  // clearing a large sample buffer takes a while: look again
@@ -266,11 +375,12 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
       // against the shutter centre's pinhole depths would lose what the lens
       // and the other times see past it.
       if (scene.settings.occlusion_culling && !mp_blur_on(fb)) {
-        OcclusionCulling& occ = impl_->occlusion;
+        activity.emplace(s, "occlusion");
+        OcclusionCulling& occ = d.occlusion;
         occ.begin_frame(fb, timer);
         camera_occlusion.pyramid = occ.pyramid();
         camera_occlusion.params = occ.params();
-        camera_occlusion.root_order = occ.root_order(buffers.host_patch_bounds, impl_->scene_key, fb);
+        camera_occlusion.root_order = occ.root_order(buffers.host_patch_bounds, d.scene_key, fb);
         camera_occlusion.waves = s.info().type == "cpu";
         sample.mark_occlusion_cells(occ.dirty(), occ.params());
         camera_occlusion.refresh = [&] {
@@ -278,13 +388,16 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
         };
         pass_occlusion = &camera_occlusion;
       }
+      activity.reset();
       const BoundSplitResult bs = run_pass(fb, PassViews{}, sink);
       pass_occlusion = &no_occlusion;
       if (cancelled || bs.cancelled) {
         stopped = true;
         break;
       }
-      covered += impl_->occlusion.covered_pixels(sample.keys(), fb, timer, bucket);
+      activity.emplace(s, "occlusion");
+      covered += d.occlusion.covered_pixels(sample.keys(), fb, timer, bucket);
+      activity.emplace(s, "resolve");
       auto t_resolve = std::chrono::steady_clock::now();
       resolve.run(sample, frame, fb, bucket, scene.settings.filter, scene.settings.filter_width,
                   scene.settings.depth_and_normal_passes, timer);
@@ -300,17 +413,18 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     }
     st.covered_pixels = covered;
     auto t_resolve = std::chrono::steady_clock::now();
+    DeviceSession::Activity readback_activity(s, "readback");
     resolve.read_back(frame, scene.settings.depth_and_normal_passes, out);
     // The world behind the frame: its program, evaluated per pixel on the
     // device (finer than the baked map), or the map a scene gave.
     if (scene.world.present() && scene.world.camera)
-      out.background = scene.world.program >= 0 ? impl_->programs.world_background(scene, buffers, f)
-                                                : world_background(impl_->world_map, frame, scene.camera);
+      out.background = scene.world.program >= 0 ? d.programs.world_background(scene, buffers, f)
+                                                : world_background(world_map, frame, scene.camera);
     else
       out.background.clear();
     st.timings_ms.readback += ms_since(t_resolve);
     timer.collect();
-    st.micropolygons = impl_->layout.micropolygons();
+    st.micropolygons = d.layout.micropolygons();
     sample.sampled_totals(st.micropolygons_sampled, st.sampled_area_px, st.sample_tests);
     st.timings_ms.bound_split = timer.ms(Stage::BoundSplit);
     st.timings_ms.dice = timer.ms(Stage::Dice);
@@ -323,8 +437,6 @@ void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallb
     st.timings_ms.shadow_sample = timer.ms(Stage::ShadowSample);
     st.timings_ms.occlusion = timer.ms(Stage::Occlusion);
     st.timings_ms.shadow = st.timings_ms.shadow_bound_split + st.timings_ms.shadow_dice + st.timings_ms.shadow_sample;
-  } catch (const cl::Error& e) {
-    throw Error("rendering on '" + s.info().name + "': " + describe_cl_error(e));
   }
   st.timings_ms.total = ms_since(t_start);
   if (progress) progress(1.0f);

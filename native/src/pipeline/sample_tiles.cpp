@@ -33,7 +33,7 @@ constexpr cl_uint kTileChunk = 128;
 void SampleStage::run_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
                             const FrameParams& f, GridBuffers& grids, StageTimer& timer,
                             const std::function<bool()>& keep_going) {
-  cl::CommandQueue& q = session_.queue();
+  DeviceQueue& q = session_.queue();
   ensure(session_, projected_, projected_bytes_, grids.slot_space(), sizeof(cl_int4), "projected grid vertices");
   // Runs of micropolygons per grid (MP_TILE_RUN): enough for the largest grid.
   const cl_uint runs_per_grid = (mp_grid_max_micropolygons(cl_uint(f.max_grid)) + MP_TILE_RUN - 1) / MP_TILE_RUN;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "cl/device_session.h"
 #include "micropoly/error.h"
 
 #include "mp_patch.h"
@@ -257,11 +258,24 @@ std::vector<glm::vec4> patch_bounds(const PatchBuffer& patches) {
 }
 
 template <typename T>
-cl::Buffer upload(cl::Context& context, cl::CommandQueue& queue, const std::vector<T>& v) {
-  size_t bytes = std::max<size_t>(v.size() * sizeof(T), 16);  // zero-sized buffers are invalid
-  cl::Buffer b(context, CL_MEM_READ_ONLY, bytes);
-  if (!v.empty()) queue.enqueueWriteBuffer(b, CL_FALSE, 0, v.size() * sizeof(T), v.data());
+cl::Buffer upload(DeviceSession& session, const std::vector<T>& v) {
+  // allocate() pads to 16 bytes: zero-sized buffers are invalid.
+  cl::Buffer b = session.allocate(v.size() * sizeof(T), "scene data", CL_MEM_READ_ONLY);
+  if (!v.empty()) session.queue().enqueueWriteBuffer(b, CL_FALSE, 0, v.size() * sizeof(T), v.data());
   return b;
+}
+
+// The writes above do not block: if the upload fails part way, the ones
+// already queued may still read the host arrays, which unwinding is about
+// to free, so the queue is drained before the error goes on.
+template <typename F>
+void upload_or_drain(DeviceSession& session, F&& body) {
+  try {
+    body();
+  } catch (...) {
+    session.queue().drain();
+    throw;
+  }
 }
 
 }  // namespace
@@ -326,46 +340,53 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
   return out;
 }
 
-void upload_lights(cl::Context& context, cl::CommandQueue& queue, const std::vector<Light>& lights,
-                   const glm::mat4& world_to_camera, SceneBuffers& buffers) {
+void upload_lights(DeviceSession& session, const std::vector<Light>& lights, const glm::mat4& world_to_camera,
+                   SceneBuffers& buffers) {
   const std::vector<DeviceLight> records = device_lights(lights, world_to_camera);
-  buffers.lights = upload(context, queue, records);
-  buffers.light_count = static_cast<cl_uint>(records.size());
-  queue.finish();  // `records` lives only for the call
+  upload_or_drain(session, [&] {
+    buffers.lights = upload(session, records);
+    buffers.light_count = static_cast<cl_uint>(records.size());
+    session.queue().finish();  // `records` lives only for the call
+  });
 }
 
-void upload_world_glossy(cl::Context& context, cl::CommandQueue& queue, const std::vector<glm::vec4>& maps,
-                         SceneBuffers& buffers) {
-  buffers.world_glossy = upload(context, queue, maps);
-  queue.finish();  // `maps` is the caller's; the write must end while it lives
+void upload_world_glossy(DeviceSession& session, const std::vector<glm::vec4>& maps, SceneBuffers& buffers) {
+  upload_or_drain(session, [&] {
+    buffers.world_glossy = upload(session, maps);
+    session.queue().finish();  // `maps` is the caller's; the write must end while it lives
+  });
 }
 
-SceneBuffers upload_scene_data(cl::Context& context, cl::CommandQueue& queue, const HostSceneData& data) {
+SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data) {
   SceneBuffers b;
-  b.points = upload(context, queue, data.patches.points);
-  b.patch_info = upload(context, queue, data.patches.info);
-  b.patch_edges = upload(context, queue, data.patches.edges);
-  b.edge_curves = upload(context, queue, data.patches.curves);
-  b.materials = upload(context, queue, data.materials);
-  b.objects = upload(context, queue, data.objects);
-  b.lights = upload(context, queue, data.lights);
-  b.patch_uvs = upload(context, queue, data.patches.uvs);
-  b.patch_normals = upload(context, queue, data.patches.normals);
-  b.host_patch_bounds = patch_bounds(data.patches);  // lives until the queue finishes below
-  b.patch_bounds = upload(context, queue, b.host_patch_bounds);
-  b.images = upload(context, queue, data.images);
-  b.texels = upload(context, queue, data.texels);
-  b.world_glossy = upload(context, queue, std::vector<glm::vec4>(1, glm::vec4(0.0f)));
-  b.motion_points = upload(context, queue, data.motion_points);
-  b.motion_curves = upload(context, queue, data.motion_curves);
-  b.motion_steps = static_cast<cl_uint>(data.motion_steps);
-  b.point_count = static_cast<cl_uint>(data.patches.points.size());
-  b.curve_count = static_cast<cl_uint>(data.patches.curves.size());
-  b.uv_layers = static_cast<cl_uint>(data.patches.uv_layers);
-  b.image_count = static_cast<cl_uint>(data.images.size());
-  b.patch_count = static_cast<cl_uint>(data.patches.size());
-  b.light_count = static_cast<cl_uint>(data.lights.size());
-  queue.finish();
+  // Read by a write that does not block: it must live until the finish below.
+  const std::vector<glm::vec4> no_world_glossy(1, glm::vec4(0.0f));
+  upload_or_drain(session, [&] {
+    b.points = upload(session, data.patches.points);
+    b.patch_info = upload(session, data.patches.info);
+    b.patch_edges = upload(session, data.patches.edges);
+    b.edge_curves = upload(session, data.patches.curves);
+    b.materials = upload(session, data.materials);
+    b.objects = upload(session, data.objects);
+    b.lights = upload(session, data.lights);
+    b.patch_uvs = upload(session, data.patches.uvs);
+    b.patch_normals = upload(session, data.patches.normals);
+    b.host_patch_bounds = patch_bounds(data.patches);  // lives until the queue finishes below
+    b.patch_bounds = upload(session, b.host_patch_bounds);
+    b.images = upload(session, data.images);
+    b.texels = upload(session, data.texels);
+    b.world_glossy = upload(session, no_world_glossy);
+    b.motion_points = upload(session, data.motion_points);
+    b.motion_curves = upload(session, data.motion_curves);
+    b.motion_steps = static_cast<cl_uint>(data.motion_steps);
+    b.point_count = static_cast<cl_uint>(data.patches.points.size());
+    b.curve_count = static_cast<cl_uint>(data.patches.curves.size());
+    b.uv_layers = static_cast<cl_uint>(data.patches.uv_layers);
+    b.image_count = static_cast<cl_uint>(data.images.size());
+    b.patch_count = static_cast<cl_uint>(data.patches.size());
+    b.light_count = static_cast<cl_uint>(data.lights.size());
+    session.queue().finish();
+  });
   return b;
 }
 

@@ -11,6 +11,8 @@
 
 namespace mp {
 
+class DeviceSession;
+
 // Host side: every surface as device patches in camera space, plus materials
 // and lights in their device layout. Pure CPU work; no OpenCL involved.
 struct HostSceneData {
@@ -56,12 +58,12 @@ struct SceneBuffers {
   cl_uint uv_layers = 0;
   cl_uint image_count = 0;
 };
-SceneBuffers upload_scene_data(cl::Context& context, cl::CommandQueue& queue, const HostSceneData& data);
+SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data);
 // Replaces the world's glossy maps (world_lighting.h, world_glossy_maps).
-void upload_world_glossy(cl::Context& context, cl::CommandQueue& queue, const std::vector<glm::vec4>& maps,
+void upload_world_glossy(DeviceSession& session, const std::vector<glm::vec4>& maps,
                          SceneBuffers& buffers);
 // Replaces the buffers' lights (the scene's and its world's, device_lights).
-void upload_lights(cl::Context& context, cl::CommandQueue& queue, const std::vector<Light>& lights,
+void upload_lights(DeviceSession& session, const std::vector<Light>& lights,
                    const glm::mat4& world_to_camera, SceneBuffers& buffers);
 
 }  // namespace mp

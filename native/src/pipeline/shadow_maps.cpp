@@ -34,7 +34,7 @@ ShadowMaps::ShadowMaps(DeviceSession& session)
       sample_(session.program(), "shadow_sample") {}
 
 void ShadowMaps::upload_records(const ShadowLayout& layout) {
-  cl::CommandQueue& q = session_.queue();
+  DeviceQueue& q = session_.queue();
   session_.reserve(inputs_.shadows, records_capacity_, layout.shadows.size() * sizeof(DeviceShadow), "shadow records");
   session_.reserve(inputs_.levels, levels_capacity_, layout.levels.size() * sizeof(DeviceShadowLevel),
        "shadow level records");
@@ -50,7 +50,7 @@ bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, const
                       std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries, ShadowStats& stats) {
   StageTimer::Redirect to(timer, Stage::ShadowMark);
   const auto started = std::chrono::steady_clock::now();
-  cl::CommandQueue& q = session_.queue();
+  DeviceQueue& q = session_.queue();
   const size_t n = layout.table_entries;
   session_.reserve(requests_, requests_capacity_, n, "shadow page requests");
   q.enqueueFillBuffer(requests_, cl_uchar(0), 0, n);
@@ -99,7 +99,7 @@ void ShadowMaps::mark_soft(const ShadowLayout& layout, const FrameSetup& frame, 
                            std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries, ShadowStats& stats) {
   StageTimer::Redirect to(timer, Stage::ShadowMark);
   const auto started = std::chrono::steady_clock::now();
-  cl::CommandQueue& q = session_.queue();
+  DeviceQueue& q = session_.queue();
   // The soft marking adds to the first's requests.
   if (kept_vertices_ > 0) {
     FrameParams coarse = frame.params;
@@ -167,7 +167,7 @@ void ShadowMaps::collect_requests(const ShadowLayout& layout, std::vector<Shadow
 }
 
 void ShadowMaps::write_table(size_t entries, const std::vector<cl_uint2>& writes) {
-  cl::CommandQueue& q = session_.queue();
+  DeviceQueue& q = session_.queue();
   session_.reserve(inputs_.pages, pages_capacity_, entries * sizeof(cl_uint), "shadow page tables");
   q.enqueueFillBuffer(inputs_.pages, cl_uint(0), 0, entries * sizeof(cl_uint));
   if (writes.empty()) return;
@@ -193,7 +193,7 @@ void ShadowMaps::ensure_pool(uint32_t pages) {
 bool ShadowMaps::render_views(const std::vector<FrameParams>& views, const std::vector<uint8_t>& masks,
                               const FrameSetup& frame, const SceneBuffers& buffers, const ShadowPassStages& stages,
                               const BoundSplitRunner& run, StageTimer& timer, ShadowStats& stats) {
-  cl::CommandQueue& q = session_.queue();
+  DeviceQueue& q = session_.queue();
   session_.reserve(masks_, masks_capacity_, masks.size(), "shadow page masks");
   if (!masks.empty()) q.enqueueWriteBuffer(masks_, CL_TRUE, 0, masks.size(), masks.data());
   const FrameParams& f = frame.params;
@@ -350,7 +350,7 @@ bool ShadowMaps::allocate_and_render(const ShadowLayout& layout, const std::vect
         break;
       }
 
-  cl::CommandQueue& q = session_.queue();
+  DeviceQueue& q = session_.queue();
   ensure_pool(pool_.extent());
   write_table(table.size(), writes);
   if (fresh.empty()) return true;

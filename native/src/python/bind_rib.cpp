@@ -9,8 +9,18 @@ namespace py = pybind11;
 
 void bind_rib(py::module_& m) {
   m.def(
-      "read_rib", [](const std::string& path) { return mp::read_rib_file(path).scene; }, py::arg("path"),
-      "Reads a RIB file into a Scene.");
+      "read_rib",
+      [](const std::string& path, const std::vector<std::string>& allowed_roots, bool allow_any_path) {
+        mp::RibReadOptions options;
+        options.allowed_roots = allowed_roots;
+        options.allow_any_path = allow_any_path;
+        return mp::read_rib_file(path, options).scene;
+      },
+      py::arg("path"), py::arg("allowed_roots") = std::vector<std::string>(), py::arg("allow_any_path") = false,
+      "Reads a RIB file into a Scene. The scene may read archives and textures only inside its own folder and "
+      "the folders in allowed_roots (after resolving '..' and symbolic links), and its material programs may not "
+      "include files or use inline assembly; allow_any_path trusts the file and lifts both rules. Raises Error on "
+      "malformed input, a file outside those folders or a refused program.");
 
   auto write = [](const mp::Scene& scene, const std::string& path, const std::string& display) {
     py::gil_scoped_release release;  // large meshes take a while to format

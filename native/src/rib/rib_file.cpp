@@ -56,10 +56,4 @@ std::string directory_of(const std::string& path) {
   return dir.empty() ? "." : dir;
 }
 
-std::string resolve_path(const std::string& base_dir, const std::string& path) {
-  const std::filesystem::path p(path);
-  if (p.is_absolute()) return path;
-  return (std::filesystem::path(base_dir.empty() ? "." : base_dir) / p).string();
-}
-
 }  // namespace mp::rib

@@ -11,7 +11,5 @@ bool read_text_file(const std::string& path, size_t max_bytes, std::string* text
 
 // The directory holding `path` ("." when it has none), for relative archives.
 std::string directory_of(const std::string& path);
-// `path` if absolute, else `base_dir`/`path`.
-std::string resolve_path(const std::string& base_dir, const std::string& path);
 
 }  // namespace mp::rib

@@ -164,8 +164,11 @@ Token Lexer::lex_number() {
   if (*first == '+') ++first;  // from_chars does not accept a leading '+'
   double value = 0.0;
   const auto res = std::from_chars(first, text_.data() + p, value);
+  // Out of range: what rounds to infinity as a float, from FLT_MAX plus half
+  // its ulp (2^104) on; the shortest decimal of FLT_MAX, 3.4028235e38, lies
+  // just above FLT_MAX and must still read.
   if (res.ec != std::errc() || res.ptr != text_.data() + p || !std::isfinite(value) ||
-      std::fabs(value) > static_cast<double>(FLT_MAX))
+      std::fabs(value) >= static_cast<double>(FLT_MAX) + 0x1p103)
     fail(line_, "number '" + std::string(text_.substr(start, p - start)) + "' is out of range");
   tok.number = value;
   pos_ = p;

@@ -21,6 +21,7 @@
 #include "rib/rib_file.h"
 #include "mp_patch.h"
 #include "rib/rib_parser.h"
+#include "rib/rib_program_check.h"
 
 namespace mp::rib {
 namespace {
@@ -111,6 +112,16 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
                });
 }
 
+void Parser::check_program(const std::string& source, const ParamList& params, const std::string& what) const {
+  if (source.empty() || paths_.allows_any()) return;
+  const std::string problem = program_source_problem(source);
+  if (!problem.empty()) {
+    const Param* p = params.find("program");
+    throw RibError(where(p ? p->line : 0) + ": " + what + " refused: " + problem +
+                   "; a scene file's program may not reach beyond the device (allow it with --allow-any-path)");
+  }
+}
+
 void Parser::read_image_option(ArgReader& args, const ParamList& params) {
   const int line = args.request().line;
   warn_unknown(params, {"image", "imagefile", "imagesrgb"}, [&](const std::string& name) {
@@ -119,7 +130,7 @@ void Parser::read_image_option(ArgReader& args, const ParamList& params) {
   });
   const std::string file = params.get_string("imagefile", "");
   if (file.empty()) args.fail("\"imagefile\" must name a texture file");
-  const std::string path = resolve_path(*source_->base_dir, file);
+  const std::string path = find_file(file, true, line, "Option \"micropoly\" \"imagefile\"").open;
   Image image;
   try {
     image = read_texture_image(path, Limits::kMaxTexels - texels_);
@@ -149,6 +160,7 @@ void Parser::read_environment_light(ArgReader& args, const ParamList& params) {
   world = World{};
   const std::string source = params.get_string("program", ""), map = params.get_string("mapname", "");
   if (source.empty() == map.empty()) args.fail(what + " needs one of \"program\" and \"mapname\"");
+  check_program(source, params, what + " \"program\"");
   if (!source.empty()) {
     // The world's node tree as a material program, shared like materials'.
     std::vector<MaterialProgram>& programs = result_.scene.material_programs;
@@ -159,9 +171,10 @@ void Parser::read_environment_light(ArgReader& args, const ParamList& params) {
   } else {
     // An equirectangular map in world space (Cycles' convention, Z up).
     // Its radiance is the texture's times "intensity".
+    const std::string path = find_file(map, true, line, what + " \"mapname\"").open;
     Image image;
     try {
-      image = read_texture_image(resolve_path(*source_->base_dir, map), Limits::kMaxTexels - texels_);
+      image = read_texture_image(path, Limits::kMaxTexels - texels_);
     } catch (const Error& e) {
       args.fail(e.what());
     }
@@ -214,6 +227,7 @@ void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
   // A material program (node tree as OpenCL C), shared by identical sources.
   MaterialProgramUse use;
   const std::string source = params.get_string("program", "");
+  check_program(source, params, "Attribute \"micropoly\" \"program\"");
   if (!source.empty()) {
     std::vector<MaterialProgram>& programs = result_.scene.material_programs;
     auto it = std::find_if(programs.begin(), programs.end(), [&](const MaterialProgram& p) { return p.source == source; });

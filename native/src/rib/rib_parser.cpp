@@ -16,7 +16,7 @@ size_t Primitive::elements() const {
   return mesh.points.size() + mesh.face_vertex_indices.size() + mesh.face_vertex_counts.size() + uvs;
 }
 
-Parser::Parser() {
+Parser::Parser(const std::string& scene_dir, const RibReadOptions& options) : paths_(scene_dir, options) {
   // RenderMan's defaults where they differ from the Scene's (RI spec 3.2,
   // tables 4.1 and 4.2): 640x480, PixelSamples 2 2, gaussian 2x2, fov 90.
   RenderSettings& s = result_.scene.settings;
@@ -610,6 +610,7 @@ void Parser::req_option(ArgReader& args) {
   const std::string name = args.string();
   ParamList params(args, decls_);
   if (name == "micropoly") return micropoly_option(args, params);
+  if (name == "searchpath") return searchpath_option(args, params);
   warn_once("option:" + name, args.request().line, "Option \"" + name + "\" is ignored");
 }
 
@@ -650,13 +651,66 @@ void Parser::req_read_archive(ArgReader& args) {
               " (recursive ReadArchive?)");
   if (++archives_read_ > Limits::kMaxArchives)
     args.fail("more than " + std::to_string(Limits::kMaxArchives) + " archives read");
-  // Relative archive paths are relative to the including file.
-  const std::string path = resolve_path(*source_->base_dir, name);
+  // Relative archive paths are looked up in the archive search path, by
+  // default the including file's folder. Messages name the file as found in
+  // its folder; the canonical path is what is opened.
+  const FoundFile file = find_file(name, false, line, "ReadArchive");
+  const std::string& path = file.shown;
   std::string text, error;
-  if (!read_text_file(path, Limits::kMaxFileBytes, &text, &error))
+  if (!read_text_file(file.open, Limits::kMaxFileBytes, &text, &error))
     fail(line, "ReadArchive: cannot read \"" + path + "\": " + error);
   parse(text, path, directory_of(path), source_->depth + 1);
 }
+
+// Option "searchpath" "string archive" "..." / "string texture" "...":
+// RenderMan's search paths (':'-separated, '@' the default, '&' the previous
+// value), with relative folders taken from the file holding the option.
+// Only the two kinds of files a scene reads here have one; others are noted.
+void Parser::searchpath_option(ArgReader& args, const ParamList& params) {
+  for (const Param& p : params.params()) {
+    SearchPath* target = p.name == "archive" ? &archive_search_ : p.name == "texture" ? &texture_search_ : nullptr;
+    if (!target) {
+      warn_once("searchpath:" + p.name, p.line, "Option \"searchpath\": \"" + p.name + "\" is ignored");
+      continue;
+    }
+    if (!p.decl.is_string() || p.value->strings.size() != 1)
+      args.fail_at(p.line, "Option \"searchpath\": \"" + p.name + "\" must be one string");
+    *target = parse_search_path(p.value->strings[0], *target, *source_->base_dir);
+  }
+}
+
+FoundFile Parser::find_file(const std::string& name, bool texture, int line, const std::string& request) const {
+  return paths_.find(name, texture ? texture_search_ : archive_search_, *source_->base_dir, where(line), request);
+}
+
+namespace {
+
+// Material programs that no material and not the world uses (a material
+// redefined without its program) are dropped and the indices renumbered:
+// the Scene then holds what renders, as the writer writes it.
+void drop_unused_programs(Scene& scene) {
+  std::vector<int> renumbered(scene.material_programs.size(), -1);
+  auto mark = [&](int program) {
+    if (program >= 0 && size_t(program) < renumbered.size()) renumbered[size_t(program)] = 0;
+  };
+  for (const Material& m : scene.materials) mark(m.program);
+  mark(scene.world.program);
+  if (std::find(renumbered.begin(), renumbered.end(), -1) == renumbered.end()) return;  // all used
+  std::vector<MaterialProgram> kept;
+  for (size_t i = 0; i < renumbered.size(); ++i) {
+    if (renumbered[i] < 0) continue;
+    renumbered[i] = int(kept.size());
+    kept.push_back(std::move(scene.material_programs[i]));
+  }
+  scene.material_programs = std::move(kept);
+  auto renumber = [&](int& program) {
+    if (program >= 0 && size_t(program) < renumbered.size()) program = renumbered[size_t(program)];
+  };
+  for (Material& m : scene.materials) renumber(m.program);
+  renumber(scene.world.program);
+}
+
+}  // namespace
 
 RibResult Parser::finish(const std::string& file) {
   const Source top{&file, &file, 0};
@@ -667,6 +721,17 @@ RibResult Parser::finish(const std::string& file) {
                    " is not closed before the end of the file");
   }
   if (motion_depth_ > 0) fail(0, "MotionBegin is not closed before the end of the file");
+  // Motion blocks that moved nothing the Scene keeps (a transform that no
+  // shape followed, or one inside an object definition) leave a still
+  // scene: the steps are dropped, so a scene renders, and writes and reads
+  // back, the same either way.
+  Scene& scene = result_.scene;
+  const bool moves = !scene.camera.motion_world_to_camera.empty() ||
+                     std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) {
+                       return !m.motion_points.empty() || !m.motion_object_to_world.empty();
+                     });
+  if (!moves) scene.motion_steps = 0;
+  drop_unused_programs(scene);
   bool partial = false;
   for (const LightRecord& rec : lights_) {
     if (!rec.supported || !rec.on_some) continue;

@@ -21,6 +21,7 @@
 
 #include "rib/rib_basis.h"
 #include "rib/rib_params.h"
+#include "rib/rib_paths.h"
 #include "rib/rib_reader.h"
 #include "rib/rib_request.h"
 
@@ -98,7 +99,9 @@ struct LightRecord {
 
 class Parser {
  public:
-  Parser();
+  // `scene_dir` is the top-level file's folder; `options` which other
+  // folders the scene may read from (rib_paths.h).
+  Parser(const std::string& scene_dir, const RibReadOptions& options);
   // Executes the requests of one file (the top level or a ReadArchive).
   void parse(std::string_view text, const std::string& file, const std::string& base_dir, int depth);
   // Checks that every block is closed and returns the scene.
@@ -181,6 +184,12 @@ class Parser {
   void req_attribute(ArgReader&);
   void req_declare(ArgReader&);
   void req_read_archive(ArgReader&);
+  // Option "searchpath": where relative archive and texture names are looked up.
+  void searchpath_option(ArgReader& args, const ParamList& params);
+  // The file `name` stands for, under the searchpath and the path rule
+  // (PathPolicy::find); `texture` picks the texture search path over the
+  // archive one.
+  FoundFile find_file(const std::string& name, bool texture, int line, const std::string& request) const;
   void req_ignore(ArgReader&);
 
   // rib_transform.cpp
@@ -254,6 +263,9 @@ class Parser {
   // for polygon meshes, shading normals ("N", per face corner or vertex).
   void read_mesh_primvars(ArgReader& args, const ParamList& params, const std::vector<int>& corners,
                            size_t npoints, Mesh* mesh) const;
+  // Refuses a program `source` that reaches beyond the device
+  // (rib_program_check.h) unless any path is allowed (the file is trusted).
+  void check_program(const std::string& source, const ParamList& params, const std::string& what) const;
   // One texture image named by Option "micropoly" "string imagefile".
   void read_image_option(ArgReader& args, const ParamList& params);
   // LightSource "micropoly_environmentlight": the Scene's World (docs/rib.md).
@@ -267,6 +279,9 @@ class Parser {
   const Source* source_ = nullptr;
   std::set<std::string> warned_;
   size_t texels_ = 0;  // read so far, against Limits::kMaxTexels
+  PathPolicy paths_;
+  SearchPath archive_search_ = default_search_path();
+  SearchPath texture_search_ = default_search_path();
 
   bool in_world_ = false;
   bool world_done_ = false;    // the first world block has ended

@@ -10,9 +10,9 @@
 namespace mp {
 
 RibResult read_rib_string(const std::string& text, const std::string& name,
-                          const std::string& base_dir) {
+                          const std::string& base_dir, const RibReadOptions& options) {
   try {
-    rib::Parser parser;
+    rib::Parser parser(base_dir, options);
     parser.parse(text, name, base_dir, 0);
     return parser.finish(name);
   } catch (const RibError&) {
@@ -24,11 +24,11 @@ RibResult read_rib_string(const std::string& text, const std::string& name,
   }
 }
 
-RibResult read_rib_file(const std::string& path) {
+RibResult read_rib_file(const std::string& path, const RibReadOptions& options) {
   std::string text, error;
   if (!rib::read_text_file(path, rib::Limits::kMaxFileBytes, &text, &error))
     throw RibError(path + ":0: cannot read the file: " + error);
-  return read_rib_string(text, path, rib::directory_of(path));
+  return read_rib_string(text, path, rib::directory_of(path), options);
 }
 
 }  // namespace mp

@@ -1,5 +1,6 @@
 #include "rib/rib_request.h"
 
+#include <cctype>
 #include <cmath>
 
 #include "rib/rib_reader.h"
@@ -101,9 +102,16 @@ void RequestReader::read_array(Arg& arg, int start_line) {
         return;
       case TokenKind::ArrayBegin:
         lexer_.fail(tok.line, "nested arrays are not allowed");
-      case TokenKind::Name:
+      case TokenKind::Name: {
+        // RIB has no literal for a non-number: a NaN or an infinity written
+        // out by some exporter lexes as a name, which is not a request.
+        std::string lower = tok.text;
+        for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        for (const char* bad : {"nan", "-nan", "+nan", "inf", "-inf", "+inf", "infinity", "-infinity"})
+          if (lower == bad) lexer_.fail(tok.line, "'" + tok.text + "' in an array is not a finite number");
         lexer_.fail(start_line, "unterminated array: '[' is not closed before request '" +
                                     tok.text + "' at line " + std::to_string(tok.line));
+      }
       case TokenKind::End:
         lexer_.fail(start_line, "unterminated array: '[' is not closed before the end of the file");
     }

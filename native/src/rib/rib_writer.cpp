@@ -290,10 +290,11 @@ void write_image_and_camera(std::string& o, const Scene& scene) {
     o += "Projection \"perspective\"";
     param(o, "fov", c.fov_degrees);
     o += '\n';
-    // Radius = focallength / (2 fstop): written with fstop 1, exact in float.
+    // Radius = focallength / (2 fstop): written with fstop 0.5, so the
+    // focal length is the radius itself (exact, and finite for any radius).
     if (c.lens_radius > 0.0f) {
-      o += "DepthOfField 1 ";
-      put_float(o, 2.0f * c.lens_radius);
+      o += "DepthOfField 0.5 ";
+      put_float(o, c.lens_radius);
       o += ' ';
       put_float(o, c.focus_distance);
       o += '\n';

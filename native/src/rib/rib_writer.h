@@ -16,7 +16,9 @@ namespace mp {
 // is not valid or the stream fails). A non-empty `display_name` adds a Display
 // request, so micropoly-render needs no -o. Texture images (Scene::images)
 // are written as `image_folder`/<k>.exr (created if missing) and named by
-// that path in the RIB; a scene with images needs a folder.
+// that path in the RIB; a scene with images needs a folder. Reading such a
+// RIB back needs that folder among the reader's allowed folders
+// (RibReadOptions) unless it lies inside the scene's folder.
 void write_rib(const Scene& scene, std::ostream& out, const std::string& display_name = {},
                const std::string& image_folder = {});
 

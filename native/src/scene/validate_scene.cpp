@@ -1,6 +1,9 @@
 // Scene validation: the one place bad input is caught, with a message that
 // names the object, so the pipeline never sees NaNs or out-of-range indices.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdint>
 #include <string>
 
 #include "micropoly/error.h"
@@ -31,6 +34,28 @@ void check_material_index(int index, size_t count, const std::string& what, cons
     fail(what, name, "material index " + std::to_string(index) + " out of range (" + std::to_string(available) + " materials)");
 }
 
+// World-space coordinates beyond this are refused. The pipeline works in
+// single precision, where squared distances overflow past ~1.8e19 and a
+// triangle spanning ~1e25 keeps bound-and-split busy for minutes on NaN
+// bounds; 1e15 scene units (0.1 light-year in metres) leaves a wide margin
+// and no real scene near it.
+constexpr float kMaxWorldCoordinate = 1e15f;
+
+// Every point of `points` through `to_world` lies within kMaxWorldCoordinate.
+void check_extent(const std::vector<glm::vec3>& points, const glm::mat4& to_world, const char* what,
+                  const std::string& name) {
+  for (size_t i = 0; i < points.size(); ++i) {
+    const glm::vec4 w = to_world * glm::vec4(points[i], 1.0f);
+    const float reach = std::max({std::abs(w.x), std::abs(w.y), std::abs(w.z)});
+    if (!(reach <= kMaxWorldCoordinate)) {
+      char far[32];
+      std::snprintf(far, sizeof far, "%.3g", double(reach));
+      fail(what, name, "point " + std::to_string(i) + " lies " + far +
+                           " units from the origin; coordinates beyond 1e15 are refused (single-precision rendering)");
+    }
+  }
+}
+
 // Motion steps of a mesh: one per Scene step, the topology's point count
 // each (the same patches move), finite.
 void validate_mesh_motion(const Mesh& m, size_t steps) {
@@ -41,6 +66,8 @@ void validate_mesh_motion(const Mesh& m, size_t steps) {
                              std::to_string(steps) + " motion steps");
     for (const glm::mat4& t : m.motion_object_to_world)
       if (!finite(t)) fail(what, m.name, "has a motion transform with NaN or infinite values");
+    if (m.motion_points.empty())
+      for (const glm::mat4& t : m.motion_object_to_world) check_extent(m.points, t, what, m.name);
   }
   if (m.motion_points.empty()) return;
   if (m.motion_points.size() != steps)
@@ -54,6 +81,9 @@ void validate_mesh_motion(const Mesh& m, size_t steps) {
     for (const glm::vec3& p : m.motion_points[k])
       if (!finite(p)) fail(what, m.name, "has a NaN or infinite motion point at step " + std::to_string(k));
   }
+  for (size_t k = 0; k < steps; ++k)
+    check_extent(m.motion_points[k], m.motion_object_to_world.empty() ? m.object_to_world : m.motion_object_to_world[k],
+                 what, m.name);
 }
 
 void validate_mesh(const Mesh& m, size_t materials) {
@@ -62,6 +92,7 @@ void validate_mesh(const Mesh& m, size_t materials) {
   for (size_t i = 0; i < m.points.size(); ++i)
     if (!finite(m.points[i]))
       fail(what, m.name, "vertex " + std::to_string(i) + " has a NaN or infinite coordinate");
+  check_extent(m.points, m.object_to_world, what, m.name);
   size_t total = 0;
   for (size_t f = 0; f < m.face_vertex_counts.size(); ++f) {
     int n = m.face_vertex_counts[f];
@@ -124,7 +155,9 @@ void validate_scene(const Scene& scene) {
   if (s.width < 1 || s.height < 1 || s.width > 65536 || s.height > 65536)
     throw Error("image size " + std::to_string(s.width) + "x" + std::to_string(s.height) + " is out of range (1..65536)");
   if (!(s.pixel_aspect > 0) || !std::isfinite(s.pixel_aspect)) throw Error("pixel aspect must be a positive number");
-  if (s.samples_x < 1 || s.samples_y < 1 || s.samples_x * s.samples_y > 1024)
+  // The product in 64 bits: two large counts would overflow an int (and
+  // could wrap to a small one that passes).
+  if (s.samples_x < 1 || s.samples_y < 1 || int64_t(s.samples_x) * int64_t(s.samples_y) > 1024)
     throw Error("samples per pixel must be between 1 and 1024");
   if (!(s.shading_rate > 0) || !std::isfinite(s.shading_rate)) throw Error("shading rate must be a positive number");
   if (!(s.filter_width > 0) || s.filter_width > 16) throw Error("pixel filter width must be in (0, 16]");
@@ -140,9 +173,16 @@ void validate_scene(const Scene& scene) {
   const Camera& c = scene.camera;
   if (!finite(c.world_to_camera)) throw Error("camera transform contains NaN or infinite values");
   if (std::abs(glm::determinant(glm::mat3(c.world_to_camera))) < 1e-12f) throw Error("camera transform is degenerate");
+  // The whole 4x4 transform must be invertible too (a projective bottom row
+  // can make it singular where its 3x3 part is not), by the RIB reader's
+  // own test at WorldBegin, so that every valid camera writes to RIB and
+  // reads back.
+  const float camera_det = glm::determinant(c.world_to_camera);
+  if (!std::isfinite(camera_det) || std::abs(camera_det) < 1e-30f) throw Error("camera transform is singular");
   if (c.projection == Camera::Projection::Perspective && !(c.fov_degrees > 0 && c.fov_degrees < 180))
     throw Error("camera field of view must be between 0 and 180 degrees");
-  if (!(c.clip_near >= 0) || !(c.clip_far > c.clip_near)) throw Error("camera clipping range must satisfy 0 <= near < far");
+  if (!(c.clip_near >= 0) || !(c.clip_far > c.clip_near) || !std::isfinite(c.clip_far))
+    throw Error("camera clipping range must satisfy 0 <= near < far < infinity");
   bool window_set = c.screen_right != c.screen_left || c.screen_top != c.screen_bottom;
   if (window_set && !(c.screen_right > c.screen_left && c.screen_top > c.screen_bottom))
     throw Error("camera screen window must have left < right and bottom < top");
@@ -234,6 +274,7 @@ void validate_scene(const Scene& scene) {
     for (const glm::vec3& p : b.control_points)
       if (!finite(p)) fail("patch set", b.name, "has a NaN or infinite control point");
     if (!finite(b.object_to_world)) fail("patch set", b.name, "transform contains NaN or infinite values");
+    check_extent(b.control_points, b.object_to_world, "patch set", b.name);
     check_material_index(b.material, scene.materials.size(), "patch set", b.name);
   }
 }

@@ -1,0 +1,78 @@
+"""A device fault mid-frame in Blender: MICROPOLY_CL_FAULT plants one OpenCL
+failure when the add-on opens its renderer (native/src/cl/device_faults.h).
+F12 must stop with the error reported in Blender (RenderEngine.report, which
+bpy.ops.render.render raises as RuntimeError in background mode), and the
+next F12 must render. The Rendered viewport's session, which keeps one
+renderer across renders, must report the failure and render the next request."""
+
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+import render_utils as ru  # noqa: E402
+
+
+def check(ok, what, detail=""):
+    print(f"{'ok  ' if ok else 'FAIL'} {what}{': ' + str(detail) if detail else ''}")
+    return 0 if ok else 1
+
+
+def main():
+    scene = ru.reset_scene()
+    bpy.ops.mesh.primitive_cube_add()
+    bpy.ops.object.modifier_add(type="SUBSURF")
+    ru.add_camera(scene, (3.0, -4.0, 2.5), (0, 0, 0))
+    ru.add_sun(scene, (0.6, 0.2, 0.4))
+    failed = 0
+
+    # F12 with the fault planted: the add-on's first renderer opens the device
+    # with it, and the frame fails while shading.
+    os.environ["MICROPOLY_CL_FAULT"] = "launch:1:CL_OUT_OF_RESOURCES@shade"
+    try:
+        ru.render_passes(scene, "MICROPOLY", 64, 48, samples=4)
+        message = None
+    except RuntimeError as e:
+        message = str(e)
+    finally:
+        del os.environ["MICROPOLY_CL_FAULT"]
+    failed += check(message is not None and "(bound_split/shade)" in message and "CL_OUT_OF_RESOURCES" in message
+                    and "ran out of memory" in message, "F12 reports the device fault", message)
+
+    # The next F12 renders, and the one after it gives the same image.
+    first = ru.render_passes(scene, "MICROPOLY", 64, 48, samples=4)
+    second = ru.render_passes(scene, "MICROPOLY", 64, 48, samples=4)
+    covered = float(first["rgba"][..., 3].sum())
+    failed += check(covered > 200.0, "the next F12 renders the cube", f"{covered:.0f} px covered")
+    failed += check(np.array_equal(first["rgba"], second["rgba"]), "and again the same image")
+
+    # The Rendered viewport: one renderer for the session's life.
+    from micropoly import export, viewport
+
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    view = viewport.view_from_camera(scene, depsgraph, 64, 48)
+    os.environ["MICROPOLY_CL_FAULT"] = "launch:1:CL_INVALID_COMMAND_QUEUE@dice"
+    session = viewport.ViewportSession("")
+    try:
+        session.request(export.export_scene(depsgraph, view=view), view, 4, 1.0)
+        idle = session.wait_idle(60.0)
+        error = session.error()
+        del os.environ["MICROPOLY_CL_FAULT"]
+        failed += check(idle and error is not None and "CL_INVALID_COMMAND_QUEUE" in error
+                        and "reopens the device" in error, "the viewport reports a lost device", error)
+        session.request(export.export_scene(depsgraph, view=view), view, 4, 1.0)
+        idle = session.wait_idle(60.0)
+        image = session.image()
+        failed += check(idle and session.error() is None and image is not None,
+                        "the viewport's next request renders", session.error())
+    finally:
+        os.environ.pop("MICROPOLY_CL_FAULT", None)
+        session.close()
+    print(f"{5 - failed} passed, {failed} failed")
+    return 0 if failed == 0 else 1
+
+
+ru.run_test(main)
