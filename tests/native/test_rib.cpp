@@ -737,6 +737,14 @@ TEST(RibPrograms, ProgramsNoMaterialUsesAreDropped) {
       "Polygon \"P\" [0 0 0 1 0 0 0 1 0]\n");
   ASSERT_EQ(r.scene.material_programs.size(), 1u);
   EXPECT_EQ(r.scene.material_programs[0].source, "second");
+  // Numbered by first use in material order, not by where the file names
+  // them, so a written scene reads back with the same numbers.
+  const mp::RibResult two = parse_world(
+      "Attribute \"micropoly\" \"integer material\" [1] \"string program\" [\"one\"]\n"
+      "Attribute \"micropoly\" \"integer material\" [0] \"string program\" [\"zero\"]\n");
+  ASSERT_EQ(two.scene.material_programs.size(), 2u);
+  EXPECT_EQ(two.scene.material_programs[0].source, "zero");
+  EXPECT_EQ(two.scene.material_programs[1].source, "one");
   int users = 0;
   for (const mp::Material& m : r.scene.materials) users += m.program == 0;
   EXPECT_EQ(users, 1);

@@ -685,29 +685,26 @@ FoundFile Parser::find_file(const std::string& name, bool texture, int line, con
 
 namespace {
 
-// Material programs that no material and not the world uses (a material
-// redefined without its program) are dropped and the indices renumbered:
-// the Scene then holds what renders, as the writer writes it.
-void drop_unused_programs(Scene& scene) {
+// Material programs are numbered by first use, materials in order and then
+// the world, and those nothing uses (a material redefined without its
+// program) are dropped: the Scene then holds what renders, in an order that
+// does not depend on where in the file each program appeared, so a written
+// scene reads back the same.
+void number_programs_by_use(Scene& scene) {
   std::vector<int> renumbered(scene.material_programs.size(), -1);
-  auto mark = [&](int program) {
-    if (program >= 0 && size_t(program) < renumbered.size()) renumbered[size_t(program)] = 0;
-  };
-  for (const Material& m : scene.materials) mark(m.program);
-  mark(scene.world.program);
-  if (std::find(renumbered.begin(), renumbered.end(), -1) == renumbered.end()) return;  // all used
   std::vector<MaterialProgram> kept;
-  for (size_t i = 0; i < renumbered.size(); ++i) {
-    if (renumbered[i] < 0) continue;
-    renumbered[i] = int(kept.size());
-    kept.push_back(std::move(scene.material_programs[i]));
-  }
-  scene.material_programs = std::move(kept);
-  auto renumber = [&](int& program) {
-    if (program >= 0 && size_t(program) < renumbered.size()) program = renumbered[size_t(program)];
+  auto use = [&](int& program) {
+    if (program < 0 || size_t(program) >= renumbered.size()) return;
+    int& to = renumbered[size_t(program)];
+    if (to < 0) {
+      to = int(kept.size());
+      kept.push_back(std::move(scene.material_programs[size_t(program)]));
+    }
+    program = to;
   };
-  for (Material& m : scene.materials) renumber(m.program);
-  renumber(scene.world.program);
+  for (Material& m : scene.materials) use(m.program);
+  use(scene.world.program);
+  scene.material_programs = std::move(kept);
 }
 
 }  // namespace
@@ -731,7 +728,7 @@ RibResult Parser::finish(const std::string& file) {
                        return !m.motion_points.empty() || !m.motion_object_to_world.empty();
                      });
   if (!moves) scene.motion_steps = 0;
-  drop_unused_programs(scene);
+  number_programs_by_use(scene);
   bool partial = false;
   for (const LightRecord& rec : lights_) {
     if (!rec.supported || !rec.on_some) continue;

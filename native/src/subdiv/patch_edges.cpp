@@ -146,6 +146,11 @@ void share_corner_uvs(PatchBuffer& buffer, size_t first, const std::vector<uint3
     float scale = std::max(1.0f, std::max(std::max(std::abs(a.x), std::abs(a.y)), std::max(std::abs(b.x), std::abs(b.y))));
     return std::max(d.x, d.y) <= 1e-5f * scale;
   };
+  // Distinct UVs kept per corner and layer. Real meshes meet a vertex with a
+  // handful of UV islands; a vertex shared by thousands of faces with
+  // different UVs each (a fan, or input built to be slow) would make the
+  // search quadratic, so past this many its values are left as they are.
+  constexpr size_t kMaxUvsPerCorner = 32;
   auto snap = [&](std::unordered_map<uint64_t, std::vector<glm::vec2>>& values, bool add) {
     for (size_t p = first; p < buffer.size(); ++p)
       for (int layer = 0; layer < layers; ++layer)
@@ -153,6 +158,7 @@ void share_corner_uvs(PatchBuffer& buffer, size_t first, const std::vector<uint3
           const uint64_t key = (uint64_t(corner_rep[(p - first) * 4 + size_t(kRepIndex[c])]) << 8) | uint64_t(layer);
           auto it = values.find(key);
           const glm::vec2 v = get(p, layer, c);
+          if (it != values.end() && it->second.size() > kMaxUvsPerCorner) continue;
           if (it != values.end()) {
             auto same = std::find_if(it->second.begin(), it->second.end(), [&](glm::vec2 w) { return close(v, w); });
             if (same != it->second.end()) {
