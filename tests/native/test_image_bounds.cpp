@@ -51,7 +51,10 @@ TEST(ImageBounds, CraftedExrHeadersAreRefused) {
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string cut = temp("cut.exr");
   std::ofstream(cut, std::ios::binary) << bytes.substr(0, 12);  // inside the first name
-  EXPECT_NE(read_error(cut).find("malformed OpenEXR header"), std::string::npos) << read_error(cut);
+  // (OpenEXRCore's header reader names what is wrong.)
+  EXPECT_NE(read_error(cut).find("not a readable OpenEXR file: File is not an OpenEXR file or has a bad header value"),
+            std::string::npos)
+      << read_error(cut);
   std::string long_attr = bytes;
   // The little-endian size of "channels" follows the magic, the version and
   // its name and type; 0x7f...7f claims about 2 GiB.
@@ -59,7 +62,8 @@ TEST(ImageBounds, CraftedExrHeadersAreRefused) {
   long_attr[8 + 9 + 7 + 3] = '\x7f';
   const std::string past = temp("past.exr");
   std::ofstream(past, std::ios::binary) << long_attr;
-  EXPECT_NE(read_error(past).find("OpenEXR attribute 'channels' runs past the end of the file"), std::string::npos)
+  EXPECT_NE(read_error(past).find("not a readable OpenEXR file: Missing required attribute in part header"),
+            std::string::npos)
       << read_error(past);
 }
 

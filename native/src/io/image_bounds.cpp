@@ -3,10 +3,10 @@
 #include <sys/stat.h>
 
 #include <cerrno>
-#include <cstdio>
 #include <cstring>
 #include <memory>
-#include <vector>
+
+#include <OpenEXR/openexr.h>
 
 #include "micropoly/error.h"
 
@@ -17,8 +17,6 @@ namespace {
 // a 258-byte match costs at least 2 bits, plus block overhead, so the limit
 // is 1032:1 (zlib's technical notes, "Maximum compression factor").
 constexpr double kDeflateRatio = 1032.0;
-
-using File = std::unique_ptr<FILE, int (*)(FILE*)>;
 
 [[noreturn]] void refuse(const std::string& path, const std::string& why) {
   throw Error("texture '" + path + "': " + why);
@@ -31,47 +29,32 @@ using File = std::unique_ptr<FILE, int (*)(FILE*)>;
                    std::to_string(static_cast<uint64_t>(ratio)) + " bytes of pixels per byte)");
 }
 
-bool read_exact(FILE* f, void* out, size_t n) { return std::fread(out, 1, n, f) == n; }
-
-int32_t le32(const unsigned char* b) {
-  return static_cast<int32_t>(uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24);
-}
-
-// A null-terminated name of at most `max_len` characters (OpenEXR file
-// layout: 31, or 255 with the long-names flag).
-bool read_name(FILE* f, size_t max_len, std::string* out) {
-  out->clear();
-  for (;;) {
-    const int c = std::fgetc(f);
-    if (c == EOF) return false;
-    if (c == 0) return true;
-    if (out->size() >= max_len) return false;
-    out->push_back(static_cast<char>(c));
-  }
-}
+// OpenEXRCore reports errors through a callback that prints by default; the
+// result codes carry what is needed here.
+void quiet(exr_const_context_t, exr_result_t, const char*) {}
 
 // Bytes of pixel data per compressed byte at most, by OpenEXR compression
 // (the "compression" attribute's values in the file layout).
-double exr_ratio(int compression, const char** name) {
+double exr_ratio(exr_compression_t compression, const char** name) {
   switch (compression) {
-    case 0: *name = "uncompressed"; return 1.0;
+    case EXR_COMPRESSION_NONE: *name = "uncompressed"; return 1.0;
     // A run record (count, value) stands for at most 128 bytes.
-    case 1: *name = "RLE"; return 64.0;
+    case EXR_COMPRESSION_RLE: *name = "RLE"; return 64.0;
     // zlib over the bytes (ZIPS: one line per block, ZIP: 16).
-    case 2: *name = "ZIPS"; return kDeflateRatio;
-    case 3: *name = "ZIP"; return kDeflateRatio;
+    case EXR_COMPRESSION_ZIPS: *name = "ZIPS"; return kDeflateRatio;
+    case EXR_COMPRESSION_ZIP: *name = "ZIP"; return kDeflateRatio;
     // zlib over 24-bit floats that expand to 32 bits.
-    case 5: *name = "PXR24"; return kDeflateRatio * 4.0 / 3.0;
+    case EXR_COMPRESSION_PXR24: *name = "PXR24"; return kDeflateRatio * 4.0 / 3.0;
     // A flat 4x4 block of halves (32 bytes) packs into 3 bytes.
-    case 6: *name = "B44"; return 32.0 / 3.0 + 1.0;
-    case 7: *name = "B44A"; return 32.0 / 3.0 + 1.0;
+    case EXR_COMPRESSION_B44: *name = "B44"; return 32.0 / 3.0 + 1.0;
+    case EXR_COMPRESSION_B44A: *name = "B44A"; return 32.0 / 3.0 + 1.0;
     // PIZ (wavelet, then Huffman with run codes) and DWAA/DWAB (DCT, then
     // run-length and zlib coding) stack several coders, so no tight figure
     // is derived; 2^17 bytes per byte is far above what they reach on a
     // flat image and still refuses absurd headers.
-    case 4: *name = "PIZ"; return 131072.0;
-    case 8: *name = "DWAA"; return 131072.0;
-    case 9: *name = "DWAB"; return 131072.0;
+    case EXR_COMPRESSION_PIZ: *name = "PIZ"; return 131072.0;
+    case EXR_COMPRESSION_DWAA: *name = "DWAA"; return 131072.0;
+    case EXR_COMPRESSION_DWAB: *name = "DWAB"; return 131072.0;
     default: *name = "unknown"; return 131072.0;
   }
 }
@@ -94,63 +77,33 @@ void check_png_claim(const std::string& path, uint64_t file_bytes, uint64_t widt
   if (raw > kDeflateRatio * double(file_bytes)) too_large(path, width, height, file_bytes, "deflate", kDeflateRatio);
 }
 
-// OpenEXR file layout: magic 20000630, a version word with flags, then the
-// header's attributes (name, type name, int32 size, value) up to an empty
-// name. Only dataWindow (box2i), compression (uchar) and channels (chlist)
-// are read; other values, previews included, are skipped by their size,
-// which must lie inside the file.
+// The header is read by OpenEXRCore, which parses attributes within the
+// file's bytes and allocates nothing from the data window until chunks are
+// read (this never reads them): the data window, compression and channels
+// of the first part.
 void check_exr_claim(const std::string& path, uint64_t file_bytes) {
-  File f(std::fopen(path.c_str(), "rb"), &std::fclose);
-  if (!f) refuse(path, std::strerror(errno));
-  unsigned char head[8];
-  if (!read_exact(f.get(), head, 8) || le32(head) != 20000630) refuse(path, "not an OpenEXR file");
-  const uint32_t flags = static_cast<uint32_t>(le32(head + 4));
-  const size_t max_name = (flags & 0x400u) ? 255 : 31;  // long names
-  bool have_window = false;
-  int32_t box[4] = {0, 0, -1, -1};
-  int compression = 0;
+  exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+  init.error_handler_fn = quiet;
+  exr_context_t raw = nullptr;
+  const exr_result_t opened = exr_start_read(&raw, path.c_str(), &init);
+  std::unique_ptr<exr_context_t, void (*)(exr_context_t*)> context(&raw, [](exr_context_t* c) {
+    if (*c) exr_finish(c);
+  });
+  if (opened != EXR_ERR_SUCCESS) refuse(path, std::string("not a readable OpenEXR file: ") + exr_get_default_error_message(opened));
+  exr_attr_box2i_t box{};
+  exr_compression_t compression = EXR_COMPRESSION_NONE;
+  const exr_attr_chlist_t* channels = nullptr;
+  if (exr_get_data_window(raw, 0, &box) != EXR_ERR_SUCCESS || exr_get_compression(raw, 0, &compression) != EXR_ERR_SUCCESS ||
+      exr_get_channels(raw, 0, &channels) != EXR_ERR_SUCCESS || !channels)
+    refuse(path, "malformed OpenEXR header");
   double bytes_per_pixel = 0.0;
-  bool have_channels = false;
-  std::string name, type;
-  for (;;) {
-    if (!read_name(f.get(), max_name, &name)) refuse(path, "malformed OpenEXR header");
-    if (name.empty()) break;
-    unsigned char sb[4];
-    if (!read_name(f.get(), max_name, &type) || !read_exact(f.get(), sb, 4)) refuse(path, "malformed OpenEXR header");
-    const int32_t size = le32(sb);
-    const long at = std::ftell(f.get());
-    if (size < 0 || at < 0 || uint64_t(at) + uint64_t(size) > file_bytes)
-      refuse(path, "OpenEXR attribute '" + name + "' runs past the end of the file");
-    if (name == "dataWindow" && type == "box2i" && size == 16) {
-      unsigned char b[16];
-      if (!read_exact(f.get(), b, 16)) refuse(path, "malformed OpenEXR header");
-      for (int i = 0; i < 4; ++i) box[i] = le32(b + 4 * i);
-      have_window = true;
-    } else if (name == "compression" && type == "compression" && size == 1) {
-      compression = std::fgetc(f.get());
-    } else if (name == "channels" && type == "chlist") {
-      if (size > (1 << 16)) refuse(path, "OpenEXR channel list over 64 KiB");
-      // Each channel: name, pixel type (0 uint, 1 half, 2 float), pLinear,
-      // 3 reserved bytes, x and y sampling; an empty name ends the list.
-      std::vector<unsigned char> v(static_cast<size_t>(size));
-      if (!read_exact(f.get(), v.data(), v.size())) refuse(path, "malformed OpenEXR header");
-      size_t i = 0;
-      while (i < v.size() && v[i] != 0) {
-        while (i < v.size() && v[i] != 0) ++i;
-        if (i + 17 > v.size()) refuse(path, "malformed OpenEXR channel list");
-        const int32_t pixel_type = le32(&v[i + 1]), xs = le32(&v[i + 9]), ys = le32(&v[i + 13]);
-        if (pixel_type < 0 || pixel_type > 2 || xs < 1 || ys < 1) refuse(path, "malformed OpenEXR channel list");
-        bytes_per_pixel += (pixel_type == 1 ? 2.0 : 4.0) / (double(xs) * double(ys));
-        i += 17;
-      }
-      have_channels = true;
-    } else if (std::fseek(f.get(), size, SEEK_CUR) != 0) {
-      refuse(path, "malformed OpenEXR header");
-    }
+  for (int i = 0; i < channels->num_channels; ++i) {
+    const exr_attr_chlist_entry_t& c = channels->entries[i];
+    if (c.x_sampling < 1 || c.y_sampling < 1) refuse(path, "malformed OpenEXR channel list");
+    bytes_per_pixel += (c.pixel_type == EXR_PIXEL_HALF ? 2.0 : 4.0) / (double(c.x_sampling) * double(c.y_sampling));
   }
-  if (!have_window) refuse(path, "OpenEXR header without a data window");
-  if (!have_channels || !(bytes_per_pixel > 0.0)) refuse(path, "OpenEXR file without channels");
-  const int64_t w = int64_t(box[2]) - box[0] + 1, h = int64_t(box[3]) - box[1] + 1;
+  if (!(bytes_per_pixel > 0.0)) refuse(path, "OpenEXR file without channels");
+  const int64_t w = int64_t(box.max.x) - box.min.x + 1, h = int64_t(box.max.y) - box.min.y + 1;
   if (w <= 0 || h <= 0) refuse(path, "empty OpenEXR data window");
   const char* codec = nullptr;
   const double ratio = exr_ratio(compression, &codec);

@@ -18,7 +18,7 @@ uint64_t image_file_bytes(const std::string& path);
 void check_png_claim(const std::string& path, uint64_t file_bytes, uint64_t width, uint64_t height);
 
 // Reads the first part's header of the OpenEXR file at `path` (data window,
-// compression, channels) with no allocation driven by it, and throws
+// compression, channels; OpenEXRCore) with no allocation driven by it, and throws
 // mp::Error unless a file of its size can hold that many pixels.
 void check_exr_claim(const std::string& path, uint64_t file_bytes);
 
