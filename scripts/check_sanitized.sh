@@ -64,6 +64,8 @@ sanitized=(env
 #                         MaterialProgramTest.*Rejected*, WorldLighting.Bad*
 #   RIB reader            Rib* (test_rib.cpp, test_rib_errors.cpp incl. RibJunk,
 #                         test_rib_patches.cpp)
+#   untrusted files       Untrusted* (paths, searchpath, program checks),
+#                         ImageBounds (crafted PNG and OpenEXR headers)
 #   RIB writer            RibWriter* (test_rib_writer.cpp, with its renders)
 #   patch building        SubdivPatchEval, SubdivRobustness, PatchEvalMath,
 #                         PolygonPatches, BezierPatches, PatchCache, Watertight,
@@ -80,7 +82,7 @@ filter="RenderTest.*:SmoothShadingInput.*:Rib*:SubdivPatchEval.*:SubdivRobustnes
 filter+=":PatchEvalMath.*:PolygonPatches.*:BezierPatches.*:PatchCache.*:Watertight.*:WatertightRender.*"
 filter+=":MaterialProgramTest.*:ProgramCache.*:SampleTilesTest.*:TileSamplerGate.*"
 filter+=":ShadowRenderTest.*:ShadowPagePool.*:WorldLighting.BadWorldsAreRefusedCleanly"
-filter+=":DeviceFault*:SanitizerSelfTest.*"
+filter+=":Untrusted*:ImageBounds.*:DeviceFault*:SanitizerSelfTest.*"
 # Left out to keep the step near ten minutes on two cores: the slowest
 # repeats of paths already covered above (bucketed tiles, and the watertight
 # renders under motion blur and depth of field).
