@@ -41,9 +41,11 @@ SHADOWS = "--shadows" in args
 # --deep: the Suzannes in five rows one behind the other (30 of them, each
 # row hiding most of the next): high depth complexity.
 DEEP = "--deep" in args
-# --material mix|principled: every Suzanne wears a Mix Shader of a Diffuse
-# and a Glossy BSDF (factor 0.5), or a Principled BSDF of the same colour
-# (the closure benchmark: shade time of two closures against one Principled).
+# --material mix|principled|glass: every Suzanne wears a Mix Shader of a
+# Diffuse and a Glossy BSDF (factor 0.5), or a Principled BSDF of the same
+# colour (the closure benchmark: shade time of two closures against one
+# Principled), or a Glass BSDF (IOR 1.45) with a world of a Noise texture
+# for it to refract (paths traced through each Suzanne's proxy).
 MATERIAL = args[args.index("--material") + 1] if "--material" in args else None
 # --engines A,B: only these engines (default: Micropoly, Cycles and EEVEE).
 ENGINES = args[args.index("--engines") + 1].split(",") if "--engines" in args else None
@@ -58,6 +60,21 @@ def bench_material(mat, kind):
     old = out.inputs["Surface"].links[0].from_node
     color = tuple(old.inputs["Color"].default_value)
     nt.nodes.remove(old)
+    if kind == "glass":
+        g = nt.nodes.new("ShaderNodeBsdfGlass")
+        g.inputs["Color"].default_value = color
+        g.inputs["Roughness"].default_value = 0.0
+        g.inputs["IOR"].default_value = 1.45
+        nt.links.new(g.outputs[0], out.inputs["Surface"])
+        world = bpy.context.scene.world
+        world.use_nodes = True
+        wt = world.node_tree
+        bg = next(n for n in wt.nodes if n.type == "BACKGROUND")
+        if not bg.inputs["Color"].is_linked:
+            noise = wt.nodes.new("ShaderNodeTexNoise")
+            noise.inputs["Scale"].default_value = 2.0
+            wt.links.new(noise.outputs["Color"], bg.inputs["Color"])
+        return
     if kind == "principled":
         p = nt.nodes.new("ShaderNodeBsdfPrincipled")
         p.inputs["Base Color"].default_value = color

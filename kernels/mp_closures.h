@@ -185,20 +185,36 @@ MP_INLINE void mp_add_glossy(MpSurface* s, float3 w, int slot, float roughness, 
 
 /* Refraction: all of its weight through the surface (Refraction BSDF), or
  * (glass = 1) what the dielectric Fresnel term does not reflect. */
-MP_INLINE void mp_add_refraction(MpSurface* s, float3 w, int slot, float roughness, float ior, int glass) {
+/* tint: what each further surface along the path through the object
+ * multiplies by (Cycles evaluates the closure again at every hit; w holds
+ * the first surface's share, tint included). */
+MP_INLINE void mp_add_refraction_tinted(MpSurface* s, float3 w, float3 tint, int slot, float roughness, float ior,
+                                        int glass) {
   float r = clamp(roughness, 0.0f, 1.0f);
   MpClosure c = mp_closure(MP_CLOSURE_REFRACTION, mp_clamp_weight(w), slot, r * r, fmax(ior, 1e-5f));
   c.fresnel = glass;
+  c.f0 = mp_clamp_weight(tint);
   mp_surface_add(s, c);
 }
 
+/* Untinted past the first surface (programs written before the tint). */
+MP_INLINE void mp_add_refraction(MpSurface* s, float3 w, int slot, float roughness, float ior, int glass) {
+  mp_add_refraction_tinted(s, w, MP_F3(1.0f, 1.0f, 1.0f), slot, roughness, ior, glass);
+}
+
 /* Glass: dielectric reflection and refraction split by the exact Fresnel
- * term (each closure applies its share). */
-MP_INLINE void mp_add_glass(MpSurface* s, float3 w, int slot, float roughness, float ior, int multiscatter) {
+ * term (each closure applies its share); w = weight * colour, tint = the
+ * colour. */
+MP_INLINE void mp_add_glass_tinted(MpSurface* s, float3 w, float3 tint, int slot, float roughness, float ior,
+                                   int multiscatter) {
   float3 one = MP_F3(1.0f, 1.0f, 1.0f);
   mp_add_glossy(s, w, slot, roughness, 0.0f, MP_F3(0.0f, 0.0f, 0.0f), MP_FRESNEL_DIELECTRIC, MP_F3(ior, 0.0f, 0.0f),
                 one, multiscatter);
-  mp_add_refraction(s, w, slot, roughness, ior, 1);
+  mp_add_refraction_tinted(s, w, tint, slot, roughness, ior, 1);
+}
+
+MP_INLINE void mp_add_glass(MpSurface* s, float3 w, int slot, float roughness, float ior, int multiscatter) {
+  mp_add_glass_tinted(s, w, MP_F3(1.0f, 1.0f, 1.0f), slot, roughness, ior, multiscatter);
 }
 
 MP_INLINE void mp_add_sheen(MpSurface* s, float3 w, int slot, float roughness, int model) {

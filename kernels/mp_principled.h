@@ -128,7 +128,8 @@ MP_INLINE void mp_add_principled_v4(MpSurface* s, float3 w, const MpPrincipled* 
     c.multiscatter = p->multiscatter;
     mp_surface_add(s, c);
     /* Light crosses the surface twice: each crossing takes the square root. */
-    mp_add_refraction(s, tw * MP_F3(sqrt(base1.x), sqrt(base1.y), sqrt(base1.z)), p->slot, roughness, ior, 1);
+    float3 root = MP_F3(sqrt(base1.x), sqrt(base1.y), sqrt(base1.z));
+    mp_add_refraction_tinted(s, tw * root, root, p->slot, roughness, ior, 1);
   }
   w = w * (1.0f - transmission);
   /* The specular layer's IOR moved so its reflectance at normal incidence
@@ -191,7 +192,7 @@ MP_INLINE void mp_add_principled_v3(MpSurface* s, float3 w, const MpPrincipled* 
     float tr = 1.0f - (1.0f - roughness) * (1.0f - clamp(p->transmission_roughness, 0.0f, 1.0f));
     mp_add_glossy(s, w * transmission_w, p->slot, roughness, 0.0f, zero, MP_FRESNEL_DIELECTRIC,
                   MP_F3(fmax(p->ior, 1e-5f), 0.0f, 0.0f), one, p->multiscatter);
-    mp_add_refraction(s, w * base * transmission_w, p->slot, tr, fmax(p->ior, 1e-5f), 1);
+    mp_add_refraction_tinted(s, w * base * transmission_w, base, p->slot, tr, fmax(p->ior, 1e-5f), 1);
   }
   /* Clearcoat: a quarter-strength coat of IOR 1.5. */
   if (p->coat > 0.0f) {

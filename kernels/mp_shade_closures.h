@@ -10,6 +10,7 @@
 #include "mp_closures.h"
 #include "mp_principled.h"
 #include "mp_shading.h"
+#include "mp_refract_trace.h"
 
 /* A closure reads its normal slot as a diffuse lobe (the normal as it is,
  * shadowed by the smooth surface) or as a glossy one (kept from reflecting
@@ -161,14 +162,54 @@ MP_INLINE int mp_refracted_exit(float3 n, float3 v, float ior, int back, int fre
   return 1;
 }
 
+/* The world seen through the object along the paths a refraction
+ * closure c sends the view on (mp_refract_paths): into the surface at p
+ * (normal n facing the viewer, `back` seen from inside), then through the
+ * object's proxy; each path that leaves reads the world's prefiltered map
+ * along its direction, blurred by the closure's roughness once per
+ * surface it crossed. Per unit of c's weight. */
+MP_INLINE float3 mp_refracted_world(const MpRefractScene* refract, float3 p, float3 n, float3 v, int back,
+                                    const MpClosure* c, MP_GLOBAL const DeviceLight* world,
+                                    MP_GLOBAL const float4* world_glossy) {
+  float3 zero = MP_F3(0.0f, 0.0f, 0.0f);
+  float ior = c->b, eta = back ? ior : 1.0f / ior;
+  float cos_i = clamp(dot(n, v), 0.0f, 1.0f), k2 = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
+  if (!(k2 > 0.0f)) return zero;
+  float3 t = normalize(-eta * v + (eta * cos_i - sqrt(k2)) * n);
+  float through = c->fresnel ? 1.0f - mp_fresnel_dielectric(cos_i, back ? 1.0f / ior : ior) : 1.0f;
+  /* Past the proxy's tessellation error about p (a small share of its
+   * size: the root's box), and off each surface hit by more than the
+   * float error of camera-space positions. */
+  float4 lo = refract->nodes[2 * (ulong)refract->root], hi = refract->nodes[2 * (ulong)refract->root + 1];
+  float size = length(MP_XYZ(hi) - MP_XYZ(lo));
+  MpRefractExits ex;
+  mp_refract_paths(refract, p, t, 2e-3f * size, fmax(1e-5f * size, 1e-6f * length(p)), ior, c->fresnel, c->f0, &ex);
+  float3 sum = zero;
+  float rough = sqrt(c->a);
+  for (int i = 0; i < ex.count; ++i) {
+    float r = fmin(rough * sqrt(0.5f * (float)(ex.interfaces[i] + 1)), 1.0f);
+    sum += ex.weight[i] * mp_world_glossy(world_glossy, mp_env_to_world(world, ex.dir[i]), r);
+  }
+  /* Paths past the budgets see the world as a rough lobe about the view
+   * would (rather than nothing). */
+  if (ex.lost.x + ex.lost.y + ex.lost.z > 0.0f)
+    sum += ex.lost * mp_world_glossy(world_glossy, mp_env_to_world(world, -v), 1.0f);
+  return through * world->color[1] * sum;
+}
+
 /* Outgoing radiance at p towards the viewer from surface s (camera space,
  * normals already facing the viewer's side as ng does when `faced`). */
 MP_INLINE float3 mp_shade_closures(float3 p, float3 ng, int faced, int ortho, const MpSurface* s,
                                    MP_GLOBAL const DeviceLight* lights, uint light_count,
-                                   MP_GLOBAL const float4* world_glossy, const MpShadowQuery* shadow) {
+                                   MP_GLOBAL const float4* world_glossy, const MpShadowQuery* shadow,
+                                   const MpRefractScene* refract) {
   float3 zero = MP_F3(0.0f, 0.0f, 0.0f);
   float3 v = ortho ? MP_F3(0.0f, 0.0f, 1.0f) : normalize(-p);
   int back = !faced && dot(ng, v) < 0.0f;
+  /* A refracting object the camera is outside of is seen from outside
+   * everywhere: grid vertices just past its silhouette (their micropolygons
+   * still straddle it) are grazing front faces, not views from inside. */
+  if (back && refract && !mp_refract_camera_inside(refract, ortho)) back = 0;
   float3 ngf = back ? -ng : ng;
   /* Each slot's normals: nf for glossy lobes, nd for diffuse ones. */
   float3 nf[MP_MAX_CLOSURE_NORMALS], nd[MP_MAX_CLOSURE_NORMALS];
@@ -322,7 +363,9 @@ MP_INLINE float3 mp_shade_closures(float3 p, float3 ng, int faced, int ortho, co
        * did before ray tracing (mp_refracted_exit). */
       float3 t;
       float through;
-      if (world && mp_refracted_exit(n, v, c->b, back, c->fresnel, &t, &through)) {
+      if (world && refract) {
+        out += c->weight * mp_refracted_world(refract, p, n, v, back, c, world, world_glossy);
+      } else if (world && mp_refracted_exit(n, v, c->b, back, c->fresnel, &t, &through)) {
         glossy_world = mp_world_glossy(world_glossy, mp_env_to_world(world, t), sqrt(c->a)) * world->color[1];
         out += c->weight * through * glossy_world;
       }
@@ -348,7 +391,8 @@ MP_INLINE float3 mp_shade_closures(float3 p, float3 ng, int faced, int ortho, co
  * micropolygon (mp_normal_spread2). */
 MP_INLINE float3 mp_shade_material(float3 p, float3 n, int faced, int ortho, const DeviceMaterial* m,
                                    MP_GLOBAL const DeviceLight* lights, uint light_count,
-                                   MP_GLOBAL const float4* world_glossy, const MpShadowQuery* shadow, float spread2) {
+                                   MP_GLOBAL const float4* world_glossy, const MpShadowQuery* shadow, float spread2,
+                                   const MpRefractScene* refract) {
   float3 zero = MP_F3(0.0f, 0.0f, 0.0f), one = MP_F3(1.0f, 1.0f, 1.0f);
   float3 cs = MP_F3(m->color[0], m->color[1], m->color[2]);
   float3 emission = MP_F3(m->emission[0], m->emission[1], m->emission[2]);
@@ -364,7 +408,7 @@ MP_INLINE float3 mp_shade_material(float3 p, float3 n, int faced, int ortho, con
       mp_surface_add(&s, mp_closure(MP_CLOSURE_PHONG, MP_F3(m->specular[0], m->specular[1], m->specular[2]) *
                                                           m->coeffs[2], 0, m->coeffs[3], 0.0f));
     mp_add_emission(&s, emission);
-    return mp_shade_closures(p, n, faced, ortho, &s, lights, light_count, world_glossy, shadow);
+    return mp_shade_closures(p, n, faced, ortho, &s, lights, light_count, world_glossy, shadow, refract);
   }
   float3 v = ortho ? MP_F3(0.0f, 0.0f, 1.0f) : normalize(-p);
   MpPrincipled pr;
@@ -395,7 +439,7 @@ MP_INLINE float3 mp_shade_material(float3 p, float3 n, int faced, int ortho, con
   pr.multiscatter = (flags >> 1) & 1;
   mp_add_principled(&s, one, &pr, n);
   mp_surface_filter_roughness(&s, spread2);
-  return mp_shade_closures(p, n, faced, ortho, &s, lights, light_count, world_glossy, shadow);
+  return mp_shade_closures(p, n, faced, ortho, &s, lights, light_count, world_glossy, shadow, refract);
 }
 
 #endif

@@ -14,7 +14,8 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
                           __global const float4* patch_normals, uint use_shadows,
                           __global const DeviceShadow* shadows, __global const DeviceShadowLevel* shadow_levels,
                           __global const uint* shadow_pages, __global const uint* shadow_pool,
-                          __global const float4* world_glossy) {
+                          __global const float4* world_glossy, __global const uint* refract_roots,
+                          __global const float4* refract_nodes, __global const float4* refract_tris) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   float2 uv;
@@ -65,7 +66,9 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
     if (!(dot(ny, ny) > 0.0f)) ny = n;
   }
   float spread2 = mp_normal_spread2(n, nx, ny);
+  MpRefractScene refract = {refract_nodes, refract_tris,
+                            refract_roots[MP_PATCH_OBJECT(patch_info[4 * (ulong)sp.patch + 2])]};
   float3 c = mp_shade_material(p, n, faced, f.ortho, &m, lights, light_count, world_glossy, use_shadows ? &shadow : 0,
-                               spread2);
+                               spread2, refract.root != MP_REFRACT_NONE ? &refract : 0);
   grid_c[index] = (float4)(c, m.opacity[3]);
 }

@@ -937,9 +937,10 @@ class NodeCompiler:
             rough = "0.0f" if dist == "SHARP" else self._f(node, "Roughness")
             ior = self._f(node, "IOR", default="1.45f")
             if t == "BSDF_GLASS":
-                add(f"  mp_add_glass(s, {weight} * {color}, {slot}, {rough}, {ior}, {1 if dist == 'MULTI_GGX' else 0});")
+                add(f"  mp_add_glass_tinted(s, {weight} * {color}, {color}, {slot}, {rough}, {ior}, "
+                    f"{1 if dist == 'MULTI_GGX' else 0});")
             else:
-                add(f"  mp_add_refraction(s, {weight} * {color}, {slot}, {rough}, {ior}, 0);")
+                add(f"  mp_add_refraction_tinted(s, {weight} * {color}, {color}, {slot}, {rough}, {ior}, 0);")
         elif t in ("BSDF_VELVET", "BSDF_SHEEN"):
             model = "MP_SHEEN_MICROFIBER" if getattr(node, "distribution", "ASHIKHMIN") == "MICROFIBER" \
                 else "MP_SHEEN_ASHIKHMIN"

@@ -145,7 +145,9 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
                                   __global const uint* vertex_offsets, uint use_shadows,
                                   __global const DeviceShadow* shadows, __global const DeviceShadowLevel* shadow_levels,
                                   __global const uint* shadow_pages, __global const uint* shadow_pool,
-                                  uint alpha_only, __global const float4* world_glossy) {
+                                  uint alpha_only, __global const float4* world_glossy,
+                                  __global const uint* refract_roots, __global const float4* refract_nodes,
+                                  __global const float4* refract_tris) {
   uint gid = get_global_id(0), material, object, i, j;
   SubPatch sp;
   float2 uv;
@@ -214,8 +216,9 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   /* Sharp lobes widened by the normal's spread across the micropolygon
    * (mp_normal_spread2): the grid's normals, final since shade.cl. */
   mp_surface_filter_roughness(&s, mp_normal_spread2(n, grid_n[gx].xyz, grid_n[gy].xyz));
+  MpRefractScene refract = {refract_nodes, refract_tris, refract_roots[object]};
   float3 c = mp_shade_closures(p, n, grid_n[index].w > 0.5f, f.ortho, &s, lights, light_count, world_glossy,
-                               use_shadows ? &shadow : 0);
+                               use_shadows ? &shadow : 0, refract.root != MP_REFRACT_NONE ? &refract : 0);
   /* Stochastic coverage multiplies by alpha, and by 1 - the held-out share
    * of it: what the closures give is the kept samples' colour. */
   float held = mp_surface_holdout_share(&s, alpha), kept = alpha * (1.0f - held);

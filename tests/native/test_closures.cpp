@@ -179,7 +179,7 @@ TEST(Closures, ShadingSumsTheClosuresItIsGiven) {
   sun.color[3] = float(MP_LIGHT_DISTANT);
   sun.direction[2] = -1.0f;  // travelling down -z: light from +z
   const float3 p = MP_F3(0.0f, 0.0f, -5.0f), n = MP_F3(0.0f, 0.0f, 1.0f);
-  auto shade = [&](const MpSurface& s) { return mp_shade_closures(p, n, 0, 0, &s, &sun, 1, nullptr, nullptr); };
+  auto shade = [&](const MpSurface& s) { return mp_shade_closures(p, n, 0, 0, &s, &sun, 1, nullptr, nullptr, nullptr); };
   MpSurface d;
   mp_surface_init(&d, n);
   mp_add_diffuse(&d, MP_F3(0.5f, 0.5f, 0.5f), 0, 0.0f);

@@ -200,6 +200,9 @@ void MaterialPrograms::run_shade(const cl::Buffer& diceable, cl_uint count, cons
     shadows.set_args(k, 19);
     k.setArg(24, cl_uint(alpha_only ? 1 : 0));
     k.setArg(25, scene.world_glossy);
+    k.setArg(26, scene.refract_roots);
+    k.setArg(27, scene.refract_nodes);
+    k.setArg(28, scene.refract_tris);
     launch(k, count, grids, Stage::Shade, timer);
   }
 }

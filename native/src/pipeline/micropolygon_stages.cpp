@@ -188,6 +188,9 @@ void ShadeStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffe
   kernel_.setArg(11, scene.patch_normals);
   shadows.set_args(kernel_, 12);
   kernel_.setArg(17, scene.world_glossy);
+  kernel_.setArg(18, scene.refract_roots);
+  kernel_.setArg(19, scene.refract_nodes);
+  kernel_.setArg(20, scene.refract_tris);
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64),
                                         nullptr, &e);

@@ -329,6 +329,13 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
   if (scene.materials.empty()) out.materials.push_back(to_device(Material{}));
   for (const Material& m : scene.materials) out.materials.push_back(to_device(m));
   out.lights = device_lights(scene.lights, w2c);
+  std::vector<bool> refracts(out.materials.size(), false);
+  for (size_t k = 0; k < scene.materials.size(); ++k) {
+    const Material& m = scene.materials[k];
+    refracts[k] = m.program_shades && m.program >= 0 && size_t(m.program) < scene.material_programs.size() &&
+                  program_refracts(scene.material_programs[size_t(m.program)].source);
+  }
+  out.refraction = build_refraction_proxies(out.patches, out.objects.size(), refracts);
   for (const Image& image : scene.images) {
     // DeviceImage offsets are 32-bit texel indices (64 GiB of float texels).
     if (out.texels.size() + image.pixels.size() > size_t(UINT32_MAX))
@@ -378,6 +385,9 @@ SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data
     b.world_glossy = upload(session, no_world_glossy);
     b.motion_points = upload(session, data.motion_points);
     b.motion_curves = upload(session, data.motion_curves);
+    b.refract_roots = upload(session, data.refraction.roots);
+    b.refract_nodes = upload(session, data.refraction.nodes);
+    b.refract_tris = upload(session, data.refraction.tris);
     b.motion_steps = static_cast<cl_uint>(data.motion_steps);
     b.point_count = static_cast<cl_uint>(data.patches.points.size());
     b.curve_count = static_cast<cl_uint>(data.patches.curves.size());

@@ -7,6 +7,7 @@
 #include "micropoly/scene.h"
 #include "mp_types.h"
 #include "pipeline/patch_cache.h"
+#include "pipeline/refraction_proxy.h"
 #include "subdiv/patch_buffer.h"
 
 namespace mp {
@@ -27,6 +28,8 @@ struct HostSceneData {
   // out as patches.points and patches.curves.
   int motion_steps = 0;
   std::vector<glm::vec4> motion_points, motion_curves;
+  // Refracting objects' own shapes (refraction_proxy.h).
+  RefractionProxies refraction;
 };
 // Surfaces' object-space patches come from `cache` when given (kept by the
 // caller between scenes; patch_cache.h), else they are built for this call.
@@ -51,6 +54,7 @@ struct SceneBuffers {
   cl::Buffer texels;      // float4
   cl::Buffer world_glossy;  // float4: the world's glossy maps (kernels/mp_world.h), or one zero texel
   cl::Buffer motion_points, motion_curves;  // HostSceneData's (one float4 when there is no motion)
+  cl::Buffer refract_roots, refract_nodes, refract_tris;  // RefractionProxies (kernels/mp_refract_trace.h)
   cl_uint motion_steps = 0;
   cl_uint point_count = 0, curve_count = 0;  // float4s of one step
   cl_uint patch_count = 0;
