@@ -82,7 +82,7 @@ filter="RenderTest.*:SmoothShadingInput.*:Rib*:SubdivPatchEval.*:SubdivRobustnes
 filter+=":PatchEvalMath.*:PolygonPatches.*:BezierPatches.*:PatchCache.*:Watertight.*:WatertightRender.*"
 filter+=":MaterialProgramTest.*:ProgramCache.*:SampleTilesTest.*:TileSamplerGate.*"
 filter+=":ShadowRenderTest.*:ShadowPagePool.*:WorldLighting.BadWorldsAreRefusedCleanly"
-filter+=":Untrusted*:ImageBounds.*:DeviceFault*:SanitizerSelfTest.*:RefractionTrace.*"
+filter+=":Untrusted*:ImageBounds.*:DeviceFault*:SanitizerSelfTest.*:RefractionTrace.*:RefractionRenderTest.*"
 # Left out to keep the step near ten minutes on two cores: the slowest
 # repeats of paths already covered above (bucketed tiles, and the watertight
 # renders under motion blur and depth of field).

@@ -14,7 +14,10 @@
 #include "mp_refract_trace.h"
 #include "pipeline/refraction_proxy.h"
 #include "scene_fixtures.h"
+#include "renderer_fixture.h"
 #include "subdiv/patch_buffer.h"
+
+#include <glm/gtc/matrix_transform.hpp>
 
 namespace {
 
@@ -218,3 +221,65 @@ TEST(RefractionTrace, OnlyRefractingProgramsGetProxies) {
   EXPECT_EQ(none.roots[0], MP_REFRACT_NONE);
   EXPECT_TRUE(none.tris.empty());
 }
+
+// Through a glass slab the world is seen along the view itself, only shifted
+// sideways (its faces are parallel): rendered, a Refraction slab turned 25
+// degrees to the view shows the pixel's own direction of a world whose red
+// is a ramp in longitude. A slab the proxy does not know (a program naming
+// its refraction in a way program_refracts misses falls back to one
+// lookup as through a sphere) shows it bent: the test can tell.
+namespace mp::test {
+namespace {
+
+class RefractionRenderTest : public SharedRendererTest {};
+
+Scene slab_in_a_ramp(const std::string& surface) {
+  Scene s = base_scene(64, 64, 4);
+  s.lights.clear();
+  s.camera.world_to_camera = glm::lookAt(glm::vec3(0, -5, 0), glm::vec3(0), glm::vec3(0, 0, 1));
+  s.camera.fov_degrees = 45.0f;
+  Mesh box = cube_mesh(SubdivScheme::None);
+  box.object_to_world = glm::rotate(glm::mat4(1.0f), glm::radians(25.0f), glm::vec3(0, 0, 1)) *
+                        glm::scale(glm::mat4(1.0f), glm::vec3(1.5f, 0.5f, 1.5f));
+  s.meshes.push_back(box);
+  s.materials[0].name = "glass";
+  s.materials[0].program = 0;
+  s.materials[0].program_shades = true;
+  s.material_programs.push_back(
+      {"glass", "float3 mp_node_displacement(const MpNodeGlobals* g) { return (float3)(0.0f); }\n"
+                "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) { " + surface + " }\n"});
+  s.world.width = 256, s.world.height = 128;
+  for (int y = 0; y < 128; ++y)
+    for (int x = 0; x < 256; ++x) s.world.radiance.insert(s.world.radiance.end(), {2.0f * (x + 0.5f) / 256.0f, 0.2f, 0.2f, 1.0f});
+  return s;
+}
+
+// The ramp's red along the world direction through pixel (px, py).
+float ramp_red(int px, int py) {
+  const float t = std::tan(glm::radians(22.5f));
+  const glm::vec3 d(((px + 0.5f) / 32.0f - 1.0f) * t, 1.0f, (1.0f - (py + 0.5f) / 32.0f) * t);
+  return 2.0f * (0.5f - std::atan2(d.y, d.x) / (2.0f * kPi));
+}
+
+}  // namespace
+
+TEST_F(RefractionRenderTest, SlabShowsTheWorldAlongTheView) {
+  const RenderResult r = renderer_->render(slab_in_a_ramp("mp_add_refraction(s, (float3)(1.0f), 0, 0.0f, 1.5f, 0);"));
+  const RenderResult bent = renderer_->render(slab_in_a_ramp(
+      "\n#define MP_JOIN(a, b) a##b\n MP_JOIN(mp_add_, refraction)(s, (float3)(1.0f), 0, 0.0f, 1.5f, 0);"));
+  float worst = 0.0f, worst_bent = 0.0f;
+  int inside = 0;
+  for (int py = 22; py < 42; ++py)
+    for (int px = 26; px < 38; ++px) {
+      const size_t i = 4 * (size_t(py) * 64 + px);
+      ASSERT_GT(r.rgba[i + 3], 0.999f) << "pixel " << px << ", " << py << " misses the slab";
+      ++inside;
+      worst = std::max(worst, std::abs(r.rgba[i] - ramp_red(px, py)));
+      worst_bent = std::max(worst_bent, std::abs(bent.rgba[i] - ramp_red(px, py)));
+    }
+  EXPECT_EQ(inside, 240);
+  EXPECT_LT(worst, 0.01f);       // the ramp changes by 0.0085 per pixel here
+  EXPECT_GT(worst_bent, 0.05f);  // six pixels' worth of bending
+}
+
+}  // namespace mp::test
