@@ -177,6 +177,9 @@ MP_INLINE void mp_add_glossy(MpSurface* s, float3 w, int slot, float roughness, 
   MpClosure c = mp_closure(MP_CLOSURE_GLOSSY, mp_clamp_weight(w), slot, ax, ay);
   c.tangent = tangent;
   c.fresnel = fresnel;
+  /* A dielectric's IOR (f0.x) from a node input may be anything: 0, less or
+   * NaN reads as the smallest IOR, as the refraction lobe reads it. */
+  if (fresnel == MP_FRESNEL_DIELECTRIC) f0.x = fmax(f0.x, 1e-5f);
   c.f0 = f0;
   c.f82 = f82;
   c.multiscatter = multiscatter;
@@ -184,10 +187,10 @@ MP_INLINE void mp_add_glossy(MpSurface* s, float3 w, int slot, float roughness, 
 }
 
 /* Refraction: all of its weight through the surface (Refraction BSDF), or
- * (glass = 1) what the dielectric Fresnel term does not reflect. */
-/* tint: what each further surface along the path through the object
- * multiplies by (Cycles evaluates the closure again at every hit; w holds
- * the first surface's share, tint included). */
+ * (glass = 1) what the dielectric Fresnel term does not reflect. tint: what
+ * each further surface along the path through the object multiplies by
+ * (Cycles evaluates the closure again at every hit; w holds the first
+ * surface's share, tint included). */
 MP_INLINE void mp_add_refraction_tinted(MpSurface* s, float3 w, float3 tint, int slot, float roughness, float ior,
                                         int glass) {
   float r = clamp(roughness, 0.0f, 1.0f);

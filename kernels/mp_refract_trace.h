@@ -41,6 +41,17 @@ typedef struct {
   uint tri;
 } MpRefractHit;
 
+/* Snell's law: d (unit, towards the surface) refracted through a surface of
+ * normal n (facing against d) with relative IOR eta (incident over
+ * transmitted), cos_i = -d.n as the caller takes it. Returns 0 under total
+ * internal reflection. */
+MP_INLINE int mp_refract_dir(float3 d, float3 n, float cos_i, float eta, float3* t) {
+  float k2 = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
+  if (!(k2 > 0.0f)) return 0;
+  *t = eta * d + (eta * cos_i - sqrt(k2)) * n;
+  return 1;
+}
+
 /* Ray against a triangle, either side (Moller and Trumbore 1997). */
 MP_INLINE int mp_refract_tri_hit(float3 o, float3 d, float3 p0, float3 p1, float3 p2, float tmin, float tmax,
                                  float* t, float* u, float* v) {
@@ -99,11 +110,18 @@ MP_INLINE int mp_refract_trace(const MpRefractScene* sc, float3 o, float3 d, flo
   return found;
 }
 
+/* The proxy's box (its root node's). */
+MP_INLINE void mp_refract_box(const MpRefractScene* sc, float3* lo, float3* hi) {
+  *lo = MP_XYZ(sc->nodes[2 * (ulong)sc->root]);
+  *hi = MP_XYZ(sc->nodes[2 * (ulong)sc->root + 1]);
+}
+
 /* Whether the camera (camera space: the origin; an orthographic camera
  * lies at infinity) is within the proxy's box, so that it may see the
  * object's surface from inside. */
 MP_INLINE int mp_refract_camera_inside(const MpRefractScene* sc, int ortho) {
-  float4 lo = sc->nodes[2 * (ulong)sc->root], hi = sc->nodes[2 * (ulong)sc->root + 1];
+  float3 lo, hi;
+  mp_refract_box(sc, &lo, &hi);
   return !ortho && lo.x <= 0.0f && lo.y <= 0.0f && lo.z <= 0.0f && hi.x >= 0.0f && hi.y >= 0.0f && hi.z >= 0.0f;
 }
 
@@ -181,22 +199,22 @@ MP_INLINE void mp_refract_paths(const MpRefractScene* sc, float3 o, float3 d, fl
     float3 p_in = p - offset * ng, p_out = p + offset * ng; /* ng faces where the ray came from */
     float eta = entering ? 1.0f / ior : ior;
     float cos_i = fmin(-dot(r.d, n), 1.0f);
-    float k2 = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
-    float fr = glass ? mp_fresnel_dielectric(cos_i, entering ? ior : 1.0f / ior) : (k2 > 0.0f ? 0.0f : 1.0f);
+    float3 td;
+    int passes = mp_refract_dir(r.d, n, cos_i, eta, &td);
+    float fr = glass ? mp_fresnel_dielectric(cos_i, entering ? ior : 1.0f / ior) : (passes ? 0.0f : 1.0f);
     float3 w = r.w * tint;
-    float tmin = 0.0f;
-    if (k2 > 0.0f) {
-      MpRefractRay t = {p_in, normalize(eta * r.d + (eta * cos_i - sqrt(k2)) * n), w * (1.0f - fr), r.depth + 1, tmin};
+    if (passes) {
+      MpRefractRay t = {p_in, normalize(td), w * (1.0f - fr), r.depth + 1, 0.0f};
       if (fmax(t.w.x, fmax(t.w.y, t.w.z)) > MP_REFRACT_MIN_WEIGHT) {
         if (top < MP_REFRACT_MAX_EXITS) stack[top++] = t;
         else ex->lost += t.w;
       }
     }
-    if (glass || !(k2 > 0.0f)) {
-      /* Reflected inside (or outside): glass's Fresnel share; a refraction
-       * lobe reflects nothing, so its totally reflected light is lost. */
-      float3 rw = glass ? w * fr : MP_F3(0.0f, 0.0f, 0.0f);
-      MpRefractRay rr = {p_out, normalize(r.d + 2.0f * cos_i * n), rw, r.depth + 1, tmin};
+    /* Reflected inside (or outside): glass's Fresnel share. A refraction
+     * lobe reflects nothing, so its totally reflected light is lost. */
+    if (glass) {
+      float3 rw = w * fr;
+      MpRefractRay rr = {p_out, normalize(r.d + 2.0f * cos_i * n), rw, r.depth + 1, 0.0f};
       if (fmax(rw.x, fmax(rw.y, rw.z)) > MP_REFRACT_MIN_WEIGHT) {
         if (top < MP_REFRACT_MAX_EXITS) stack[top++] = rr;
         else ex->lost += rw;

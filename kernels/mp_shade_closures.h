@@ -143,9 +143,9 @@ MP_INLINE float mp_closure_sheen(const MpClosure* c, float3 n, float3 l, float3 
  * under total internal reflection. */
 MP_INLINE int mp_refracted_exit(float3 n, float3 v, float ior, int back, int fresnel, float3* out, float* through) {
   float eta = back ? ior : 1.0f / ior;
-  float cos_i = dot(n, v), k2 = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
-  if (!(k2 > 0.0f)) return 0;
-  float3 d = -v, t = -eta * v + (eta * cos_i - sqrt(k2)) * n;
+  float cos_i = dot(n, v);
+  float3 d = -v, t;
+  if (!mp_refract_dir(d, n, cos_i, eta, &t)) return 0;
   float fr = fresnel ? mp_fresnel_dielectric(cos_i, back ? 1.0f / ior : ior) : 0.0f;
   *through = 1.0f - fr;
   if (!back) {
@@ -173,15 +173,17 @@ MP_INLINE float3 mp_refracted_world(const MpRefractScene* refract, float3 p, flo
                                     MP_GLOBAL const float4* world_glossy) {
   float3 zero = MP_F3(0.0f, 0.0f, 0.0f);
   float ior = c->b, eta = back ? ior : 1.0f / ior;
-  float cos_i = clamp(dot(n, v), 0.0f, 1.0f), k2 = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
-  if (!(k2 > 0.0f)) return zero;
-  float3 t = normalize(-eta * v + (eta * cos_i - sqrt(k2)) * n);
+  float cos_i = clamp(dot(n, v), 0.0f, 1.0f);
+  float3 t;
+  if (!mp_refract_dir(-v, n, cos_i, eta, &t)) return zero;
+  t = normalize(t);
   float through = c->fresnel ? 1.0f - mp_fresnel_dielectric(cos_i, back ? 1.0f / ior : ior) : 1.0f;
   /* Past the proxy's tessellation error about p (a small share of its
    * size: the root's box), and off each surface hit by more than the
    * float error of camera-space positions. */
-  float4 lo = refract->nodes[2 * (ulong)refract->root], hi = refract->nodes[2 * (ulong)refract->root + 1];
-  float size = length(MP_XYZ(hi) - MP_XYZ(lo));
+  float3 lo, hi;
+  mp_refract_box(refract, &lo, &hi);
+  float size = length(hi - lo);
   MpRefractExits ex;
   mp_refract_paths(refract, p, t, 2e-3f * size, fmax(1e-5f * size, 1e-6f * length(p)), ior, c->fresnel, c->f0, &ex);
   float3 sum = zero;

@@ -207,6 +207,19 @@ TEST(RefractionTrace, PatchProxyMatchesBruteForce) {
   EXPECT_GT(hits, from_centre);
 }
 
+// A mesh collapsed to a point has no triangle to trace: no proxy (the shade
+// falls back to the single lookup) rather than an empty tree.
+TEST(RefractionTrace, CollapsedMeshGetsNoProxy) {
+  mp::Mesh point = mp::test::cube_mesh(mp::SubdivScheme::CatmullClark);
+  for (glm::vec3& q : point.points) q = glm::vec3(0.25f);
+  mp::PatchBuffer buf;
+  mp::append_subdiv_patches(point, glm::mat4(1.0f), buf);
+  mp::share_patch_edges(buf, 0);
+  const mp::RefractionProxies data = mp::build_refraction_proxies(buf, 1, {true});
+  EXPECT_EQ(data.roots[0], MP_REFRACT_NONE);
+  EXPECT_TRUE(data.nodes.empty());
+}
+
 // Only refracting materials get a proxy, and programs are told apart by
 // what the node compiler writes.
 TEST(RefractionTrace, OnlyRefractingProgramsGetProxies) {
@@ -280,6 +293,22 @@ TEST_F(RefractionRenderTest, SlabShowsTheWorldAlongTheView) {
   EXPECT_EQ(inside, 240);
   EXPECT_LT(worst, 0.01f);       // the ramp changes by 0.0085 per pixel here
   EXPECT_GT(worst_bent, 0.05f);  // six pixels' worth of bending
+}
+
+// A slab squashed to no thickness (front and back faces coincide) and glass
+// of IOR 0 or NaN: the paths end cleanly and every pixel stays finite.
+TEST_F(RefractionRenderTest, DegenerateGlassRendersFinite) {
+  Scene flat = slab_in_a_ramp("mp_add_glass(s, (float3)(1.0f), 0, 0.0f, 1.5f, 0);");
+  flat.meshes[0].object_to_world = glm::rotate(glm::mat4(1.0f), glm::radians(25.0f), glm::vec3(0, 0, 1));
+  for (glm::vec3& q : flat.meshes[0].points) q.y = 0.0f;
+  for (const char* ior : {"0.0f", "NAN"}) {
+    SCOPED_TRACE(ior);
+    Scene odd = slab_in_a_ramp(std::string("mp_add_glass(s, (float3)(1.0f), 0, 0.0f, ") + ior + ", 0);");
+    for (const Scene* sc : {&flat, &odd}) {
+      const RenderResult r = renderer_->render(*sc);
+      for (float v : r.rgba) ASSERT_TRUE(std::isfinite(v));
+    }
+  }
 }
 
 }  // namespace mp::test

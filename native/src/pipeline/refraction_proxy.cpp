@@ -77,7 +77,9 @@ struct Box {
 // the traversal's stack, MP_REFRACT_STACK, holds depth + 1 entries).
 class BvhBuilder {
  public:
-  BvhBuilder(std::vector<ProxyTriangle>& tris, RefractionProxies& out) : tris_(tris), out_(out) {}
+  // Triangles are numbered from `tri_base` (those already in `out`).
+  BvhBuilder(std::vector<ProxyTriangle>& tris, RefractionProxies& out, size_t tri_base)
+      : tris_(tris), out_(out), tri_base_(tri_base) {}
 
   uint32_t build(size_t first, size_t count, int depth) {
     const uint32_t node = uint32_t(out_.nodes.size() / 2);
@@ -104,12 +106,11 @@ class BvhBuilder {
     out_.nodes[2 * size_t(node) + 1] = glm::vec4(box.hi, as_float(b));
     return node;
   }
-  void set_tri_base(size_t base) { tri_base_ = base; }
 
  private:
   std::vector<ProxyTriangle>& tris_;
   RefractionProxies& out_;
-  size_t tri_base_ = 0;
+  size_t tri_base_;
 };
 
 }  // namespace
@@ -153,8 +154,7 @@ RefractionProxies build_refraction_proxies(const PatchBuffer& patches, size_t ob
 }
 
 uint32_t append_refraction_proxy(std::vector<ProxyTriangle>& tris, RefractionProxies& out) {
-  BvhBuilder builder(tris, out);
-  builder.set_tri_base(out.tris.size() / 6);
+  BvhBuilder builder(tris, out, out.tris.size() / 6);
   const uint32_t root = builder.build(0, tris.size(), 0);
   for (const ProxyTriangle& t : tris) {
     for (const glm::vec3& q : t.p) out.tris.emplace_back(q, 0.0f);
