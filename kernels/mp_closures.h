@@ -53,6 +53,7 @@ typedef struct {
   int fresnel;    /* glossy: MP_FRESNEL_*; sheen: MP_SHEEN_* */
   int slot;       /* normal slot */
   int multiscatter;
+  float film, film_ior; /* glossy: a thin film's thickness (nm; 0: none) and IOR (mp_thin_film.h) */
 } MpClosure;
 
 typedef struct {
@@ -120,6 +121,8 @@ MP_INLINE MpClosure mp_closure(int kind, float3 weight, int slot, float a, float
   c.fresnel = 0;
   c.slot = slot;
   c.multiscatter = 0;
+  c.film = 0.0f;
+  c.film_ior = 1.0f;
   return c;
 }
 

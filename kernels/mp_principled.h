@@ -8,6 +8,7 @@
 #include "mp_compat.h"
 #include "mp_bsdf.h"
 #include "mp_closures.h"
+#include "mp_thin_film.h"
 #include "mp_world.h"
 
 typedef struct {
@@ -30,6 +31,8 @@ typedef struct {
   int v4, multiscatter;
   int retro;            /* 3.x: Disney's diffuse with retro-reflection (a Diffuse BSDF's is Lambert) */
   float diffuse_roughness; /* 4.3 and later: Oren-Nayar's sigma for the diffuse base */
+  float thin_film, thin_film_ior; /* 4.2 and later: thickness (nm) and IOR over the specular layer */
+  int film_on_metal;              /* 5.0 and later: over the metal too */
 } MpPrincipled;
 
 MP_INLINE float mp_luminance(float3 c) { return 0.212671f * c.x + 0.71516f * c.y + 0.072169f * c.z; }
@@ -68,7 +71,7 @@ MP_INLINE float3 mp_min3(float3 c, float m) { return MP_F3(fmin(c.x, m), fmin(c.
  * a in [0, 1], aspect sqrt(1 - 0.9 a), alpha_x = r^2 / aspect, alpha_y =
  * r^2 aspect, along `tangent`. */
 MP_INLINE void mp_add_glossy_aspect(MpSurface* s, float3 w, int slot, float roughness, float anisotropy, float3 tangent,
-                                    int fresnel, float3 f0, float3 f82, int multiscatter) {
+                                    int fresnel, float3 f0, float3 f82, int multiscatter, float film, float film_ior) {
   float r = clamp(roughness, 0.0f, 1.0f), r2 = r * r;
   float an = clamp(anisotropy, 0.0f, 1.0f), aspect = sqrt(1.0f - 0.9f * an);
   MpClosure c = mp_closure(MP_CLOSURE_GLOSSY, mp_clamp_weight(w), slot, r2 / aspect, r2 * aspect);
@@ -77,6 +80,10 @@ MP_INLINE void mp_add_glossy_aspect(MpSurface* s, float3 w, int slot, float roug
   c.f0 = f0;
   c.f82 = f82;
   c.multiscatter = multiscatter;
+  if (film > MP_THIN_FILM_MIN) {
+    c.film = film;
+    c.film_ior = fmax(film_ior, 1e-5f);
+  }
   mp_surface_add(s, c);
 }
 
@@ -115,7 +122,8 @@ MP_INLINE void mp_add_principled_v4(MpSurface* s, float3 w, const MpPrincipled* 
   mp_add_emission(s, w * p->emission);
   if (metallic > 1e-5f)
     mp_add_glossy_aspect(s, w * metallic, p->slot, roughness, p->anisotropy, tangent, MP_FRESNEL_F82, base1,
-                         mp_min3(tint, 1.0f), p->multiscatter);
+                         mp_min3(tint, 1.0f), p->multiscatter, p->film_on_metal ? p->thin_film : 0.0f,
+                         p->thin_film_ior);
   w = w * (1.0f - metallic);
   float ior = fmax(p->ior, 1e-5f);
   if (transmission > 1e-5f) {
@@ -140,11 +148,16 @@ MP_INLINE void mp_add_principled_v4(MpSurface* s, float3 w, const MpPrincipled* 
     eta = mp_ior_from_f0(f0);
     if (ior < 1.0f) eta = 1.0f / eta;
   }
-  if (eta != 1.0f) {
+  int film = p->thin_film > MP_THIN_FILM_MIN;
+  if (eta != 1.0f || film) {
     float3 f0c = MP_F3(clamp(f0 * tint.x, 0.0f, 1.0f), clamp(f0 * tint.y, 0.0f, 1.0f), clamp(f0 * tint.z, 0.0f, 1.0f));
     mp_add_glossy_aspect(s, w, p->slot, roughness, p->anisotropy, tangent, MP_FRESNEL_GENERALIZED, f0c,
-                         MP_F3(eta, 0.0f, 0.0f), p->multiscatter);
-    w = w * mp_below(mp_layer_albedo(f0c, roughness, p->nv));
+                         MP_F3(eta, 0.0f, 0.0f), p->multiscatter, p->thin_film, p->thin_film_ior);
+    /* A film's layer albedo is its reflectance along the view, as Cycles
+     * estimates it (no table spans the film's parameters). */
+    float3 albedo = film ? mp_film_dielectric(clamp(p->nv, 0.0f, 1.0f), p->thin_film, fmax(p->thin_film_ior, 1e-5f), eta, f0c)
+                         : mp_layer_albedo(f0c, roughness, p->nv);
+    w = w * mp_below(albedo);
   }
   float sss = clamp(p->subsurface, 0.0f, 1.0f);
   mp_add_subsurface(s, w * sss * base1, p->slot);

@@ -59,6 +59,12 @@ MP_INLINE void mp_surface_filter_roughness(MpSurface* s, float spread2) {
  * IOR is inverted. */
 MP_INLINE float3 mp_closure_fresnel(const MpClosure* c, float cos_vh, int back) {
   float3 one = MP_F3(1.0f, 1.0f, 1.0f);
+  if (c->film > 0.0f) {
+    /* A thin film (mp_thin_film.h) over the dielectric or metal. */
+    if (c->fresnel == MP_FRESNEL_GENERALIZED)
+      return mp_film_dielectric(cos_vh, c->film, c->film_ior, back ? 1.0f / c->f82.x : c->f82.x, c->f0);
+    if (c->fresnel == MP_FRESNEL_F82) return mp_film_metal(cos_vh, c->film, c->film_ior, c->f0, c->f82);
+  }
   if (c->fresnel == MP_FRESNEL_SCHLICK) return c->f0 + (one - c->f0) * mp_schlick_weight(cos_vh);
   if (c->fresnel == MP_FRESNEL_DIELECTRIC) return c->f82 * mp_fresnel_dielectric(cos_vh, back ? 1.0f / c->f0.x : c->f0.x);
   if (c->fresnel == MP_FRESNEL_GENERALIZED) {
@@ -103,7 +109,12 @@ MP_INLINE float3 mp_closure_glossy_albedo(const MpClosure* c, float nv) {
   float2 ab = mp_ggx_albedo(r, fmax(nv, 1e-4f));
   float e = fmax(ab.x + ab.y, 1e-3f);
   float3 albedo = MP_F3(e, e, e);
-  if (c->fresnel != MP_FRESNEL_NONE) {
+  if (c->film > 0.0f && (c->fresnel == MP_FRESNEL_GENERALIZED || c->fresnel == MP_FRESNEL_F82)) {
+    /* A film's colour changes too quickly with the angle for a split: its
+     * reflectance along the view (where a sharp lobe reflects the world
+     * from) times the lobe's albedo. */
+    albedo = albedo * mp_closure_fresnel(c, clamp(nv, 0.0f, 1.0f), 0);
+  } else if (c->fresnel != MP_FRESNEL_NONE) {
     /* Schlick's split: f0 a + b; for the exact and rescaled dielectric curves
      * the same with their value at normal incidence. */
     float3 f0 = c->fresnel == MP_FRESNEL_DIELECTRIC ? c->f82 * mp_f0_from_ior(c->f0.x) : c->f0;
@@ -432,6 +443,9 @@ MP_INLINE float3 mp_shade_material(float3 p, float3 n, int faced, int ortho, con
   pr.subsurface = 0.0f;
   pr.subsurface_color = zero;
   pr.diffuse_roughness = 0.0f;
+  pr.thin_film = 0.0f;
+  pr.thin_film_ior = 1.33f;
+  pr.film_on_metal = 0;
   pr.emission = emission;
   pr.slot = pr.coat_slot = 0;
   pr.nv = pr.coat_nv = fabs(dot(n, v));

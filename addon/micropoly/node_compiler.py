@@ -966,8 +966,10 @@ class NodeCompiler:
                 tint = "(float3)(1.0f)"
             aniso = self._f(node, "Anisotropy")
             tangent = self._anisotropy_tangent(node, aniso, slot)
+            film = f"{self._f(node, 'Thin Film Thickness')}, {self._f(node, 'Thin Film IOR', default='1.33f')}"
             add(f"  mp_add_glossy_aspect(s, {weight}, {slot}, {self._f(node, 'Roughness')}, {aniso}, {tangent}, "
-                f"MP_FRESNEL_F82, {f0}, {tint}, {1 if getattr(node, 'distribution', 'GGX') == 'MULTI_GGX' else 0});")
+                f"MP_FRESNEL_F82, {f0}, {tint}, {1 if getattr(node, 'distribution', 'GGX') == 'MULTI_GGX' else 0}, "
+                f"{film});")
         else:
             # Anything else (hair, volumes, ray portals, shaders of newer
             # Blender): a diffuse of its Color input, and a warning.
@@ -987,10 +989,6 @@ class NodeCompiler:
         alpha = node.inputs.get("Alpha")
         if alpha is not None and (alpha.is_linked or float(alpha.default_value) < 1.0):
             self.transparent = True
-        if v4:
-            thin = node.inputs.get("Thin Film Thickness")
-            if thin is not None and (thin.is_linked or float(thin.default_value) > 0.0):
-                self.warn(node, "Thin Film is not supported; it is left out")
         fields = {
             "base_color": c(node, "Base Color"), "metallic": f(node, "Metallic"), "roughness": f(node, "Roughness"),
             "ior": f(node, "IOR", default="1.45f"), "alpha": f(node, "Alpha", default="1.0f"),
@@ -1008,6 +1006,9 @@ class NodeCompiler:
             else f"(float3)({f(node, 'Sheen Tint')})",
             "subsurface": f(node, "Subsurface Weight", "Subsurface"),
             "diffuse_roughness": f(node, "Diffuse Roughness") if v4 else "0.0f",
+            "thin_film": f(node, "Thin Film Thickness"), "thin_film_ior": f(node, "Thin Film IOR", default="1.33f"),
+            # Cycles colours metal by the film from Blender 5.0 on.
+            "film_on_metal": "1" if self.version >= 500 else "0",
             "subsurface_color": c(node, "Subsurface Color", default="(float3)(0.0f)"),
             "emission": f"{c(node, 'Emission Color', 'Emission')} * {f(node, 'Emission Strength', default='1.0f')}",
             "slot": slot, "coat_slot": coat_slot, "v4": "1" if v4 else "0", "retro": "0" if v4 else "1",
