@@ -41,11 +41,12 @@ SHADOWS = "--shadows" in args
 # --deep: the Suzannes in five rows one behind the other (30 of them, each
 # row hiding most of the next): high depth complexity.
 DEEP = "--deep" in args
-# --material mix|principled|glass: every Suzanne wears a Mix Shader of a
+# --material mix|principled|glass|film: every Suzanne wears a Mix Shader of a
 # Diffuse and a Glossy BSDF (factor 0.5), or a Principled BSDF of the same
 # colour (the closure benchmark: shade time of two closures against one
 # Principled), or a Glass BSDF (IOR 1.45) with a world of a Noise texture
-# for it to refract (paths traced through each Suzanne's proxy).
+# for it to refract (paths traced through each Suzanne's proxy); film: the
+# Principled BSDF with a 450 nm Thin Film (Blender 4.2 and later).
 MATERIAL = args[args.index("--material") + 1] if "--material" in args else None
 # --engines A,B: only these engines (default: Micropoly, Cycles and EEVEE).
 ENGINES = args[args.index("--engines") + 1].split(",") if "--engines" in args else None
@@ -75,10 +76,13 @@ def bench_material(mat, kind):
             noise.inputs["Scale"].default_value = 2.0
             wt.links.new(noise.outputs["Color"], bg.inputs["Color"])
         return
-    if kind == "principled":
+    film = kind == "film"  # Blender 4.2 and later
+    if kind in ("principled", "film"):
         p = nt.nodes.new("ShaderNodeBsdfPrincipled")
         p.inputs["Base Color"].default_value = color
         p.inputs["Roughness"].default_value = 0.3
+        if film:
+            p.inputs["Thin Film Thickness"].default_value = 450.0
         nt.links.new(p.outputs[0], out.inputs["Surface"])
         return
     d = nt.nodes.new("ShaderNodeBsdfDiffuse")

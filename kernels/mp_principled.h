@@ -8,7 +8,9 @@
 #include "mp_compat.h"
 #include "mp_bsdf.h"
 #include "mp_closures.h"
+#ifdef MP_THIN_FILM
 #include "mp_thin_film.h"
+#endif
 #include "mp_world.h"
 
 typedef struct {
@@ -80,10 +82,12 @@ MP_INLINE void mp_add_glossy_aspect(MpSurface* s, float3 w, int slot, float roug
   c.f0 = f0;
   c.f82 = f82;
   c.multiscatter = multiscatter;
+#ifdef MP_THIN_FILM
   if (film > MP_THIN_FILM_MIN) {
     c.film = film;
     c.film_ior = fmax(film_ior, 1e-5f);
   }
+#endif
   mp_surface_add(s, c);
 }
 
@@ -148,15 +152,23 @@ MP_INLINE void mp_add_principled_v4(MpSurface* s, float3 w, const MpPrincipled* 
     eta = mp_ior_from_f0(f0);
     if (ior < 1.0f) eta = 1.0f / eta;
   }
+#ifdef MP_THIN_FILM
   int film = p->thin_film > MP_THIN_FILM_MIN;
+#else
+  int film = 0;
+#endif
   if (eta != 1.0f || film) {
     float3 f0c = MP_F3(clamp(f0 * tint.x, 0.0f, 1.0f), clamp(f0 * tint.y, 0.0f, 1.0f), clamp(f0 * tint.z, 0.0f, 1.0f));
     mp_add_glossy_aspect(s, w, p->slot, roughness, p->anisotropy, tangent, MP_FRESNEL_GENERALIZED, f0c,
                          MP_F3(eta, 0.0f, 0.0f), p->multiscatter, p->thin_film, p->thin_film_ior);
     /* A film's layer albedo is its reflectance along the view, as Cycles
      * estimates it (no table spans the film's parameters). */
+#ifdef MP_THIN_FILM
     float3 albedo = film ? mp_film_dielectric(clamp(p->nv, 0.0f, 1.0f), p->thin_film, fmax(p->thin_film_ior, 1e-5f), eta, f0c)
                          : mp_layer_albedo(f0c, roughness, p->nv);
+#else
+    float3 albedo = mp_layer_albedo(f0c, roughness, p->nv);
+#endif
     w = w * mp_below(albedo);
   }
   float sss = clamp(p->subsurface, 0.0f, 1.0f);

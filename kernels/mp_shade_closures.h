@@ -57,14 +57,22 @@ MP_INLINE void mp_surface_filter_roughness(MpSurface* s, float spread2) {
 /* The glossy closure's Fresnel term at the cosine c between the view and
  * the half vector; `back`: seen from inside, where a dielectric's relative
  * IOR is inverted. */
+#ifdef MP_THIN_FILM
+#define MP_FILM_ON(c) ((c)->film > 0.0f)
+#else
+#define MP_FILM_ON(c) 0
+#endif
+
 MP_INLINE float3 mp_closure_fresnel(const MpClosure* c, float cos_vh, int back) {
   float3 one = MP_F3(1.0f, 1.0f, 1.0f);
+#ifdef MP_THIN_FILM
   if (c->film > 0.0f) {
     /* A thin film (mp_thin_film.h) over the dielectric or metal. */
     if (c->fresnel == MP_FRESNEL_GENERALIZED)
       return mp_film_dielectric(cos_vh, c->film, c->film_ior, back ? 1.0f / c->f82.x : c->f82.x, c->f0);
     if (c->fresnel == MP_FRESNEL_F82) return mp_film_metal(cos_vh, c->film, c->film_ior, c->f0, c->f82);
   }
+#endif
   if (c->fresnel == MP_FRESNEL_SCHLICK) return c->f0 + (one - c->f0) * mp_schlick_weight(cos_vh);
   if (c->fresnel == MP_FRESNEL_DIELECTRIC) return c->f82 * mp_fresnel_dielectric(cos_vh, back ? 1.0f / c->f0.x : c->f0.x);
   if (c->fresnel == MP_FRESNEL_GENERALIZED) {
@@ -109,7 +117,7 @@ MP_INLINE float3 mp_closure_glossy_albedo(const MpClosure* c, float nv) {
   float2 ab = mp_ggx_albedo(r, fmax(nv, 1e-4f));
   float e = fmax(ab.x + ab.y, 1e-3f);
   float3 albedo = MP_F3(e, e, e);
-  if (c->film > 0.0f && (c->fresnel == MP_FRESNEL_GENERALIZED || c->fresnel == MP_FRESNEL_F82)) {
+  if (MP_FILM_ON(c) && (c->fresnel == MP_FRESNEL_GENERALIZED || c->fresnel == MP_FRESNEL_F82)) {
     /* A film's colour changes too quickly with the angle for a split: its
      * reflectance along the view (where a sharp lobe reflects the world
      * from) times the lobe's albedo. */

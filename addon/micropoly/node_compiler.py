@@ -138,6 +138,7 @@ class NodeCompiler:
         self.fn = None
         self.helpers = []          # extra functions (Bump heights), emitted before the main two
         self.uses_neighbours = False
+        self.uses_thin_film = False
         self.displacement_world = False
         self.groups = []           # the Group nodes whose trees are being compiled, outermost first
         self.world = False         # compiling a world (baked into a map) rather than a material
@@ -789,6 +790,9 @@ class NodeCompiler:
         includes = "".join(f'#include "textures/{h}"\n' for h in sorted(self.headers))
         if self.uses_neighbours:
             includes = "#define MP_NODE_USES_NEIGHBOURS 1\n" + includes
+        if self.uses_thin_film:
+            # Ahead of the kernel headers (program_cache.cpp hoists it).
+            includes = "#define MP_NODE_USES_THIN_FILM 1\n" + includes
         source = includes + "".join(self.helpers) + disp_src + surf_src
         return CompiledMaterial(source, displaces, shades, bound, displaces and self.displacement_world,
                                 alpha=self.transparent)
@@ -966,6 +970,7 @@ class NodeCompiler:
                 tint = "(float3)(1.0f)"
             aniso = self._f(node, "Anisotropy")
             tangent = self._anisotropy_tangent(node, aniso, slot)
+            self._note_thin_film(node)
             film = f"{self._f(node, 'Thin Film Thickness')}, {self._f(node, 'Thin Film IOR', default='1.33f')}"
             add(f"  mp_add_glossy_aspect(s, {weight}, {slot}, {self._f(node, 'Roughness')}, {aniso}, {tangent}, "
                 f"MP_FRESNEL_F82, {f0}, {tint}, {1 if getattr(node, 'distribution', 'GGX') == 'MULTI_GGX' else 0}, "
@@ -975,6 +980,13 @@ class NodeCompiler:
             # Blender): a diffuse of its Color input, and a warning.
             self.warn(node, "is not supported; it is shaded as a Diffuse BSDF of its color")
             add(f"  mp_add_diffuse(s, {weight} * {color}, {slot}, 0.0f);")
+
+    def _note_thin_film(self, node):
+        """A Thin Film Thickness that is linked or above 0 makes the program
+        compile the film's code (kernels/mp_closures.h, MP_THIN_FILM)."""
+        thin = node.inputs.get("Thin Film Thickness")
+        if thin is not None and (thin.is_linked or float(thin.default_value) > 0.0):
+            self.uses_thin_film = True
 
     def emit_principled(self, node, weight):
         """Principled BSDF: every input, in the running Blender's layout
@@ -989,6 +1001,7 @@ class NodeCompiler:
         alpha = node.inputs.get("Alpha")
         if alpha is not None and (alpha.is_linked or float(alpha.default_value) < 1.0):
             self.transparent = True
+        self._note_thin_film(node)
         fields = {
             "base_color": c(node, "Base Color"), "metallic": f(node, "Metallic"), "roughness": f(node, "Roughness"),
             "ior": f(node, "IOR", default="1.45f"), "alpha": f(node, "Alpha", default="1.0f"),

@@ -111,7 +111,16 @@ std::string assemble_material_program_source(const std::string& generated) {
   const size_t at = text.find(marker);
   if (at == std::string::npos) throw Error("kernel sources: material program marker missing");
   text.replace(at, marker.size(), generated);
-  return expand_includes(text, files, 0);
+  // Switches the generated code sets for the kernel headers
+  // ("#define MP_NODE_USES_..." lines) go ahead of them.
+  std::string switches;
+  for (size_t line = 0; line < generated.size();) {
+    size_t end = generated.find('\n', line);
+    if (end == std::string::npos) end = generated.size();
+    if (generated.compare(line, 21, "#define MP_NODE_USES_") == 0) switches += generated.substr(line, end - line) + "\n";
+    line = end + 1;
+  }
+  return expand_includes(switches + text, files, 0);
 }
 
 BuiltProgram build_program_cached(const cl::Context& context, const cl::Device& device, const std::string& source,
