@@ -100,6 +100,20 @@ TEST(ProgramCache, EmbeddedSourcesResolveEveryInclude) {
     EXPECT_NE(source.find(kernel), std::string::npos) << kernel;
 }
 
+// A material program's switches for the kernel headers ("#define
+// MP_NODE_USES_...") reach them: they go ahead of the headers, so the thin
+// film's code is in a program that asks for it and in no other.
+TEST(ProgramCache, MaterialProgramSwitchesPrecedeTheHeaders) {
+  const std::string body = "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {}\n";
+  const std::string with = assemble_material_program_source("#define MP_NODE_USES_THIN_FILM 1\n" + body);
+  const std::string without = assemble_material_program_source(body);
+  EXPECT_LT(with.find("#define MP_NODE_USES_THIN_FILM 1"), with.find("#ifndef MP_CLOSURES_H"));
+  EXPECT_NE(with.find("mp_film_dielectric"), std::string::npos);
+  // The source without the switch still holds the header's text, but the
+  // preprocessor drops it: nothing defines the switch ahead of it.
+  EXPECT_EQ(without.find("#define MP_NODE_USES_THIN_FILM"), std::string::npos);
+}
+
 TEST(DeviceChoice, UnknownSelectorsAreRejected) {
   EXPECT_THROW(DeviceSession("banana"), Error);
   EXPECT_THROW(DeviceSession("99"), Error);
