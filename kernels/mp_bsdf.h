@@ -26,6 +26,24 @@ MP_INLINE float mp_schlick_weight(float c) {
   return t2 * t2 * t;
 }
 
+/* Hoffman's F82 model for metals, one channel: Schlick's curve from f0 less
+ * b mu (1 - mu)^6, a dip that peaks near 82 degrees (mu = 1/7). mp_f82_b:
+ * the b that takes the curve through f82 at mu = 1/7; mp_f82_tint_b: the b
+ * of the F82-tint form, Schlick's value there times tint (Cycles' metal). */
+MP_INLINE float mp_f82(float mu, float f0, float b) {
+  float s = clamp(1.0f - mu, 0.0f, 1.0f), s5 = s * s * s * s * s;
+  return clamp(f0 + (1.0f - f0) * s5 - b * mu * s5 * s, 0.0f, 1.0f);
+}
+MP_INLINE float mp_f82_b(float f0, float f82) {
+  const float q = 6.0f / 7.0f;
+  float q5 = q * q * q * q * q;
+  return (7.0f / (q5 * q)) * (f0 + (1.0f - f0) * q5 - f82);
+}
+MP_INLINE float mp_f82_tint_b(float f0, float tint) {
+  const float q = 6.0f / 7.0f;
+  return mp_f82_b(f0, (f0 + (1.0f - f0) * q * q * q * q * q) * tint);
+}
+
 /* F0 of a dielectric of IOR eta. */
 MP_INLINE float mp_f0_from_ior(float eta) {
   float r = (eta - 1.0f) / (eta + 1.0f);

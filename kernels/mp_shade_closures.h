@@ -84,18 +84,10 @@ MP_INLINE float3 mp_closure_fresnel(const MpClosure* c, float cos_vh, int back) 
     float t = f0 < 1.0f ? clamp((mp_fresnel_dielectric(cos_vh, eta) - f0) / (1.0f - f0), 0.0f, 1.0f) : 1.0f;
     return c->f0 + (one - c->f0) * t;
   }
-  if (c->fresnel == MP_FRESNEL_F82) {
-    /* Hoffman's F82-tint: Schlick minus a term that dips at 82 degrees to
-     * f82 times Schlick's value there. */
-    const float mu82 = 1.0f / 7.0f;
-    float3 schlick82 = c->f0 + (one - c->f0) * mp_schlick_weight(mu82);
-    float denom = mu82 * 0.3965694566f; /* mu82 (1 - mu82)^6 at mu82 = 1/7 */
-    float3 b = (schlick82 * (one - c->f82)) / denom;
-    float t = 1.0f - cos_vh, t6 = t * t * t;
-    t6 *= t6;
-    float3 f = c->f0 + (one - c->f0) * mp_schlick_weight(cos_vh) - b * (cos_vh * t6);
-    return MP_F3(clamp(f.x, 0.0f, 1.0f), clamp(f.y, 0.0f, 1.0f), clamp(f.z, 0.0f, 1.0f));
-  }
+  if (c->fresnel == MP_FRESNEL_F82) /* Hoffman's F82-tint (mp_bsdf.h) */
+    return MP_F3(mp_f82(cos_vh, c->f0.x, mp_f82_tint_b(c->f0.x, c->f82.x)),
+                 mp_f82(cos_vh, c->f0.y, mp_f82_tint_b(c->f0.y, c->f82.y)),
+                 mp_f82(cos_vh, c->f0.z, mp_f82_tint_b(c->f0.z, c->f82.z)));
   return one;
 }
 

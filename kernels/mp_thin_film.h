@@ -56,19 +56,6 @@ MP_INLINE int mp_fresnel_polarized(float cos_i, float eta, float2* r, float2* si
   return 1;
 }
 
-/* Hoffman's F82 model for one channel (as mp_closure_fresnel): Schlick's
- * curve from f0 less b mu (1 - mu)^6, and b from the reflectance f82 at
- * mu = 1/7. */
-MP_INLINE float mp_f82_b(float f0, float f82) {
-  const float f = 6.0f / 7.0f;
-  float f5 = f * f * f * f * f;
-  return (7.0f / (f5 * f)) * (f0 + (1.0f - f0) * f5 - f82);
-}
-MP_INLINE float mp_f82(float mu, float f0, float b) {
-  float s = clamp(1.0f - mu, 0.0f, 1.0f), s5 = s * s * s * s * s;
-  return clamp(f0 + (1.0f - f0) * s5 - b * mu * s5 * s, 0.0f, 1.0f);
-}
-
 /* Reflectance of the s and p waves from a medium of IOR n1 onto a
  * conductor of IOR n + ik (Born and Wolf, Principles of Optics, 14.4.1,
  * with n + ik for the complex index), and the phase of each reflected
@@ -165,13 +152,9 @@ MP_INLINE float3 mp_film_dielectric(float cos_i, float thickness, float film_ior
  * Metallic Fresnel", r = F0 and g = the reflectance at 82 degrees). */
 MP_INLINE float3 mp_film_metal(float cos_i, float thickness, float film_ior, float3 f0, float3 tint) {
   float f[3], f0c[3] = {f0.x, f0.y, f0.z}, tc[3] = {tint.x, tint.y, tint.z};
-  const float q = 6.0f / 7.0f;
-  float q5 = q * q * q * q * q;
   for (int c = 0; c < 3; ++c) {
-    /* b of the F82-tint: Schlick's value at 82 degrees times (1 - tint). */
     float r = fmin(f0c[c], 0.999f), sr = sqrt(r);
-    float b = (f0c[c] + (1.0f - f0c[c]) * q5) * (7.0f / (q5 * q)) * (1.0f - tc[c]);
-    float g = mp_f82(1.0f / 7.0f, f0c[c], b);
+    float g = mp_f82(1.0f / 7.0f, f0c[c], mp_f82_tint_b(f0c[c], tc[c]));
     float n = (1.0f + sr) / (1.0f - sr) + ((1.0f - r) / (1.0f + r) - (1.0f + sr) / (1.0f - sr)) * g;
     float k = sqrt(fmax((r * (n + 1.0f) * (n + 1.0f) - (n - 1.0f) * (n - 1.0f)) / (1.0f - r), 0.0f));
     f[c] = mp_film_channel(c, cos_i, thickness, film_ior, 0.0f, n, k, g, 1);

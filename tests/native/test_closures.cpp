@@ -9,6 +9,7 @@
 #include "mp_compat.h"
 #include "mp_types.h"
 #include "mp_shade_closures.h"
+#include "principled_fixture.h"
 
 namespace {
 
@@ -108,23 +109,6 @@ TEST(Closures, MicrofiberSheenAlbedoTableMatchesItsLobe) {
       const double e = hemisphere([&](float3 l) { return double(mp_microfiber_sheen(n, l, v, r)); });
       EXPECT_NEAR(mp_microfiber_sheen_albedo(nv, r), std::min(e, 1.0), 0.01) << r << " " << nv;
     }
-}
-
-MpPrincipled principled_defaults() {
-  MpPrincipled p{};
-  p.base_color = MP_F3(0.8f, 0.8f, 0.8f);
-  p.roughness = 0.5f;
-  p.ior = 1.5f;
-  p.alpha = 1.0f;
-  p.specular = 0.5f;
-  p.specular_tint = MP_F3(1.0f, 1.0f, 1.0f);
-  p.coat_ior = 1.5f;
-  p.coat_tint = p.sheen_tint = MP_F3(1.0f, 1.0f, 1.0f);
-  p.nv = p.coat_nv = 1.0f;
-  p.v4 = 1;
-  p.retro = 0;
-  p.diffuse_roughness = 0.0f;
-  return p;
 }
 
 // Blender 4.x's layers: the diffuse base gets what the specular layer does

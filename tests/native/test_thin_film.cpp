@@ -10,10 +10,12 @@
 
 #include <cmath>
 #include <complex>
+#include <limits>
 
 #include "mp_compat.h"
 #include "mp_types.h"
 #include "mp_shade_closures.h"
+#include "principled_fixture.h"
 #include "textures/mp_tex_color.h"
 
 namespace {
@@ -107,17 +109,9 @@ TEST(ThinFilm, VanishingFilmIsThePlainInterface) {
 // the diffuse base gets what the film does not reflect along the view;
 // a film of 0 nm changes nothing.
 TEST(ThinFilm, PrincipledSpecularLayerCarriesTheFilm) {
-  MpPrincipled p{};
-  p.base_color = MP_F3(0.8f, 0.8f, 0.8f);
+  MpPrincipled p = principled_defaults();
   p.roughness = 0.2f;
-  p.ior = 1.5f;
-  p.alpha = 1.0f;
-  p.specular = 0.5f;
-  p.specular_tint = MP_F3(1.0f, 1.0f, 1.0f);
-  p.coat_ior = 1.5f;
-  p.coat_tint = p.sheen_tint = MP_F3(1.0f, 1.0f, 1.0f);
   p.nv = p.coat_nv = 0.8f;
-  p.v4 = 1;
   p.thin_film_ior = 1.33f;
   const float3 n = MP_F3(0.0f, 0.0f, 1.0f), one = MP_F3(1.0f, 1.0f, 1.0f);
   MpSurface plain, film;
@@ -168,4 +162,37 @@ TEST(ThinFilm, MetalKeepsItsColourUnderAVanishingFilm) {
     const float3 d = thick - bare;
     EXPECT_GT(std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)}), 0.04f) << "cos " << ci;
   }
+}
+
+// Film inputs straight from nodes may be anything: a NaN or negative
+// thickness is no film, and an IOR of 0, NaN or a huge one, or an infinite
+// thickness, still gives reflectances in [0, 1].
+TEST(ThinFilm, DegenerateInputsStayReflectances) {
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  const float3 n = MP_F3(0.0f, 0.0f, 1.0f), one = MP_F3(1.0f, 1.0f, 1.0f);
+  const float cases[][2] = {{nan, 1.33f}, {-50.0f, 1.33f}, {400.0f, 0.0f}, {400.0f, nan}, {400.0f, 1e6f},
+                            {inf, 1.33f}, {1e9f, 1.5f}};
+  for (const auto& c : cases)
+    for (int metal = 0; metal < 2; ++metal) {
+      MpPrincipled p = principled_defaults();
+      p.metallic = float(metal);
+      p.thin_film = c[0];
+      p.thin_film_ior = c[1];
+      p.film_on_metal = 1;
+      MpSurface s;
+      mp_surface_init(&s, n);
+      mp_add_principled_v4(&s, one, &p, n);
+      ASSERT_GE(s.count, 1);
+      if (!(c[0] > MP_THIN_FILM_MIN)) EXPECT_EQ(s.c[0].film, 0.0f);
+      for (int i = 0; i < s.count; ++i) {
+        EXPECT_TRUE(std::isfinite(s.c[i].weight.x)) << c[0] << " " << c[1];
+        for (float cos_vh : {1.0f, 0.5f, 0.05f}) {
+          const float3 f = mp_closure_fresnel(&s.c[i], cos_vh, 0);
+          for (int k = 0; k < 3; ++k) {
+            EXPECT_GE(f[k], 0.0f) << c[0] << " " << c[1] << " metal " << metal;
+            EXPECT_LE(f[k], 1.0f) << c[0] << " " << c[1] << " metal " << metal;
+          }
+        }
+      }
+    }
 }
