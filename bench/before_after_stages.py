@@ -5,6 +5,10 @@ first of each, per stage, and the sample stage's nanoseconds per
 micropolygon (its kernel time over the micropolygons diced).
 
   python3 bench/before_after_stages.py --before OLD_CLI --after NEW_CLI [--device gpu] [--repeat 3] [--rounds 2] scene.rib ...
+
+A scene given as OLD.rib:NEW.rib is read by the old build from OLD.rib and
+by the new one from NEW.rib: the same scene exported by each build's add-on,
+where the new one writes material programs the old build cannot compile.
 """
 
 import argparse
@@ -38,8 +42,9 @@ def main():
     frames = {(rib, w): [] for rib in a.ribs for w in ("before", "after")}
     for _ in range(a.rounds):
         for rib in a.ribs:
+            pair = dict(zip(("before", "after"), rib.split(":", 1) if ":" in rib else (rib, rib)))
             for which in ("before", "after"):
-                frames[(rib, which)] += run(getattr(a, which), rib, out, a.device, a.repeat)
+                frames[(rib, which)] += run(getattr(a, which), pair[which], out, a.device, a.repeat)
     print("| scene | build | micropolygons | " + " | ".join(STAGES) + " | sample ns / micropolygon |")
     print("|---|---|---|" + "---|" * len(STAGES) + "---|")
     summary = {}
@@ -47,7 +52,7 @@ def main():
         med = {k: statistics.median(r["timings_ms"].get(k, 0.0) for r in runs) for k in STAGES}
         mps = statistics.median(r["micropolygons"] for r in runs)  # diced: the same count for both builds
         ns = med["sample"] * 1e6 / mps if mps else 0.0
-        name = os.path.splitext(os.path.basename(rib))[0]
+        name = os.path.splitext(os.path.basename(rib.split(":")[-1]))[0]
         summary[f"{name}/{which}"] = {"stages_ms": med, "micropolygons_sampled": mps, "sample_ns_per_micropolygon": ns}
         print(f"| {name} | {which} | {int(mps):,} | " + " | ".join(f"{med[k]:.0f}" for k in STAGES) + f" | {ns:.0f} |")
     print(json.dumps(summary))

@@ -121,6 +121,49 @@ MP_INLINE float mp_oren_nayar(float3 n, float3 l, float3 v, float sigma) {
   return nl * (a + sigma * a * t);
 }
 
+/* Oren-Nayar's directional albedo for white light from every direction:
+ * the integral of (A + B s) cos over the hemisphere is A (pi + sigma G(c)),
+ * c the cosine to the normal, with G from Fujii's derivation (OpenPBR's
+ * energy-preserving Oren-Nayar, "EON": Portsmouth et al. 2024). Below
+ * c = 1e-6 tan explodes; G's value at grazing is its first-order series. */
+MP_INLINE float mp_oren_nayar_g(float c) {
+  if (!(c >= 1e-6f)) return (0.5f * MP_BSDF_PI - 2.0f / 3.0f) - fmax(c, 0.0f);
+  float s = sqrt(fmax(1.0f - c * c, 0.0f)), theta = acos(fmin(c, 1.0f));
+  return s * (theta - 2.0f / 3.0f - s * c) + (2.0f / 3.0f) * (s / c) * (1.0f - s * s * s);
+}
+MP_INLINE float mp_oren_nayar_albedo(float c, float sigma) {
+  float a = 1.0f / (MP_BSDF_PI + (0.5f * MP_BSDF_PI - 2.0f / 3.0f) * sigma);
+  return a * (MP_BSDF_PI + sigma * mp_oren_nayar_g(c));
+}
+/* Its cosine-weighted average over directions (EON: A + (2/3 - 28/(15 pi)) B
+ * in OpenPBR's normalisation). */
+MP_INLINE float mp_oren_nayar_average(float sigma) {
+  float a = 1.0f / (MP_BSDF_PI + (0.5f * MP_BSDF_PI - 2.0f / 3.0f) * sigma);
+  return a * (MP_BSDF_PI + (2.0f * MP_BSDF_PI / 3.0f - 28.0f / 15.0f) * sigma);
+}
+/* EON's multiple-scattering lobe, per unit irradiance, for albedo rho
+ * (clamped to [0, 1]): rho_ms / pi (1 - E(nl)) (1 - E(nv)) / (1 - Eavg) with
+ * rho_ms = rho^2 Eavg / (1 - rho (1 - Eavg)), which gives back what the
+ * single-scattering lobe loses (a white surface reflects all it receives).
+ * Cycles 4.3 and later multiply the closure's weight (the colour) on top,
+ * and so does mp_shade_closures. */
+MP_INLINE float mp_eon_ms_scale(float rho, float eavg) {
+  if (!(eavg < 1.0f)) return 0.0f; /* no roughness, nothing lost */
+  rho = clamp(rho, 0.0f, 1.0f);
+  return rho * rho * eavg / ((1.0f - eavg) * (1.0f - rho * (1.0f - eavg))) * (1.0f / MP_BSDF_PI);
+}
+MP_INLINE float3 mp_eon_ms(float3 rho, float sigma, float nl, float nv) {
+  float eavg = mp_oren_nayar_average(sigma);
+  float k = (1.0f - mp_oren_nayar_albedo(nl, sigma)) * (1.0f - mp_oren_nayar_albedo(nv, sigma));
+  return MP_F3(mp_eon_ms_scale(rho.x, eavg), mp_eon_ms_scale(rho.y, eavg), mp_eon_ms_scale(rho.z, eavg)) * k;
+}
+/* The same lobe's directional albedo: rho_ms (1 - E(nv)) (its integral of
+ * (1 - E(nl)) cos is pi (1 - Eavg)). */
+MP_INLINE float3 mp_eon_ms_albedo(float3 rho, float sigma, float nv) {
+  float eavg = mp_oren_nayar_average(sigma), k = MP_BSDF_PI * (1.0f - eavg) * (1.0f - mp_oren_nayar_albedo(nv, sigma));
+  return MP_F3(mp_eon_ms_scale(rho.x, eavg), mp_eon_ms_scale(rho.y, eavg), mp_eon_ms_scale(rho.z, eavg)) * k;
+}
+
 /* Disney's diffuse with retro-reflection (Principled 3.x), f cos:
  * nl / pi ((1 - FL/2)(1 - FV/2) + R (FL + FV + FL FV (R - 1))), F = (1 - cos)^5,
  * R = roughness (1 + l.v). */

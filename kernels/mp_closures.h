@@ -28,7 +28,7 @@
 #define MP_MAX_CLOSURE_NORMALS 4
 
 /* Closure kinds. */
-#define MP_CLOSURE_DIFFUSE 1      /* Lambert, or Oren-Nayar with a = sigma */
+#define MP_CLOSURE_DIFFUSE 1      /* Lambert, or Oren-Nayar with a = sigma (EON: multiscatter, f82 = albedo) */
 #define MP_CLOSURE_TRANSLUCENT 2  /* Lambert from the other side */
 #define MP_CLOSURE_GLOSSY 3       /* GGX reflection; a, b = alpha_x, alpha_y */
 #define MP_CLOSURE_REFRACTION 4   /* GGX transmission; a = alpha, b = IOR */
@@ -154,6 +154,16 @@ MP_INLINE float3 mp_clamp_weight(float3 w) {
 MP_INLINE void mp_add_diffuse(MpSurface* s, float3 w, int slot, float roughness) {
   MpClosure c = mp_closure(MP_CLOSURE_DIFFUSE, mp_clamp_weight(w), slot, clamp(roughness, 0.0f, 1.0f), 0.0f);
   c.f0 = c.weight;
+  mp_surface_add(s, c);
+}
+/* A rough diffuse lobe as Cycles 4.3 and later shade it: Oren-Nayar plus
+ * EON's multiple scattering (mp_eon_ms), which depends on the albedo
+ * `color` (kept in f82; `multiscatter` marks the lobe). */
+MP_INLINE void mp_add_diffuse_eon(MpSurface* s, float3 w, float3 color, int slot, float roughness) {
+  MpClosure c = mp_closure(MP_CLOSURE_DIFFUSE, mp_clamp_weight(w), slot, clamp(roughness, 0.0f, 1.0f), 0.0f);
+  c.f0 = c.weight;
+  c.f82 = MP_F3(clamp(color.x, 0.0f, 1.0f), clamp(color.y, 0.0f, 1.0f), clamp(color.z, 0.0f, 1.0f));
+  c.multiscatter = 1;
   mp_surface_add(s, c);
 }
 MP_INLINE void mp_add_translucent(MpSurface* s, float3 w, int slot) {

@@ -173,7 +173,8 @@ MP_INLINE void mp_add_principled_v4(MpSurface* s, float3 w, const MpPrincipled* 
   }
   float sss = clamp(p->subsurface, 0.0f, 1.0f);
   mp_add_subsurface(s, w * sss * base1, p->slot);
-  mp_add_diffuse(s, w * (1.0f - sss) * base, p->slot, p->diffuse_roughness);
+  /* Diffuse Roughness (4.3 and later) is EON's Oren-Nayar of the base colour. */
+  mp_add_diffuse_eon(s, w * (1.0f - sss) * base, base, p->slot, p->diffuse_roughness);
 }
 
 MP_INLINE void mp_add_principled_v3(MpSurface* s, float3 w, const MpPrincipled* p, float3 normal) {

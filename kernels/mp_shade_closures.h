@@ -320,9 +320,13 @@ MP_INLINE float3 mp_shade_closures(float3 p, float3 ng, int faced, int ortho, co
       }
       if (!(e > 0.0f) || !(nl > 0.0f)) continue;
       float nv = fmax(dot(n, v), 1e-6f);
-      if (c->kind == MP_CLOSURE_DIFFUSE)
+      if (c->kind == MP_CLOSURE_DIFFUSE) {
         f = c->fresnel ? mp_disney_diffuse(n, l, v, c->b) / nl
             : c->a > 0.0f ? mp_oren_nayar(n, l, v, c->a) / nl : 1.0f / MP_PI;
+        /* EON's multiple scattering, added to the single-scattering lobe. */
+        if (c->multiscatter && c->a > 0.0f && !c->fresnel)
+          out += c->weight * mp_eon_ms(c->f82, c->a, nl, nv) * (cl * (e * shadowing));
+      }
       else if (c->kind == MP_CLOSURE_SUBSURFACE)
         f = 1.0f / MP_PI;
       else if (c->kind == MP_CLOSURE_GLOSSY) {
@@ -386,8 +390,15 @@ MP_INLINE float3 mp_shade_closures(float3 p, float3 ng, int faced, int ortho, co
       float3 dn = c->kind == MP_CLOSURE_TRANSLUCENT ? -n : n;
       if (world)
         diffuse_world = mp_env_irradiance(world, dn) * ((c->kind == MP_CLOSURE_TRANSLUCENT ? vis_b : vis) * world->color[0]);
-      float albedo = 1.0f;
-      if (c->kind == MP_CLOSURE_SHEEN) albedo = mp_sheen_albedo(c, nv);
+      /* Light from every side reflected by the lobe: Lambert's all, a
+       * rough diffuse lobe its directional albedo (with EON's multiple
+       * scattering), a sheen its table's. */
+      float3 albedo = MP_F3(1.0f, 1.0f, 1.0f);
+      if (c->kind == MP_CLOSURE_SHEEN) albedo *= mp_sheen_albedo(c, nv);
+      if (c->kind == MP_CLOSURE_DIFFUSE && c->a > 0.0f && !c->fresnel) {
+        albedo *= mp_oren_nayar_albedo(nv, c->a);
+        if (c->multiscatter) albedo += mp_eon_ms_albedo(c->f82, c->a, nv);
+      }
       out += (c->kind == MP_CLOSURE_DIFFUSE ? c->f0 : c->weight) * albedo * (diffuse_world + ambient);
     }
   }

@@ -919,7 +919,11 @@ class NodeCompiler:
         self.closures += 2 if t == "BSDF_GLASS" else 1
         slot = self._normal_slot(node)
         color = self._c(node, "Color", "Base Color", default="(float3)(0.8f)")
-        if t == "BSDF_DIFFUSE":
+        if t == "BSDF_DIFFUSE" and self.version >= 403:
+            # 4.3 and later: Oren-Nayar with EON's multiple scattering, which
+            # depends on the colour alone (not the weight above it).
+            add(f"  {{ float3 albedo_ = {color}; mp_add_diffuse_eon(s, {weight} * albedo_, albedo_, {slot}, {self._f(node, 'Roughness')}); }}")
+        elif t == "BSDF_DIFFUSE":
             add(f"  mp_add_diffuse(s, {weight} * {color}, {slot}, {self._f(node, 'Roughness')});")
         elif t == "BSDF_TRANSLUCENT":
             add(f"  mp_add_translucent(s, {weight} * {color}, {slot});")

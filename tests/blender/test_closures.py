@@ -190,6 +190,15 @@ def m_thin_film(metallic, thickness):
     return build
 
 
+def m_principled_diffuse_rough(roughness):
+    """A pale Principled BSDF whose diffuse base has Diffuse Roughness (4.3
+    and later: Oren-Nayar with EON's multiple scattering)."""
+    def build(nt):
+        return principled(nt, **{"Base Color": rgba(0.8, 0.75, 0.7), "Roughness": 0.5,
+                                 "Diffuse Roughness": roughness}).outputs[0]
+    return build
+
+
 def m_rerouted_principled(nt):
     """A constant Principled BSDF reaching the output through a reroute."""
     p = principled(nt, **{"Base Color": rgba(0.2, 0.5, 0.3), "Roughness": 0.35})
@@ -367,6 +376,28 @@ def case_through_glass(name, build, threshold=25.0):
         failures.append(f"unrefracted it reaches {wrong['unrefracted']:.2f} dB: the case cannot tell")
     shown = ", ".join(f"{k} {v:.2f} dB" for k, v in wrong.items())
     return report(name, failures, f"PSNR {db:.2f} dB over {int(mask.sum())} px; instead: {shown}")
+
+
+def case_diffuse_roughness(name, threshold=30.0):
+    """Principled's Diffuse Roughness 1: the same material rendered by
+    Micropoly as a Lambert base (Diffuse Roughness 0) must fall short, so
+    the case tells the rough lobe from a smooth one."""
+    if VERSION < 403:
+        return report(name, [], "skipped: no Diffuse Roughness before 4.3")
+    scene = scene_with(name, m_principled_diffuse_rough(1.0))
+    cycles, micro = render_pair(scene, name)
+    db, covered = covered_psnr(cycles, micro)
+    obj = next(o for o in scene.objects if o.name.startswith("Suzanne"))
+    obj.data.materials[0] = material(name + "_smooth", m_principled_diffuse_rough(0.0))
+    db_wrong, _ = covered_psnr(cycles, ru.render_passes(scene, "MICROPOLY", W, H, samples=16)["rgba"])
+    failures = []
+    if covered < 0.3 * W * H:
+        failures.append(f"only {covered} covered pixels")
+    if db < threshold:
+        failures.append(f"PSNR {db:.2f} dB < {threshold}")
+    if db_wrong >= threshold:
+        failures.append(f"as a Lambert base it reaches {db_wrong:.2f} dB: the case cannot tell")
+    return report(name, failures, f"PSNR {db:.2f} dB over {covered} px; as a Lambert base {db_wrong:.2f} dB")
 
 
 def case_thin_film(name, metallic, threshold=30.0):
@@ -631,6 +662,7 @@ CASES = {
     "translucent": lambda: case_material("translucent", m_translucent),
     "subsurface": lambda: case_material("subsurface", m_subsurface),
     "diffuse_rough": lambda: case_material("diffuse_rough", m_diffuse_rough),
+    "principled_diffuse_rough": lambda: case_diffuse_roughness("principled_diffuse_rough"),
     "rerouted_principled": lambda: case_material("rerouted_principled", m_rerouted_principled),
     # The Metallic BSDF (F82 tint, anisotropy along the default tangent) came with 4.2.
     "thin_film": lambda: case_thin_film("thin_film", 0),

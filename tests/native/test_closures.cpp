@@ -92,6 +92,45 @@ TEST(Closures, OrenNayarWithoutRoughnessIsLambert) {
   EXPECT_GT(e, 0.7);
 }
 
+// Oren-Nayar's closed-form directional albedo (Fujii's G) against
+// quadrature of the lobe, and EON's multiple scattering (Blender 4.3 and
+// later): a white rough surface reflects all it receives at every angle, a
+// coloured one what the closed form says.
+TEST(Closures, EonOrenNayarConservesEnergy) {
+  const float3 n = MP_F3(0.0f, 0.0f, 1.0f);
+  for (float sigma : {0.3f, 0.7f, 1.0f})
+    for (float nv : {0.05f, 0.3f, 0.7f, 1.0f}) {
+      const float3 v = MP_F3(std::sqrt(1.0f - nv * nv), 0.0f, nv);
+      const double single = hemisphere([&](float3 l) { return double(mp_oren_nayar(n, l, v, sigma)); }, 384);
+      EXPECT_NEAR(single, mp_oren_nayar_albedo(nv, sigma), 2e-3) << sigma << " " << nv;
+      EXPECT_LT(single, 1.0) << sigma << " " << nv;  // single scattering alone loses energy
+      if (sigma == 1.0f && nv == 1.0f) EXPECT_LT(single, 0.8);
+      for (float rho : {1.0f, 0.5f}) {
+        const float3 albedo = MP_F3(rho, rho, rho);
+        const double ms = hemisphere([&](float3 l) { return double(mp_eon_ms(albedo, sigma, l.z, nv).x) * l.z; }, 384);
+        EXPECT_NEAR(ms, mp_eon_ms_albedo(albedo, sigma, nv).x, 2e-3) << sigma << " " << nv;
+        // The closure's weight (rho) times both lobes.
+        const double total = rho * (single + ms);
+        if (rho == 1.0f) EXPECT_NEAR(total, 1.0, 3e-3) << sigma << " " << nv;
+        else EXPECT_LT(total, rho) << sigma << " " << nv;
+      }
+    }
+  // The cosine-weighted average of the closed form is EON's Eavg.
+  for (float sigma : {0.3f, 1.0f}) {
+    double avg = 0.0;
+    const int k = 2000;
+    for (int i = 0; i < k; ++i) {
+      const double c = (i + 0.5) / k;
+      avg += 2.0 * c * mp_oren_nayar_albedo(float(c), sigma) / k;
+    }
+    EXPECT_NEAR(avg, mp_oren_nayar_average(sigma), 1e-3) << sigma;
+  }
+  // No roughness: no multiple scattering, and nothing undefined at grazing.
+  EXPECT_EQ(mp_eon_ms(MP_F3(1.0f, 1.0f, 1.0f), 0.0f, 0.5f, 0.5f).x, 0.0f);
+  EXPECT_TRUE(std::isfinite(mp_oren_nayar_albedo(0.0f, 1.0f)));
+  EXPECT_NEAR(mp_oren_nayar_albedo(1e-7f, 1.0f), mp_oren_nayar_albedo(2e-6f, 1.0f), 1e-4);
+}
+
 // A toon lobe with a hard edge reflects exactly what arrives within its cone.
 TEST(Closures, ToonIsNormalisedOverItsCone) {
   for (float size : {0.2f, 0.5f, 0.9f}) {
