@@ -336,6 +336,23 @@ def emit_gamma(compiler, node):
     return {"Color": compiler.fn.temp(VEC, f"mp_gamma({color[0]}, {gamma[0]})")}
 
 
+ROTATE_TYPES = ("AXIS_ANGLE", "X_AXIS", "Y_AXIS", "Z_AXIS", "EULER_XYZ")
+
+
+def emit_vector_rotate(compiler, node):
+    """Vector Rotate: the Vector about Center, by the type's inputs (Axis and
+    Angle, Angle alone, or Rotation as Euler XYZ); an unlinked Vector is
+    (0, 0, 0) as in Cycles."""
+    from .node_compiler import VEC
+
+    compiler.headers.add("mp_vector_rotate.h")
+    vec, center, axis, angle, rotation = _inputs(compiler, node, ("Vector", "v"), ("Center", "v"), ("Axis", "v"),
+                                                 ("Angle", "f"), ("Rotation", "v"))
+    kind = ROTATE_TYPES.index(node.rotation_type)
+    return {"Vector": compiler.fn.temp(VEC, f"mp_vector_rotate({kind}, {1 if node.invert else 0}, {vec[0]}, "
+                                            f"{center[0]}, {axis[0]}, {angle[0]}, {rotation[0]})")}
+
+
 _HANDLERS = {
     "TEX_CHECKER": emit_checker,
     "TEX_BRICK": emit_brick,
@@ -350,4 +367,5 @@ _HANDLERS = {
     "CURVE_FLOAT": emit_curves,
     "BRIGHTCONTRAST": emit_bright_contrast,
     "GAMMA": emit_gamma,
+    "VECTOR_ROTATE": emit_vector_rotate,
 }

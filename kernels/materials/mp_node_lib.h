@@ -13,6 +13,7 @@
 #include "mp_types.h"
 #include "mp_closures.h"
 #include "mp_principled.h"
+#include "textures/mp_vector_rotate.h"
 
 /* What the nodes can read at a shading point. Object-space position and
  * normal (Texture Coordinate > Object and Normal), Generated coordinates,
@@ -592,17 +593,6 @@ MP_INLINE float mp_clamp_node(int range_mode, float value, float lo, float hi) {
 #define MP_MAPPING_TEXTURE 1
 #define MP_MAPPING_VECTOR 2
 #define MP_MAPPING_NORMAL 3
-
-/* Rotation by Euler angles, X first, then Y, then Z (Blender's XYZ order). */
-MP_INLINE float3 mp_nl_euler_rotate(float3 v, float3 r, int inverse) {
-  float cx = cos(r.x), sx = sin(r.x), cy = cos(r.y), sy = sin(r.y), cz = cos(r.z), sz = sin(r.z);
-  /* Rows of R = Rz * Ry * Rx. */
-  float3 r0 = MP_F3(cy * cz, sy * sx * cz - cx * sz, sy * cx * cz + sx * sz);
-  float3 r1 = MP_F3(cy * sz, sy * sx * sz + cx * cz, sy * cx * sz - sx * cz);
-  float3 r2 = MP_F3(-sy, cy * sx, cy * cx);
-  if (!inverse) return MP_F3(dot(r0, v), dot(r1, v), dot(r2, v));
-  return v.x * r0 + v.y * r1 + v.z * r2; /* the transpose */
-}
 
 MP_INLINE float3 mp_mapping(int type, float3 v, float3 location, float3 rotation, float3 scale) {
   switch (type) {

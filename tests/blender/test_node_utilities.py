@@ -7,7 +7,8 @@ test. Its inputs are two smooth colours built from Object coordinates by Math
 nodes, A = (x, y, 1 - xy) and B = (1 - y, 0.2 + 0.6x, 0.5 + 0.3y) with x, y in
 [0, 1] across the quad, so every case covers a range of inputs. Cases: the
 Mix node with every blend mode Blender offers, the Hue/Saturation/Value node,
-vector Map Range in each interpolation mode, node groups (nested, with
+vector Map Range in each interpolation mode, Vector Rotate of each type
+(with and without Invert), node groups (nested, with
 linked and unlinked group inputs, and node names repeated inside and outside
 the groups), and Texture Coordinate > Object of another object (an Empty
 moved, turned and scaled: 65-68 dB; this object's own coordinates instead
@@ -181,6 +182,28 @@ def build_cases():
         nt.links.new(gain.outputs[0], n.inputs["Gain"])
         return n.outputs["Result"]
     cases.append(("Node groups, nested", group_case))
+
+    for rtype, invert in (("AXIS_ANGLE", False), ("AXIS_ANGLE", True), ("X_AXIS", False), ("Y_AXIS", True),
+                          ("Z_AXIS", False), ("EULER_XYZ", False), ("EULER_XYZ", True)):
+        def rotate_case(nt, a, b, rtype=rtype, invert=invert):
+            # A turned about (0.5, 0.5, 0.5) by an angle from B's x (or fixed
+            # Euler angles), lifted by 0.5 to stay positive.
+            n = nt.nodes.new("ShaderNodeVectorRotate")
+            n.rotation_type, n.invert = rtype, invert
+            ids = {s.identifier: s for s in n.inputs}  # 4.5 hides unavailable sockets from lookups by name
+            nt.links.new(a, ids["Vector"])
+            ids["Center"].default_value = (0.5, 0.5, 0.5)
+            ids["Axis"].default_value = (1.0, 2.0, 0.5)
+            ids["Rotation"].default_value = (0.3, -1.2, 2.0)
+            sep = nt.nodes.new("ShaderNodeSeparateXYZ")
+            nt.links.new(b, sep.inputs[0])
+            nt.links.new(_math(nt, "MULTIPLY", sep.outputs[0], 2.5), ids["Angle"])
+            lift = nt.nodes.new("ShaderNodeVectorMath")
+            lift.operation = "ADD"
+            lift.inputs[1].default_value = (0.5, 0.5, 0.5)
+            nt.links.new(n.outputs["Vector"], lift.inputs[0])
+            return lift.outputs["Vector"]
+        cases.append((f"Vector Rotate {rtype}{' inverted' if invert else ''}", rotate_case))
 
     def other_object_case(nt, a, b):
         # Texture Coordinate > Object of another object (an Empty moved,

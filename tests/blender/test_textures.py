@@ -240,6 +240,23 @@ def build_color_cases(cases):
     cases.append(dict(kind="gamma", label="gamma 2.2", const={"Gamma": 2.2}))
     cases.append(dict(kind="gamma", label="gamma 0.33-1.98 (z)", drive={"Gamma": (2, 1.5, 1.0)}))
     cases.append(dict(kind="gamma", label="gamma 0", const={"Gamma": 0.0}))
+    # Vector Rotate (a converter, checked here as the colour nodes are): the
+    # Object coordinate rotated about a centre, by a driven angle.
+    rotate = dict(kind="vector_rotate", const={"Center": (0.1, -0.2, 0.3), "Axis": (1.0, 2.0, 0.5),
+                                                "Rotation": (0.3, -1.2, 2.0)})
+    cases.append(dict(rotate, label="vector rotate axis-angle", rtype="AXIS_ANGLE", invert=False,
+                      drive={"Angle": (0, 3.0, 0.4)}))
+    cases.append(dict(rotate, label="vector rotate axis-angle inverted", rtype="AXIS_ANGLE", invert=True,
+                      drive={"Angle": (1, 3.0, -0.7)}))
+    cases.append(dict(rotate, label="vector rotate x axis", rtype="X_AXIS", invert=False, drive={"Angle": (2, 2.0, 1.0)}))
+    cases.append(dict(rotate, label="vector rotate y axis inverted", rtype="Y_AXIS", invert=True,
+                      drive={"Angle": (0, 2.0, 1.0)}))
+    cases.append(dict(rotate, label="vector rotate z axis", rtype="Z_AXIS", invert=False, drive={"Angle": (1, 2.0, 1.0)}))
+    cases.append(dict(rotate, label="vector rotate euler xyz", rtype="EULER_XYZ", invert=False))
+    cases.append(dict(rotate, label="vector rotate euler xyz inverted", rtype="EULER_XYZ", invert=True))
+    cases.append(dict(kind="vector_rotate", label="vector rotate zero axis", rtype="AXIS_ANGLE", invert=False,
+                      const={"Center": (0.1, -0.2, 0.3), "Axis": (0.0, 0.0, 0.0), "Angle": 1.0,
+                             "Rotation": (0.0, 0.0, 0.0)}))
 
 
 # Output groups rendered per kind: (name, probe columns).
@@ -263,9 +280,10 @@ OUTPUT_GROUPS = {
     "float_curve": [("value", (0, 0, 0))],
     "bright_contrast": [("color", (0, 1, 2))],
     "gamma": [("color", (0, 1, 2))],
+    "vector_rotate": [("vector", (0, 1, 2))],
 }
 NEW_KINDS = {"checker", "brick", "gradient", "magic", "white_noise", "gabor", "blackbody", "wavelength", "curves",
-             "float_curve", "bright_contrast", "gamma"}
+             "float_curve", "bright_contrast", "gamma", "vector_rotate"}
 
 
 def g(x):
@@ -311,6 +329,10 @@ def new_probe_line(case, x, y, z, w, d):
         c = dict(case.get("const", {}), **d)
         return f"bright_contrast {g(c['Bright'])} {g(c['Contrast'])} {VERSION} {xyz}"
     c = dict(case.get("const", {}), **d)
+    if k == "vector_rotate":
+        kind = ("AXIS_ANGLE", "X_AXIS", "Y_AXIS", "Z_AXIS", "EULER_XYZ").index(case["rtype"])
+        return (f"vector_rotate {kind} {int(case['invert'])} {gs(c['Center'])} {gs(c['Axis'])} {g(c.get('Angle', 0.0))} "
+                f"{gs(c['Rotation'])} {VERSION} {xyz}")
     return f"gamma {g(c['Gamma'])} {VERSION} {xyz}"
 
 
@@ -397,7 +419,7 @@ def drive_input(nt, coords, node, identifier, axis, mul, add):
 
 COLOR_NODES = {"blackbody": "ShaderNodeBlackbody", "wavelength": "ShaderNodeWavelength",
                "bright_contrast": "ShaderNodeBrightContrast", "gamma": "ShaderNodeGamma",
-               "float_curve": "ShaderNodeFloatCurve"}
+               "float_curve": "ShaderNodeFloatCurve", "vector_rotate": "ShaderNodeVectorRotate"}
 
 
 def new_texture_node(nt, case, coords):
@@ -454,11 +476,14 @@ def new_texture_node(nt, case, coords):
             set_curve(n.mapping, case["points"], case["extend"])
         if k in ("bright_contrast", "gamma"):
             nt.links.new(coords, n.inputs["Color"])
+        if k == "vector_rotate":
+            n.rotation_type, n.invert = case["rtype"], case["invert"]
+            nt.links.new(coords, n.inputs["Vector"])
     for ident, value in case.get("const", {}).items():
         set_input_id(n, ident, value)
     for ident, (axis, mul, add) in case.get("drive", {}).items():
         drive_input(nt, coords, n, ident, axis, mul, add)
-    key = "value" if k == "float_curve" else "color"
+    key = {"float_curve": "value", "vector_rotate": "vector"}.get(k, "color")
     return n, {key: n.outputs[0]}
 
 

@@ -22,12 +22,13 @@
 //   float_curve table min_x max_x extrapolate fac version v
 //   bright_contrast bright contrast version r g b
 //   gamma    gamma version r g b
+//   vector_rotate type invert cx cy cz ax ay az angle ex ey ez version x y z   (type: MP_ROTATE_*)
 // Output lines:
 //   noise: fac r g b   musgrave: fac   wave: fac r g b
 //   voronoi: distance r g b px py pz w radius
 //   checker, brick, gradient, magic: fac r g b   white_noise: value r g b
 //   gabor: value phase intensity   float_curve: value
-//   blackbody, wavelength, curves, bright_contrast, gamma: r g b
+//   blackbody, wavelength, curves, bright_contrast, gamma, vector_rotate: r g b (x y z)
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -41,6 +42,7 @@
 #include "textures/mp_tex_pattern.h"
 #include "textures/mp_tex_voronoi.h"
 #include "textures/mp_tex_wave.h"
+#include "textures/mp_vector_rotate.h"
 
 namespace {
 
@@ -179,6 +181,10 @@ int main() {
     else if (name == "gamma") {
       if (!need(f, 5, name, line_no)) { status = 1; std::puts("nan"); continue; }
       print3(mp_gamma(vec(f, 2), f[0]));
+    }
+    else if (name == "vector_rotate") {
+      if (!need(f, 16, name, line_no)) { status = 1; std::puts("nan"); continue; }
+      print3(mp_vector_rotate((int)f[0], (int)f[1], vec(f, 13), vec(f, 2), vec(f, 5), f[8], vec(f, 9)));
     }
     else {
       std::fprintf(stderr, "line %ld: unknown texture '%s'\n", line_no, name.c_str());
