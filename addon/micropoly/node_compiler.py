@@ -394,6 +394,13 @@ class NodeCompiler:
             scl = self.input(node, "Scale", VEC)[0] if "Scale" in node.inputs else "(float3)(1.0f)"
             return {"Vector": fn.temp(VEC, f"mp_mapping({MAPPING_TYPES.index(node.vector_type)}, {v}, {loc}, "
                                            f"{rot}, {scl})")}
+        if t == "VECT_TRANSFORM":
+            spaces = ("WORLD", "OBJECT", "CAMERA")
+            v = self.input(node, "Vector", VEC)[0]
+            kind = ("POINT", "VECTOR", "NORMAL").index(node.vector_type)
+            return {"Vector": fn.temp(VEC, f"mp_vector_transform(g, {kind}, {spaces.index(node.convert_from)}, "
+                                           f"{spaces.index(node.convert_to)}, {v}, "
+                                           f"{1 if self.version < 400 else 0})")}
         if t == "VALTORGB":
             return self.emit_ramp(node)
         if t in ("SEPXYZ", "SEPRGB", "SEPARATE_COLOR"):

@@ -110,6 +110,50 @@ MP_INLINE float3 mp_world_position(const MpNodeGlobals* g) {
   return mp_nl_rows(m, g->P) + MP_F3(m[3], m[7], m[11]);
 }
 
+/* ---- Vector Transform: between world, object and camera space ----------
+ * As Cycles converts (svm vector_transform): points with the translation,
+ * vectors without, normals by the inverse transpose and normalised whenever
+ * the space changes. Camera space is Cycles' (+Z forward: Blender's camera
+ * space with Z mirrored); object space is the hub every conversion passes.
+ * Without an object (a RIB shape without one), unchanged. */
+#define MP_VT_POINT 0
+#define MP_VT_VECTOR 1
+#define MP_VT_NORMAL 2
+#define MP_SPACE_WORLD 0
+#define MP_SPACE_OBJECT 1
+#define MP_SPACE_CAMERA 2
+
+/* Points and vectors by a 3x4's rows; normals by the columns of the
+ * inverse (`inverse`), which is the inverse transpose. */
+MP_INLINE float3 mp_nl_convert(const MP_GLOBAL float* m, const MP_GLOBAL float* inverse, int type, float3 v) {
+  if (type == MP_VT_NORMAL) return mp_nl_columns(inverse, v);
+  float3 r = mp_nl_rows(m, v);
+  return type == MP_VT_POINT ? r + MP_F3(m[3], m[7], m[11]) : r;
+}
+
+MP_INLINE float3 mp_vector_transform_v4(const MpNodeGlobals* g, int type, int from, int to, float3 v) {
+  if (from == to || !g->object) return v;
+  MP_GLOBAL const DeviceObject* o = g->object;
+  if (from == MP_SPACE_WORLD) v = mp_nl_convert(o->from_world, o->to_world, type, v);
+  if (from == MP_SPACE_CAMERA) v = mp_nl_convert(o->to_object, o->to_camera, type, MP_F3(v.x, v.y, -v.z));
+  if (to == MP_SPACE_WORLD) v = mp_nl_convert(o->to_world, o->from_world, type, v);
+  if (to == MP_SPACE_CAMERA) {
+    v = mp_nl_convert(o->to_camera, o->to_object, type, v);
+    v.z = -v.z;
+  }
+  float len = length(v);
+  return type == MP_VT_NORMAL && len > 0.0f ? v / len : v;
+}
+
+/* Before 4.0 Cycles turned normals as vectors and normalised them always
+ * (`v3_normals`). */
+MP_INLINE float3 mp_vector_transform(const MpNodeGlobals* g, int type, int from, int to, float3 v, int v3_normals) {
+  if (!(v3_normals && type == MP_VT_NORMAL)) return mp_vector_transform_v4(g, type, from, to, v);
+  v = mp_vector_transform_v4(g, MP_VT_VECTOR, from, to, v);
+  float len = length(v);
+  return len > 0.0f ? v / len : v;
+}
+
 /* This shading point in another object's space (Texture Coordinate ▸ Object
  * with an object set): world -> that object given as the rows of a 3x4. */
 MP_INLINE float3 mp_point_in_space(const MpNodeGlobals* g, float4 r0, float4 r1, float4 r2) {

@@ -8,7 +8,9 @@ nodes, A = (x, y, 1 - xy) and B = (1 - y, 0.2 + 0.6x, 0.5 + 0.3y) with x, y in
 [0, 1] across the quad, so every case covers a range of inputs. Cases: the
 Mix node with every blend mode Blender offers, the Hue/Saturation/Value node,
 vector Map Range in each interpolation mode, Vector Rotate of each type
-(with and without Invert), node groups (nested, with
+(with and without Invert), Vector Transform between world, object and
+camera space (points, vectors, normals; on tiles turned and scaled
+unevenly), node groups (nested, with
 linked and unlinked group inputs, and node names repeated inside and outside
 the groups), and Texture Coordinate > Object of another object (an Empty
 moved, turned and scaled: 65-68 dB; this object's own coordinates instead
@@ -19,7 +21,7 @@ both at 16 samples per pixel. Compared on each tile's interior (two pixels in
 from the quad's edge): PSNR >= 40 dB per case, with the case's largest value
 as peak. Prints a table. Exits non-zero on failure.
 
-Observed: 44-70 dB; the lowest is stepped Map Range, whose steps Micropoly
+Observed: 44-72 dB; the lowest is stepped Map Range, whose steps Micropoly
 ramps over one micropolygon. Switching one blend mode off (it falls back to
 Mix) drops its case to 18 dB."""
 
@@ -205,6 +207,28 @@ def build_cases():
             return lift.outputs["Vector"]
         cases.append((f"Vector Rotate {rtype}{' inverted' if invert else ''}", rotate_case))
 
+    for vtype, src, dst in (("POINT", "WORLD", "OBJECT"), ("POINT", "OBJECT", "WORLD"), ("VECTOR", "OBJECT", "WORLD"),
+                            ("NORMAL", "OBJECT", "WORLD"), ("NORMAL", "WORLD", "OBJECT"), ("POINT", "WORLD", "CAMERA"),
+                            ("POINT", "CAMERA", "OBJECT"), ("VECTOR", "OBJECT", "CAMERA"),
+                            ("NORMAL", "CAMERA", "WORLD")):
+        def transform_case(nt, a, b, vtype=vtype, src=src, dst=dst):
+            # A taken as a point, vector or normal in one space to another
+            # (the tile turned and scaled unevenly, build_scene), through
+            # sines so far-away values stay in range.
+            n = nt.nodes.new("ShaderNodeVectorTransform")
+            n.vector_type, n.convert_from, n.convert_to = vtype, src, dst
+            nt.links.new(a, n.inputs["Vector"])
+            wave = nt.nodes.new("ShaderNodeVectorMath")
+            wave.operation = "SINE"
+            nt.links.new(n.outputs["Vector"], wave.inputs[0])
+            shift = nt.nodes.new("ShaderNodeVectorMath")
+            shift.operation = "MULTIPLY_ADD"
+            shift.inputs[1].default_value = (0.4, 0.4, 0.4)
+            shift.inputs[2].default_value = (0.5, 0.5, 0.5)
+            nt.links.new(wave.outputs["Vector"], shift.inputs[0])
+            return shift.outputs["Vector"]
+        cases.append((f"Vector Transform {vtype} {src}>{dst}", transform_case))
+
     def other_object_case(nt, a, b):
         # Texture Coordinate > Object of another object (an Empty moved,
         # turned and scaled), through smooth sines so the case has no edges.
@@ -241,7 +265,10 @@ def build_scene(cases):
         mesh = bpy.data.meshes.new(f"quad{i}")
         mesh.from_pydata([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [], [(0, 1, 2, 3)])
         mesh.materials.append(mat)
-        ru.add_tile(scene, f"quad{i}", mesh, row, col, rows, COLS, tile_world)
+        obj = ru.add_tile(scene, f"quad{i}", mesh, row, col, rows, COLS, tile_world)
+        if name.startswith("Vector Transform"):
+            obj.rotation_euler = (0.0, 0.0, 0.25)
+            obj.scale = (0.8, 0.75, 1.3)
     cam = ru.add_camera(scene, (0.0, 0.0, 10.0), (0.0, 0.0, 0.0), ortho_scale=COLS * tile_world)
     cam.rotation_euler = (0.0, 0.0, 0.0)  # straight down, +y up, so tiles read left to right
     scene.micropoly.shading_rate = 0.25
