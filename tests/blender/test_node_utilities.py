@@ -62,6 +62,20 @@ def _combine(nt, x, y, z):
     return n.outputs[0]
 
 
+def _sine(nt, vector):
+    """0.5 + 0.4 sin(v) per component: any vector as a colour in range, with
+    no edges."""
+    wave = nt.nodes.new("ShaderNodeVectorMath")
+    wave.operation = "SINE"
+    nt.links.new(vector, wave.inputs[0])
+    shift = nt.nodes.new("ShaderNodeVectorMath")
+    shift.operation = "MULTIPLY_ADD"
+    shift.inputs[1].default_value = (0.4, 0.4, 0.4)
+    shift.inputs[2].default_value = (0.5, 0.5, 0.5)
+    nt.links.new(wave.outputs["Vector"], shift.inputs[0])
+    return shift.outputs["Vector"]
+
+
 def inputs_ab(nt):
     """A and B (see the module docstring) from Object coordinates."""
     coords = nt.nodes.new("ShaderNodeTexCoord")
@@ -218,15 +232,7 @@ def build_cases():
             n = nt.nodes.new("ShaderNodeVectorTransform")
             n.vector_type, n.convert_from, n.convert_to = vtype, src, dst
             nt.links.new(a, n.inputs["Vector"])
-            wave = nt.nodes.new("ShaderNodeVectorMath")
-            wave.operation = "SINE"
-            nt.links.new(n.outputs["Vector"], wave.inputs[0])
-            shift = nt.nodes.new("ShaderNodeVectorMath")
-            shift.operation = "MULTIPLY_ADD"
-            shift.inputs[1].default_value = (0.4, 0.4, 0.4)
-            shift.inputs[2].default_value = (0.5, 0.5, 0.5)
-            nt.links.new(wave.outputs["Vector"], shift.inputs[0])
-            return shift.outputs["Vector"]
+            return _sine(nt, n.outputs["Vector"])
         cases.append((f"Vector Transform {vtype} {src}>{dst}", transform_case))
 
     def other_object_case(nt, a, b):
@@ -239,15 +245,7 @@ def build_cases():
         ref.scale = (0.7, 1.6, 1.0)
         coords = nt.nodes.new("ShaderNodeTexCoord")
         coords.object = ref
-        wave = nt.nodes.new("ShaderNodeVectorMath")
-        wave.operation = "SINE"
-        nt.links.new(coords.outputs["Object"], wave.inputs[0])
-        shift = nt.nodes.new("ShaderNodeVectorMath")
-        shift.operation = "MULTIPLY_ADD"
-        shift.inputs[1].default_value = (0.4, 0.4, 0.4)
-        shift.inputs[2].default_value = (0.5, 0.5, 0.5)
-        nt.links.new(wave.outputs["Vector"], shift.inputs[0])
-        return shift.outputs["Vector"]
+        return _sine(nt, coords.outputs["Object"])
     cases.append(("Texture Coordinate, other object", other_object_case))
     return cases
 
