@@ -54,15 +54,16 @@ MP_INLINE void mp_surface_filter_roughness(MpSurface* s, float spread2) {
   }
 }
 
-/* The glossy closure's Fresnel term at the cosine c between the view and
- * the half vector; `back`: seen from inside, where a dielectric's relative
- * IOR is inverted. */
+/* A closure carries a thin film (never where the program compiled none). */
 #ifdef MP_THIN_FILM
 #define MP_FILM_ON(c) ((c)->film > 0.0f)
 #else
 #define MP_FILM_ON(c) 0
 #endif
 
+/* The glossy closure's Fresnel term at the cosine c between the view and
+ * the half vector; `back`: seen from inside, where a dielectric's relative
+ * IOR is inverted. */
 MP_INLINE float3 mp_closure_fresnel(const MpClosure* c, float cos_vh, int back) {
   float3 one = MP_F3(1.0f, 1.0f, 1.0f);
 #ifdef MP_THIN_FILM

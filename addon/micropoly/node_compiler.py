@@ -929,7 +929,8 @@ class NodeCompiler:
         if t == "BSDF_DIFFUSE" and self.version >= 403:
             # 4.3 and later: Oren-Nayar with EON's multiple scattering, which
             # depends on the colour alone (not the weight above it).
-            add(f"  {{ float3 albedo_ = {color}; mp_add_diffuse_eon(s, {weight} * albedo_, albedo_, {slot}, {self._f(node, 'Roughness')}); }}")
+            add(f"  {{ float3 albedo_ = {color}; mp_add_diffuse_eon(s, {weight} * albedo_, albedo_, {slot}, "
+                f"{self._f(node, 'Roughness')}); }}")
         elif t == "BSDF_DIFFUSE":
             add(f"  mp_add_diffuse(s, {weight} * {color}, {slot}, {self._f(node, 'Roughness')});")
         elif t == "BSDF_TRANSLUCENT":

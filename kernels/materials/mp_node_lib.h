@@ -50,6 +50,10 @@ MP_INLINE float3 mp_nl_columns(const MP_GLOBAL float* m, float3 v) {
   return MP_F3(m[0] * v.x + m[4] * v.y + m[8] * v.z, m[1] * v.x + m[5] * v.y + m[9] * v.z,
                m[2] * v.x + m[6] * v.y + m[10] * v.z);
 }
+MP_INLINE float3 mp_nl_safe_normalize(float3 a) {
+  float l = length(a);
+  return l > 0.0f ? a / l : MP_F3(0.0f, 0.0f, 0.0f);
+}
 MP_INLINE float3 mp_world_dir_to_object(const MpNodeGlobals* g, float3 v) {
   return g->object ? mp_nl_rows(g->object->from_world, v) : v;
 }
@@ -131,27 +135,20 @@ MP_INLINE float3 mp_nl_convert(const MP_GLOBAL float* m, const MP_GLOBAL float* 
   return type == MP_VT_POINT ? r + MP_F3(m[3], m[7], m[11]) : r;
 }
 
-MP_INLINE float3 mp_vector_transform_v4(const MpNodeGlobals* g, int type, int from, int to, float3 v) {
-  if (from == to || !g->object) return v;
+/* Before 4.0 Cycles turned normals as vectors and normalised them always,
+ * even within one space (`v3_normals`). */
+MP_INLINE float3 mp_vector_transform(const MpNodeGlobals* g, int type, int from, int to, float3 v, int v3_normals) {
+  int normal = type == MP_VT_NORMAL, as = normal && v3_normals ? MP_VT_VECTOR : type;
+  if (from == to || !g->object) return normal && v3_normals ? mp_nl_safe_normalize(v) : v;
   MP_GLOBAL const DeviceObject* o = g->object;
-  if (from == MP_SPACE_WORLD) v = mp_nl_convert(o->from_world, o->to_world, type, v);
-  if (from == MP_SPACE_CAMERA) v = mp_nl_convert(o->to_object, o->to_camera, type, MP_F3(v.x, v.y, -v.z));
-  if (to == MP_SPACE_WORLD) v = mp_nl_convert(o->to_world, o->from_world, type, v);
+  if (from == MP_SPACE_WORLD) v = mp_nl_convert(o->from_world, o->to_world, as, v);
+  if (from == MP_SPACE_CAMERA) v = mp_nl_convert(o->to_object, o->to_camera, as, MP_F3(v.x, v.y, -v.z));
+  if (to == MP_SPACE_WORLD) v = mp_nl_convert(o->to_world, o->from_world, as, v);
   if (to == MP_SPACE_CAMERA) {
-    v = mp_nl_convert(o->to_camera, o->to_object, type, v);
+    v = mp_nl_convert(o->to_camera, o->to_object, as, v);
     v.z = -v.z;
   }
-  float len = length(v);
-  return type == MP_VT_NORMAL && len > 0.0f ? v / len : v;
-}
-
-/* Before 4.0 Cycles turned normals as vectors and normalised them always
- * (`v3_normals`). */
-MP_INLINE float3 mp_vector_transform(const MpNodeGlobals* g, int type, int from, int to, float3 v, int v3_normals) {
-  if (!(v3_normals && type == MP_VT_NORMAL)) return mp_vector_transform_v4(g, type, from, to, v);
-  v = mp_vector_transform_v4(g, MP_VT_VECTOR, from, to, v);
-  float len = length(v);
-  return len > 0.0f ? v / len : v;
+  return normal ? mp_nl_safe_normalize(v) : v;
 }
 
 /* This shading point in another object's space (Texture Coordinate ▸ Object
@@ -391,10 +388,6 @@ MP_INLINE float mp_math(int op, float a, float b, float c) {
 #define MP_VMATH_TANGENT 24
 #define MP_VMATH_FACEFORWARD 25
 
-MP_INLINE float3 mp_nl_safe_normalize(float3 a) {
-  float l = length(a);
-  return l > 0.0f ? a / l : MP_F3(0.0f, 0.0f, 0.0f);
-}
 
 /* Returns the vector output; *value gets the float output. */
 MP_INLINE float3 mp_vector_math(int op, float3 a, float3 b, float3 c, float scale, float* value) {
