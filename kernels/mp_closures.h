@@ -158,11 +158,14 @@ MP_INLINE void mp_add_diffuse(MpSurface* s, float3 w, int slot, float roughness)
 }
 /* A rough diffuse lobe as Cycles 4.3 and later shade it: Oren-Nayar plus
  * EON's multiple scattering (mp_eon_ms), which depends on the albedo
- * `color` (kept in f82; `multiscatter` marks the lobe). */
+ * `color` (kept in f82; `multiscatter` marks the lobe). fmin/fmax rather
+ * than clamp: a NaN input (a texture's) reads as 0, where clamp leaves it
+ * undefined. */
 MP_INLINE void mp_add_diffuse_eon(MpSurface* s, float3 w, float3 color, int slot, float roughness) {
-  MpClosure c = mp_closure(MP_CLOSURE_DIFFUSE, mp_clamp_weight(w), slot, clamp(roughness, 0.0f, 1.0f), 0.0f);
+  MpClosure c = mp_closure(MP_CLOSURE_DIFFUSE, mp_clamp_weight(w), slot, fmin(fmax(roughness, 0.0f), 1.0f), 0.0f);
   c.f0 = c.weight;
-  c.f82 = MP_F3(clamp(color.x, 0.0f, 1.0f), clamp(color.y, 0.0f, 1.0f), clamp(color.z, 0.0f, 1.0f));
+  float3 albedo = mp_clamp_weight(color);
+  c.f82 = MP_F3(fmin(albedo.x, 1.0f), fmin(albedo.y, 1.0f), fmin(albedo.z, 1.0f));
   c.multiscatter = 1;
   mp_surface_add(s, c);
 }

@@ -131,6 +131,40 @@ TEST(Closures, EonOrenNayarConservesEnergy) {
   EXPECT_NEAR(mp_oren_nayar_albedo(1e-7f, 1.0f), mp_oren_nayar_albedo(2e-6f, 1.0f), 1e-4);
 }
 
+// A rough diffuse closure of any input shades to a finite, non-negative
+// colour under a sun and ambient light (the world's path); out-of-range
+// roughness reads as its clamp, and EON's lobe adds light to Fujii's.
+TEST(Closures, EonDegenerateInputsShadeFinite) {
+  DeviceLight lights[2] = {};
+  lights[0].color[0] = lights[0].color[1] = lights[0].color[2] = 3.0f;
+  lights[0].color[3] = float(MP_LIGHT_DISTANT);
+  lights[0].direction[0] = -0.6f;
+  lights[0].direction[2] = -0.8f;
+  lights[1].color[0] = lights[1].color[1] = lights[1].color[2] = 0.5f;
+  lights[1].color[3] = float(MP_LIGHT_AMBIENT);
+  const float3 p = MP_F3(0.3f, 0.0f, -5.0f), n = MP_F3(0.0f, 0.0f, 1.0f);
+  auto shade = [&](float3 color, float roughness, bool eon) {
+    MpSurface s;
+    mp_surface_init(&s, n);
+    if (eon) mp_add_diffuse_eon(&s, color * 0.8f, color, 0, roughness);
+    else mp_add_diffuse(&s, color * 0.8f, 0, roughness);
+    return mp_shade_closures(p, n, 0, 0, &s, lights, 2, nullptr, nullptr, nullptr);
+  };
+  const float inf = INFINITY, nan = NAN;
+  for (float r : {nan, -1.0f, 0.0f, 1e-9f, 0.5f, 1.0f, 2.0f, inf})
+    for (float c : {nan, -1.0f, 0.0f, 0.5f, 2.0f, inf}) {
+      const float3 out = shade(MP_F3(c, 0.5f * c, 0.25f), r, true);
+      for (float v : {out.x, out.y, out.z}) {
+        EXPECT_TRUE(std::isfinite(v)) << r << " " << c;
+        EXPECT_GE(v, 0.0f) << r << " " << c;
+      }
+    }
+  const float3 grey = MP_F3(0.7f, 0.7f, 0.7f);
+  EXPECT_EQ(shade(grey, 2.0f, true).x, shade(grey, 1.0f, true).x);
+  EXPECT_GT(shade(grey, 1.0f, true).x, shade(grey, 1.0f, false).x * 1.02f);
+  EXPECT_EQ(shade(grey, 0.0f, true).x, shade(grey, 0.0f, false).x);  // no roughness: Lambert either way
+}
+
 // A toon lobe with a hard edge reflects exactly what arrives within its cone.
 TEST(Closures, ToonIsNormalisedOverItsCone) {
   for (float size : {0.2f, 0.5f, 0.9f}) {
