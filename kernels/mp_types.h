@@ -112,6 +112,11 @@ typedef struct {
   /* Some material can hold out (its program calls mp_add_holdout): else
    * the resolve skips reading the held-out share. */
   int holdouts;
+  /* Texture Coordinate > Window: the whole image's normalised device
+   * coordinates of a camera-space point (x, y, -d), 0 to 1 from its
+   * bottom-left corner: (ndc_ax x / d + ndc_bx, ndc_ay y / d + ndc_by), d
+   * replaced by 1 for orthographic views. Shadow views keep the camera's. */
+  float ndc_ax, ndc_bx, ndc_ay, ndc_by;
 } FrameParams;
 
 /* The camera view's occlusion pyramid (mp_occlusion.h): level 0 has a cell

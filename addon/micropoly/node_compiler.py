@@ -151,7 +151,8 @@ class NodeCompiler:
         key = (where, node.name, what)
         if key not in self.warned:
             self.warned.add(key)
-            self.warnings.append(f"material '{self.material.name}': {where}node '{node.name}' ({node.bl_label}): "
+            owner = "world" if self.world else "material"
+            self.warnings.append(f"{owner} '{self.material.name}': {where}node '{node.name}' ({node.bl_label}): "
                                  f"{what}")
 
     def key(self, node, identifier):
@@ -283,9 +284,11 @@ class NodeCompiler:
         t = node.type
         fn = self.fn
         if t == "TEX_COORD":
-            for name in ("Camera", "Window", "Reflection"):
-                if node.outputs[name].is_linked:
-                    self.warn(node, f"the {name} output is not supported yet; it gives zero")
+            if self.world:
+                for name in ("Camera", "Window"):
+                    if node.outputs[name].is_linked:
+                        self.warn(node, f"the {name} output is not supported in the world (it is baked into "
+                                        "a map, not seen through the camera); it gives zero")
             obj_coords = "g->P"
             other = getattr(node, "object", None)
             if other is not None and node.outputs["Object"].is_linked:
@@ -294,8 +297,12 @@ class NodeCompiler:
                 m = other.matrix_world.inverted()
                 rows = ", ".join("(float4)(" + ", ".join(_lit(m[r][c]) for c in range(4)) + ")" for r in range(3))
                 obj_coords = fn.temp(VEC, f"mp_point_in_space(g, {rows})")[0]
+            # Normal is object space, Reflection (the view mirrored about
+            # the normal) world space, Camera Cycles' +Z-forward camera space.
+            reflection = "(2.0f * dot(g->Nw, g->I) * g->Nw - g->I)"
             outs = {"Generated": ("g->generated", VEC, None), "Object": (obj_coords, VEC, None),
-                    "Normal": ("g->N", VEC, None)}
+                    "Normal": ("g->N", VEC, None), "Camera": ("g->camera", VEC, None),
+                    "Window": ("g->window", VEC, None), "Reflection": (reflection, VEC, None)}
             if node.outputs["UV"].is_linked:
                 outs["UV"] = (self.uv(), VEC, None)
             return outs
@@ -311,12 +318,14 @@ class NodeCompiler:
             return self.emit_sky(node)
         if t == "NEW_GEOMETRY":
             return self.emit_geometry(node)
+        if t == "TANGENT":
+            return self.emit_tangent(node)
         if t == "FRESNEL":
-            n = self.input(node, "Normal", VEC)[0] if node.inputs["Normal"].is_linked else "g->N"
+            n = self.input(node, "Normal", VEC)[0] if node.inputs["Normal"].is_linked else "g->Nw"
             return {"Fac": fn.temp(FLOAT, f"mp_fresnel_node(g, {self.input(node, 'IOR', FLOAT)[0]}, {n})",
                                    (0.0, 1.0))}
         if t == "LAYER_WEIGHT":
-            n = self.input(node, "Normal", VEC)[0] if node.inputs["Normal"].is_linked else "g->N"
+            n = self.input(node, "Normal", VEC)[0] if node.inputs["Normal"].is_linked else "g->Nw"
             facing = fn.temp(FLOAT, "0.0f", (0.0, 1.0))
             fresnel = fn.temp(FLOAT, f"mp_layer_weight(g, {self.input(node, 'Blend', FLOAT)[0]}, {n}, &{facing[0]})",
                               (0.0, 1.0))
@@ -435,16 +444,30 @@ class NodeCompiler:
         return {}
 
     def emit_geometry(self, node):
-        """Geometry node. Normal, True Normal, Tangent and Incoming are in
-        object space, as every vector the node programs pass on (BSDF Normal
-        inputs read them so); Position is in world space, as Cycles'."""
+        """Geometry node, in world space as Cycles': True Normal is the
+        limit surface's normal (the smooth one; Micropoly's surfaces have
+        no facets), Tangent the radial one about the object's Z axis."""
         for name in ("Parametric", "Pointiness", "Random Per Island"):
             if name in node.outputs and node.outputs[name].is_linked:
                 self.warn(node, f"the {name} output is not supported; it gives its default")
         backfacing = self.fn.temp(FLOAT, "(float)mp_backfacing(g)", (0.0, 1.0))
-        return {"Position": ("mp_world_position(g)", VEC, None), "Normal": ("g->N", VEC, None),
-                "True Normal": ("g->N", VEC, None), "Incoming": ("mp_world_dir_to_object(g, g->I)", VEC, None),
-                "Tangent": ("normalize(mp_radial_tangent(g))", VEC, None), "Backfacing": backfacing}
+        tangent = self.fn.temp(VEC, "mp_world_tangent(g, mp_radial_tangent(g))")
+        return {"Position": ("mp_world_position(g)", VEC, None), "Normal": ("g->Nw", VEC, None),
+                "True Normal": ("g->Nw", VEC, None), "Incoming": ("g->I", VEC, None),
+                "Tangent": tangent, "Backfacing": backfacing}
+
+    def emit_tangent(self, node):
+        """Tangent node: radial about an object axis through Generated
+        coordinates, or a UV map's MikkTSpace tangent (zero without one, as
+        Cycles gives), in world space and orthogonal to the normal."""
+        if node.direction_type == "UV_MAP":
+            ta, tb = self.resources.tangent_layers(node.uv_map)
+            if ta < 0:
+                return {"Tangent": ("(float3)(0.0f)", VEC, None)}
+            t = f"(float3)(g->uv[{ta}].x, g->uv[{ta}].y, g->uv[{tb}].x)"
+        else:
+            t = f"mp_radial_tangent_axis(g, {'XYZ'.index(node.axis)})"
+        return {"Tangent": self.fn.temp(VEC, f"mp_world_tangent(g, {t})")}
 
     def emit_attribute(self, node):
         """Attribute (Geometry type) and Color Attribute: a mesh attribute's
@@ -630,7 +653,7 @@ class NodeCompiler:
         self.uses_neighbours = True
         strength = self.input(node, "Strength", FLOAT)[0]
         distance = self.input(node, "Distance", FLOAT)[0]
-        n_in = self.input(node, "Normal", VEC)[0] if node.inputs["Normal"].is_linked else "g->N"
+        n_in = self.input(node, "Normal", VEC)[0] if node.inputs["Normal"].is_linked else "g->Nw"
         if not node.inputs["Height"].is_linked:
             return {"Normal": (n_in, VEC, None)}
         h = self.height_function(node, "Height")
@@ -771,8 +794,9 @@ class NodeCompiler:
         if bump_only:
             self.uses_neighbours = True
             h = "dot(mp_node_displacement({0}), g->N)"
-            bump_line = (f"  mp_surface_set_normal(s, mp_bump(g, {h.format('g')}, g->dx ? {h.format('g->dx')} : 0.0f, "
-                         f"g->dy ? {h.format('g->dy')} : 0.0f, 1.0f, 1.0f, 0, g->N));\n")
+            bump_line = (f"  mp_surface_set_normal(s, mp_world_normal_to_object(g, mp_bump(g, {h.format('g')}, "
+                         f"g->dx ? {h.format('g->dx')} : 0.0f, g->dy ? {h.format('g->dy')} : 0.0f, 1.0f, 1.0f, 0, "
+                         f"g->Nw)));\n")
         shades = not constant or bool(bump_line)
         if not displaces and not shades:
             return None
@@ -857,22 +881,25 @@ class NodeCompiler:
         self.emit_shader(src, weight)
 
     def _normal_slot(self, node, key="Normal"):
-        """The normal slot of a BSDF's Normal input: 0 (the surface's) unless linked."""
+        """The normal slot of a BSDF's Normal input: 0 (the surface's) unless
+        linked. Node values are world space, closure normals object space."""
         socket = node.inputs.get(key)
         if socket is None or not socket.is_linked:
             return "0"
-        expr = self.input(node, key, VEC)[0]
+        expr = f"mp_world_normal_to_object(g, {self.input(node, key, VEC)[0]})"
         return self.fn.temp("int", f"mp_surface_normal_slot(s, {expr}, {self._normal_input_mode()})")[0]
 
     def _slot_normal(self, slot):
         return "g->N" if slot == "0" else f"s->normal[{slot}]"
 
     def _tangent(self, node):
-        """A BSDF's Tangent input, or the Tangent node's default: radial
-        about the object's Z axis through Generated coordinates."""
+        """A BSDF's Tangent input (a world-space node value, turned into
+        object space as the closures' normals), or the Tangent node's
+        default: radial about the object's Z axis through Generated
+        coordinates."""
         socket = node.inputs.get("Tangent")
         if socket is not None and socket.is_linked:
-            return self.input(node, "Tangent", VEC)[0]
+            return f"mp_world_dir_to_object(g, {self.input(node, 'Tangent', VEC)[0]})"
         return "mp_radial_tangent(g)"
 
     def _anisotropy_tangent(self, node, aniso, slot):

@@ -46,8 +46,9 @@ typedef struct {
 } MpProgramInputs;
 
 inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, float3 n, const MpProgramInputs* in,
-                                     uint patch, float2 uv, int ortho) {
+                                     uint patch, float2 uv, const FrameParams* f) {
   MpNodeGlobals g;
+  int ortho = f->ortho;
   /* The view direction: camera -> object -> world. */
   float3 v = ortho ? (float3)(0.0f, 0.0f, 1.0f) : normalize(-p);
   float3 vo = (float3)(mp_row3(o->to_object, 0, v, 0.0f), mp_row3(o->to_object, 1, v, 0.0f), mp_row3(o->to_object, 2, v, 0.0f));
@@ -60,6 +61,11 @@ inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, f
   g.P = (float3)(mp_row3(o->to_object, 0, p, 1.0f), mp_row3(o->to_object, 1, p, 1.0f), mp_row3(o->to_object, 2, p, 1.0f));
   g.N = mp_camera_normal_to_object(o, n);
   g.object = o;
+  g.Nw = mp_object_normal_to_world(&g, g.N);
+  g.camera = (float3)(p.x, p.y, -p.z);
+  float d = ortho ? 1.0f : -p.z;
+  d = d != 0.0f ? d : 1e-30f;
+  g.window = (float3)(f->ndc_ax * p.x / d + f->ndc_bx, f->ndc_ay * p.y / d + f->ndc_by, 0.0f);
   float3 loc = (float3)(o->texspace_location[0], o->texspace_location[1], o->texspace_location[2]);
   float3 size = (float3)(o->texspace_size[0], o->texspace_size[1], o->texspace_size[2]);
   float3 rel = g.P - loc;
@@ -84,6 +90,8 @@ inline MpNodeGlobals mp_node_globals_toward(const MpNodeGlobals* g, const MpNode
   MpNodeGlobals r = *g;
   r.P = g->P + t * (to->P - g->P);
   r.generated = g->generated + t * (to->generated - g->generated);
+  r.camera = g->camera + t * (to->camera - g->camera);
+  r.window = g->window + t * (to->window - g->window);
   for (uint k = 0; k < MP_MAX_UV_LAYERS; ++k) r.uv[k] = g->uv[k] + t * (to->uv[k] - g->uv[k]);
   return r;
 }
@@ -130,7 +138,7 @@ __kernel void displace_grids(__global const SubPatch* diceable, uint count, __gl
   __global const DeviceObject* o = objects + object;
   float3 p = grid_p[index].xyz;
   MpProgramInputs in = MP_PROGRAM_INPUTS;
-  MpNodeGlobals g = mp_node_globals(o, p, grid_n[index].xyz, &in, sp.patch, uv, f.ortho);
+  MpNodeGlobals g = mp_node_globals(o, p, grid_n[index].xyz, &in, sp.patch, uv, &f);
   float3 d = mp_node_displacement(&g);
   if (!(isfinite(d.x) && isfinite(d.y) && isfinite(d.z))) return;
   grid_p[index] = (float4)(p + mp_object_dir_to_camera(o, d), 1.0f);
@@ -162,7 +170,7 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   float3 p = grid_p[index].xyz, n = grid_n[index].xyz;
   MpProgramInputs in = MP_PROGRAM_INPUTS;
   __global const DeviceObject* o = objects + object;
-  MpNodeGlobals g = mp_node_globals(o, p, n, &in, sp.patch, uv, f.ortho);
+  MpNodeGlobals g = mp_node_globals(o, p, n, &in, sp.patch, uv, &f);
   /* Smooth shading normals already face the viewer (shade.cl); w = 2 says
    * the surface itself faced away. */
   if (grid_n[index].w > 0.5f) g.backfacing = grid_n[index].w > 1.5f;
@@ -182,8 +190,8 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   float2 uvx = uv, uvy = uv;
   mp_slot_uv(&sp, &shape, sx % stride, sx / stride, &uvx);
   mp_slot_uv(&sp, &shape, sy % stride, sy / stride, &uvy);
-  MpNodeGlobals nx = mp_node_globals(o, grid_p[gx].xyz, grid_n[gx].xyz, &in, sp.patch, uvx, f.ortho);
-  MpNodeGlobals ny = mp_node_globals(o, grid_p[gy].xyz, grid_n[gy].xyz, &in, sp.patch, uvy, f.ortho);
+  MpNodeGlobals nx = mp_node_globals(o, grid_p[gx].xyz, grid_n[gx].xyz, &in, sp.patch, uvx, &f);
+  MpNodeGlobals ny = mp_node_globals(o, grid_p[gy].xyz, grid_n[gy].xyz, &in, sp.patch, uvy, &f);
   MpNodeGlobals g_dx = mp_node_globals_toward(&g, &nx, 0.1f), g_dy = mp_node_globals_toward(&g, &ny, 0.1f);
   g.dx = &g_dx;
   g.dy = &g_dy;
@@ -237,7 +245,12 @@ float3 mp_world_radiance(float3 d, const MpProgramInputs* in) {
   MpNodeGlobals g;
   g.P = d;
   g.N = d;
+  g.Nw = d;
   g.generated = d;
+  /* The world is baked into a map: no image position (the node compiler
+   * warns of these outputs in a world). */
+  g.camera = (float3)(0.0f);
+  g.window = (float3)(0.0f);
   for (uint k = 0; k < MP_MAX_UV_LAYERS; ++k) g.uv[k] = (float3)(0.0f);
   g.object = 0;
   g.images = in->images;

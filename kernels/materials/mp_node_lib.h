@@ -18,12 +18,21 @@
 /* What the nodes can read at a shading point. Object-space position and
  * normal (Texture Coordinate > Object and Normal), Generated coordinates,
  * the scene's UV layers (z = 0, as Blender's UV output) and the texture
- * images (Image Texture, textures/mp_tex_image.h). */
+ * images (Image Texture, textures/mp_tex_image.h).
+ *
+ * Normals and tangents that pass between nodes are in world space, as in
+ * Cycles (Geometry > Normal, Bump, Normal Map, a BSDF's Normal input); the
+ * node compiler turns a BSDF's into object space where it enters the
+ * closures (MpSurface's normals, which shade_program_grids maps to camera
+ * space). */
 typedef struct MpNodeGlobals {
   float3 P;
-  float3 N;
+  float3 N;  /* unit normal, object space */
+  float3 Nw; /* the same in world space (Cycles' N) */
   float3 generated;
   float3 I; /* unit direction towards the viewer, world space (Geometry > Incoming) */
+  float3 camera; /* the point in Cycles' camera space, +Z forward (Texture Coordinate > Camera) */
+  float3 window; /* the image's normalised device coordinates, z = 0 (Texture Coordinate > Window) */
   float ray_length; /* distance from the camera (Light Path > Ray Length) */
   int shadow_ray;   /* evaluated for a shadow map's transparency (Light Path > Is Shadow Ray) */
   int backfacing;   /* the surface faces away from the viewer (Geometry > Backfacing) */
@@ -77,25 +86,43 @@ MP_INLINE float3 mp_radial_tangent(const MpNodeGlobals* g) {
   return MP_F3(-(g->generated.y - 0.5f), g->generated.x - 0.5f, 0.0f);
 }
 
-/* The cosine between the view and object-space normal n (Layer Weight,
- * Fresnel, the Principled BSDF's layering), taken in world space. */
+/* Radial about the object's X (axis 0), Y (1) or Z (2) axis, as the Tangent
+ * node's Radial directions (object space, unnormalised). */
+MP_INLINE float3 mp_radial_tangent_axis(const MpNodeGlobals* g, int axis) {
+  float3 c = g->generated - MP_F3(0.5f, 0.5f, 0.5f);
+  if (axis == 0) return MP_F3(0.0f, -c.z, c.y);
+  if (axis == 1) return MP_F3(-c.z, 0.0f, c.x);
+  return MP_F3(-c.y, c.x, 0.0f);
+}
+
+/* A tangent node output from an object-space direction t, as Cycles makes
+ * it (svm tangent, primitive_tangent): turned into world space as a normal
+ * is, then made orthogonal to the normal. Zero where t is. */
+MP_INLINE float3 mp_world_tangent(const MpNodeGlobals* g, float3 t) {
+  float3 w = mp_object_normal_to_world(g, t);
+  return cross(g->Nw, mp_nl_safe_normalize(cross(w, g->Nw)));
+}
+
+/* The cosine between the view and object-space normal n (the Principled
+ * BSDF's layering, whose normals are the closures'), taken in world space. */
 MP_INLINE float mp_view_cos(const MpNodeGlobals* g, float3 n) { return dot(mp_object_normal_to_world(g, n), g->I); }
 
 /* Whether the surface faces away from the viewer (Geometry > Backfacing). */
 MP_INLINE int mp_backfacing(const MpNodeGlobals* g) { return g->backfacing; }
 
 /* Fresnel node: the dielectric reflectance of IOR ior (its inverse seen
- * from behind) at the view's angle to normal n. */
+ * from behind) at the view's angle to world-space normal n. */
 MP_INLINE float mp_fresnel_node(const MpNodeGlobals* g, float ior, float3 n) {
   float eta = fmax(ior, 1e-5f);
   if (mp_backfacing(g)) eta = 1.0f / eta;
-  return mp_fresnel_dielectric(mp_view_cos(g, n), eta);
+  return mp_fresnel_dielectric(dot(n, g->I), eta);
 }
 
 /* Layer Weight node: Fresnel (of IOR 1 / (1 - blend)) and Facing
- * (1 - |cos|^p, p = 2 blend below a half, 0.5 / (1 - blend) above). */
+ * (1 - |cos|^p, p = 2 blend below a half, 0.5 / (1 - blend) above), for
+ * world-space normal n. */
 MP_INLINE float mp_layer_weight(const MpNodeGlobals* g, float blend, float3 n, float* facing) {
-  float c = mp_view_cos(g, n);
+  float c = dot(n, g->I);
   float eta = fmax(1.0f - blend, 1e-5f);
   float fresnel = mp_fresnel_dielectric(c, mp_backfacing(g) ? eta : 1.0f / eta);
   float f = fabs(c);
@@ -162,18 +189,20 @@ MP_INLINE float3 mp_point_in_space(const MpNodeGlobals* g, float4 r0, float4 r1,
 /* Displacement node in World space: height along the world-space normal,
  * in world units (Cycles), as an object-space vector. */
 MP_INLINE float3 mp_displacement_world(const MpNodeGlobals* g, float amount) {
-  return mp_world_dir_to_object(g, mp_object_normal_to_world(g, g->N) * amount);
+  return mp_world_dir_to_object(g, g->Nw * amount);
 }
 
 /* Bump node: the normal tilted by the height's gradient over the surface,
  * from heights at the point and a small step along u and v (hc, hx, hy),
  * with the surface-gradient formulation Cycles' Bump node uses: tangents
  * Rx = dPdy x N and Ry = N x dPdx, and the normal |det| N - distance
- * sign(det) ((hx - hc) Rx + (hy - hc) Ry), blended with N by strength. */
+ * sign(det) ((hx - hc) Rx + (hy - hc) Ry), blended with N by strength.
+ * World space, as Cycles: distance is in world units. */
 MP_INLINE float3 mp_bump(const MpNodeGlobals* g, float hc, float hx, float hy, float strength, float distance,
                          int invert, float3 n_in) {
   if (g->dx == 0 || g->dy == 0) return n_in;
-  float3 dpdx = g->dx->P - g->P, dpdy = g->dy->P - g->P;
+  float3 pw = mp_world_position(g);
+  float3 dpdx = mp_world_position(g->dx) - pw, dpdy = mp_world_position(g->dy) - pw;
   float3 rx = cross(dpdy, n_in), ry = cross(n_in, dpdx);
   float det = dot(dpdx, rx);
   float3 surfgrad = (hx - hc) * rx + (hy - hc) * ry;
@@ -189,13 +218,12 @@ MP_INLINE float3 mp_bump(const MpNodeGlobals* g, float hc, float hx, float hy, f
 }
 
 /* Normal Map node, as Cycles evaluates it: the color is mapped to [-1, 1],
- * then read in tangent space (below) or as an object-space normal, and the
- * result is blended with the surface normal by strength. Everything here is
- * object space, like MpNodeGlobals. */
+ * then read in tangent space (below), object or world space, and the
+ * result (world space) is blended with the surface normal by strength. */
 MP_INLINE float3 mp_normal_map_strength(const MpNodeGlobals* g, float3 n, float strength) {
-  if (strength != 1.0f) n = g->N + (n - g->N) * fmax(strength, 0.0f);
+  if (strength != 1.0f) n = g->Nw + (n - g->Nw) * fmax(strength, 0.0f);
   float len = length(n);
-  return len > 0.0f && isfinite(len) ? n / len : g->N;
+  return len > 0.0f && isfinite(len) ? n / len : g->Nw;
 }
 
 /* Tangent space, for the UV map in layer `uv`. Layers `ta` and `tb` hold
@@ -207,6 +235,8 @@ MP_INLINE float3 mp_normal_map_strength(const MpNodeGlobals* g, float3 n, float 
  * orthogonal to the normal. `v4`: Blender 4.0's Strength (below). */
 MP_INLINE float3 mp_normal_map_tangent(const MpNodeGlobals* g, int uv, int ta, int tb, float strength,
                                        float3 color, int v4) {
+  /* The tangent frame is the object's: its tangents and UV differences are
+   * object-space. */
   float3 n = g->N;
   float3 t = MP_F3(0.0f, 0.0f, 0.0f);
   float sign = 1.0f;
@@ -215,15 +245,15 @@ MP_INLINE float3 mp_normal_map_tangent(const MpNodeGlobals* g, int uv, int ta, i
     sign = g->uv[tb].y < 0.0f ? -1.0f : 1.0f;
   }
   if (!(dot(t, t) > 0.0f)) {
-    if (g->dx == 0 || g->dy == 0) return n;
+    if (g->dx == 0 || g->dy == 0) return g->Nw;
     float3 p1 = g->dx->P - g->P, p2 = g->dy->P - g->P;
     float3 uv1 = g->dx->uv[uv] - g->uv[uv], uv2 = g->dy->uv[uv] - g->uv[uv];
     float det = uv1.x * uv2.y - uv2.x * uv1.y;
-    if (!(fabs(det) > 0.0f)) return n;
+    if (!(fabs(det) > 0.0f)) return g->Nw;
     float3 du = (p1 * uv2.y - p2 * uv1.y) / det; /* dP/dU */
     float3 dv = (p2 * uv1.x - p1 * uv2.x) / det; /* dP/dV */
     t = du - n * dot(n, du);
-    if (!(dot(t, t) > 0.0f)) return n;
+    if (!(dot(t, t) > 0.0f)) return g->Nw;
     t = normalize(t);
     sign = dot(cross(n, t), dv) < 0.0f ? -1.0f : 1.0f;
   }
@@ -236,7 +266,7 @@ MP_INLINE float3 mp_normal_map_tangent(const MpNodeGlobals* g, int uv, int ta, i
     strength = 1.0f;
   }
   float3 b = sign * cross(n, t);
-  return mp_normal_map_strength(g, c.x * t + c.y * b + c.z * n, strength);
+  return mp_normal_map_strength(g, mp_object_normal_to_world(g, c.x * t + c.y * b + c.z * n), strength);
 }
 
 /* Object or world space; Blender's own spaces have y and z flipped. */
@@ -245,9 +275,9 @@ MP_INLINE float3 mp_normal_map_object(const MpNodeGlobals* g, int blender_space,
   float3 c = 2.0f * (color - MP_F3(0.5f, 0.5f, 0.5f));
   if (blender_space) c.y = -c.y, c.z = -c.z;
   float len = length(c);
-  if (!(len > 0.0f)) return mp_normal_map_strength(g, g->N, strength);
+  if (!(len > 0.0f)) return g->Nw;
   c = c / len;
-  return mp_normal_map_strength(g, world ? mp_world_normal_to_object(g, c) : c, strength);
+  return mp_normal_map_strength(g, world ? c : mp_object_normal_to_world(g, c), strength);
 }
 
 MP_INLINE float mp_nl_safe_div(float a, float b) { return b != 0.0f ? a / b : 0.0f; }

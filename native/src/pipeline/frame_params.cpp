@@ -37,6 +37,10 @@ FrameSetup make_frame_setup(const Scene& scene) {
   f.ay = -h * focal / (t - b);
   f.by = t * h / (t - b) - static_cast<float>(out.crop_y0);
   f.ortho = ortho ? 1 : 0;
+  f.ndc_ax = focal / (r - l);
+  f.ndc_bx = -l / (r - l);
+  f.ndc_ay = focal / (t - b);
+  f.ndc_by = -b / (t - b);
   f.width = x1 - out.crop_x0;
   f.height = y1 - out.crop_y0;
   f.spp_x = std::max(1, s.samples_x);
