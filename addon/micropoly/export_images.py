@@ -55,15 +55,22 @@ class ImageTable:
         self.index = {}
 
     def get(self, image, warn):
-        """(native index or -1, whether it holds 8-bit values)."""
+        """(native index or -1, the (lowest, highest) value its colour
+        channels hold, or None): 8-bit images hold [0, 1], a float image
+        what its pixels hold (so a displacement it drives has a bound)."""
         if image is None:
             warn("has no image; it renders magenta")
-            return -1, False
+            return -1, None
         key = image.name_full if hasattr(image, "name_full") else image.name
         if key not in self.index:
             pixels, srgb = image_pixels(image, warn)
-            self.index[key] = -1 if pixels is None else self.native.add_image(key, pixels, srgb=srgb)
-        return self.index[key], not image.is_float
+            if pixels is None:
+                self.index[key] = -1, None
+            else:
+                rgb = pixels[..., :3]
+                value_range = (0.0, 1.0) if not image.is_float else (float(rgb.min()), float(rgb.max()))
+                self.index[key] = self.native.add_image(key, pixels, srgb=srgb), value_range
+        return self.index[key]
 
     def array(self, key, pixels):
         """Native index of a (height, width, 4) float RGBA image held in

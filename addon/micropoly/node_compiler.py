@@ -118,7 +118,7 @@ class NoResources:
         return -1, -1
 
     def image(self, image, warn):
-        return -1, False
+        return -1, None
 
     def array_image(self, key, pixels):
         """Index of an in-memory float RGBA image (`pixels`: the array or a
@@ -140,6 +140,7 @@ class NodeCompiler:
         self.uses_neighbours = False
         self.uses_thin_film = False
         self.displacement_world = False
+        self.displacement_bounds = []
         self.groups = []           # the Group nodes whose trees are being compiled, outermost first
         self.world = False         # compiling a world (baked into a map) rather than a material
         self.transparent = False   # the surface has Transparent closures (its alpha can be below 1)
@@ -320,6 +321,8 @@ class NodeCompiler:
             return self.emit_geometry(node)
         if t == "TANGENT":
             return self.emit_tangent(node)
+        if t == "VECTOR_DISPLACEMENT":
+            return self.emit_vector_displacement(node)
         if t == "FRESNEL":
             n = self.input(node, "Normal", VEC)[0] if node.inputs["Normal"].is_linked else "g->Nw"
             return {"Fac": fn.temp(FLOAT, f"mp_fresnel_node(g, {self.input(node, 'IOR', FLOAT)[0]}, {n})",
@@ -581,13 +584,34 @@ class NodeCompiler:
         if node.inputs["Normal"].is_linked:
             self.warn(node, "a linked Normal input is not supported; the surface normal is used")
         h, mid, scale = (self.input(node, k, FLOAT) for k in ("Height", "Midlevel", "Scale"))
-        self.height_info = (h, mid, scale)
+        self.displacement_bounds.append(_displacement_node_bound(h, mid, scale, 1.0))
         amount = f"(({h[0]}) - ({mid[0]})) * ({scale[0]})"
         if getattr(node, "space", "OBJECT") == "WORLD":
             # World units along the world-space normal: the bound is in world units too.
             self.displacement_world = True
             return {"Displacement": self.fn.temp(VEC, f"mp_displacement_world(g, {amount})")}
         return {"Displacement": self.fn.temp(VEC, f"{amount} * g->N")}
+
+    def emit_vector_displacement(self, node):
+        """Vector Displacement: (Vector - Midlevel) x Scale in tangent space
+        (x along the active UV map's tangent, y along the normal, z along
+        the bitangent, as Cycles reads it), object space or world space."""
+        vec = self.input(node, "Vector", VEC)
+        mid, scale = self.input(node, "Midlevel", FLOAT), self.input(node, "Scale", FLOAT)
+        self.displacement_bounds.append(_displacement_node_bound(vec, mid, scale, math.sqrt(3.0)))
+        d = f"((({vec[0]}) - (float3)({mid[0]})) * ({scale[0]}))"
+        if node.space == "TANGENT":
+            ta, tb = self.resources.tangent_layers("")
+            if ta < 0:
+                self.warn(node, "has no tangents to read (no UV map, or too many layers); only the "
+                                "normal component displaces")
+            expr = f"mp_vector_displacement_tangent(g, {ta}, {tb}, {d})"
+        elif node.space == "WORLD":
+            self.displacement_world = True
+            expr = f"mp_world_dir_to_object(g, {d})"
+        else:
+            expr = d
+        return {"Displacement": self.fn.temp(VEC, expr)}
 
     def emit_texture(self, node):
         t, fn, ver = node.type, self.fn, self.version
@@ -681,7 +705,7 @@ class NodeCompiler:
 
     def emit_image(self, node):
         self.headers.add("mp_tex_image.h")
-        index, byte_image = self.resources.image(node.image, lambda what: self.warn(node, what))
+        index, value_range = self.resources.image(node.image, lambda what: self.warn(node, what))
         vec = self.input(node, "Vector", VEC)[0] if node.inputs["Vector"].is_linked else self.uv()
         interp = IMAGE_INTERPOLATION.get(node.interpolation, 0)
         ext = IMAGE_EXTENSION.get(node.extension, 0)
@@ -700,22 +724,23 @@ class NodeCompiler:
         straight = node.outputs["Alpha"].is_linked or image is None or image.alpha_mode in ("CHANNEL_PACKED", "NONE") \
             or image.colorspace_settings.is_data
         color = f"{rgba}.xyz" if straight else f"({rgba}.xyz * {rgba}.w)"
-        rng = (0.0, 1.0) if byte_image else None  # 8-bit images hold [0, 1]
+        rng = value_range
+        if rng is not None and not straight:  # times an alpha in [0, 1]
+            rng = (min(rng[0], 0.0), max(rng[1], 0.0))
         return {"Color": (color, VEC, rng), "Alpha": (f"{rgba}.w", FLOAT, (0.0, 1.0))}
 
     def emit_environment(self, node):
         """An Environment Texture: the image at a direction (the world's
         own by default), equirectangular or mirror ball, wrapping in longitude."""
         self.headers.add("mp_tex_image.h")
-        index, byte_image = self.resources.image(node.image, lambda what: self.warn(node, what))
+        index, value_range = self.resources.image(node.image, lambda what: self.warn(node, what))
         vec = self.input(node, "Vector", VEC)[0] if node.inputs["Vector"].is_linked else "g->generated"
         proj = "mirror_ball" if node.projection == "MIRROR_BALL" else "equirect"
         uv = self.fn.temp("float2", f"mp_env_{proj}_uv({vec})")[0]
         interp = IMAGE_INTERPOLATION.get(node.interpolation, 0)
         images = f"g->images, g->image_count, g->texels, {index}"
         rgba = self.fn.temp("float4", f"mp_tex_image({images}, ({uv}).x, ({uv}).y, {interp}, 0)")[0]
-        rng = (0.0, 1.0) if byte_image else None
-        return {"Color": (f"{rgba}.xyz", VEC, rng)}
+        return {"Color": (f"{rgba}.xyz", VEC, value_range)}
 
     def emit_sky(self, node):
         """A Sky Texture of a physical model (Nishita before 5.0; Single and
@@ -801,7 +826,7 @@ class NodeCompiler:
         if not displaces and not shades:
             return None
 
-        self.height_info = None
+        self.displacement_bounds = []  # one per Displacement / Vector Displacement node reached (None: unknown)
         disp_src = self._function("float3 mp_node_displacement(const MpNodeGlobals* g)",
                                   lambda: "  return " + self.input(out, "Displacement", VEC)[0] + ";\n"
                                   if displaces or bump_only else "  return (float3)(0.0f);\n")
@@ -1094,11 +1119,11 @@ class NodeCompiler:
             return 0.0
         if self.user_bound > 0.0:
             return self.user_bound
-        info = self.height_info
-        if info is not None:
-            (_, _, hr), (_, _, mr), (_, _, sr) = info
-            if hr and mr and sr and mr[0] == mr[1] and sr[0] == sr[1]:
-                return abs(sr[0]) * max(abs(hr[1] - mr[0]), abs(hr[0] - mr[0]))
+        # The nodes' bounds add up: a tree adding two displacements moves no
+        # further than both together.
+        bounds = self.displacement_bounds
+        if bounds and all(b is not None for b in bounds):
+            return sum(bounds)
         self.warnings.append(f"material '{self.material.name}': its displacement bound could not be derived from "
                              "the node tree; 1 unit is assumed. Set Material > Micropoly > Displacement Bound if "
                              "displaced geometry is clipped")
@@ -1111,6 +1136,16 @@ class NodeCompiler:
 _PRINCIPLED_NEUTRAL = {"Diffuse Roughness": 0.0, "Subsurface Weight": 0.0, "Subsurface": 0.0, "Transmission Weight": 0.0,
                        "Transmission": 0.0, "Coat Weight": 0.0, "Clearcoat": 0.0, "Sheen Weight": 0.0, "Sheen": 0.0,
                        "Anisotropic": 0.0, "Thin Film Thickness": 0.0}
+
+
+def _displacement_node_bound(value, mid, scale, spread):
+    """How far a displacement node moves the surface, from its inputs' value
+    ranges (value: a height, or each component of a vector, `spread` sqrt(3)
+    for the vector's length), or None when they are unknown."""
+    (_, _, vr), (_, _, mr), (_, _, sr) = value, mid, scale
+    if vr and mr and sr and mr[0] == mr[1] and sr[0] == sr[1]:
+        return abs(sr[0]) * spread * max(abs(vr[1] - mr[0]), abs(vr[0] - mr[0]))
+    return None
 
 
 def _constant_shader(node):

@@ -192,6 +192,21 @@ MP_INLINE float3 mp_displacement_world(const MpNodeGlobals* g, float amount) {
   return mp_world_dir_to_object(g, g->Nw * amount);
 }
 
+/* Vector Displacement in tangent space, as Cycles reads it: x along the
+ * UV map's tangent (layers ta and tb as for mp_normal_map_tangent; -1:
+ * none, only y displaces), y along the normal, z along the bitangent (the
+ * normal x tangent, by the tangent's sign); object space. */
+MP_INLINE float3 mp_vector_displacement_tangent(const MpNodeGlobals* g, int ta, int tb, float3 d) {
+  float3 n = g->N, t = MP_F3(0.0f, 0.0f, 0.0f);
+  float sign = 1.0f;
+  if (ta >= 0 && tb >= 0) {
+    t = MP_F3(g->uv[ta].x, g->uv[ta].y, g->uv[tb].x);
+    sign = g->uv[tb].y < 0.0f ? -1.0f : 1.0f;
+  }
+  float3 b = sign * mp_nl_safe_normalize(cross(n, t));
+  return t * d.x + n * d.y + b * d.z;
+}
+
 /* Bump node: the normal tilted by the height's gradient over the surface,
  * from heights at the point and a small step along u and v (hc, hx, hy),
  * with the surface-gradient formulation Cycles' Bump node uses: tangents

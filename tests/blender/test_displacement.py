@@ -6,6 +6,10 @@ Cycles rendering the same scene (adaptive subdivision at a dicing rate of
     texture read through the UV map: silhouettes agree (alpha IoU >= 0.97)
     and so does depth on the pixels both cover (median relative difference
     <= 1%);
+  - a Vector Displacement node reading a vector image (8-bit, or raw in
+    a float OpenEXR file), in tangent, object and world space: the same,
+    and Combined >= 30 dB against Cycles' direct light (the displaced
+    normals);
   - a diffuse object whose base color comes from procedural textures through
     a Color Ramp and Mix and from an image through its UV map: Combined
     >= 30 dB PSNR against Cycles' direct light;
@@ -20,6 +24,7 @@ import math
 import os
 import random
 import sys
+import tempfile
 
 import bpy
 import numpy as np
@@ -153,6 +158,90 @@ def case_displaced(shape, texture, space="OBJECT"):
         if med > 0.01:
             failures.append(f"depth median relative difference {med:.4f} > 0.01")
     return [f"{shape} displaced by {texture}: {f}" for f in failures]
+
+
+def vector_image(raw):
+    """A smooth vector field over the UV square, periodic in u and v: x and
+    z across the surface in tangent space, y along the normal. Stored as
+    0.5 + 0.5 v in an 8-bit PNG (Midlevel 0.5), or raw (`raw`) in a float
+    OpenEXR file (Midlevel 0), as sculpted vector displacement maps are;
+    Micropoly bounds the displacement by the values the file holds."""
+    v, u = np.meshgrid((np.arange(64) + 0.5) / 64, (np.arange(128) + 0.5) / 128, indexing="ij")
+    tau = 2 * math.pi
+    field = np.stack([0.5 * np.sin(tau * 3 * u) * np.cos(tau * v),
+                      0.2 + 0.6 * np.cos(tau * 2 * u) * np.sin(tau * 2 * v),
+                      0.5 * np.cos(tau * 3 * u + 1.0) * np.sin(tau * v)], axis=-1)
+    rgba = np.ones((64, 128, 4))
+    if not raw:
+        rgba[..., :3] = 0.5 + 0.5 * field
+        return ru.png_image("vector_field", rgba, "Non-Color")
+    rgba[..., :3] = 0.5 * field
+    img = bpy.data.images.new("vector_field_src", 128, 64, alpha=True, float_buffer=True)
+    img.colorspace_settings.name = "Non-Color"  # saved as given, no view transform
+    img.pixels.foreach_set(np.ascontiguousarray(rgba, dtype=np.float32).reshape(-1))
+    img.filepath_raw = os.path.join(tempfile.mkdtemp(prefix="micropoly_images_"), "vector_field.exr")
+    img.file_format = "OPEN_EXR"
+    img.save()
+    path = img.filepath_raw
+    bpy.data.images.remove(img)
+    loaded = bpy.data.images.load(path)
+    loaded.colorspace_settings.name = "Non-Color"
+    return loaded
+
+
+def case_vector_displaced(space):
+    """A Vector Displacement node reading a vector image through the UV map:
+    on a torus in tangent space (along the UV map's tangents, normal and
+    bitangents) and in object space; in world space on a plane turned and
+    flattened to a tenth in z (object space would displace it ten times
+    less in z). Silhouette and depth as for the height displacements."""
+    scene = ru.reset_scene()
+    if space == "WORLD":
+        obj = add_surface("plane")
+        obj.scale = (1.0, 1.0, 0.1)
+        obj.rotation_euler = (0.35, 0.0, 0.3)
+    else:
+        bpy.ops.mesh.primitive_torus_add(major_segments=24, minor_segments=12, major_radius=1.0,
+                                         minor_radius=0.4)
+        obj = bpy.context.active_object
+        obj.modifiers.new("Subdivision", "SUBSURF")
+        obj.rotation_euler = (0.5, 0.2, 0.0)
+        # Smooth, as a sculpted surface is: flat faces get tangents of
+        # their own (MikkTSpace follows the face normal), which tear a
+        # tangent-space displacement apart along face edges.
+        ru.shade_smooth(obj)
+    mat = ru.diffuse_material("vector_displaced_" + space.lower(), (0.8, 0.8, 0.8))
+    nt = mat.node_tree
+    tex = nt.nodes.new("ShaderNodeTexImage")  # default vector: the UV map
+    tex.image = vector_image(raw=space == "OBJECT")
+    disp = nt.nodes.new("ShaderNodeVectorDisplacement")
+    disp.space = space
+    disp.inputs["Scale"].default_value = 0.25
+    disp.inputs["Midlevel"].default_value = 0.0 if space == "OBJECT" else 0.5
+    nt.links.new(tex.outputs["Color"], disp.inputs["Vector"])
+    out = next(n for n in nt.nodes if n.type == "OUTPUT_MATERIAL")
+    nt.links.new(disp.outputs["Displacement"], out.inputs["Displacement"])
+    set_displacement_method(mat, "DISPLACEMENT")
+    obj.data.materials.append(mat)
+    ru.add_camera(scene, (0.0, -3.6, 1.6), (0.0, 0.0, 0.0), lens=40)
+    sun(scene)
+    mp, cy = render_both(scene)
+    label = f"vector displacement, {space.lower()} space"
+    iou = ru.iou(mp["rgba"][..., 3], cy["rgba"][..., 3])
+    both = (mp["rgba"][..., 3] > 0.99) & (cy["rgba"][..., 3] > 0.99)
+    lit = ru.psnr(mp["rgba"][..., :3][both], cy["rgba"][..., :3][both])
+    failures = [] if iou >= 0.97 else [f"silhouette IoU {iou:.4f} < 0.97"]
+    if lit < 30.0:
+        failures.append(f"Combined PSNR {lit:.2f} dB < 30")
+    line = f"{label}: IoU {iou:.4f}, Combined {lit:.2f} dB"
+    if mp["depth"] is not None:
+        rel = np.abs(mp["depth"][both] - cy["depth"][both]) / cy["depth"][both]
+        med = float(np.median(rel))
+        line += f", depth median relative difference {med:.5f} (95th percentile {np.percentile(rel, 95):.5f})"
+        if med > 0.01:
+            failures.append(f"depth median relative difference {med:.4f} > 0.01")
+    print(line + f" over {both.sum()} pixels")
+    return [f"{label}: {f}" for f in failures]
 
 
 def case_textured():
@@ -312,6 +401,8 @@ def main():
         for texture in ("noise", "voronoi", "image"):
             failures += case_displaced(shape, texture)
     failures += case_displaced("plane", "noise", space="WORLD")
+    for space in ("TANGENT", "OBJECT", "WORLD"):
+        failures += case_vector_displaced(space)
     failures += case_textured()
     failures += case_bump("node") + case_bump("method")
     failures += case_image_modes()
