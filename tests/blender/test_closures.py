@@ -150,6 +150,16 @@ def m_anisotropic(nt):
     return glossy(nt, 0.4, (0.8, 0.8, 0.8), anisotropy=0.7).outputs[0]
 
 
+def m_anisotropic_tangent(nt):
+    """Stretched along a Tangent node's radial X direction (a world-space
+    node value, where the default tangent is radial about Z)."""
+    g = glossy(nt, 0.35, (0.8, 0.8, 0.8), anisotropy=0.8)
+    tangent = nt.nodes.new("ShaderNodeTangent")
+    tangent.direction_type, tangent.axis = "RADIAL", "X"
+    nt.links.new(tangent.outputs["Tangent"], g.inputs["Tangent"])
+    return g.outputs[0]
+
+
 def principled(nt, **inputs):
     p = node(nt, "ShaderNodeBsdfPrincipled", **{"Base Color": rgba(0.6, 0.2, 0.15), "Roughness": 0.4})
     for name, value in inputs.items():
@@ -656,6 +666,7 @@ CASES = {
     "glossy_0.1": lambda: case_material("glossy_0.1", m_glossy(0.1)),
     "glossy_0.5": lambda: case_material("glossy_0.5", m_glossy(0.5)),
     "anisotropic": lambda: case_material("anisotropic", m_anisotropic),
+    "anisotropic_tangent": lambda: case_material("anisotropic_tangent", m_anisotropic_tangent),
     "principled_coat": lambda: case_material("principled_coat", m_principled_coat),
     "principled_sheen": lambda: case_material("principled_sheen", m_principled_sheen),
     "principled_specular_tint": lambda: case_material("principled_specular_tint", m_principled_specular_tint),
