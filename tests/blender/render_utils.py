@@ -354,6 +354,15 @@ def psnr(a, b, peak=None):
     return math.inf if mse == 0 else 10.0 * math.log10(peak * peak / mse)
 
 
+def masked_psnr(ours, ref, mask):
+    """PSNR of ours against ref (RGBA images) on the mask's pixels, RGB,
+    with the reference's largest value there as peak; and the largest
+    absolute difference."""
+    a, b = ours[mask][:, :3], ref[mask][:, :3]
+    peak = max(float(np.abs(b).max()), 1e-3)
+    return psnr(a, b, peak=peak), float(np.abs(a - b).max())
+
+
 def covered_interior(a, b, margin=2):
     """Pixels fully covered in both RGBA images and at least `margin` pixels
     from any pixel that is not (where the two renderers' edges differ)."""
