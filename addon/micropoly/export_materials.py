@@ -89,8 +89,9 @@ class MaterialTable:
         """Two layers holding the MikkTSpace tangents of UV map `name`
         (export_mesh computes them), or (-1, -1) when the layers run out."""
         if len(self.uv_names) + sum(("tangent", name, k) not in self.uv_names for k in (0, 1)) > MAX_UV_LAYERS:
-            self.warnings.append(f"more than {MAX_UV_LAYERS} UV layers with tangents are used; normal maps of "
-                                 f"'{name or 'the active UV map'}' take their tangents from the UVs")
+            self.warnings.append(f"more than {MAX_UV_LAYERS} UV layers with tangents are used; "
+                                 f"'{name or 'the active UV map'}' gets none: Normal Map takes its tangents "
+                                 "from the UVs there, Tangent and Vector Displacement have none")
             return -1, -1
         return tuple(self.uv_layer(("tangent", name, k)) for k in (0, 1))
 

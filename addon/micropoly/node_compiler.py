@@ -465,9 +465,7 @@ class NodeCompiler:
         Cycles gives), in world space and orthogonal to the normal."""
         if node.direction_type == "UV_MAP":
             ta, tb = self.resources.tangent_layers(node.uv_map)
-            if ta < 0:
-                return {"Tangent": ("(float3)(0.0f)", VEC, None)}
-            t = f"(float3)(g->uv[{ta}].x, g->uv[{ta}].y, g->uv[{tb}].x)"
+            t = f"mp_uv_tangent(g, {ta}, {tb}, 0)"
         else:
             t = f"mp_radial_tangent_axis(g, {'XYZ'.index(node.axis)})"
         return {"Tangent": self.fn.temp(VEC, f"mp_world_tangent(g, {t})")}
@@ -603,8 +601,8 @@ class NodeCompiler:
         if node.space == "TANGENT":
             ta, tb = self.resources.tangent_layers("")
             if ta < 0:
-                self.warn(node, "has no tangents to read (no UV map, or too many layers); only the "
-                                "normal component displaces")
+                self.warn(node, "the UV layers ran out, so it has no tangents; only the normal component "
+                                "displaces")
             expr = f"mp_vector_displacement_tangent(g, {ta}, {tb}, {d})"
         elif node.space == "WORLD":
             self.displacement_world = True

@@ -95,6 +95,15 @@ MP_INLINE float3 mp_radial_tangent_axis(const MpNodeGlobals* g, int axis) {
   return MP_F3(-c.y, c.x, 0.0f);
 }
 
+/* A UV map's MikkTSpace tangent, object space, from the layers holding it
+ * (ta: its x and y; tb: its z and the bitangent sign, into *sign when
+ * given), or zero where they are -1. */
+MP_INLINE float3 mp_uv_tangent(const MpNodeGlobals* g, int ta, int tb, float* sign) {
+  if (ta < 0 || tb < 0) return MP_F3(0.0f, 0.0f, 0.0f);
+  if (sign) *sign = g->uv[tb].y < 0.0f ? -1.0f : 1.0f;
+  return MP_F3(g->uv[ta].x, g->uv[ta].y, g->uv[tb].x);
+}
+
 /* A tangent node output from an object-space direction t, as Cycles makes
  * it (svm tangent, primitive_tangent): turned into world space as a normal
  * is, then made orthogonal to the normal. Zero where t is. */
@@ -197,12 +206,8 @@ MP_INLINE float3 mp_displacement_world(const MpNodeGlobals* g, float amount) {
  * none, only y displaces), y along the normal, z along the bitangent (the
  * normal x tangent, by the tangent's sign); object space. */
 MP_INLINE float3 mp_vector_displacement_tangent(const MpNodeGlobals* g, int ta, int tb, float3 d) {
-  float3 n = g->N, t = MP_F3(0.0f, 0.0f, 0.0f);
   float sign = 1.0f;
-  if (ta >= 0 && tb >= 0) {
-    t = MP_F3(g->uv[ta].x, g->uv[ta].y, g->uv[tb].x);
-    sign = g->uv[tb].y < 0.0f ? -1.0f : 1.0f;
-  }
+  float3 n = g->N, t = mp_uv_tangent(g, ta, tb, &sign);
   float3 b = sign * mp_nl_safe_normalize(cross(n, t));
   return t * d.x + n * d.y + b * d.z;
 }
@@ -252,13 +257,8 @@ MP_INLINE float3 mp_normal_map_tangent(const MpNodeGlobals* g, int uv, int ta, i
                                        float3 color, int v4) {
   /* The tangent frame is the object's: its tangents and UV differences are
    * object-space. */
-  float3 n = g->N;
-  float3 t = MP_F3(0.0f, 0.0f, 0.0f);
   float sign = 1.0f;
-  if (ta >= 0 && tb >= 0) {
-    t = MP_F3(g->uv[ta].x, g->uv[ta].y, g->uv[tb].x);
-    sign = g->uv[tb].y < 0.0f ? -1.0f : 1.0f;
-  }
+  float3 n = g->N, t = mp_uv_tangent(g, ta, tb, &sign);
   if (!(dot(t, t) > 0.0f)) {
     if (g->dx == 0 || g->dy == 0) return g->Nw;
     float3 p1 = g->dx->P - g->P, p2 = g->dy->P - g->P;
