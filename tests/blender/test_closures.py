@@ -26,6 +26,7 @@ each case. Arguments after "--" pick cases by name. Exits non-zero on failure.""
 import math
 import os
 import sys
+import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
@@ -593,7 +594,7 @@ def case_unsupported_warning():
     bpy.ops.mesh.primitive_cube_add(location=(2.5, 0.0, 0.0))
     bpy.context.object.data.materials.append(material("odd2", odd2))
     from micropoly import operators
-    path = os.path.join(os.environ.get("TMPDIR", "/tmp"), "closures_warning.rib")
+    path = os.path.join(tempfile.mkdtemp(prefix="mp-closures-"), "warning.rib")
     warnings = operators.export_rib(bpy.context.evaluated_depsgraph_get(), path)
     for w in warnings:
         print("     warning:", w)

@@ -35,6 +35,7 @@ Weight, whose results do not depend on that, stay where they are."""
 
 import os
 import sys
+import tempfile
 
 import bpy
 import numpy as np
@@ -192,7 +193,7 @@ def world_window_warning(scene):
     nt.links.new(as_colour(nt, coords.outputs["Window"], 2.0), background.inputs["Color"])
     nt.links.new(coords.outputs["Generated"], background.inputs["Strength"])
     from micropoly import operators
-    path = os.path.join(os.environ.get("TMPDIR", "/tmp"), "node_vectors_world.rib")
+    path = os.path.join(tempfile.mkdtemp(prefix="mp-node-vectors-"), "world.rib")
     warnings = operators.export_rib(bpy.context.evaluated_depsgraph_get(), path)
     hits = [w for w in warnings if "'Screen'" in w]
     print(f"world warnings: {hits}")

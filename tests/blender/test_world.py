@@ -8,6 +8,8 @@ not. An occlusion check: the floor under a ball is darker than the open
 floor by the ratio Cycles gives, and not without the world's shadows.
 
   MICROPOLY_ADDON_DIR=build/addons blender -b --factory-startup --python tests/blender/test_world.py
+
+MICROPOLY_TEST_OUTPUT=folder saves Cycles | Micropoly | difference x4 there.
 """
 import math
 import os
@@ -18,6 +20,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import render_utils as ru  # noqa: E402
+
+OUTPUT = os.environ.get("MICROPOLY_TEST_OUTPUT")  # a folder for Cycles | Micropoly | difference images
 
 W, H = 160, 120
 # Issue targets over covered pixels: 30 dB diffuse, 28 dB glossy.
@@ -157,7 +161,7 @@ def main():
     ru.enable_addon()
     for hdri in ("forest.exr", "city.exr"):
         mp, cy = compare(hdri)
-        ru.save_png(f"/tmp/mp_world_{hdri}.png", np.concatenate([mp, cy], axis=1))
+        ru.save_side_by_side(OUTPUT, f"world_{hdri}", cy, mp)
         db = covered_psnr(mp, cy)
         print(f"{hdri}: diffuse, Micropoly vs Cycles {db:.1f} dB over covered pixels")
         turned_mp, turned_cy = compare(hdri, math.pi / 2)
@@ -165,7 +169,7 @@ def main():
         ignored = covered_psnr(mp, turned_cy)
         print(f"{hdri}: turned 90 degrees {turned:.1f} dB; rotation ignored {ignored:.1f} dB")
         glossy_mp, glossy_cy = compare(hdri, glossy=True)
-        ru.save_png(f"/tmp/mp_world_glossy_{hdri}.png", np.concatenate([glossy_mp, glossy_cy], axis=1))
+        ru.save_side_by_side(OUTPUT, f"world_glossy_{hdri}", glossy_cy, glossy_mp)
         glossy = covered_psnr(glossy_mp, glossy_cy)
         print(f"{hdri}: Principled roughness 0.3, {glossy:.1f} dB over covered pixels")
         # The world behind the objects on an opaque film.

@@ -15,6 +15,8 @@ Scattering from 5.0) against Cycles:
   on a transparent film), Cycles' direct light as the reference.
 
   MICROPOLY_ADDON_DIR=build/addons blender -b --factory-startup --python tests/blender/test_world_sky.py
+
+MICROPOLY_TEST_OUTPUT=folder saves Cycles | Micropoly | difference x4 there.
 """
 import math
 import os
@@ -25,6 +27,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import render_utils as ru  # noqa: E402
+
+OUTPUT = os.environ.get("MICROPOLY_TEST_OUTPUT")  # a folder for Cycles | Micropoly | difference images
 
 W, H = 160, 120
 SKY_MIN_DB = float(os.environ.get("MP_SKY_MIN_DB", "35"))
@@ -124,7 +128,8 @@ def main():
         mp = render(sky_scene(model, right), "MICROPOLY", False)
         cy = render(sky_scene(model, right), "CYCLES", False)
         cy_left = render(sky_scene(model, left), "CYCLES", False)
-        ru.save_png(f"/tmp/mp_world_sky_{model}.png", np.concatenate([mp, cy], axis=1) / max(cy[..., :3].max(), 1e-6))
+        scale = max(float(cy[..., :3].max()), 1e-6)
+        ru.save_side_by_side(OUTPUT, f"world_sky_{model}", cy / scale, mp / scale)
         sky_db = ru.psnr(mp[..., :3], cy[..., :3])
         mirrored_db = ru.psnr(mp[..., :3], cy_left[..., :3])
         ratio = float(mp[..., :3].mean() / max(cy[..., :3].mean(), 1e-12))
@@ -135,7 +140,7 @@ def main():
 
         mp = render(lit_scene(model), "MICROPOLY", True)
         cy = render(lit_scene(model), "CYCLES", True)
-        ru.save_png(f"/tmp/mp_world_sky_lit_{model}.png", np.concatenate([mp, cy], axis=1))
+        ru.save_side_by_side(OUTPUT, f"world_sky_lit_{model}", cy, mp)
         covered = (mp[..., 3] > 0.0) & (cy[..., 3] > 0.0)
         lit_db = ru.psnr(mp[..., :3][covered], cy[..., :3][covered])
         ratio = float(mp[..., :3][covered].mean() / max(cy[..., :3][covered].mean(), 1e-12))
