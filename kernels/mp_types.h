@@ -144,6 +144,7 @@ typedef struct {
   float principled[4];      /* metallic, specular, layered (Blender 4.0 and later), flags: 1 retro_diffuse + 2 multiscatter */
   float program[4];         /* compiled node program index or -1, displaces (1/0), surface program (1/0),
                                program computes the alpha (1/0) */
+  uint params[4];           /* its program's node values: first in the scene's parameter buffer, count */
 } DeviceMaterial;
 
 /* Per object, for material programs: camera -> object space (rows of a 3x4

@@ -228,7 +228,8 @@ class MicropolyRenderEngine(bpy.types.RenderEngine):
         write_started = time.perf_counter()
         self._write_result(scene, view_layer, exported, result)
         _final_renderers.last_timings.update(native_s=native_s, native_total_s=stats["timings_ms"]["total"] / 1000.0,
-                                             write_s=time.perf_counter() - write_started, buckets=stats["buckets"])
+                                             write_s=time.perf_counter() - write_started, buckets=stats["buckets"],
+                                             program_build_s=stats["program_build_ms"] / 1000.0)
         mib = stats["bound_split_peak_bytes"] / 2**20
         shadows = stats["shadows"]
         shadow_note = (f"shadow maps {shadows['pages_requested']:,} pages, {shadows['peak_bytes'] / 2**20:.0f} of "

@@ -53,13 +53,13 @@ def export_world(native_scene, world, materials=None, warnings=None, film_transp
         if background is not None and background.type == "BACKGROUND":
             linked = background.inputs["Color"].is_linked or background.inputs["Strength"].is_linked
             if linked and materials is not None:
-                source = node_compiler.NodeCompiler(world, materials.warnings, resources=materials) \
-                    .compile_world(background)
+                compiler = node_compiler.NodeCompiler(world, materials.warnings, resources=materials)
+                source = compiler.compile_world(background)
                 program = native_scene.add_material_program("world " + world.name, source)
                 camera, diffuse, glossy = _ray_visibility(world)
                 camera = camera and not film_transparent  # behind objects only on an opaque film
                 native_scene.set_world(program=program, camera=camera, diffuse=float(diffuse),
-                                       glossy=float(glossy))
+                                       glossy=float(glossy), program_params=compiler.params)
                 return np.zeros(3, dtype=np.float32)
             color = np.array(list(background.inputs["Color"].default_value)[:3], dtype=np.float32)
             color *= float(background.inputs["Strength"].default_value)

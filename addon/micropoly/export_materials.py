@@ -123,7 +123,7 @@ class MaterialTable:
                 if program is None:
                     program = self.native.add_material_program(key, compiled.source)
                     self.programs[compiled.source] = program
-                params.update(program=program, program_displaces=compiled.displaces,
+                params.update(program=program, program_params=compiled.params, program_displaces=compiled.displaces,
                               program_shades=compiled.shades, displacement_bound=compiled.displacement_bound,
                               displacement_bound_world=compiled.displacement_world, program_alpha=compiled.alpha)
             self.native.add_material(name=key, **params)

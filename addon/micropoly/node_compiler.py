@@ -58,11 +58,13 @@ def blender_version():
     return major * 100 + minor
 
 
-def _lit(x):
+def _finite(x):
     x = float(x)
-    if x != x or x in (float("inf"), float("-inf")):
-        x = 0.0
-    return repr(x) + "f"
+    return 0.0 if x != x or x in (float("inf"), float("-inf")) else x
+
+
+def _lit(x):
+    return repr(_finite(x)) + "f"
 
 
 def _vec_lit(v):
@@ -79,8 +81,12 @@ def _dims(s):
 
 
 class CompiledMaterial:
-    def __init__(self, source, displaces, shades, displacement_bound, displacement_world=False, alpha=False):
+    def __init__(self, source, displaces, shades, displacement_bound, displacement_world=False, alpha=False,
+                 params=()):
         self.source = source
+        # The node values the program reads (MP_PARAM in its source): trees
+        # that differ only in values share one source, so one program.
+        self.params = list(params)
         self.displaces = displaces
         self.shades = shades
         self.alpha = alpha  # the program computes the surface's alpha (which shadow views read too)
@@ -145,6 +151,26 @@ class NodeCompiler:
         self.world = False         # compiling a world (baked into a map) rather than a material
         self.transparent = False   # the surface has Transparent closures (its alpha can be below 1)
         self.closures = 0          # closures the surface adds at most (MP_MAX_CLOSURES per vertex)
+        self.params = []           # node values the program reads (MP_PARAM); not compiled in
+
+    # ---- node values ----------------------------------------------------------
+    # An artist's numbers (socket values, Value and RGB nodes, ramp stops, an
+    # object's placement) are read from the material's parameters rather than
+    # written into the source: a dragged slider or an animated value then
+    # re-uploads numbers and rebuilds no program.
+    def param(self, x):
+        self.params.append(_finite(x))
+        return f"MP_PARAM({len(self.params) - 1})"
+
+    def param3(self, v):
+        v = list(v)[:3] + [0.0] * max(0, 3 - len(list(v)))
+        self.params.extend(_finite(c) for c in v)
+        return f"MP_PARAM3({len(self.params) - 3})"
+
+    def param4(self, v):
+        v = list(v)[:4]
+        self.params.extend(_finite(c) for c in v)
+        return f"MP_PARAM4({len(self.params) - 4})"
 
     # ---- helpers ----------------------------------------------------------
     def warn(self, node, what):
@@ -203,8 +229,8 @@ class NodeCompiler:
             seq = None
         if kind == FLOAT:
             x = float(seq[0]) if seq is not None else float(v)
-            return _lit(x), FLOAT, (x, x)
-        return _vec_lit(seq if seq is not None else [float(v)] * 3), VEC, None
+            return self.param(x), FLOAT, (x, x)
+        return self.param3(seq if seq is not None else [float(v)] * 3), VEC, None
 
     def output(self, node, socket):
         key = self.key(node, socket.identifier)
@@ -296,7 +322,7 @@ class NodeCompiler:
                 # That object's placement is part of the program: moving it
                 # gives a new program (a new source), as editing the tree does.
                 m = other.matrix_world.inverted()
-                rows = ", ".join("(float4)(" + ", ".join(_lit(m[r][c]) for c in range(4)) + ")" for r in range(3))
+                rows = ", ".join(self.param4([m[r][c] for c in range(4)]) for r in range(3))
                 obj_coords = fn.temp(VEC, f"mp_point_in_space(g, {rows})")[0]
             # Normal is object space, Reflection (the view mirrored about
             # the normal) world space, Camera Cycles' +Z-forward camera space.
@@ -352,9 +378,9 @@ class NodeCompiler:
             return {node.outputs[name].identifier: value for name, value in outs.items() if name in node.outputs}
         if t == "VALUE":
             x = float(node.outputs[0].default_value)
-            return {node.outputs[0].identifier: (_lit(x), FLOAT, (x, x))}
+            return {node.outputs[0].identifier: (self.param(x), FLOAT, (x, x))}
         if t == "RGB":
-            return {node.outputs[0].identifier: (_vec_lit(node.outputs[0].default_value), VEC, None)}
+            return {node.outputs[0].identifier: (self.param3(node.outputs[0].default_value), VEC, None)}
         if t == "MATH":
             return self.emit_math(node)
         if t == "VECT_MATH":
@@ -571,8 +597,8 @@ class NodeCompiler:
         fac = self.input(node, "Fac", FLOAT)[0]
         k = self.fn.counter
         self.fn.counter += 1
-        pos = ", ".join(_lit(e.position) for e in elems)
-        cols = ", ".join("(float4)(" + ", ".join(_lit(c) for c in e.color) + ")" for e in elems)
+        pos = ", ".join(self.param(e.position) for e in elems)
+        cols = ", ".join(self.param4(e.color) for e in elems)
         self.fn.lines.append(f"  const float ramp_pos{k}[{n}] = {{{pos}}};")
         self.fn.lines.append(f"  const float4 ramp_col{k}[{n}] = {{{cols}}};")
         c = self.fn.temp("float4", f"mp_color_ramp({interp}, {n}, ramp_pos{k}, ramp_col{k}, {fac})")
@@ -710,7 +736,7 @@ class NodeCompiler:
         images = f"g->images, g->image_count, g->texels, {index}"
         if node.projection == "BOX":
             # Blended by the object-space normal, as Cycles does.
-            blend = _lit(float(node.projection_blend))
+            blend = self.param(float(node.projection_blend))
             rgba = self.fn.temp("float4", f"mp_tex_image_box({images}, {vec}, g->N, {blend}, {interp}, {ext})")[0]
         else:
             if node.projection in ("SPHERE", "TUBE"):
@@ -769,9 +795,9 @@ class NodeCompiler:
             else "g->generated"
         name = f"sky{self.fn.counter}"
         self.fn.counter += 1
-        fields = [_vec_lit(sun["sun_bottom"]), _vec_lit(sun["sun_top"]), _vec_lit(sun["sun_flux"])]
-        fields += [_lit(sun[k]) for k in ("sun_elevation", "sun_rotation", "sun_diameter", "sun_intensity",
-                                          "earth_angle", "spread")]
+        fields = [self.param3(sun["sun_bottom"]), self.param3(sun["sun_top"]), self.param3(sun["sun_flux"])]
+        fields += [self.param(sun[k]) for k in ("sun_elevation", "sun_rotation", "sun_diameter", "sun_intensity",
+                                                "earth_angle", "spread")]
         fields.append(str(int(sun["layout"])))
         self.fn.lines.append(f"  MpSky {name} = {{{', '.join(fields)}}};")
         images = f"g->images, g->image_count, g->texels, {index}"
@@ -780,7 +806,8 @@ class NodeCompiler:
     # ---- the world ------------------------------------------------------------
     def compile_world(self, background):
         """The world program: its Background's colour times strength as the
-        Surface emission, for each direction (material_program.cl, bake_world)."""
+        Surface emission, for each direction (material_program.cl, bake_world).
+        Returns the source; its node values are then in self.params."""
         self.world = True
         disp_src = "float3 mp_node_displacement(const MpNodeGlobals* g) {\n  return (float3)(0.0f);\n}\n"
         surf_src = self._function(
@@ -849,7 +876,7 @@ class NodeCompiler:
             includes = "#define MP_NODE_USES_THIN_FILM 1\n" + includes
         source = includes + "".join(self.helpers) + disp_src + surf_src
         return CompiledMaterial(source, displaces, shades, bound, displaces and self.displacement_world,
-                                alpha=self.transparent)
+                                alpha=self.transparent, params=self.params)
 
     # ---- shader trees -> closures ------------------------------------------------
     @staticmethod

@@ -213,8 +213,9 @@ def emit_brick(compiler, node):
         ("Mortar Smooth", "f"), ("Bias", "f"), ("Brick Width", "f"), ("Row Height", "f"))
     color = compiler.fn.temp(VEC, "(float3)(0.0f)", None)
     args = ", ".join(a[0] for a in (c1, c2, mortar, scale, size, smooth, bias, width, height))
-    fac = compiler.fn.temp(FLOAT, f"mp_tex_brick({vec}, {args}, {flit(node.offset)}, {int(node.offset_frequency)}, "
-                                  f"{flit(node.squash)}, {int(node.squash_frequency)}, {compiler.version}, "
+    fac = compiler.fn.temp(FLOAT, f"mp_tex_brick({vec}, {args}, {compiler.param(node.offset)}, "
+                                  f"{int(node.offset_frequency)}, {compiler.param(node.squash)}, "
+                                  f"{int(node.squash_frequency)}, {compiler.version}, "
                                   f"&{color[0]})", (0.0, 1.0))
     # The colour mixes the brick colours by the tint, then the mortar by Fac.
     rng = _union(_union(c1[2], c2[2]), mortar[2])

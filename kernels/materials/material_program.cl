@@ -43,6 +43,7 @@ typedef struct {
   __global const DeviceImage* images;
   uint image_count;
   __global const float4* texels;
+  __global const float* params; /* the node values of the material (or world) being evaluated */
 } MpProgramInputs;
 
 inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, float3 n, const MpProgramInputs* in,
@@ -78,6 +79,7 @@ inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, f
   g.images = in->images;
   g.image_count = in->image_count;
   g.texels = in->texels;
+  g.params = in->params;
   g.dx = 0;
   g.dy = 0;
   return g;
@@ -119,8 +121,9 @@ inline int mp_program_vertex(uint gid, uint count, __global const uint* vertex_o
 
 #define MP_PROGRAM_INPUT_ARGS                                                                             \
   __global const uint *patch_edges, __global const float4 *patch_uvs, uint uv_layers,                     \
-      __global const DeviceImage *images, uint image_count, __global const float4 *texels
-#define MP_PROGRAM_INPUTS {patch_edges, patch_uvs, uv_layers, images, image_count, texels}
+      __global const DeviceImage *images, uint image_count, __global const float4 *texels,                \
+      __global const float *params
+#define MP_PROGRAM_INPUTS {patch_edges, patch_uvs, uv_layers, images, image_count, texels, params}
 
 /* Moves each vertex by the program's displacement vector (object space). */
 __kernel void displace_grids(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
@@ -138,6 +141,7 @@ __kernel void displace_grids(__global const SubPatch* diceable, uint count, __gl
   __global const DeviceObject* o = objects + object;
   float3 p = grid_p[index].xyz;
   MpProgramInputs in = MP_PROGRAM_INPUTS;
+  in.params += materials[material].params[0];
   MpNodeGlobals g = mp_node_globals(o, p, grid_n[index].xyz, &in, sp.patch, uv, &f);
   float3 d = mp_node_displacement(&g);
   if (!(isfinite(d.x) && isfinite(d.y) && isfinite(d.z))) return;
@@ -169,6 +173,7 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   if (alpha_only && !(m.program[3] > 0.0f)) return;
   float3 p = grid_p[index].xyz, n = grid_n[index].xyz;
   MpProgramInputs in = MP_PROGRAM_INPUTS;
+  in.params += m.params[0];
   __global const DeviceObject* o = objects + object;
   MpNodeGlobals g = mp_node_globals(o, p, n, &in, sp.patch, uv, &f);
   /* Smooth shading normals already face the viewer (shade.cl); w = 2 says
@@ -256,6 +261,7 @@ float3 mp_world_radiance(float3 d, const MpProgramInputs* in) {
   g.images = in->images;
   g.image_count = in->image_count;
   g.texels = in->texels;
+  g.params = in->params;
   g.dx = 0;
   g.dy = 0;
   g.I = -d;
@@ -271,12 +277,13 @@ float3 mp_world_radiance(float3 d, const MpProgramInputs* in) {
 }
 
 /* The world over an equirectangular map (scene.h, World), at each texel's
- * centre. */
-__kernel void bake_world(uint width, uint height, MP_PROGRAM_INPUT_ARGS, __global float4* out) {
+ * centre; the world's node values from params_at in the parameter buffer. */
+__kernel void bake_world(uint width, uint height, MP_PROGRAM_INPUT_ARGS, uint params_at, __global float4* out) {
   uint i = get_global_id(0);
   if (i >= width * height) return;
   float u = ((float)(i % width) + 0.5f) / (float)width, v = ((float)(i / width) + 0.5f) / (float)height;
   MpProgramInputs in = MP_PROGRAM_INPUTS;
+  in.params += params_at;
   out[i] = (float4)(mp_world_radiance(mp_env_equirect_direction(u, v), &in), 1.0f);
 }
 
@@ -284,11 +291,12 @@ __kernel void bake_world(uint width, uint height, MP_PROGRAM_INPUT_ARGS, __globa
  * stratified rays through the pixel, the raster mapping of FrameParams
  * inverted, turned into the world by rows r0..r2 (camera to world). */
 __kernel void world_pixels(FrameParams f, float4 r0, float4 r1, float4 r2, MP_PROGRAM_INPUT_ARGS,
-                           __global float* out) {
+                           uint params_at, __global float* out) {
   uint i = get_global_id(0);
   if (i >= (uint)f.width * (uint)f.height) return;
   float px = (float)(i % (uint)f.width), py = (float)(i / (uint)f.width);
   MpProgramInputs in = MP_PROGRAM_INPUTS;
+  in.params += params_at;
   float3 sum = (float3)(0.0f);
   for (int s = 0; s < 4; ++s) {
     float3 d = (float3)(0.0f, 0.0f, -1.0f);

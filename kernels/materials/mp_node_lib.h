@@ -41,11 +41,28 @@ typedef struct MpNodeGlobals {
   MP_GLOBAL const DeviceImage* images;
   MP_GLOBAL const float4* texels;
   uint image_count;
+  /* The material's node values (its parameters, node_compiler.py): the
+   * numbers a program reads rather than compiles in, so that a tree whose
+   * values change keeps its program and only these are uploaded again. */
+  MP_GLOBAL const float* params;
   /* The same a small step towards the next grid vertex along u and along v
    * (the finite differences of Bump nodes), or null. */
   const struct MpNodeGlobals* dx;
   const struct MpNodeGlobals* dy;
 } MpNodeGlobals;
+
+/* Node value k of the material, and three (four) from k as a vector or
+ * colour. Programs name them only in these forms, with k a literal, so the
+ * host can tell how many values a program reads (validate_scene.cpp). */
+MP_INLINE float3 mp_param3(const MpNodeGlobals* g, int k) {
+  return MP_F3(g->params[k], g->params[k + 1], g->params[k + 2]);
+}
+MP_INLINE float4 mp_param4(const MpNodeGlobals* g, int k) {
+  return (float4)(g->params[k], g->params[k + 1], g->params[k + 2], g->params[k + 3]);
+}
+#define MP_PARAM(k) (g->params[k])
+#define MP_PARAM3(k) mp_param3(g, k)
+#define MP_PARAM4(k) mp_param4(g, k)
 
 
 /* World-space vectors for nodes that work in world space: a direction from

@@ -129,6 +129,47 @@ def test_animation():
     check("an animation renders every frame, following the keyframes", moving, f"alpha centroids {sums}")
 
 
+def test_edited_value_builds_nothing():
+    """A node value edited between renders (a colour, a texture's scale, a
+    ramp's stop) keeps the material's program: the second F12 builds
+    nothing and still shows the new values. Linking a socket changes the
+    tree, and that builds."""
+    from micropoly import engine, node_compiler
+    scene = ru.reset_scene()
+    bpy.ops.mesh.primitive_plane_add(size=4.0)
+    mat = bpy.data.materials.new("edited")
+    mat.use_nodes = True
+    nt = mat.node_tree
+    bsdf = next(n for n in nt.nodes if n.type == "BSDF_PRINCIPLED")
+    noise = nt.nodes.new("ShaderNodeTexNoise")
+    ramp = nt.nodes.new("ShaderNodeValToRGB")
+    nt.links.new(noise.outputs["Fac"], ramp.inputs["Fac"])
+    nt.links.new(ramp.outputs["Color"], bsdf.inputs["Base Color"])
+    bpy.context.object.data.materials.append(mat)
+    ru.add_camera(scene, (0, 0, 6), (0, 0, 0))
+    light = bpy.data.objects.new("sun", bpy.data.lights.new("sun", "SUN"))
+    scene.collection.objects.link(light)
+
+    source = node_compiler.compile_material(mat, []).source
+    before = ru.render_passes(scene, "MICROPOLY", 48, 48, samples=4)["rgba"]
+    ramp.color_ramp.elements[1].color = (0.1, 0.9, 0.2, 1.0)
+    noise.inputs["Scale"].default_value = 11.0
+    bsdf.inputs["Roughness"].default_value = 0.9
+    edited_source = node_compiler.compile_material(mat, []).source
+    after = ru.render_passes(scene, "MICROPOLY", 48, 48, samples=4)["rgba"]
+    built = engine._final_renderers.last_timings.get("program_build_s")
+    # The ramp's white stop turned green: green over red across the plane grows.
+    covered = before[..., 3] > 0.5
+    ratio = [float(img[..., 1][covered].mean() / max(img[..., 0][covered].mean(), 1e-6)) for img in (before, after)]
+    check("an edited node value keeps the program's source", source == edited_source)
+    check("an edited node value renders without building a program, with the new values",
+          built == 0.0 and ratio[1] > 1.5 * ratio[0], f"built for {built} s; green / red {ratio[0]:.2f} -> {ratio[1]:.2f}")
+    nt.links.new(noise.outputs["Fac"], bsdf.inputs["Roughness"])
+    ru.render_passes(scene, "MICROPOLY", 48, 48, samples=4)
+    built = engine._final_renderers.last_timings.get("program_build_s")
+    check("a new link builds a program", built is not None and built > 0.0, f"built for {built} s")
+
+
 def test_old_blend_files():
     pattern = os.path.join(os.path.dirname(bpy.app.binary_path or "/"), "..", "share", "blender", "scripts",
                            "addons", "materials_library_vx", "*.blend")
@@ -269,7 +310,7 @@ def test_exit_with_viewport_render_in_flight():
 def main():
     print(f"Blender {bpy.app.version_string}")
     for test in (test_nan_mesh, test_empty_scene, test_camera_inside_object, test_cancel_is_quick,
-                 test_rib_export_matches_f12, test_animation, test_old_blend_files,
+                 test_rib_export_matches_f12, test_animation, test_edited_value_builds_nothing, test_old_blend_files,
                  test_exit_with_viewport_render_in_flight):
         try:
             test()

@@ -214,9 +214,9 @@ TEST_F(MaterialProgramTest, ProgramThatDoesNotCompileNamesTheMaterial) {
   }
 }
 
-// Node values are constants in a program's source, so an animated value
-// builds a program per frame: the renderer keeps those the scene uses and a
-// few spare (MaterialPrograms::kSparePrograms), not every one it ever built.
+// A tree whose structure changes from frame to frame builds a program per
+// frame: the renderer keeps those the scene uses and a few spare
+// (MaterialPrograms::kSparePrograms), not every one it ever built.
 TEST_F(MaterialProgramTest, ProgramsNoLongerUsedAreReleasedBeyondAFewSpare) {
   auto emitting = [](int value) {
     Scene s = facing_plane(static_cast<int>(Material::Model::Constant));
@@ -236,6 +236,72 @@ TEST_F(MaterialProgramTest, ProgramsNoLongerUsedAreReleasedBeyondAFewSpare) {
   EXPECT_GT(r.stats.program_build_ms, 0.0) << "the least recently used program is released";
   EXPECT_NEAR(r.rgba[4 * (32 * 64 + 32)], 0.0f, 1e-6f);
   EXPECT_NEAR(renderer_->render(emitting(9)).rgba[4 * (32 * 64 + 32)], 9.0f / 64.0f, 1e-5f);
+}
+
+// Node values travel beside the program (Material::program_params, read by
+// MP_PARAM): two materials share one program and each shows its own
+// values; new values render without a build; RIB carries them.
+TEST_F(MaterialProgramTest, MaterialsSharingAProgramReadTheirOwnNodeValues) {
+  Scene s = facing_plane(static_cast<int>(Material::Model::Constant));
+  s.meshes[0] = polygon({{-3, -3, 0}, {-0.5f, -3, 0}, {-0.5f, 3, 0}, {-3, 3, 0}});
+  s.meshes.push_back(polygon({{0.5f, -3, 0}, {3, -3, 0}, {3, 3, 0}, {0.5f, 3, 0}}));
+  s.meshes[1].material = 1;
+  s.materials.push_back(s.materials[0]);
+  s.materials[1].name = "second";
+  s.material_programs.push_back(
+      {"values", std::string(kNoDisplacement) + "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {"
+                                                " mp_add_emission(s, MP_PARAM3(1) * MP_PARAM(0)); }\n"});
+  s.materials[0].program_shades = s.materials[1].program_shades = true;
+  s.materials[0].program_params = {2.0f, 0.1f, 0.2f, 0.3f};
+  s.materials[1].program_params = {0.5f, 1.2f, 0.8f, 0.4f};
+  auto expect_colours = [](const RenderResult& r, glm::vec3 left, glm::vec3 right, const char* what) {
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(r.rgba[4 * (32 * 64 + 12) + c], left[c], 1e-5f) << what << " left, channel " << c;
+      EXPECT_NEAR(r.rgba[4 * (32 * 64 + 52) + c], right[c], 1e-5f) << what << " right, channel " << c;
+    }
+  };
+  RenderResult first = renderer_->render(s);
+  expect_colours(first, {0.2f, 0.4f, 0.6f}, {0.6f, 0.4f, 0.2f}, "first render");
+
+  s.materials[0].program_params = {1.0f, 0.9f, 0.0f, 0.5f};
+  RenderResult edited = renderer_->render(s);
+  EXPECT_EQ(edited.stats.program_build_ms, 0.0) << "new values need no new program";
+  expect_colours(edited, {0.9f, 0.0f, 0.5f}, {0.6f, 0.4f, 0.2f}, "edited");
+
+  std::ostringstream rib;
+  write_rib(s, rib);
+  Scene back = read_rib_string(rib.str(), "roundtrip").scene;
+  ASSERT_EQ(back.material_programs.size(), 1u);
+  ASSERT_EQ(back.materials.size(), 2u);
+  EXPECT_EQ(back.materials[0].program_params, s.materials[0].program_params);
+  EXPECT_EQ(back.materials[1].program_params, s.materials[1].program_params);
+  expect_colours(renderer_->render(back), {0.9f, 0.0f, 0.5f}, {0.6f, 0.4f, 0.2f}, "read back from RIB");
+}
+
+// A program that reads more node values than its material has, or values
+// that are not finite, are refused before anything reaches the device.
+TEST_F(MaterialProgramTest, MissingOrNonFiniteNodeValuesAreRejected) {
+  Scene s = facing_plane(static_cast<int>(Material::Model::Constant));
+  s.material_programs.push_back(
+      {"values", std::string(kNoDisplacement) + "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {"
+                                                " mp_add_emission(s, MP_PARAM(1) * MP_PARAM4(2).xyz); }\n"});
+  s.materials[0].program_shades = true;
+  s.materials[0].program_params = {0, 0, 0, 0, 0};
+  try {
+    validate_scene(s);
+    FAIL() << "expected an error for 5 values of 6";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("'node material': its program reads 6 node values, but it has 5"),
+              std::string::npos) << e.what();
+  }
+  s.materials[0].program_params.push_back(1.0f);
+  validate_scene(s);
+  s.materials[0].program_params[3] = std::nanf("");
+  EXPECT_THROW(validate_scene(s), Error);
+  s.materials[0].program_params[3] = 0.0f;
+  s.world.program = 0;  // the world reads the same six values of its own
+  s.world.program_params = {1, 2, 3};
+  EXPECT_THROW(validate_scene(s), Error);
 }
 
 TEST_F(MaterialProgramTest, BadProgramReferencesAndBoundsAreRejected) {

@@ -118,6 +118,10 @@ struct Material {
   // The program computes the alpha (opacity), which the shadow views then
   // evaluate too, so that a texture's cut-outs cast cut-out shadows.
   bool program_alpha = false;
+  // The program's node values (the numbers it reads rather than compiles
+  // in: node_compiler.py), so that materials whose trees differ only in
+  // values share one program, and editing a value rebuilds nothing.
+  std::vector<float> program_params;
   float displacement_bound = 0.0f;
   // The bound is in world units rather than object units (a Displacement
   // node in World space: its distance does not scale with the object).
@@ -199,6 +203,7 @@ struct Light {
 // emission is the radiance). Without either, the scene has no world light.
 struct World {
   int program = -1;                 // index into Scene::material_programs
+  std::vector<float> program_params;  // its node values (Material::program_params)
   int bake_width = 512;             // the baked map's width; its height is half
   int width = 0, height = 0;        // of `radiance`
   std::vector<float> radiance;

@@ -76,6 +76,7 @@ void set_program_input_args(cl::Kernel& k, cl_uint first, const SceneBuffers& bu
   k.setArg(first + 3, buffers.images);
   k.setArg(first + 4, buffers.image_count);
   k.setArg(first + 5, buffers.texels);
+  k.setArg(first + 6, buffers.params);
 }
 
 }  // namespace
@@ -91,7 +92,8 @@ WorldMap MaterialPrograms::bake_world(const Scene& scene, const SceneBuffers& bu
   k.setArg(0, cl_uint(map.width));
   k.setArg(1, cl_uint(map.height));
   set_program_input_args(k, 2, buffers);
-  k.setArg(8, out);
+  k.setArg(9, buffers.world_params_at);
+  k.setArg(10, out);
   DeviceQueue& q = session_.queue();
   q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(cl_uint(texels)), cl::NDRange(64));
   std::vector<cl_float4> host(texels);
@@ -113,7 +115,8 @@ std::vector<float> MaterialPrograms::world_background(const Scene& scene, const 
   for (int r = 0; r < 3; ++r)
     k.setArg(cl_uint(1 + r), cl_float4{{to_world[0][r], to_world[1][r], to_world[2][r], 0.0f}});
   set_program_input_args(k, 4, buffers);
-  k.setArg(10, out);
+  k.setArg(11, buffers.world_params_at);
+  k.setArg(12, out);
   DeviceQueue& q = session_.queue();
   q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(cl_uint(pixels)), cl::NDRange(64));
   std::vector<float> host(pixels * 3);
@@ -135,12 +138,7 @@ void set_grid_args(cl::Kernel& k, const cl::Buffer& diceable, cl_uint count, con
   k.setArg(6, program);
   k.setArg(7, grids.p);
   k.setArg(8, grids.n);
-  k.setArg(9, scene.patch_edges);
-  k.setArg(10, scene.patch_uvs);
-  k.setArg(11, scene.uv_layers);
-  k.setArg(12, scene.images);
-  k.setArg(13, scene.image_count);
-  k.setArg(14, scene.texels);
+  set_program_input_args(k, 9, scene);
 }
 
 }  // namespace
@@ -159,7 +157,7 @@ void MaterialPrograms::displace(const cl::Buffer& diceable, cl_uint count, const
     if (!a.displaces) continue;
     cl::Kernel& k = a.built->displace;
     set_grid_args(k, diceable, count, scene, f, a.index, grids);
-    k.setArg(15, grids.vertex_offsets);
+    k.setArg(16, grids.vertex_offsets);
     launch(k, count, grids, Stage::Dice, timer);
   }
   if (!normals) return;
@@ -193,16 +191,16 @@ void MaterialPrograms::run_shade(const cl::Buffer& diceable, cl_uint count, cons
     if (!(alpha_only ? a.alpha : a.shades)) continue;
     cl::Kernel& k = a.built->shade;
     set_grid_args(k, diceable, count, scene, f, a.index, grids);
-    k.setArg(15, scene.lights);
-    k.setArg(16, scene.light_count);
-    k.setArg(17, grids.c);
-    k.setArg(18, grids.vertex_offsets);
-    shadows.set_args(k, 19);
-    k.setArg(24, cl_uint(alpha_only ? 1 : 0));
-    k.setArg(25, scene.world_glossy);
-    k.setArg(26, scene.refract_roots);
-    k.setArg(27, scene.refract_nodes);
-    k.setArg(28, scene.refract_tris);
+    k.setArg(16, scene.lights);
+    k.setArg(17, scene.light_count);
+    k.setArg(18, grids.c);
+    k.setArg(19, grids.vertex_offsets);
+    shadows.set_args(k, 20);
+    k.setArg(25, cl_uint(alpha_only ? 1 : 0));
+    k.setArg(26, scene.world_glossy);
+    k.setArg(27, scene.refract_roots);
+    k.setArg(28, scene.refract_nodes);
+    k.setArg(29, scene.refract_tris);
     launch(k, count, grids, Stage::Shade, timer);
   }
 }

@@ -52,11 +52,11 @@ class MaterialPrograms {
     unsigned long long used = 0;  // the last prepare() that used it
   };
   // Programs kept beyond those the current scene uses: node values are
-  // constants in a program's source, so an animated value or a dragged
-  // slider builds a new program per frame, and keeping them all would grow
-  // without limit (about 8 MiB each on PoCL). A few are kept for scenes
-  // that switch back and forth; the rest are rebuilt from the on-disk
-  // binary cache when they return.
+  // parameters (Material::program_params), but a tree whose structure
+  // changes (a link made, a node added, a mode switched) builds a new
+  // program, and keeping them all would grow without limit (about 8 MiB each
+  // on PoCL). A few are kept for scenes that switch back and forth; the rest
+  // are rebuilt from the on-disk binary cache when they return.
   static constexpr size_t kSparePrograms = 8;
   void evict_unused();
   struct Active {

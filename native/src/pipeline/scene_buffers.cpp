@@ -39,6 +39,18 @@ DeviceMaterial to_device(const Material& m) {
   return d;
 }
 
+// Node values of a material (or the world) appended to the scene's
+// parameter buffer; `at` gets where they start and how many there are.
+void append_params(const std::vector<float>& values, const std::string& owner, std::vector<float>& params,
+                   uint32_t at[4]) {
+  if (params.size() + values.size() > size_t(UINT32_MAX))
+    throw Error(owner + ": the scene's node values exceed 2^32");
+  at[0] = uint32_t(params.size());
+  at[1] = uint32_t(values.size());
+  at[2] = at[3] = 0;
+  params.insert(params.end(), values.begin(), values.end());
+}
+
 // Camera <-> object transforms and texture space of one surface.
 DeviceObject to_device_object(const glm::mat4& to_camera, const glm::mat4& to_world, glm::vec3 texspace_location,
                               glm::vec3 texspace_size, const std::vector<glm::vec3>& points, const ObjectInfo& info) {
@@ -327,7 +339,17 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
   }
   if (scene.motion_steps >= 2) place_motion(scene, surfaces, cache ? cache : &local, out);
   if (scene.materials.empty()) out.materials.push_back(to_device(Material{}));
-  for (const Material& m : scene.materials) out.materials.push_back(to_device(m));
+  for (const Material& m : scene.materials) {
+    DeviceMaterial d = to_device(m);
+    append_params(m.program_params, "material '" + m.name + "'", out.params, d.params);
+    out.materials.push_back(d);
+  }
+  {
+    uint32_t at[4];
+    append_params(scene.world.program_params, "the world", out.params, at);
+    out.world_params_at = at[0];
+  }
+  if (out.params.empty()) out.params.push_back(0.0f);  // a buffer of at least one value
   out.lights = device_lights(scene.lights, w2c);
   std::vector<bool> refracts(out.materials.size(), false);
   for (size_t k = 0; k < scene.materials.size(); ++k) {
@@ -382,6 +404,8 @@ SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data
     b.patch_bounds = upload(session, b.host_patch_bounds);
     b.images = upload(session, data.images);
     b.texels = upload(session, data.texels);
+    b.params = upload(session, data.params);
+    b.world_params_at = static_cast<cl_uint>(data.world_params_at);
     b.world_glossy = upload(session, no_world_glossy);
     b.motion_points = upload(session, data.motion_points);
     b.motion_curves = upload(session, data.motion_curves);

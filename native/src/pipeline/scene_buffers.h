@@ -23,6 +23,10 @@ struct HostSceneData {
   std::vector<DeviceObject> objects;  // one per surface, in patch order (MP_PATCH_OBJECT)
   std::vector<DeviceImage> images;
   std::vector<glm::vec4> texels;      // every image's pixels, one after the other
+  // Every material's node values (DeviceMaterial.params gives where each
+  // starts), then the world's from world_params_at.
+  std::vector<float> params;
+  uint32_t world_params_at = 0;
   // Motion blur (Scene::motion_steps): the patches' control points and edge
   // curves in camera space at each step, step after step, each step laid
   // out as patches.points and patches.curves.
@@ -52,6 +56,8 @@ struct SceneBuffers {
   std::vector<glm::vec4> host_patch_bounds;  // the same on the host (occlusion culling's root order)
   cl::Buffer images;      // DeviceImage per image
   cl::Buffer texels;      // float4
+  cl::Buffer params;      // float: HostSceneData::params
+  cl_uint world_params_at = 0;
   cl::Buffer world_glossy;  // float4: the world's glossy maps (kernels/mp_world.h), or one zero texel
   cl::Buffer motion_points, motion_curves;  // HostSceneData's (one float4 when there is no motion)
   cl::Buffer refract_roots, refract_nodes, refract_tris;  // RefractionProxies (kernels/mp_refract_trace.h)

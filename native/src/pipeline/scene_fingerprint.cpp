@@ -120,6 +120,7 @@ void hash_surfaces(Hasher& h, const Scene& scene) {
     h.value(m.specular_color), h.value(m.metallic), h.value(m.specular), h.value(m.emission);
     h.value(m.program), h.value(m.program_displaces), h.value(m.program_shades), h.value(m.displacement_bound);
     h.value(m.displacement_bound_world), h.value(m.program_alpha);
+    h.value(m.program_params.size()), h.values(m.program_params);
   }
   h.value(scene.material_programs.size());
   for (const MaterialProgram& p : scene.material_programs) h.text(p.source);
@@ -160,6 +161,7 @@ uint64_t world_fingerprint(const Scene& scene) {
   h.value(w.program);
   if (w.program >= 0 && size_t(w.program) < scene.material_programs.size())
     h.text(scene.material_programs[size_t(w.program)].source);
+  h.value(w.program_params.size()), h.values(w.program_params);
   h.value(w.bake_width), h.value(w.width), h.value(w.height);
   h.values(w.radiance);
   h.value(w.camera), h.value(w.diffuse), h.value(w.glossy), h.value(w.cast_shadows);

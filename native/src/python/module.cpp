@@ -273,8 +273,9 @@ PYBIND11_MODULE(_native, m) {
              std::vector<float> opacity, float ka, float kd, float ks, float roughness, std::vector<float> specular_color,
              std::vector<float> emission, float metallic, float specular, int program, bool program_displaces,
              bool program_shades, float displacement_bound, bool displacement_bound_world, bool program_alpha,
-             bool layered, bool retro_diffuse, bool multiscatter) {
+             bool layered, bool retro_diffuse, bool multiscatter, std::vector<float> program_params) {
             Material mat;
+            mat.program_params = std::move(program_params);
             mat.layered = layered;
             mat.retro_diffuse = retro_diffuse;
             mat.multiscatter = multiscatter;
@@ -307,7 +308,9 @@ PYBIND11_MODULE(_native, m) {
           py::arg("program") = -1, py::arg("program_displaces") = false, py::arg("program_shades") = false,
           py::arg("displacement_bound") = 0.0f, py::arg("displacement_bound_world") = false,
           py::arg("program_alpha") = false, py::arg("layered") = false, py::arg("retro_diffuse") = false, py::arg("multiscatter") = false,
-          "Adds a material (constant, matte, plastic or principled; see scene.h); returns its index.")
+          py::arg("program_params") = std::vector<float>{},
+          "Adds a material (constant, matte, plastic or principled; see scene.h); returns its index. "
+          "program_params are its program's node values (Material::program_params).")
       .def(
           "add_material_program",
           [](Scene& s, const std::string& name, const std::string& source) {
@@ -435,9 +438,10 @@ PYBIND11_MODULE(_native, m) {
       .def(
           "set_world",
           [](Scene& s, int program, int bake_width, const Array<float>& radiance, bool camera, float diffuse,
-             float glossy, bool cast_shadows) {
+             float glossy, bool cast_shadows, std::vector<float> program_params) {
             World w;
             w.program = program;
+            w.program_params = std::move(program_params);
             w.bake_width = bake_width;
             if (radiance.size() > 0) {
               if (radiance.ndim() != 3 || radiance.shape(2) != 4)
@@ -451,6 +455,7 @@ PYBIND11_MODULE(_native, m) {
           },
           py::arg("program") = -1, py::arg("bake_width") = 512, py::arg("radiance") = Array<float>(),
           py::arg("camera") = true, py::arg("diffuse") = 1.0f, py::arg("glossy") = 1.0f, py::arg("cast_shadows") = true,
+          py::arg("program_params") = std::vector<float>{},
           "Sets the world (scene.h, World): a world program's index (add_material_program) baked to a map "
           "bake_width wide, or an equirectangular radiance map (height, width, 4), rows bottom to top.")
       .def("validate", [](const Scene& s) { validate_scene(s); })

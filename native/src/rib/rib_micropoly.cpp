@@ -150,8 +150,8 @@ void Parser::read_image_option(ArgReader& args, const ParamList& params) {
 void Parser::read_environment_light(ArgReader& args, const ParamList& params) {
   const int line = args.request().line;
   const std::string what = "LightSource \"micropoly_environmentlight\"";
-  warn_unknown(params, {"program", "programname", "mapname", "bakewidth", "camera", "diffuse", "glossy",
-                        "shadowname", "intensity"},
+  warn_unknown(params, {"program", "programname", "programparams", "mapname", "bakewidth", "camera", "diffuse",
+                        "glossy", "shadowname", "intensity"},
                [&](const std::string& name) {
                  warn_once("envlight-param:" + name, line, what + ": parameter \"" + name + "\" is ignored");
                });
@@ -167,6 +167,7 @@ void Parser::read_environment_light(ArgReader& args, const ParamList& params) {
     auto it = std::find_if(programs.begin(), programs.end(), [&](const MaterialProgram& p) { return p.source == source; });
     world.program = static_cast<int>(it - programs.begin());
     if (it == programs.end()) programs.push_back({params.get_string("programname", "world"), source});
+    world.program_params = params.get_float_list("programparams");
     params.get_int("bakewidth", 8, 8192, &world.bake_width);
   } else {
     // An equirectangular map in world space (Cycles' convention, Z up).
@@ -198,7 +199,7 @@ void Parser::read_environment_light(ArgReader& args, const ParamList& params) {
 
 void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
   const int line = args.request().line;
-  warn_unknown(params, {"material", "materialname", "program", "programdisplaces", "programshades",
+  warn_unknown(params, {"material", "materialname", "program", "programparams", "programdisplaces", "programshades",
                         "programalpha", "displacementbound", "displacementworld", "objectcolor", "objectalpha",
                         "objectindex", "objectrandom"}, [&](const std::string& name) {
     warn_once("attribute-micropoly:" + name, line,
@@ -242,6 +243,7 @@ void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
     flag = 0;
     params.get_int("programalpha", 0, 1, &flag);
     use.alpha = flag != 0;
+    use.params = params.get_float_list("programparams");
     use.displacement_bound = params.get_float("displacementbound", 0.0f);
     flag = 0;
     params.get_int("displacementworld", 0, 1, &flag);
@@ -264,6 +266,7 @@ void Parser::define_material(int index, const std::string& name, const MaterialP
   m.program_displaces = use.displaces;
   m.program_shades = use.shades;
   m.program_alpha = use.alpha;
+  m.program_params = use.params;
   m.displacement_bound = use.displacement_bound;
   m.displacement_bound_world = use.displacement_world;
   std::vector<Material>& materials = result_.scene.materials;

@@ -1,5 +1,6 @@
 #include "rib/rib_params.h"
 
+#include <cmath>
 #include <sstream>
 
 namespace mp::rib {
@@ -179,6 +180,20 @@ void ParamList::get_floats(const std::string& name, float* out, size_t n) const 
                                (n == 1 ? " number" : " numbers") + ", found " +
                                std::to_string(p->value->size()) + " values");
   for (size_t i = 0; i < n; ++i) out[i] = static_cast<float>(p->value->numbers[i]);
+}
+
+std::vector<float> ParamList::get_float_list(const std::string& name) const {
+  std::vector<float> out;
+  const Param* p = find(name);
+  if (!p) return out;
+  if (p->decl.is_string()) args_.fail_at(p->line, "parameter \"" + name + "\" expects numbers");
+  out.reserve(p->value->numbers.size());
+  for (double v : p->value->numbers) {
+    if (!std::isfinite(v) || std::fabs(v) > 3.4e38)
+      args_.fail_at(p->line, "parameter \"" + name + "\" holds a value that is not a finite float");
+    out.push_back(static_cast<float>(v));
+  }
+  return out;
 }
 
 std::string ParamList::get_string(const std::string& name, const std::string& fallback) const {

@@ -62,6 +62,8 @@ class ParamList {
   // the value must hold exactly `n` numbers (or one string). Absent -> default.
   float get_float(const std::string& name, float fallback) const;
   void get_floats(const std::string& name, float* out, size_t n) const;  // unchanged if absent
+  // Any number of numbers, each finite (an error otherwise); empty if absent.
+  std::vector<float> get_float_list(const std::string& name) const;
   std::string get_string(const std::string& name, const std::string& fallback) const;
   // One integer in [lo, hi] (an error at the parameter's line otherwise);
   // `out` is unchanged when the parameter is absent.

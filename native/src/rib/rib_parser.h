@@ -251,6 +251,7 @@ class Parser {
     bool displaces = false, shades = false, alpha = false;
     float displacement_bound = 0.0f;
     bool displacement_world = false;
+    std::vector<float> params;  // the program's node values
   };
   void define_material(int index, const std::string& name, const MaterialProgramUse& use);
   // Per-face Scene material indices ("uniform integer micropoly:material"),

@@ -54,7 +54,7 @@ void read_light_radius(const ParamList& params, Light& light) {
 
 std::vector<float> Parser::material_key(const Material& m) {
   // Equal shading states share one material; the name is not part of it.
-  return {static_cast<float>(m.model),
+  std::vector<float> key{static_cast<float>(m.model),
           m.color.x, m.color.y, m.color.z,
           m.opacity.x, m.opacity.y, m.opacity.z,
           m.ka, m.kd, m.ks, m.roughness,
@@ -63,7 +63,10 @@ std::vector<float> Parser::material_key(const Material& m) {
           m.metallic, m.specular, static_cast<float>(m.program), m.displacement_bound,
           static_cast<float>(m.program_displaces), static_cast<float>(m.program_shades),
           static_cast<float>(m.displacement_bound_world), static_cast<float>(m.program_alpha),
-          static_cast<float>(m.layered), static_cast<float>(m.retro_diffuse), static_cast<float>(m.multiscatter)};
+          static_cast<float>(m.layered), static_cast<float>(m.retro_diffuse), static_cast<float>(m.multiscatter),
+          static_cast<float>(m.program_params.size())};
+  key.insert(key.end(), m.program_params.begin(), m.program_params.end());
+  return key;
 }
 
 int Parser::material_index(const Attributes& attrs) {

@@ -151,6 +151,14 @@ void param(std::string& out, const char* name, const glm::vec3& v) {
   out += "\" ";
   put_vec3(out, v);
 }
+// A list of any length, declared inline as float[n] (none when empty).
+void param_list(std::string& out, const char* name, const std::vector<float>& v) {
+  if (v.empty()) return;
+  out += " \"float[" + std::to_string(v.size()) + "] ";
+  out += name;
+  out += "\" ";
+  put_floats(out, v.data(), v.size());
+}
 void param(std::string& out, const char* name, long long v) {
   out += " \"";
   out += name;
@@ -442,6 +450,7 @@ void write_material(std::string& o, const Material& m, int index, const char* in
   param(o, "string materialname", m.name);
   if (m.program >= 0 && static_cast<size_t>(m.program) < programs.size()) {
     param(o, "string program", programs[static_cast<size_t>(m.program)].source);
+    param_list(o, "programparams", m.program_params);
     param(o, "integer programdisplaces", static_cast<long long>(m.program_displaces ? 1 : 0));
     param(o, "integer programshades", static_cast<long long>(m.program_shades ? 1 : 0));
     if (m.program_alpha) param(o, "integer programalpha", static_cast<long long>(1));
@@ -631,6 +640,7 @@ void write_world(std::string& o, const Scene& scene, const std::string& folder, 
     const MaterialProgram& p = scene.material_programs[size_t(w.program)];
     param(o, "string programname", p.name);
     param(o, "string program", p.source);
+    param_list(o, "programparams", w.program_params);
     param(o, "integer bakewidth", static_cast<long long>(w.bake_width));
   } else {
     if (folder.empty()) throw Error("the scene's world map needs a folder to be written to");

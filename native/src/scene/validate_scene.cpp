@@ -1,6 +1,7 @@
 // Scene validation: the one place bad input is caught, with a message that
 // names the object, so the pipeline never sees NaNs or out-of-range indices.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdint>
@@ -12,6 +13,32 @@
 
 namespace mp {
 namespace {
+
+// How many node values a program reads: past the largest k of its
+// MP_PARAM(k), MP_PARAM3(k) and MP_PARAM4(k) (kernels/materials/mp_node_lib.h).
+size_t program_param_count(const std::string& source) {
+  size_t need = 0;
+  for (size_t at = source.find("MP_PARAM"); at != std::string::npos; at = source.find("MP_PARAM", at + 1)) {
+    size_t i = at + 8, width = 1;
+    if (i < source.size() && (source[i] == '3' || source[i] == '4')) width = size_t(source[i++] - '0');
+    if (i >= source.size() || source[i] != '(') continue;
+    size_t k = 0, digits = 0;
+    for (++i; i < source.size() && std::isdigit(static_cast<unsigned char>(source[i])) && digits < 10; ++i, ++digits)
+      k = 10 * k + size_t(source[i] - '0');
+    if (digits > 0 && i < source.size() && source[i] == ')') need = std::max(need, k + width);
+  }
+  return need;
+}
+
+// A material's or the world's node values: as many as its program reads, all finite.
+void check_program_params(const std::vector<float>& params, const std::string& source, const std::string& owner) {
+  const size_t need = program_param_count(source);
+  if (params.size() < need)
+    throw Error(owner + ": its program reads " + std::to_string(need) + " node values, but it has " +
+                std::to_string(params.size()));
+  for (float v : params)
+    if (!std::isfinite(v)) throw Error(owner + ": a node value is NaN or infinite");
+}
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
@@ -234,10 +261,14 @@ void validate_scene(const Scene& scene) {
                std::to_string(scene.material_programs.size()));
     if (!std::isfinite(m.displacement_bound) || m.displacement_bound < 0)
       fail("material", m.name.empty() ? std::to_string(i) : m.name, "needs a finite, non-negative displacement bound");
+    if (m.program >= 0)
+      check_program_params(m.program_params, scene.material_programs[size_t(m.program)].source,
+                           "material '" + (m.name.empty() ? std::to_string(i) : m.name) + "'");
   }
   const World& w = scene.world;
   if (w.program >= 0 && size_t(w.program) >= scene.material_programs.size())
     throw Error("world: program " + std::to_string(w.program) + " does not exist");
+  if (w.program >= 0) check_program_params(w.program_params, scene.material_programs[size_t(w.program)].source, "world");
   if (w.program >= 0 && (w.bake_width < 8 || w.bake_width > 8192))
     throw Error("world: the baked map's width must be 8 to 8192 texels, not " + std::to_string(w.bake_width));
   if (w.width < 0 || w.height < 0 || w.radiance.size() != size_t(w.width) * size_t(w.height) * 4)
