@@ -2,7 +2,7 @@
 refinement arrive after the view opens, after an edit and after an orbit.
 Run with Blender (or a Python with bpy):
 
-  MICROPOLY_ADDON_DIR=build/addons blender -b --factory-startup --python bench/viewport_bench.py -- [--repeat 5] [--rate 1.0] [--no-shadows]
+  MICROPOLY_ADDON_DIR=build/addons blender -b --factory-startup --python bench/viewport_bench.py -- [--repeat 5] [--rate 1.0] [--no-shadows] [--material mix] [--edit move|value]
 
 Scene: bench/blender_bench.py's six subdivided Suzannes on a floor, seen
 from its camera at 1280x720 through the viewport session
@@ -36,6 +36,10 @@ args = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 REPEAT = int(args[args.index("--repeat") + 1]) if "--repeat" in args else 5
 RATE = float(args[args.index("--rate") + 1]) if "--rate" in args else 1.0
 SHADOWS = "--no-shadows" not in args
+# The edit between rounds: "move" (a Suzanne moves: geometry changes) or
+# "value" (a node value of a Suzanne's material changes: with --material mix
+# its Diffuse colour, else its Principled Base Color).
+EDIT = args[args.index("--edit") + 1] if "--edit" in args else "move"
 WIDTH, HEIGHT, SAMPLES = 1280, 720, 16
 
 
@@ -105,15 +109,21 @@ def main():
             results["orbit"].append((first, final, 0.0))
             pages["orbit"].append((image.stats["shadows"]["pages_rendered"], image.stats["shadows"]["pages_requested"]))
             view = orbit
-            # The edit for the next round: one Suzanne moves.
+            # The edit for the next round.
             obj = next(o for o in scene.objects if o.type == "MESH" and o.modifiers)
-            obj.location.z += 0.05
+            if EDIT == "value":
+                nodes = obj.active_material.node_tree.nodes
+                shader = next(n for n in nodes if n.type in ("BSDF_DIFFUSE", "BSDF_PRINCIPLED"))
+                socket = shader.inputs["Color" if shader.type == "BSDF_DIFFUSE" else "Base Color"]
+                socket.default_value = (0.2 + 0.05 * run, 0.4, 0.6, 1.0)
+            else:
+                obj.location.z += 0.05
             depsgraph.update()
         stats = image.stats
     finally:
         session.close()
     print(f"\nBlender {bpy.app.version_string}, viewport {WIDTH}x{HEIGHT}, {SAMPLES} spp, shading rate {RATE}, "
-          f"shadows {'on' if SHADOWS else 'off'}, device {session.device}; final pass: "
+          f"shadows {'on' if SHADOWS else 'off'}, edit: {EDIT}, device {session.device}; final pass: "
           f"{stats['micropolygons']:,} micropolygons")
     if SHADOWS:
         for name, rows in pages.items():

@@ -952,11 +952,22 @@ class NodeCompiler:
             return f"mp_world_dir_to_object(g, {self.input(node, 'Tangent', VEC)[0]})"
         return "mp_radial_tangent(g)"
 
+    @staticmethod
+    def _unlinked_zero(node, *names):
+        """Whether the first of `names` that the node has is an unlinked
+        socket at 0 (or the node has none): a value the tree's structure
+        may depend on, as it decides whether code is needed at all."""
+        for name in names:
+            socket = node.inputs.get(name)
+            if socket is not None:
+                return not socket.is_linked and float(socket.default_value) == 0.0
+        return True
+
     def _anisotropy_tangent(self, node, aniso, slot):
         """The tangent an anisotropic lobe stretches along (zero while the
         anisotropy is the constant 0), turned about its normal by the node's
         Rotation."""
-        if aniso == "0.0f":
+        if self._unlinked_zero(node, "Anisotropy"):
             return "(float3)(0.0f)"
         return f"mp_rotate_tangent({self._tangent(node)}, {self._slot_normal(slot)}, {self._f(node, 'Rotation')})"
 
@@ -1116,7 +1127,7 @@ class NodeCompiler:
             "slot": slot, "coat_slot": coat_slot, "v4": "1" if v4 else "0", "retro": "0" if v4 else "1",
             "multiscatter": "1" if getattr(node, "distribution", "GGX") == "MULTI_GGX" else "0",
         }
-        fields["tangent"] = self._tangent(node) if fields["anisotropy"] != "0.0f" else "(float3)(0.0f)"
+        fields["tangent"] = "(float3)(0.0f)" if self._unlinked_zero(node, "Anisotropic") else self._tangent(node)
         add = self.fn.lines.append
         add(f"  MpPrincipled {p};")
         for k, v in fields.items():

@@ -223,10 +223,15 @@ TEST(RefractionTrace, CollapsedMeshGetsNoProxy) {
 // Only refracting materials get a proxy, and programs are told apart by
 // what the node compiler writes.
 TEST(RefractionTrace, OnlyRefractingProgramsGetProxies) {
-  EXPECT_TRUE(mp::program_refracts("  mp_add_glass_tinted(s, w, c, 0, 0.0f, 1.45f, 0);"));
-  EXPECT_TRUE(mp::program_refracts("  mp_add_refraction(s, w, 0, 0.0f, 1.45f, 0);"));
-  EXPECT_TRUE(mp::program_refracts("  p1.transmission = v7;\n"));
-  EXPECT_FALSE(mp::program_refracts("  p1.transmission = 0.0f;\n  p1.metallic = 1.0f;"));
+  const std::vector<float> no_values;
+  EXPECT_TRUE(mp::program_refracts("  mp_add_glass_tinted(s, w, c, 0, 0.0f, 1.45f, 0);", no_values));
+  EXPECT_TRUE(mp::program_refracts("  mp_add_refraction(s, w, 0, 0.0f, 1.45f, 0);", no_values));
+  EXPECT_TRUE(mp::program_refracts("  p1.transmission = v7;\n", no_values));
+  EXPECT_FALSE(mp::program_refracts("  p1.transmission = 0.0f;\n  p1.metallic = 1.0f;", no_values));
+  // A node value (MP_PARAM) refracts unless the material's value is 0.
+  EXPECT_FALSE(mp::program_refracts("  p1.transmission = MP_PARAM(1);\n", {0.5f, 0.0f}));
+  EXPECT_TRUE(mp::program_refracts("  p1.transmission = MP_PARAM(0);\n", {0.5f, 0.0f}));
+  EXPECT_TRUE(mp::program_refracts("  p1.transmission = MP_PARAM(1) * v2;\n", {0.5f, 0.0f}));
   mp::PatchBuffer buf;
   mp::append_subdiv_patches(mp::test::cube_mesh(mp::SubdivScheme::CatmullClark), glm::mat4(1.0f), buf);
   mp::share_patch_edges(buf, 0);

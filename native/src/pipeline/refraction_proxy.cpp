@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 
 #include "mp_compat.h"
@@ -16,13 +17,20 @@ namespace mp {
 namespace {
 
 // A Principled BSDF's transmission line in a program, as node_compiler.py
-// writes it: "  p3.transmission = <expression>;".
-bool principled_transmits(const std::string& source) {
+// writes it: "  p3.transmission = <expression>;", where an unlinked socket's
+// value is a literal (programs written before node values became
+// parameters) or MP_PARAM(k), the material's value k.
+bool principled_transmits(const std::string& source, const std::vector<float>& params) {
   const std::string key = ".transmission = ";
   for (size_t at = source.find(key); at != std::string::npos; at = source.find(key, at + 1)) {
     const size_t start = at + key.size(), end = source.find(';', start);
     const std::string value = source.substr(start, end == std::string::npos ? std::string::npos : end - start);
-    if (value != "0.0f" && value != "0.0" && value != "0") return true;
+    if (value == "0.0f" || value == "0.0" || value == "0") continue;
+    unsigned long k = 0;
+    if (std::sscanf(value.c_str(), "MP_PARAM(%lu)", &k) == 1 && value == "MP_PARAM(" + std::to_string(k) + ")" &&
+        k < params.size() && params[k] == 0.0f)
+      continue;
+    return true;
   }
   return false;
 }
@@ -115,9 +123,9 @@ class BvhBuilder {
 
 }  // namespace
 
-bool program_refracts(const std::string& source) {
+bool program_refracts(const std::string& source, const std::vector<float>& params) {
   return source.find("mp_add_glass") != std::string::npos || source.find("mp_add_refraction") != std::string::npos ||
-         principled_transmits(source);
+         principled_transmits(source, params);
 }
 
 RefractionProxies build_refraction_proxies(const PatchBuffer& patches, size_t objects,

@@ -34,9 +34,10 @@ struct ProxyTriangle {
 // hierarchy) to `out`; returns its root node.
 uint32_t append_refraction_proxy(std::vector<ProxyTriangle>& tris, RefractionProxies& out);
 
-// Whether a material program can refract: a Glass or Refraction node, or a
-// Principled BSDF whose Transmission is not the constant 0.
-bool program_refracts(const std::string& source);
+// Whether a material program can refract with the material's node values
+// `params`: a Glass or Refraction node, or a Principled BSDF whose
+// Transmission is not the constant 0 (a literal or a value of 0).
+bool program_refracts(const std::string& source, const std::vector<float>& params);
 
 // Proxies for every object (MP_PATCH_OBJECT of the patches' flags, object
 // count `objects`) wearing a material for which `refracts` is true: the

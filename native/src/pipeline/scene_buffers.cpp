@@ -355,7 +355,7 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
   for (size_t k = 0; k < scene.materials.size(); ++k) {
     const Material& m = scene.materials[k];
     refracts[k] = m.program_shades && m.program >= 0 && size_t(m.program) < scene.material_programs.size() &&
-                  program_refracts(scene.material_programs[size_t(m.program)].source);
+                  program_refracts(scene.material_programs[size_t(m.program)].source, m.program_params);
   }
   out.refraction = build_refraction_proxies(out.patches, out.objects.size(), refracts);
   for (const Image& image : scene.images) {
