@@ -81,7 +81,10 @@ uint64_t patch_set_shape_key(const BezierPatches& set, int uv_layers) {
 namespace {
 
 // Surfaces, materials and images (scene_fingerprint and geometry_fingerprint).
-void hash_surfaces(Hasher& h, const Scene& scene) {
+// For shadows only what a shadow view reads of a material counts: its
+// opacity, and the node values of programs that displace or compute the
+// alpha; a colour edited in a material keeps the shadow maps.
+void hash_surfaces(Hasher& h, const Scene& scene, bool shadows_only) {
   h.value(scene.meshes.size());
   for (const Mesh& m : scene.meshes) {
     h.text(m.name);
@@ -114,13 +117,16 @@ void hash_surfaces(Hasher& h, const Scene& scene) {
   }
   h.value(scene.materials.size());
   for (const Material& m : scene.materials) {
-    h.value(m.model);
-    h.value(m.color), h.value(m.opacity);
-    h.value(m.ka), h.value(m.kd), h.value(m.ks), h.value(m.roughness);
-    h.value(m.specular_color), h.value(m.metallic), h.value(m.specular), h.value(m.emission);
+    h.value(m.opacity);
     h.value(m.program), h.value(m.program_displaces), h.value(m.program_shades), h.value(m.displacement_bound);
     h.value(m.displacement_bound_world), h.value(m.program_alpha);
-    h.value(m.program_params.size()), h.values(m.program_params);
+    if (!shadows_only || m.program_displaces || m.program_alpha)
+      h.value(m.program_params.size()), h.values(m.program_params);
+    if (shadows_only) continue;
+    h.value(m.model);
+    h.value(m.color);
+    h.value(m.ka), h.value(m.kd), h.value(m.ks), h.value(m.roughness);
+    h.value(m.specular_color), h.value(m.metallic), h.value(m.specular), h.value(m.emission);
   }
   h.value(scene.material_programs.size());
   for (const MaterialProgram& p : scene.material_programs) h.text(p.source);
@@ -142,7 +148,7 @@ void hash_light(Hasher& h, const Light& l) {
 
 uint64_t geometry_fingerprint(const Scene& scene) {
   Hasher h;
-  hash_surfaces(h, scene);
+  hash_surfaces(h, scene, true);
   return h.result();
 }
 
@@ -178,7 +184,7 @@ uint64_t scene_fingerprint(const Scene& scene) {
   // Device light records include the world's (world_lighting.h).
   h.value(scene.world.present() ? world_fingerprint(scene) : uint64_t(0));
   h.value(scene.camera.world_to_camera);
-  hash_surfaces(h, scene);
+  hash_surfaces(h, scene, false);
   h.value(scene.lights.size());
   for (const Light& l : scene.lights) {
     hash_light(h, l);
