@@ -162,15 +162,16 @@ class NodeCompiler:
         self.params.append(_finite(x))
         return f"MP_PARAM({len(self.params) - 1})"
 
+    def _params(self, v, n):
+        """n values from v (padded with 0) as MP_PARAMn."""
+        self.params.extend(_finite(c) for c in (list(v) + [0.0] * n)[:n])
+        return f"MP_PARAM{n}({len(self.params) - n})"
+
     def param3(self, v):
-        v = list(v)[:3] + [0.0] * max(0, 3 - len(list(v)))
-        self.params.extend(_finite(c) for c in v)
-        return f"MP_PARAM3({len(self.params) - 3})"
+        return self._params(v, 3)
 
     def param4(self, v):
-        v = list(v)[:4]
-        self.params.extend(_finite(c) for c in v)
-        return f"MP_PARAM4({len(self.params) - 4})"
+        return self._params(v, 4)
 
     # ---- helpers ----------------------------------------------------------
     def warn(self, node, what):
@@ -319,8 +320,8 @@ class NodeCompiler:
             obj_coords = "g->P"
             other = getattr(node, "object", None)
             if other is not None and node.outputs["Object"].is_linked:
-                # That object's placement is part of the program: moving it
-                # gives a new program (a new source), as editing the tree does.
+                # That object's placement is among the material's node
+                # values: moving it re-uploads them and builds nothing.
                 m = other.matrix_world.inverted()
                 rows = ", ".join(self.param4([m[r][c] for c in range(4)]) for r in range(3))
                 obj_coords = fn.temp(VEC, f"mp_point_in_space(g, {rows})")[0]
@@ -963,7 +964,7 @@ class NodeCompiler:
                 return not socket.is_linked and float(socket.default_value) == 0.0
         return True
 
-    def _anisotropy_tangent(self, node, aniso, slot):
+    def _anisotropy_tangent(self, node, slot):
         """The tangent an anisotropic lobe stretches along (zero while the
         anisotropy is the constant 0), turned about its normal by the node's
         Rotation."""
@@ -1031,7 +1032,7 @@ class NodeCompiler:
                 self.warn(node, f"the {dist.replace('_', '-').title()} distribution is shaded as GGX")
             rough = "0.0f" if dist == "SHARP" else self._f(node, "Roughness")
             aniso = self._f(node, "Anisotropy")
-            tangent = self._anisotropy_tangent(node, aniso, slot)
+            tangent = self._anisotropy_tangent(node, slot)
             add(f"  mp_add_glossy(s, {weight} * {color}, {slot}, {rough}, {aniso}, {tangent}, MP_FRESNEL_NONE, "
                 f"(float3)(0.0f), (float3)(1.0f), {1 if dist == 'MULTI_GGX' else 0});")
         elif t in ("BSDF_GLASS", "BSDF_REFRACTION"):
@@ -1069,7 +1070,7 @@ class NodeCompiler:
                 f0 = self.fn.temp(VEC, f"mp_conductor_f0({self._c(node, 'IOR')}, {self._c(node, 'Extinction')})")[0]
                 tint = "(float3)(1.0f)"
             aniso = self._f(node, "Anisotropy")
-            tangent = self._anisotropy_tangent(node, aniso, slot)
+            tangent = self._anisotropy_tangent(node, slot)
             self._note_thin_film(node)
             film = f"{self._f(node, 'Thin Film Thickness')}, {self._f(node, 'Thin Film IOR', default='1.33f')}"
             add(f"  mp_add_glossy_aspect(s, {weight}, {slot}, {self._f(node, 'Roughness')}, {aniso}, {tangent}, "

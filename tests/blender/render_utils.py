@@ -48,6 +48,16 @@ def run_test(main):
     sys.exit(code)
 
 
+def verdict(failures, ok):
+    """A test's exit status: 1 after printing its failures, else 0 after
+    printing `ok`."""
+    if failures:
+        print("FAIL: " + "; ".join(failures))
+        return 1
+    print("OK: " + ok)
+    return 0
+
+
 def reset_scene():
     """A fresh, empty scene with the add-on registered and a black world."""
     while _registered:

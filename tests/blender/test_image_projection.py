@@ -88,11 +88,7 @@ def main():
         print(f"{name:18s} {value:8.1f} {int(mask.sum()):7d}")
         if not value >= MIN_PSNR:
             failures.append(f"{name}: {value:.1f} dB < {MIN_PSNR} dB")
-    if failures:
-        print("FAIL: " + "; ".join(failures))
-        return 1
-    print(f"OK: {len(CASES)} projections within {MIN_PSNR} dB of Cycles")
-    return 0
+    return ru.verdict(failures, f"{len(CASES)} projections within {MIN_PSNR} dB of Cycles")
 
 
 ru.run_test(main)

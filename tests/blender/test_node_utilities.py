@@ -295,11 +295,7 @@ def main():
         print(f"{name:34s} {value:8.1f} {worst:10.4f}")
         if not value >= MIN_PSNR:
             failures.append(f"{name}: {value:.1f} dB < {MIN_PSNR} dB")
-    if failures:
-        print("FAIL: " + "; ".join(failures))
-        return 1
-    print(f"OK: {len(cases)} node cases within {MIN_PSNR} dB of Cycles")
-    return 0
+    return ru.verdict(failures, f"{len(cases)} node cases within {MIN_PSNR} dB of Cycles")
 
 
 if __name__ == "__main__":

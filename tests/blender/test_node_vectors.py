@@ -236,11 +236,7 @@ def main():
         if not value >= least:
             failures.append(f"{name}: {value:.1f} dB < {least} dB")
     failures += world_window_warning(scene)
-    if failures:
-        print("FAIL: " + "; ".join(failures))
-        return 1
-    print(f"OK: {len(cases)} vector cases within {MIN_PSNR} dB of Cycles")
-    return 0
+    return ru.verdict(failures, f"{len(cases)} vector cases within {MIN_PSNR} dB of Cycles")
 
 
 if __name__ == "__main__":

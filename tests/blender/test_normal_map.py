@@ -164,11 +164,7 @@ def main():
     for case in (lambda: case_sphere(True, 1.0), lambda: case_sphere(False, 0.6), case_object_space,
                  case_world_space, case_ngon_caps):
         failures += case()
-    if failures:
-        print("FAIL: " + "; ".join(failures))
-        return 1
-    print(f"OK: normal maps within {MIN_PSNR} dB of Cycles")
-    return 0
+    return ru.verdict(failures, f"normal maps within {MIN_PSNR} dB of Cycles")
 
 
 ru.run_test(main)

@@ -100,11 +100,7 @@ def background_main():
         failures += r.get("failures", [])
         if not r.get("quit_requested"):
             failures.append("the window part did not reach the quit step")
-    if failures:
-        print("FAIL: " + "; ".join(failures))
-        return 1
-    print(f"OK: viewport matched F12, followed an edit and quit cleanly ({seconds:.1f} s)")
-    return 0
+    return ru.verdict(failures, f"viewport matched F12, followed an edit and quit cleanly ({seconds:.1f} s)")
 
 
 # ---------------------------------------------------------------------------

@@ -40,15 +40,13 @@ DeviceMaterial to_device(const Material& m) {
 }
 
 // Node values of a material (or the world) appended to the scene's
-// parameter buffer; `at` gets where they start and how many there are.
-void append_params(const std::vector<float>& values, const std::string& owner, std::vector<float>& params,
-                   uint32_t at[4]) {
+// parameter buffer; returns where they start.
+uint32_t append_params(const std::vector<float>& values, const std::string& owner, std::vector<float>& params) {
   if (params.size() + values.size() > size_t(UINT32_MAX))
     throw Error(owner + ": the scene's node values exceed 2^32");
-  at[0] = uint32_t(params.size());
-  at[1] = uint32_t(values.size());
-  at[2] = at[3] = 0;
+  const uint32_t at = uint32_t(params.size());
   params.insert(params.end(), values.begin(), values.end());
+  return at;
 }
 
 // Camera <-> object transforms and texture space of one surface.
@@ -341,14 +339,11 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
   if (scene.materials.empty()) out.materials.push_back(to_device(Material{}));
   for (const Material& m : scene.materials) {
     DeviceMaterial d = to_device(m);
-    append_params(m.program_params, "material '" + m.name + "'", out.params, d.params);
+    d.params[0] = append_params(m.program_params, "material '" + m.name + "'", out.params);
+    d.params[1] = uint32_t(m.program_params.size());
     out.materials.push_back(d);
   }
-  {
-    uint32_t at[4];
-    append_params(scene.world.program_params, "the world", out.params, at);
-    out.world_params_at = at[0];
-  }
+  out.world_params_at = append_params(scene.world.program_params, "the world", out.params);
   if (out.params.empty()) out.params.push_back(0.0f);  // a buffer of at least one value
   out.lights = device_lights(scene.lights, w2c);
   std::vector<bool> refracts(out.materials.size(), false);

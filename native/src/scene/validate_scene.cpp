@@ -30,9 +30,9 @@ size_t program_param_count(const std::string& source) {
   return need;
 }
 
-// A material's or the world's node values: as many as its program reads, all finite.
-void check_program_params(const std::vector<float>& params, const std::string& source, const std::string& owner) {
-  const size_t need = program_param_count(source);
+// A material's or the world's node values: as many as its program reads
+// (`need`, program_param_count), all finite.
+void check_program_params(const std::vector<float>& params, size_t need, const std::string& owner) {
   if (params.size() < need)
     throw Error(owner + ": its program reads " + std::to_string(need) + " node values, but it has " +
                 std::to_string(params.size()));
@@ -250,6 +250,9 @@ void validate_scene(const Scene& scene) {
   if (!(s.sample_memory_mib >= 1.0f) || !std::isfinite(s.sample_memory_mib))
     throw Error("the sample memory must be a finite number of MiB, at least 1");
 
+  // Each program's source is read once for the values it needs.
+  std::vector<size_t> needs;
+  for (const MaterialProgram& p : scene.material_programs) needs.push_back(program_param_count(p.source));
   for (size_t i = 0; i < scene.materials.size(); ++i) {
     const Material& m = scene.materials[i];
     if (!finite(m.color) || !finite(m.opacity) || !finite(m.specular_color) || !finite(m.emission) ||
@@ -262,13 +265,13 @@ void validate_scene(const Scene& scene) {
     if (!std::isfinite(m.displacement_bound) || m.displacement_bound < 0)
       fail("material", m.name.empty() ? std::to_string(i) : m.name, "needs a finite, non-negative displacement bound");
     if (m.program >= 0)
-      check_program_params(m.program_params, scene.material_programs[size_t(m.program)].source,
+      check_program_params(m.program_params, needs[size_t(m.program)],
                            "material '" + (m.name.empty() ? std::to_string(i) : m.name) + "'");
   }
   const World& w = scene.world;
   if (w.program >= 0 && size_t(w.program) >= scene.material_programs.size())
     throw Error("world: program " + std::to_string(w.program) + " does not exist");
-  if (w.program >= 0) check_program_params(w.program_params, scene.material_programs[size_t(w.program)].source, "world");
+  if (w.program >= 0) check_program_params(w.program_params, needs[size_t(w.program)], "world");
   if (w.program >= 0 && (w.bake_width < 8 || w.bake_width > 8192))
     throw Error("world: the baked map's width must be 8 to 8192 texels, not " + std::to_string(w.bake_width));
   if (w.width < 0 || w.height < 0 || w.radiance.size() != size_t(w.width) * size_t(w.height) * 4)
