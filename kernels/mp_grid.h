@@ -273,4 +273,26 @@ MP_INLINE void mp_grid_steps(const MpGridShape* g, uint i, uint j, uint* sx, uin
   *sy = yp != here ? yp : ym;
 }
 
+/* Whether grid vertex (i, j), whose normal faces away from the viewer, has a
+ * neighbour whose normal faces it: the vertex then lies within one
+ * micropolygon of the surface's contour. There a smooth surface folds, both
+ * sides project to the same side of the contour, and the side facing the
+ * viewer is in front (always, seen from outside a solid); a micropolygon
+ * straddling the contour shows that side, as Cycles' ray hits the triangle
+ * facing it. Shading the vertex past the contour as the surface's back would
+ * light the silhouette from the wrong side. A surface seen from behind, with
+ * no contour on it, keeps every vertex facing away. `base` is the grid's
+ * first slot in grid_p and grid_n. */
+MP_INLINE int mp_grid_beside_contour(const MP_GLOBAL float4* grid_p, const MP_GLOBAL float4* grid_n, ulong base,
+                                     const MpGridShape* g, uint i, uint j, int ortho) {
+  uint s[4];
+  mp_grid_neighbours(g, i, j, &s[0], &s[1], &s[2], &s[3]);
+  for (int k = 0; k < 4; ++k) {
+    float3 p = MP_XYZ(grid_p[base + s[k]]), n = MP_XYZ(grid_n[base + s[k]]);
+    float3 v = ortho ? MP_F3(0.0f, 0.0f, 1.0f) : -p;
+    if (dot(n, v) > 0.0f) return 1;
+  }
+  return 0;
+}
+
 #endif

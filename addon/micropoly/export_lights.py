@@ -18,17 +18,18 @@ from mathutils import Vector
 from . import node_compiler
 
 
-def _world_background_node(world):
-    """The Background node feeding the world's active World Output, or None."""
+def _world_shader(world):
+    """The world's active World Output and the node feeding its Surface
+    (past reroutes), or (output, None), or (None, None)."""
     outputs = [n for n in world.node_tree.nodes
                if n.type == "OUTPUT_WORLD" and getattr(n, "target", "ALL") in ("ALL", "CYCLES")]
     out = next((n for n in outputs if n.is_active_output), outputs[0] if outputs else None)
     if out is None or not out.inputs["Surface"].is_linked:
-        return None
+        return out, None
     node = out.inputs["Surface"].links[0].from_node
     while node is not None and node.type == "REROUTE":
         node = node.inputs[0].links[0].from_node if node.inputs[0].is_linked else None
-    return node
+    return out, node
 
 
 def _ray_visibility(world):
@@ -41,30 +42,37 @@ def _ray_visibility(world):
 
 def export_world(native_scene, world, materials=None, warnings=None, film_transparent=False):
     """The world: a uniform color as ambient light; a Background whose color
-    or strength comes from nodes (an HDRI, a gradient) as a world program
-    baked into an environment map, whose light the scene shadows
+    or strength comes from nodes (an HDRI, a gradient), or a tree of
+    Backgrounds mixed or added, as a world program baked into an
+    environment map, whose light the scene shadows
     (native world_lighting.h). Returns the background color (for a uniform
     world; a baked world's background comes with the render result)."""
     if world is None:
         return np.zeros(3, dtype=np.float32)
     color = np.array(list(world.color)[:3], dtype=np.float32)
     if world.use_nodes and world.node_tree is not None:
-        background = _world_background_node(world)
-        if background is not None and background.type == "BACKGROUND":
-            linked = background.inputs["Color"].is_linked or background.inputs["Strength"].is_linked
-            if linked and materials is not None:
-                compiler = node_compiler.NodeCompiler(world, materials.warnings, resources=materials)
-                source = compiler.compile_world(background)
-                program = native_scene.add_material_program("world " + world.name, source)
-                camera, diffuse, glossy = _ray_visibility(world)
-                camera = camera and not film_transparent  # behind objects only on an opaque film
-                native_scene.set_world(program=program, camera=camera, diffuse=float(diffuse),
-                                       glossy=float(glossy), program_params=compiler.params)
-                return np.zeros(3, dtype=np.float32)
-            color = np.array(list(background.inputs["Color"].default_value)[:3], dtype=np.float32)
-            color *= float(background.inputs["Strength"].default_value)
-        elif background is not None and warnings is not None:
-            warnings.append(f"world '{world.name}': a {background.bl_label} node at its output is not supported; "
+        output, shader = _world_shader(world)
+        # A Background of plain values is a uniform ambient light; one fed
+        # by nodes, or a tree of shaders (a Mix Shader of two Backgrounds by
+        # Light Path), is compiled and baked.
+        compiled = shader is not None and shader.type in ("BACKGROUND", "EMISSION", "MIX_SHADER", "ADD_SHADER",
+                                                           "GROUP")
+        plain = compiled and shader.type == "BACKGROUND" and not (
+            shader.inputs["Color"].is_linked or shader.inputs["Strength"].is_linked)
+        if compiled and not plain and materials is not None:
+            compiler = node_compiler.NodeCompiler(world, materials.warnings, resources=materials)
+            source = compiler.compile_world(output)
+            program = native_scene.add_material_program("world " + world.name, source)
+            camera, diffuse, glossy = _ray_visibility(world)
+            camera = camera and not film_transparent  # behind objects only on an opaque film
+            native_scene.set_world(program=program, camera=camera, diffuse=float(diffuse),
+                                   glossy=float(glossy), program_params=compiler.params)
+            return np.zeros(3, dtype=np.float32)
+        if shader is not None and shader.type == "BACKGROUND":
+            color = np.array(list(shader.inputs["Color"].default_value)[:3], dtype=np.float32)
+            color *= float(shader.inputs["Strength"].default_value)
+        elif shader is not None and warnings is not None:
+            warnings.append(f"world '{world.name}': a {shader.bl_label} node at its output is not supported; "
                             "its viewport color lights the scene")
     if np.any(color > 0):
         native_scene.add_light("ambient", color=color.tolist(), intensity=1.0)

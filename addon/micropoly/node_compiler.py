@@ -173,6 +173,11 @@ class NodeCompiler:
     def param4(self, v):
         return self._params(v, 4)
 
+    def param_table(self, values):
+        """A table of values (a curve's samples) as a pointer to the first."""
+        self.params.extend(_finite(c) for c in values)
+        return f"MP_PARAM_TABLE({len(self.params) - len(values)}, {len(values)})"
+
     # ---- helpers ----------------------------------------------------------
     def warn(self, node, what):
         where = "".join(f"group '{g.name}' > " for g in self.groups)
@@ -315,8 +320,8 @@ class NodeCompiler:
             if self.world:
                 for name in ("Camera", "Window"):
                     if node.outputs[name].is_linked:
-                        self.warn(node, f"the {name} output is not supported in the world (it is baked into "
-                                        "a map, not seen through the camera); it gives zero")
+                        self.warn(node, f"the {name} output gives zero in the world's light (baked once for "
+                                        "every view); the background behind objects has it")
             obj_coords = "g->P"
             other = getattr(node, "object", None)
             if other is not None and node.outputs["Object"].is_linked:
@@ -519,10 +524,12 @@ class NodeCompiler:
 
     def emit_light_path(self, node):
         """Light Path: what a camera ray shading direct light sees (every
-        depth 0, no scattering), or a shadow map's ray where Micropoly
-        evaluates transparency for shadows."""
+        depth 0, no scattering), a shadow map's ray where Micropoly
+        evaluates transparency for shadows, or in a world the camera's view
+        of it (Is Camera Ray 1) or the light it sends to surfaces (all 0, as
+        Cycles evaluates its background light)."""
         outs = {o.identifier: ("0.0f", FLOAT, (0.0, 0.0)) for o in node.outputs}
-        outs["Is Camera Ray"] = ("(g->shadow_ray ? 0.0f : 1.0f)", FLOAT, (0.0, 1.0))
+        outs["Is Camera Ray"] = ("(g->camera_ray ? 1.0f : 0.0f)", FLOAT, (0.0, 1.0))
         outs["Is Shadow Ray"] = ("(g->shadow_ray ? 1.0f : 0.0f)", FLOAT, (0.0, 1.0))
         outs["Ray Length"] = ("g->ray_length", FLOAT, None)
         return outs
@@ -805,16 +812,19 @@ class NodeCompiler:
         return {"Color": self.fn.temp(VEC, f"mp_tex_sky({images}, {vec}, &{name})")}
 
     # ---- the world ------------------------------------------------------------
-    def compile_world(self, background):
-        """The world program: its Background's colour times strength as the
-        Surface emission, for each direction (material_program.cl, bake_world).
+    def compile_world(self, output):
+        """The world program: the shader tree at World Output `output`'s
+        Surface as emission for each direction (material_program.cl,
+        bake_world): Backgrounds (and Emissions) give their colour times
+        strength, Mix and Add Shaders weigh and sum them, as in Cycles.
         Returns the source; its node values are then in self.params."""
         self.world = True
         disp_src = "float3 mp_node_displacement(const MpNodeGlobals* g) {\n  return (float3)(0.0f);\n}\n"
-        surf_src = self._function(
-            "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s)",
-            lambda: f"  s->emission = {self.input(background, 'Color', VEC)[0]} * "
-                    f"{self.input(background, 'Strength', FLOAT)[0]};\n")
+
+        def surface_body():
+            self.shader_input(output, "Surface", "(float3)(1.0f)")
+            return ""
+        surf_src = self._function("void mp_node_surface(const MpNodeGlobals* g, MpSurface* s)", surface_body)
         includes = "".join(f'#include "textures/{h}"\n' for h in sorted(self.headers))
         return includes + "".join(self.helpers) + disp_src + surf_src
 
@@ -1001,6 +1011,11 @@ class NodeCompiler:
             return
         if t in ("EMISSION", "BACKGROUND"):
             add(f"  mp_add_emission(s, {weight} * {self._c(node, 'Color')} * {self._f(node, 'Strength')});")
+            return
+        if self.world:
+            # A world shows and sends only light: Cycles renders other
+            # shaders there as nothing.
+            self.warn(node, "is not a Background or Emission; a world gives no light through it")
             return
         if t == "BSDF_PRINCIPLED":
             self.closures += 5  # its most layers at once (coat, sheen, metal, glass, specular; diffuse replaces one)

@@ -160,17 +160,6 @@ def _default_mapping(node):
             and not m.use_min and not m.use_max)
 
 
-def _table_array(compiler, values):
-    """Declares a const float array of `values` in the current function."""
-    k = compiler.fn.counter
-    compiler.fn.counter += 1
-    name = f"curve_table{k}"
-    items = [flit(v) for v in values]
-    rows = [", ".join(items[i:i + 12]) for i in range(0, len(items), 12)]
-    compiler.fn.lines.append(f"  const float {name}[{len(values)}] = {{\n    " + ",\n    ".join(rows) + "};")
-    return name
-
-
 def emit(compiler, node):
     handler = _HANDLERS.get(node.type)
     if handler is None:
@@ -307,17 +296,15 @@ def emit_curves(compiler, node):
     if node.type == "CURVE_FLOAT":
         fac, value = _inputs(compiler, node, ("Factor", "f"), ("Value", "f"))
         lo, hi, extrapolate, values = curve_table(node.mapping, "FLOAT", compiler.version)
-        table = _table_array(compiler, values)
-        expr = (f"mp_curve_float({table}, {len(values)}, {flit(lo)}, {flit(hi)}, {int(extrapolate)}, {fac[0]}, "
-                f"{value[0]})")
+        table, lo, hi = compiler.param_table(values), compiler.param(lo), compiler.param(hi)
+        expr = f"mp_curve_float_p({table}, {len(values)}, {lo}, {hi}, {int(extrapolate)}, {fac[0]}, {value[0]})"
         return {"Value": compiler.fn.temp(FLOAT, expr)}
     rgb = node.type == "CURVE_RGB"
     key = "Color" if rgb else "Vector"
     fac, value = _inputs(compiler, node, ("Fac", "f"), (key, "v"))
     lo, hi, extrapolate, values = curve_table(node.mapping, "RGB" if rgb else "VECTOR", compiler.version)
-    table = _table_array(compiler, values)
-    expr = (f"mp_curves_rgb({table}, {len(values) // 3}, {flit(lo)}, {flit(hi)}, {int(extrapolate)}, {fac[0]}, "
-            f"{value[0]})")
+    table, lo, hi = compiler.param_table(values), compiler.param(lo), compiler.param(hi)
+    expr = f"mp_curves_rgb_p({table}, {len(values) // 3}, {lo}, {hi}, {int(extrapolate)}, {fac[0]}, {value[0]})"
     return {key: compiler.fn.temp(VEC, expr)}
 
 

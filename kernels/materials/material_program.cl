@@ -58,6 +58,7 @@ inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, f
   g.I = vl > 0.0f ? vw / vl : (float3)(0.0f, 0.0f, 1.0f);
   g.ray_length = ortho ? -p.z : length(p);
   g.shadow_ray = 0;
+  g.camera_ray = 1;
   g.backfacing = dot(n, v) < 0.0f;
   g.P = (float3)(mp_row3(o->to_object, 0, p, 1.0f), mp_row3(o->to_object, 1, p, 1.0f), mp_row3(o->to_object, 2, p, 1.0f));
   g.N = mp_camera_normal_to_object(o, n);
@@ -143,6 +144,7 @@ __kernel void displace_grids(__global const SubPatch* diceable, uint count, __gl
   MpProgramInputs in = MP_PROGRAM_INPUTS;
   in.params += materials[material].params[0];
   MpNodeGlobals g = mp_node_globals(o, p, grid_n[index].xyz, &in, sp.patch, uv, &f);
+  g.camera_ray = 0; /* Cycles displaces with no ray */
   float3 d = mp_node_displacement(&g);
   if (!(isfinite(d.x) && isfinite(d.y) && isfinite(d.z))) return;
   grid_p[index] = (float4)(p + mp_object_dir_to_camera(o, d), 1.0f);
@@ -180,6 +182,7 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
    * the surface itself faced away. */
   if (grid_n[index].w > 0.5f) g.backfacing = grid_n[index].w > 1.5f;
   g.shadow_ray = alpha_only != 0;
+  g.camera_ray = alpha_only == 0;
   /* The next grid vertex along u and along v (the previous one on the
    * grid's far border): bump nodes difference towards them, and sharp lobes
    * widen by the normal's spread to them. */
@@ -187,6 +190,10 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   uint here = mp_slot(&shape, i, j), sx, sy;
   mp_grid_steps(&shape, i, j, &sx, &sy);
   ulong gx = index - here + sx, gy = index - here + sy;
+  /* Past the contour by less than a micropolygon: the side in front. */
+  int faced = grid_n[index].w > 0.5f;
+  if (!faced && g.backfacing && mp_grid_beside_contour(grid_p, grid_n, index - here, &shape, i, j, f.ortho))
+    faced = 1, g.backfacing = 0;
 #ifdef MP_NODE_USES_NEIGHBOURS
   /* Bump nodes go a tenth of the way: a small step keeps the difference
    * first-order even where a micropolygon spans much of a texture's feature
@@ -230,7 +237,7 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
    * (mp_normal_spread2): the grid's normals, final since shade.cl. */
   mp_surface_filter_roughness(&s, mp_normal_spread2(n, grid_n[gx].xyz, grid_n[gy].xyz));
   MpRefractScene refract = {refract_nodes, refract_tris, refract_roots[object]};
-  float3 c = mp_shade_closures(p, n, grid_n[index].w > 0.5f, f.ortho, &s, lights, light_count, world_glossy,
+  float3 c = mp_shade_closures(p, n, faced, f.ortho, &s, lights, light_count, world_glossy,
                                use_shadows ? &shadow : 0, refract.root != MP_REFRACT_NONE ? &refract : 0);
   /* Stochastic coverage multiplies by alpha, and by 1 - the held-out share
    * of it: what the closures give is the kept samples' colour. */
@@ -245,17 +252,19 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
 /* The world's radiance towards world direction d: the world program's
  * Surface emission (a Background node's colour times its strength). World
  * nodes see that direction as their position, normal and Generated
- * coordinate, as in Cycles' world shaders. */
-float3 mp_world_radiance(float3 d, const MpProgramInputs* in) {
+ * coordinate, as in Cycles' world shaders. `camera_ray`: the world seen
+ * behind the frame (1) or lighting surfaces (0, Cycles' background light:
+ * Light Path's outputs all 0 but Ray Length). `camera` and `window`: the
+ * view's direction in Cycles' camera space and its image position, for
+ * the world behind the frame (zero in the baked light). */
+float3 mp_world_radiance(float3 d, const MpProgramInputs* in, int camera_ray, float3 camera, float3 window) {
   MpNodeGlobals g;
   g.P = d;
   g.N = d;
   g.Nw = d;
   g.generated = d;
-  /* The world is baked into a map: no image position (the node compiler
-   * warns of these outputs in a world). */
-  g.camera = (float3)(0.0f);
-  g.window = (float3)(0.0f);
+  g.camera = camera;
+  g.window = window;
   for (uint k = 0; k < MP_MAX_UV_LAYERS; ++k) g.uv[k] = (float3)(0.0f);
   g.object = 0;
   g.images = in->images;
@@ -267,6 +276,7 @@ float3 mp_world_radiance(float3 d, const MpProgramInputs* in) {
   g.I = -d;
   g.ray_length = 1e30f;
   g.shadow_ray = 0;
+  g.camera_ray = camera_ray;
   g.backfacing = 0;
   MpSurface s;
   mp_surface_init(&s, d);
@@ -277,14 +287,18 @@ float3 mp_world_radiance(float3 d, const MpProgramInputs* in) {
 }
 
 /* The world over an equirectangular map (scene.h, World), at each texel's
- * centre; the world's node values from params_at in the parameter buffer. */
+ * centre, as the light surfaces receive; the world's node values from
+ * params_at in the parameter buffer. */
 __kernel void bake_world(uint width, uint height, MP_PROGRAM_INPUT_ARGS, uint params_at, __global float4* out) {
   uint i = get_global_id(0);
   if (i >= width * height) return;
   float u = ((float)(i % width) + 0.5f) / (float)width, v = ((float)(i / width) + 0.5f) / (float)height;
   MpProgramInputs in = MP_PROGRAM_INPUTS;
   in.params += params_at;
-  out[i] = (float4)(mp_world_radiance(mp_env_equirect_direction(u, v), &in), 1.0f);
+  /* The light is baked once for every view: no image position (the node
+   * compiler warns of these outputs in a world). */
+  float3 zero = (float3)(0.0f);
+  out[i] = (float4)(mp_world_radiance(mp_env_equirect_direction(u, v), &in, 0, zero, zero), 1.0f);
 }
 
 /* The world behind each pixel of the frame (its crop): the mean of 2 x 2
@@ -299,11 +313,18 @@ __kernel void world_pixels(FrameParams f, float4 r0, float4 r1, float4 r2, MP_PR
   in.params += params_at;
   float3 sum = (float3)(0.0f);
   for (int s = 0; s < 4; ++s) {
-    float3 d = (float3)(0.0f, 0.0f, -1.0f);
-    if (!f.ortho)
-      d = (float3)((px + ((float)(s % 2) + 0.5f) * 0.5f - f.bx) / f.ax,
-                   (py + ((float)(s / 2) + 0.5f) * 0.5f - f.by) / f.ay, -1.0f);
-    sum += mp_world_radiance((float3)(dot(r0.xyz, d), dot(r1.xyz, d), dot(r2.xyz, d)), &in);
+    /* The ray's point on the image plane at depth 1 (perspective: its
+     * direction; orthographic: where it starts, looking down -z). */
+    float3 c = (float3)((px + ((float)(s % 2) + 0.5f) * 0.5f - f.bx) / f.ax,
+                        (py + ((float)(s / 2) + 0.5f) * 0.5f - f.by) / f.ay, -1.0f);
+    float3 d = f.ortho ? (float3)(0.0f, 0.0f, -1.0f) : c;
+    /* Texture Coordinate: Camera is the direction in Cycles' +Z-forward
+     * camera space, Window the image position, as Cycles gives a camera
+     * ray that meets the world. */
+    float3 dn = normalize(d);
+    float3 window = (float3)(f.ndc_ax * c.x + f.ndc_bx, f.ndc_ay * c.y + f.ndc_by, 0.0f);
+    sum += mp_world_radiance((float3)(dot(r0.xyz, d), dot(r1.xyz, d), dot(r2.xyz, d)), &in, 1,
+                             (float3)(dn.x, dn.y, -dn.z), window);
   }
   sum *= 0.25f;
   out[3 * i] = sum.x, out[3 * i + 1] = sum.y, out[3 * i + 2] = sum.z;

@@ -35,6 +35,8 @@ typedef struct MpNodeGlobals {
   float3 window; /* the image's normalised device coordinates, z = 0 (Texture Coordinate > Window) */
   float ray_length; /* distance from the camera (Light Path > Ray Length) */
   int shadow_ray;   /* evaluated for a shadow map's transparency (Light Path > Is Shadow Ray) */
+  int camera_ray;   /* shading what the camera sees (Light Path > Is Camera Ray): not for shadow
+                       maps, displacement or the world's light, as in Cycles */
   int backfacing;   /* the surface faces away from the viewer (Geometry > Backfacing) */
   float3 uv[MP_MAX_UV_LAYERS];
   MP_GLOBAL const DeviceObject* object; /* object <-> world (world-space nodes), or null */
@@ -52,8 +54,9 @@ typedef struct MpNodeGlobals {
 } MpNodeGlobals;
 
 /* Node value k of the material, and three (four) from k as a vector or
- * colour. Programs name them only in these forms, with k a literal, so the
- * host can tell how many values a program reads (validate_scene.cpp). */
+ * colour; a table of n from k. Programs name them only in these forms, with
+ * k and n literals, so the host can tell how many values a program reads
+ * (validate_scene.cpp). */
 MP_INLINE float3 mp_param3(const MpNodeGlobals* g, int k) {
   return MP_F3(g->params[k], g->params[k + 1], g->params[k + 2]);
 }
@@ -63,6 +66,7 @@ MP_INLINE float4 mp_param4(const MpNodeGlobals* g, int k) {
 #define MP_PARAM(k) (g->params[k])
 #define MP_PARAM3(k) mp_param3(g, k)
 #define MP_PARAM4(k) mp_param4(g, k)
+#define MP_PARAM_TABLE(k, n) (g->params + (k)) /* n values from k: a curve's samples */
 
 
 /* World-space vectors for nodes that work in world space: a direction from

@@ -142,49 +142,59 @@ MP_INLINE float3 mp_wavelength(float lambda_nm, float3 r0, float3 r1, float3 r2)
 
 /* ---- curves ------------------------------------------------------------------ */
 
-/* Channel `channel` of a table of n entries of `stride` floats, at relative
- * position f (0: first entry, 1: last). */
-MP_INLINE float mp_curve_lookup(const float* table, int stride, int channel, int n, float f, int extrapolate) {
-  if ((f < 0.0f || f > 1.0f) && extrapolate) {
-    float t0, dy;
-    if (f < 0.0f) {
-      t0 = table[channel];
-      dy = t0 - table[stride + channel];
-      f = -f;
-    }
-    else {
-      t0 = table[(n - 1) * stride + channel];
-      dy = t0 - table[(n - 2) * stride + channel];
-      f = f - 1.0f;
-    }
-    return t0 + dy * f * (float)(n - 1);
+/* The lookups are defined twice, by MP_CURVE_FUNCTIONS: for a table among
+ * the material's node values (suffix _p, in global memory, so an edited
+ * curve builds no program) and for a table compiled into the program as an
+ * array (programs written before curve tables became node values). */
+#define MP_CURVE_FUNCTIONS(SUFFIX, SPACE)                                                                      \
+  /* Channel `channel` of a table of n entries of `stride` floats, at relative                                 \
+   * position f (0: first entry, 1: last). */                                                                  \
+  MP_INLINE float mp_curve_lookup##SUFFIX(SPACE const float* table, int stride, int channel, int n, float f,   \
+                                          int extrapolate) {                                                   \
+    if ((f < 0.0f || f > 1.0f) && extrapolate) {                                                               \
+      float t0, dy;                                                                                            \
+      if (f < 0.0f) {                                                                                          \
+        t0 = table[channel];                                                                                   \
+        dy = t0 - table[stride + channel];                                                                     \
+        f = -f;                                                                                                \
+      }                                                                                                        \
+      else {                                                                                                   \
+        t0 = table[(n - 1) * stride + channel];                                                                \
+        dy = t0 - table[(n - 2) * stride + channel];                                                           \
+        f = f - 1.0f;                                                                                          \
+      }                                                                                                        \
+      return t0 + dy * f * (float)(n - 1);                                                                     \
+    }                                                                                                          \
+    f = fmin(fmax(f, 0.0f), 1.0f) * (float)(n - 1);                                                            \
+    int i = clamp((int)f, 0, n - 1);                                                                           \
+    float t = f - (float)i;                                                                                    \
+    float a = table[i * stride + channel];                                                                     \
+    if (t > 0.0f) a = (1.0f - t) * a + t * table[(i + 1) * stride + channel];                                  \
+    return a;                                                                                                  \
+  }                                                                                                            \
+                                                                                                               \
+  /* RGB Curves and Vector Curves: `table` holds n (r, g, b) entries sampled                                   \
+   * over [min_x, max_x]. */                                                                                   \
+  MP_INLINE float3 mp_curves_rgb##SUFFIX(SPACE const float* table, int n, float min_x, float max_x,            \
+                                         int extrapolate, float fac, float3 c) {                               \
+    float range = max_x - min_x;                                                                               \
+    float rx = (c.x - min_x) / range, ry = (c.y - min_x) / range, rz = (c.z - min_x) / range;                  \
+    float3 m = MP_F3(mp_curve_lookup##SUFFIX(table, 3, 0, n, rx, extrapolate),                                 \
+                     mp_curve_lookup##SUFFIX(table, 3, 1, n, ry, extrapolate),                                 \
+                     mp_curve_lookup##SUFFIX(table, 3, 2, n, rz, extrapolate));                                \
+    return (1.0f - fac) * c + fac * m;                                                                         \
+  }                                                                                                            \
+                                                                                                               \
+  /* Float Curve: `table` holds n values sampled over [min_x, max_x]. */                                       \
+  MP_INLINE float mp_curve_float##SUFFIX(SPACE const float* table, int n, float min_x, float max_x,            \
+                                         int extrapolate, float fac, float v) {                                \
+    float rel = (v - min_x) / (max_x - min_x);                                                                 \
+    float m = mp_curve_lookup##SUFFIX(table, 1, 0, n, rel, extrapolate);                                       \
+    return (1.0f - fac) * v + fac * m;                                                                         \
   }
-  f = fmin(fmax(f, 0.0f), 1.0f) * (float)(n - 1);
-  int i = clamp((int)f, 0, n - 1);
-  float t = f - (float)i;
-  float a = table[i * stride + channel];
-  if (t > 0.0f) a = (1.0f - t) * a + t * table[(i + 1) * stride + channel];
-  return a;
-}
 
-/* RGB Curves and Vector Curves: `table` holds n (r, g, b) entries sampled
- * over [min_x, max_x]. */
-MP_INLINE float3 mp_curves_rgb(const float* table, int n, float min_x, float max_x, int extrapolate, float fac,
-                               float3 c) {
-  float range = max_x - min_x;
-  float rx = (c.x - min_x) / range, ry = (c.y - min_x) / range, rz = (c.z - min_x) / range;
-  float3 m = MP_F3(mp_curve_lookup(table, 3, 0, n, rx, extrapolate), mp_curve_lookup(table, 3, 1, n, ry, extrapolate),
-                   mp_curve_lookup(table, 3, 2, n, rz, extrapolate));
-  return (1.0f - fac) * c + fac * m;
-}
-
-/* Float Curve: `table` holds n values sampled over [min_x, max_x]. */
-MP_INLINE float mp_curve_float(const float* table, int n, float min_x, float max_x, int extrapolate, float fac,
-                               float v) {
-  float rel = (v - min_x) / (max_x - min_x);
-  float m = mp_curve_lookup(table, 1, 0, n, rel, extrapolate);
-  return (1.0f - fac) * v + fac * m;
-}
+MP_CURVE_FUNCTIONS(, )
+MP_CURVE_FUNCTIONS(_p, MP_GLOBAL)
 
 /* ---- Bright/Contrast and Gamma ------------------------------------------------- */
 

@@ -143,8 +143,10 @@ def test_edited_value_builds_nothing():
     bsdf = next(n for n in nt.nodes if n.type == "BSDF_PRINCIPLED")
     noise = nt.nodes.new("ShaderNodeTexNoise")
     ramp = nt.nodes.new("ShaderNodeValToRGB")
+    curves = nt.nodes.new("ShaderNodeRGBCurve")
     nt.links.new(noise.outputs["Fac"], ramp.inputs["Fac"])
-    nt.links.new(ramp.outputs["Color"], bsdf.inputs["Base Color"])
+    nt.links.new(ramp.outputs["Color"], curves.inputs["Color"])
+    nt.links.new(curves.outputs["Color"], bsdf.inputs["Base Color"])
     bpy.context.object.data.materials.append(mat)
     ru.add_camera(scene, (0, 0, 6), (0, 0, 0))
     light = bpy.data.objects.new("sun", bpy.data.lights.new("sun", "SUN"))
@@ -164,6 +166,16 @@ def test_edited_value_builds_nothing():
     check("an edited node value keeps the program's source", source == edited_source)
     check("an edited node value renders without building a program, with the new values",
           built == 0.0 and ratio[1] > 1.5 * ratio[0], f"built for {built} s; green / red {ratio[0]:.2f} -> {ratio[1]:.2f}")
+    # A curve point moved: the red curve's end from (1, 1) down to (1, 0.1).
+    curves.mapping.curves[0].points[-1].location = (1.0, 0.1)
+    curves.mapping.update()
+    curved_source = node_compiler.compile_material(mat, []).source
+    curved = ru.render_passes(scene, "MICROPOLY", 48, 48, samples=4)["rgba"]
+    built = engine._final_renderers.last_timings.get("program_build_s")
+    red = [float(img[..., 0][covered].mean()) for img in (after, curved)]
+    check("a moved curve point keeps the program's source", source == curved_source)
+    check("a moved curve point renders without building a program, with the new curve",
+          built == 0.0 and red[1] < 0.6 * red[0], f"built for {built} s; red {red[0]:.3f} -> {red[1]:.3f}")
     nt.links.new(noise.outputs["Fac"], bsdf.inputs["Roughness"])
     ru.render_passes(scene, "MICROPOLY", 48, 48, samples=4)
     built = engine._final_renderers.last_timings.get("program_build_s")

@@ -8,7 +8,8 @@ nodes, A = (x, y, 1 - xy) and B = (1 - y, 0.2 + 0.6x, 0.5 + 0.3y) with x, y in
 [0, 1] across the quad, so every case covers a range of inputs. Cases: the
 Mix node with every blend mode Blender offers, the Hue/Saturation/Value node,
 vector Map Range in each interpolation mode, Vector Rotate of each type
-(with and without Invert), Vector Transform between world, object and
+(with and without Invert), RGB Curves, Vector Curves and Float Curve
+(their tables among the material's node values), Vector Transform between world, object and
 camera space (points, vectors, normals; on tiles turned and scaled
 unevenly), node groups (nested, with
 linked and unlinked group inputs, and node names repeated inside and outside
@@ -234,6 +235,48 @@ def build_cases():
             nt.links.new(a, n.inputs["Vector"])
             return _sine(nt, n.outputs["Vector"])
         cases.append((f"Vector Transform {vtype} {src}>{dst}", transform_case))
+
+    def set_points(curve, points):
+        while len(curve.points) < len(points):
+            curve.points.new(0.5, 0.5)
+        for point, xy in zip(curve.points, points):
+            point.location = xy
+
+    def rgb_curves_case(nt, a, b):
+        # Red and the combined curve bent, the combined extrapolated: the
+        # table travels as node values (MP_PARAM_TABLE).
+        n = nt.nodes.new("ShaderNodeRGBCurve")
+        set_points(n.mapping.curves[0], [(0.0, 0.1), (0.45, 0.8), (1.0, 0.6)])
+        set_points(n.mapping.curves[3], [(0.1, 0.0), (0.6, 0.45), (0.9, 1.0)])
+        n.mapping.extend = "EXTRAPOLATED"
+        n.mapping.update()
+        n.inputs["Fac"].default_value = 0.9
+        nt.links.new(a, n.inputs["Color"])
+        return n.outputs["Color"]
+    cases.append(("RGB Curves", rgb_curves_case))
+
+    def vector_curves_case(nt, a, b):
+        n = nt.nodes.new("ShaderNodeVectorCurve")
+        set_points(n.mapping.curves[1], [(-1.0, 0.2), (0.3, 0.9), (1.0, -0.4)])
+        n.mapping.update()
+        nt.links.new(b, n.inputs["Vector"])
+        lift = nt.nodes.new("ShaderNodeVectorMath")
+        lift.operation = "ADD"
+        lift.inputs[1].default_value = (0.0, 0.5, 0.0)
+        nt.links.new(n.outputs["Vector"], lift.inputs[0])
+        return lift.outputs["Vector"]
+    cases.append(("Vector Curves", vector_curves_case))
+
+    if hasattr(bpy.types, "ShaderNodeFloatCurve"):
+        def float_curve_case(nt, a, b):
+            sep = nt.nodes.new("ShaderNodeSeparateXYZ")
+            nt.links.new(a, sep.inputs[0])
+            n = nt.nodes.new("ShaderNodeFloatCurve")
+            set_points(n.mapping.curves[0], [(0.0, 0.9), (0.35, 0.2), (1.0, 0.7)])
+            n.mapping.update()
+            nt.links.new(sep.outputs[0], n.inputs["Value"])
+            return _combine(nt, n.outputs["Value"], sep.outputs[1], sep.outputs[2])
+        cases.append(("Float Curve", float_curve_case))
 
     def other_object_case(nt, a, b):
         # Texture Coordinate > Object of another object (an Empty moved,

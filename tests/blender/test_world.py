@@ -5,7 +5,10 @@ Subdivision Surface on a floor, lit only by an HDRI that ships with Blender
 opaque film; a mutation check: the HDRI turned 90 degrees by a Mapping node
 still agrees, and an unturned render compared with Cycles' turned one does
 not. An occlusion check: the floor under a ball is darker than the open
-floor by the ratio Cycles gives, and not without the world's shadows.
+floor by the ratio Cycles gives, and not without the world's shadows. A
+world split by Light Path's Is Camera Ray lights the objects with the HDRI
+while the camera sees a plain backdrop, as in Cycles; Texture Coordinate's
+Window and Camera colour the background as Cycles' camera rays see them.
 
   MICROPOLY_ADDON_DIR=build/addons blender -b --factory-startup --python tests/blender/test_world.py
 
@@ -146,6 +149,93 @@ def check_occlusion():
     assert abs(unshadowed / cy - 1.0) > 0.10, "the check should fail without the world's shadows"
 
 
+def split_world(scene, backdrop):
+    """The HDRI world, with a Light Path's Is Camera Ray mixing in a plain
+    `backdrop` colour for what the camera sees (an artist's usual split:
+    the HDRI lights the scene, the camera sees a studio colour)."""
+    nodes, links = scene.world.node_tree.nodes, scene.world.node_tree.links
+    hdri = nodes["Background"]
+    plain = nodes.new("ShaderNodeBackground")
+    plain.inputs["Color"].default_value = (*backdrop, 1.0)
+    path = nodes.new("ShaderNodeLightPath")
+    mix = nodes.new("ShaderNodeMixShader")
+    links.new(path.outputs["Is Camera Ray"], mix.inputs["Fac"])
+    links.new(hdri.outputs["Background"], mix.inputs[1])
+    links.new(plain.outputs["Background"], mix.inputs[2])
+    links.new(mix.outputs["Shader"], nodes["World Output"].inputs["Surface"])
+
+
+def check_camera_ray_split():
+    """Objects lit by the HDRI while the camera sees a plain backdrop: the
+    world's light is what Cycles' background light evaluates (Is Camera Ray
+    0), the backdrop what its camera rays see. Lit by the backdrop instead,
+    the objects would not match."""
+    backdrop = (0.3, 0.32, 0.36)
+
+    def scene_of(split):
+        scene = build_scene("forest.exr")
+        if split:
+            split_world(scene, backdrop)
+        else:  # the backdrop everywhere, through a node so its light is shadowed as well
+            world = scene.world.node_tree
+            rgb = world.nodes.new("ShaderNodeRGB")
+            rgb.outputs[0].default_value = (*backdrop, 1.0)
+            world.links.new(rgb.outputs[0], world.nodes["Background"].inputs["Color"])
+        return scene
+
+    mp = render("MICROPOLY", scene_of(True), transparent=False)
+    cy = render("CYCLES", scene_of(True), transparent=False)
+    ru.save_side_by_side(OUTPUT, "world_camera_ray_split", cy, mp)
+    lit_by_backdrop = render("CYCLES", scene_of(False), transparent=False)
+    mp_t, cy_t = render("MICROPOLY", scene_of(True)), render("CYCLES", scene_of(True))
+    objects = ru.covered_interior(mp_t, cy_t, margin=1)
+    behind = (mp_t[..., 3] < 0.001) & (cy_t[..., 3] < 0.001)
+    assert behind.sum() > 100, "the backdrop should show above the floor"
+    lit = ru.psnr(mp[objects][:, :3], cy[objects][:, :3])
+    wrong = ru.psnr(mp[objects][:, :3], lit_by_backdrop[objects][:, :3])
+    seen = float(np.abs(mp[behind][:, :3] - np.array(backdrop)).max())
+    print(f"camera ray split: objects {lit:.1f} dB against Cycles ({wrong:.1f} dB against Cycles lit by the "
+          f"backdrop); the backdrop behind them within {seen:.4f} of its colour")
+    assert lit >= MIN_GLOSSY_DB and wrong < MIN_GLOSSY_DB, (lit, wrong)
+    assert seen <= 0.01, seen
+
+
+def check_view_coordinates():
+    """Texture Coordinate's Window and Camera in a world: the background
+    behind the frame, coloured (Window x, Window y, Camera x + 0.5), as
+    Cycles' camera rays see it (a camera turned and shifted)."""
+    def scene_of():
+        scene = ru.reset_scene()
+        cam = ru.add_camera(scene, (1.0, -6.0, 2.0), (0.0, 0.0, 1.0), lens=40.0)
+        cam.data.shift_x = 0.1
+        world = bpy.data.worlds.new("View coordinates")
+        scene.world = world
+        world.use_nodes = True
+        nodes, links = world.node_tree.nodes, world.node_tree.links
+        coords = nodes.new("ShaderNodeTexCoord")
+        window, camera = nodes.new("ShaderNodeSeparateXYZ"), nodes.new("ShaderNodeSeparateXYZ")
+        links.new(coords.outputs["Window"], window.inputs[0])
+        links.new(coords.outputs["Camera"], camera.inputs[0])
+        lift = nodes.new("ShaderNodeMath")
+        lift.inputs[1].default_value = 0.5
+        links.new(camera.outputs["X"], lift.inputs[0])
+        colour = nodes.new("ShaderNodeCombineXYZ")
+        links.new(window.outputs["X"], colour.inputs[0])
+        links.new(window.outputs["Y"], colour.inputs[1])
+        links.new(lift.outputs[0], colour.inputs[2])
+        links.new(colour.outputs[0], nodes["Background"].inputs["Color"])
+        return scene
+
+    mp = render("MICROPOLY", scene_of(), transparent=False)
+    cy = render("CYCLES", scene_of(), transparent=False)
+    ru.save_side_by_side(OUTPUT, "world_view_coordinates", cy, mp)
+    db = ru.psnr(mp[..., :3], cy[..., :3])
+    spread = float(cy[..., :3].reshape(-1, 3).std(axis=0).min())
+    print(f"view coordinates in the world: {db:.1f} dB against Cycles (Cycles' channels vary by {spread:.3f})")
+    assert spread > 0.05, "the coordinates should vary across the frame"
+    assert db >= 40.0, db
+
+
 def check_rib():
     """The HDRI scene exported to RIB renders in micropoly-render as F12
     renders it: the world's program, its image and the background."""
@@ -183,6 +273,8 @@ def main():
         assert glossy >= MIN_GLOSSY_DB, f"{hdri}: glossy {glossy:.1f} dB < {MIN_GLOSSY_DB}"
         assert background >= 35.0, f"{hdri}: background {background:.1f} dB"
     check_occlusion()
+    check_camera_ray_split()
+    check_view_coordinates()
     check_rib()
     return 0
 

@@ -278,6 +278,39 @@ TEST_F(MaterialProgramTest, MaterialsSharingAProgramReadTheirOwnNodeValues) {
   expect_colours(renderer_->render(back), {0.9f, 0.0f, 0.5f}, {0.6f, 0.4f, 0.2f}, "read back from RIB");
 }
 
+// A curve's samples travel as node values too (MP_PARAM_TABLE, read by the
+// _p lookups of kernels/textures/mp_tex_color.h): a moved curve point
+// renders with no build, and a table shorter than the program reads is
+// refused.
+TEST_F(MaterialProgramTest, CurveTablesAreNodeValues) {
+  Scene s = facing_plane(static_cast<int>(Material::Model::Constant));
+  s.material_programs.push_back(
+      {"curve", "#include \"textures/mp_tex_color.h\"\n" + std::string(kNoDisplacement) +
+                    "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {"
+                    " float v = mp_curve_float_p(MP_PARAM_TABLE(2, 3), 3, MP_PARAM(0), MP_PARAM(1), 0, 1.0f, 0.75f);"
+                    " mp_add_emission(s, (float3)(v)); }\n"});
+  s.materials[0].program_shades = true;
+  // Samples 0, 0.2, 1 over [0.5, 1]: 0.75 is the middle sample.
+  s.materials[0].program_params = {0.5f, 1.0f, 0.0f, 0.2f, 1.0f};
+  const size_t centre = 4 * (32 * 64 + 32);
+  EXPECT_NEAR(renderer_->render(s).rgba[centre], 0.2f, 1e-5f);
+  s.materials[0].program_params[3] = 0.6f;
+  const RenderResult moved = renderer_->render(s);
+  EXPECT_EQ(moved.stats.program_build_ms, 0.0) << "a moved curve point needs no new program";
+  EXPECT_NEAR(moved.rgba[centre], 0.6f, 1e-5f);
+  // Over [0, 1] instead, 0.75 lies between the last two samples.
+  s.materials[0].program_params[0] = 0.0f;
+  EXPECT_NEAR(renderer_->render(s).rgba[centre], 0.8f, 1e-5f);
+  s.materials[0].program_params.pop_back();
+  try {
+    validate_scene(s);
+    FAIL() << "expected an error for 4 values of 5";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("its program reads 5 node values, but it has 4"), std::string::npos)
+        << e.what();
+  }
+}
+
 // A program that reads more node values than its material has, or values
 // that are not finite, are refused before anything reaches the device.
 TEST_F(MaterialProgramTest, MissingOrNonFiniteNodeValuesAreRejected) {

@@ -11,6 +11,8 @@
 #include <sstream>
 #include <string>
 
+#include <unistd.h>
+
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "io/image_io.h"
@@ -24,11 +26,14 @@
 namespace mp::test {
 namespace {
 
-// Texture images go to a folder; the RIB names them by absolute path, so the
-// string reads back from anywhere.
+// Texture images go to a folder of this process (ctest runs tests side by
+// side, each in its own process); the RIB names them by absolute path, so
+// the string reads back from anywhere.
+std::string texture_folder() { return ::testing::TempDir() + "/rib_writer_textures_" + std::to_string(::getpid()); }
+
 std::string to_rib(const Scene& scene) {
   std::ostringstream out;
-  write_rib(scene, out, "", ::testing::TempDir() + "/rib_writer_textures");
+  write_rib(scene, out, "", texture_folder());
   return out.str();
 }
 
@@ -37,7 +42,7 @@ std::string to_rib(const Scene& scene) {
 Scene round_trip(const Scene& scene) {
   const std::string text = to_rib(scene);
   RibReadOptions options;  // the textures are written to an absolute temporary folder
-  options.allowed_roots = {::testing::TempDir() + "/rib_writer_textures"};
+  options.allowed_roots = {texture_folder()};
   RibResult r = read_rib_string(text, "written.rib", ".", options);
   for (const std::string& w : r.warnings) ADD_FAILURE() << "warning: " << w << "\n" << text;
   return std::move(r.scene);

@@ -14,18 +14,34 @@
 namespace mp {
 namespace {
 
-// How many node values a program reads: past the largest k of its
-// MP_PARAM(k), MP_PARAM3(k) and MP_PARAM4(k) (kernels/materials/mp_node_lib.h).
+// The decimal number at source[i] (at most 9 digits); i moves past it.
+// False where there is none.
+bool read_count(const std::string& source, size_t& i, size_t& value) {
+  size_t digits = 0;
+  value = 0;
+  for (; i < source.size() && std::isdigit(static_cast<unsigned char>(source[i])) && digits < 9; ++i, ++digits)
+    value = 10 * value + size_t(source[i] - '0');
+  return digits > 0;
+}
+
+// How many node values a program reads: past the last value of every
+// MP_PARAM(k), MP_PARAM3(k), MP_PARAM4(k) and MP_PARAM_TABLE(k, n)
+// (kernels/materials/mp_node_lib.h).
 size_t program_param_count(const std::string& source) {
+  static const std::string table = "_TABLE(";
   size_t need = 0;
   for (size_t at = source.find("MP_PARAM"); at != std::string::npos; at = source.find("MP_PARAM", at + 1)) {
-    size_t i = at + 8, width = 1;
-    if (i < source.size() && (source[i] == '3' || source[i] == '4')) width = size_t(source[i++] - '0');
-    if (i >= source.size() || source[i] != '(') continue;
-    size_t k = 0, digits = 0;
-    for (++i; i < source.size() && std::isdigit(static_cast<unsigned char>(source[i])) && digits < 10; ++i, ++digits)
-      k = 10 * k + size_t(source[i] - '0');
-    if (digits > 0 && i < source.size() && source[i] == ')') need = std::max(need, k + width);
+    size_t i = at + 8, k = 0, width = 1;
+    const bool is_table = source.compare(i, table.size(), table) == 0;
+    if (is_table) i += table.size() - 1;
+    else if (i < source.size() && (source[i] == '3' || source[i] == '4')) width = size_t(source[i++] - '0');
+    if (i >= source.size() || source[i] != '(' || !read_count(source, ++i, k)) continue;
+    if (is_table) {
+      if (source.compare(i, 2, ", ") != 0) continue;
+      i += 2;
+      if (!read_count(source, i, width)) continue;
+    }
+    if (i < source.size() && source[i] == ')') need = std::max(need, k + width);
   }
   return need;
 }

@@ -171,8 +171,8 @@ int main() {
         continue;
       }
       const std::vector<float>& t = it->second;
-      if (rgb) print3(mp_curves_rgb(t.data(), (int)(t.size() / 3), f[1], f[2], (int)f[3], f[4], vec(f, 6)));
-      else std::printf("%.9g\n", mp_curve_float(t.data(), (int)t.size(), f[1], f[2], (int)f[3], f[4], f[6]));
+      if (rgb) print3(mp_curves_rgb_p(t.data(), (int)(t.size() / 3), f[1], f[2], (int)f[3], f[4], vec(f, 6)));
+      else std::printf("%.9g\n", mp_curve_float_p(t.data(), (int)t.size(), f[1], f[2], (int)f[3], f[4], f[6]));
     }
     else if (name == "bright_contrast") {
       if (!need(f, 6, name, line_no)) { status = 1; std::puts("nan"); continue; }
