@@ -53,7 +53,9 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
   mp_grid_steps(&shape, i, j, &sx, &sy);
   ulong gx = index - here + sx, gy = index - here + sy;
   float3 view = f.ortho ? (float3)(0.0f, 0.0f, 1.0f) : -p;
-  if (!faced && dot(n, view) < 0.0f && mp_grid_beside_contour(grid_p, grid_n, index - here, &shape, i, j, f.ortho))
+  /* (Not for smooth-shaded polygons, whose neighbours' normals this
+   * kernel is replacing.) */
+  if (!smooth && dot(n, view) < 0.0f && mp_grid_beside_contour(grid_p, grid_n, index - here, &shape, i, j, f.ortho))
     faced = 1;
   float3 nx, ny;
   if (!smooth) {

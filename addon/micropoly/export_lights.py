@@ -24,12 +24,9 @@ def _world_shader(world):
     outputs = [n for n in world.node_tree.nodes
                if n.type == "OUTPUT_WORLD" and getattr(n, "target", "ALL") in ("ALL", "CYCLES")]
     out = next((n for n in outputs if n.is_active_output), outputs[0] if outputs else None)
-    if out is None or not out.inputs["Surface"].is_linked:
-        return out, None
-    node = out.inputs["Surface"].links[0].from_node
-    while node is not None and node.type == "REROUTE":
-        node = node.inputs[0].links[0].from_node if node.inputs[0].is_linked else None
-    return out, node
+    if out is None:
+        return None, None
+    return out, node_compiler.linked_from(out.inputs["Surface"])[0]
 
 
 def _ray_visibility(world):
@@ -57,7 +54,7 @@ def export_world(native_scene, world, materials=None, warnings=None, film_transp
         # Light Path), is compiled and baked.
         compiled = shader is not None and shader.type in ("BACKGROUND", "EMISSION", "MIX_SHADER", "ADD_SHADER",
                                                            "GROUP")
-        plain = compiled and shader.type == "BACKGROUND" and not (
+        plain = compiled and shader.type == "BACKGROUND" and not shader.mute and not (
             shader.inputs["Color"].is_linked or shader.inputs["Strength"].is_linked)
         if compiled and not plain and materials is not None:
             compiler = node_compiler.NodeCompiler(world, materials.warnings, resources=materials)
@@ -68,10 +65,10 @@ def export_world(native_scene, world, materials=None, warnings=None, film_transp
             native_scene.set_world(program=program, camera=camera, diffuse=float(diffuse),
                                    glossy=float(glossy), program_params=compiler.params)
             return np.zeros(3, dtype=np.float32)
-        if shader is not None and shader.type == "BACKGROUND":
+        if compiled and shader.type == "BACKGROUND" and not shader.mute:  # plain, or nothing to compile with
             color = np.array(list(shader.inputs["Color"].default_value)[:3], dtype=np.float32)
             color *= float(shader.inputs["Strength"].default_value)
-        elif shader is not None and warnings is not None:
+        elif shader is not None and not compiled and warnings is not None:
             warnings.append(f"world '{world.name}': a {shader.bl_label} node at its output is not supported; "
                             "its viewport color lights the scene")
     if np.any(color > 0):
