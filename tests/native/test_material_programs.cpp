@@ -332,6 +332,14 @@ TEST_F(MaterialProgramTest, MissingOrNonFiniteNodeValuesAreRejected) {
   s.materials[0].program_params[3] = std::nanf("");
   EXPECT_THROW(validate_scene(s), Error);
   s.materials[0].program_params[3] = 0.0f;
+  // Written by hand, with blanks: still counted (8 and 10 values).
+  for (const char* read : {"MP_PARAM ( 7 )", "MP_PARAM_TABLE( 4 ,6)[0]"}) {
+    Scene spaced = s;
+    spaced.material_programs[0].source = std::string(kNoDisplacement) +
+                                         "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {"
+                                         " mp_add_emission(s, (float3)(" + read + ")); }\n";
+    EXPECT_THROW(validate_scene(spaced), Error) << read;
+  }
   s.world.program = 0;  // the world reads the same six values of its own
   s.world.program_params = {1, 2, 3};
   EXPECT_THROW(validate_scene(s), Error);

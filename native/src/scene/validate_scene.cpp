@@ -14,13 +14,19 @@
 namespace mp {
 namespace {
 
-// The decimal number at source[i] (at most 9 digits); i moves past it.
-// False where there is none.
+// The decimal number at source[i], after any blanks, and the blanks after
+// it; i moves past them. False where there is none. A number too long to
+// be an index reads as the largest, so the program is refused.
 bool read_count(const std::string& source, size_t& i, size_t& value) {
+  auto blanks = [&] {
+    while (i < source.size() && std::isspace(static_cast<unsigned char>(source[i]))) ++i;
+  };
   size_t digits = 0;
   value = 0;
-  for (; i < source.size() && std::isdigit(static_cast<unsigned char>(source[i])) && digits < 9; ++i, ++digits)
-    value = 10 * value + size_t(source[i] - '0');
+  blanks();
+  for (; i < source.size() && std::isdigit(static_cast<unsigned char>(source[i])); ++i, ++digits)
+    value = digits < 12 ? 10 * value + size_t(source[i] - '0') : size_t(1) << 40;
+  blanks();
   return digits > 0;
 }
 
@@ -35,12 +41,9 @@ size_t program_param_count(const std::string& source) {
     const bool is_table = source.compare(i, table.size(), table) == 0;
     if (is_table) i += table.size() - 1;
     else if (i < source.size() && (source[i] == '3' || source[i] == '4')) width = size_t(source[i++] - '0');
+    while (i < source.size() && std::isspace(static_cast<unsigned char>(source[i]))) ++i;
     if (i >= source.size() || source[i] != '(' || !read_count(source, ++i, k)) continue;
-    if (is_table) {
-      if (source.compare(i, 2, ", ") != 0) continue;
-      i += 2;
-      if (!read_count(source, i, width)) continue;
-    }
+    if (is_table && (i >= source.size() || source[i] != ',' || !read_count(source, ++i, width))) continue;
     if (i < source.size() && source[i] == ')') need = std::max(need, k + width);
   }
   return need;
