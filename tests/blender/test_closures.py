@@ -593,6 +593,18 @@ def case_unsupported_warning():
     scene = scene_with("odd", odd)
     bpy.ops.mesh.primitive_cube_add(location=(2.5, 0.0, 0.0))
     bpy.context.object.data.materials.append(material("odd2", odd2))
+    # A world mixing a Background with a BSDF: the BSDF gives no light there
+    # (as in Cycles) and is named once.
+    world = bpy.data.worlds.new("Odd world")
+    scene.world = world
+    world.use_nodes = True
+    wt = world.node_tree
+    dull = wt.nodes.new("ShaderNodeBsdfDiffuse")
+    dull.name = "Dull"
+    mix = wt.nodes.new("ShaderNodeMixShader")
+    wt.links.new(wt.nodes["Background"].outputs[0], mix.inputs[1])
+    wt.links.new(dull.outputs[0], mix.inputs[2])
+    wt.links.new(mix.outputs[0], wt.nodes["World Output"].inputs["Surface"])
     from micropoly import operators
     path = os.path.join(tempfile.mkdtemp(prefix="mp-closures-"), "warning.rib")
     warnings = operators.export_rib(bpy.context.evaluated_depsgraph_get(), path)
@@ -603,6 +615,9 @@ def case_unsupported_warning():
         hits = [w for w in warnings if f"material '{mat}'" in w and "Strands" in w]
         if len(hits) != 1:
             failures.append(f"material '{mat}': {len(hits)} warnings naming node 'Strands', not 1")
+    hits = [w for w in warnings if "world 'Odd world'" in w and "Dull" in w]
+    if len(hits) != 1:
+        failures.append(f"world 'Odd world': {len(hits)} warnings naming node 'Dull', not 1")
     # The render goes on: the frame renders with the rest of the tree.
     micro = ru.render_passes(scene, "MICROPOLY", W, H, samples=4)["rgba"]
     if not (micro[..., 3] > 0.5).any():
