@@ -30,6 +30,8 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
    * for shading, node programs and the Normal pass (w = 1: already faced).
    * Displaced surfaces keep the normal of their displaced grid. */
   int faced = 0;
+  /* The surface itself faces away from the viewer. */
+  int away = dot(n, f.ortho ? (float3)(0.0f, 0.0f, 1.0f) : -p) < 0.0f;
   int smooth = (patch_info[4 * (ulong)sp.patch + 2] & MP_PATCH_SMOOTH_NORMALS) && !(m.program[1] > 0.0f);
   if (smooth) {
     float3 ns = mp_face_shading_normal(patch_normals, sp.patch, uv.x, uv.y, n, p, f.ortho);
@@ -37,8 +39,7 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
       /* w, for node programs: 1 faced, 2 faced and the surface itself faces
        * away (Backfacing). They replace it by the held-out share the sampler
        * reads (material_program.cl); for other materials it stays 0. */
-      float3 view = f.ortho ? (float3)(0.0f, 0.0f, 1.0f) : -p;
-      float flag = dot(n, view) < 0.0f ? 2.0f : 1.0f;
+      float flag = away ? 2.0f : 1.0f;
       grid_n[index] = (float4)(ns, m.program[2] > 0.0f ? flag : 0.0f);
       n = ns, faced = 1;
     }
@@ -52,10 +53,10 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
   uint here = mp_slot(&shape, i, j), sx, sy;
   mp_grid_steps(&shape, i, j, &sx, &sy);
   ulong gx = index - here + sx, gy = index - here + sy;
-  float3 view = f.ortho ? (float3)(0.0f, 0.0f, 1.0f) : -p;
-  /* (Not for smooth-shaded polygons, whose neighbours' normals this
-   * kernel is replacing.) */
-  if (!smooth && dot(n, view) < 0.0f && mp_grid_beside_contour(grid_p, grid_n, index - here, &shape, i, j, f.ortho))
+  /* Past the contour by less than a micropolygon: the side in front (not
+   * for smooth-shaded polygons, whose neighbours' normals this kernel is
+   * replacing). */
+  if (!smooth && away && mp_grid_beside_contour(grid_p, grid_n, index - here, &shape, i, j, f.ortho))
     faced = 1;
   float3 nx, ny;
   if (!smooth) {

@@ -17,16 +17,17 @@ namespace {
 // The decimal number at source[i], after any blanks, and the blanks after
 // it; i moves past them. False where there is none. A number too long to
 // be an index reads as the largest, so the program is refused.
+void skip_blanks(const std::string& source, size_t& i) {
+  while (i < source.size() && std::isspace(static_cast<unsigned char>(source[i]))) ++i;
+}
+
 bool read_count(const std::string& source, size_t& i, size_t& value) {
-  auto blanks = [&] {
-    while (i < source.size() && std::isspace(static_cast<unsigned char>(source[i]))) ++i;
-  };
   size_t digits = 0;
   value = 0;
-  blanks();
+  skip_blanks(source, i);
   for (; i < source.size() && std::isdigit(static_cast<unsigned char>(source[i])); ++i, ++digits)
     value = digits < 12 ? 10 * value + size_t(source[i] - '0') : size_t(1) << 40;
-  blanks();
+  skip_blanks(source, i);
   return digits > 0;
 }
 
@@ -41,7 +42,7 @@ size_t program_param_count(const std::string& source) {
     const bool is_table = source.compare(i, table.size(), table) == 0;
     if (is_table) i += table.size() - 1;
     else if (i < source.size() && (source[i] == '3' || source[i] == '4')) width = size_t(source[i++] - '0');
-    while (i < source.size() && std::isspace(static_cast<unsigned char>(source[i]))) ++i;
+    skip_blanks(source, i);
     if (i >= source.size() || source[i] != '(' || !read_count(source, ++i, k)) continue;
     if (is_table && (i >= source.size() || source[i] != ',' || !read_count(source, ++i, width))) continue;
     if (i < source.size() && source[i] == ')') need = std::max(need, k + width);
