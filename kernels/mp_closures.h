@@ -14,6 +14,7 @@
 #define MP_CLOSURES_H
 
 #include "mp_compat.h"
+#include "mp_subsurface.h"
 
 /* Thin film (mp_thin_film.h) costs registers in every shading kernel that
  * compiles it (12% of the Principled BSDF's shade time on an H100), so an
@@ -35,7 +36,7 @@
 #define MP_CLOSURE_SHEEN 5        /* a = roughness; fresnel: MP_SHEEN_* */
 #define MP_CLOSURE_TOON_DIFFUSE 6 /* a = size, b = smooth */
 #define MP_CLOSURE_TOON_GLOSSY 7
-#define MP_CLOSURE_SUBSURFACE 8   /* diffusion approximated by Lambert */
+#define MP_CLOSURE_SUBSURFACE 8   /* Lambert, of the random walk's albedo from 4.x on (mp_subsurface.h) */
 #define MP_CLOSURE_CLEARCOAT 9    /* Principled 3.x's clearcoat: GTR1, IOR 1.5; a = b = alpha */
 #define MP_CLOSURE_PHONG 10       /* RenderMan's plastic specular, (n.h)^(1/a) per unit irradiance */
 
@@ -172,8 +173,21 @@ MP_INLINE void mp_add_diffuse_eon(MpSurface* s, float3 w, float3 color, int slot
 MP_INLINE void mp_add_translucent(MpSurface* s, float3 w, int slot) {
   mp_surface_add(s, mp_closure(MP_CLOSURE_TRANSLUCENT, mp_clamp_weight(w), slot, 0.0f, 0.0f));
 }
+/* Subsurface scattering as Blender 3.x's walk (and Christensen-Burley)
+ * returns it: Lambert of its Color. */
 MP_INLINE void mp_add_subsurface(MpSurface* s, float3 w, int slot) {
   mp_surface_add(s, mp_closure(MP_CLOSURE_SUBSURFACE, mp_clamp_weight(w), slot, 0.0f, 0.0f));
+}
+/* As a 4.x walk (model MP_SSS_*) returns it: w (Color times the weight
+ * above) scaled per channel by the walk's ratio for that Color (albedo), the
+ * view's cosine nv to the normal, the entry's GGX roughness and IOR and the
+ * radius (mp_subsurface_ratio). */
+MP_INLINE void mp_add_subsurface_walk(MpSurface* s, float3 w, float3 albedo, float3 radius, float nv, float roughness,
+                                      float ior, int model, int slot) {
+  float3 a = mp_clamp_weight(albedo);
+  a = MP_F3(fmin(a.x, 1.0f), fmin(a.y, 1.0f), fmin(a.z, 1.0f));
+  float3 ratio = mp_subsurface_ratio(model, a, radius, nv, roughness, ior);
+  mp_surface_add(s, mp_closure(MP_CLOSURE_SUBSURFACE, mp_clamp_weight(w) * ratio, slot, 0.0f, 0.0f));
 }
 MP_INLINE void mp_add_emission(MpSurface* s, float3 w) { s->emission += w; }
 MP_INLINE void mp_add_transparent(MpSurface* s, float3 w) { s->transparent += mp_clamp_weight(w); }

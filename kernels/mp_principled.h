@@ -27,6 +27,9 @@ typedef struct {
   float3 sheen_tint;    /* 4.x: a colour; 3.x: the amount in .x */
   float subsurface;
   float3 subsurface_color; /* 3.x */
+  float3 subsurface_radius; /* 4.x: Subsurface Radius times Scale */
+  float subsurface_ior;     /* 4.x: Subsurface IOR (Random Walk (Skin)) */
+  int subsurface_model;     /* 4.x: MP_SSS_* (mp_subsurface.h) */
   float3 emission;      /* colour times strength */
   int slot, coat_slot;  /* normal slots */
   float nv, coat_nv;    /* cosines between the view and those normals */
@@ -171,8 +174,12 @@ MP_INLINE void mp_add_principled_v4(MpSurface* s, float3 w, const MpPrincipled* 
 #endif
     w = w * mp_below(albedo);
   }
+  /* The walk enters through the specular layer's IOR and the squared
+   * roughness (Skin: its own Subsurface IOR), as in Cycles. */
   float sss = clamp(p->subsurface, 0.0f, 1.0f);
-  mp_add_subsurface(s, w * sss * base1, p->slot);
+  if (sss > 0.0f)
+    mp_add_subsurface_walk(s, w * sss * base1, base1, p->subsurface_radius, p->nv, roughness * roughness,
+                           p->subsurface_model == MP_SSS_SKIN ? p->subsurface_ior : eta, p->subsurface_model, p->slot);
   /* Diffuse Roughness (4.3 and later) is EON's Oren-Nayar of the base colour. */
   mp_add_diffuse_eon(s, w * (1.0f - sss) * base, base, p->slot, p->diffuse_roughness);
 }

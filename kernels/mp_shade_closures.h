@@ -453,7 +453,9 @@ MP_INLINE float3 mp_shade_material(float3 p, float3 n, int faced, int ortho, con
   pr.sheen = pr.sheen_roughness = 0.0f;
   pr.sheen_tint = one;
   pr.subsurface = 0.0f;
-  pr.subsurface_color = zero;
+  pr.subsurface_color = pr.subsurface_radius = zero;
+  pr.subsurface_ior = 1.4f;
+  pr.subsurface_model = MP_SSS_LAMBERT;
   pr.diffuse_roughness = 0.0f;
   pr.thin_film = 0.0f;
   pr.thin_film_ior = 1.33f;

@@ -1039,6 +1039,12 @@ class NodeCompiler:
             add(f"  mp_add_diffuse(s, {weight} * {color}, {slot}, {self._f(node, 'Roughness')});")
         elif t == "BSDF_TRANSLUCENT":
             add(f"  mp_add_translucent(s, {weight} * {color}, {slot});")
+        elif t == "SUBSURFACE_SCATTERING" and self._subsurface_model(node) != "MP_SSS_LAMBERT":
+            # 4.x's random walk: the albedo it returns (kernels/mp_subsurface.h).
+            radius = f"{self._c(node, 'Radius', default='(float3)(1.0f)')} * {self._f(node, 'Scale', default='1.0f')}"
+            add(f"  {{ float3 albedo_ = {color}; mp_add_subsurface_walk(s, {weight} * albedo_, albedo_, {radius}, "
+                f"fabs(mp_view_cos(g, {self._slot_normal(slot)})), clamp({self._f(node, 'Roughness', default='1.0f')}, "
+                f"0.0f, 1.0f), {self._f(node, 'IOR', default='1.4f')}, {self._subsurface_model(node)}, {slot}); }}")
         elif t == "SUBSURFACE_SCATTERING":
             add(f"  mp_add_subsurface(s, {weight} * {color}, {slot});")
         elif t in ("BSDF_GLOSSY", "BSDF_ANISOTROPIC"):
@@ -1139,6 +1145,10 @@ class NodeCompiler:
             # Cycles colours metal by the film from Blender 5.0 on.
             "film_on_metal": "1" if self.version >= 500 else "0",
             "subsurface_color": c(node, "Subsurface Color", default="(float3)(0.0f)"),
+            "subsurface_radius": f"{c(node, 'Subsurface Radius', default='(float3)(1.0f)')} * "
+                                 f"{f(node, 'Subsurface Scale', default='0.05f')}",
+            "subsurface_ior": f(node, "Subsurface IOR", default="1.4f"),
+            "subsurface_model": self._subsurface_model(node),
             "emission": f"{c(node, 'Emission Color', 'Emission')} * {f(node, 'Emission Strength', default='1.0f')}",
             "slot": slot, "coat_slot": coat_slot, "v4": "1" if v4 else "0", "retro": "0" if v4 else "1",
             "multiscatter": "1" if getattr(node, "distribution", "GGX") == "MULTI_GGX" else "0",
@@ -1151,6 +1161,16 @@ class NodeCompiler:
         add(f"  {p}.nv = fabs(mp_view_cos(g, {n}));")
         add(f"  {p}.coat_nv = fabs(mp_view_cos(g, {cn}));")
         add(f"  mp_add_principled(s, {weight}, &{p}, {n});")
+
+    def _subsurface_model(self, node):
+        """How a subsurface closure returns light (kernels/mp_subsurface.h):
+        from 4.0 on Cycles' random walk enters through a rough boundary and
+        returns less or more than its Color with the view's angle; Blender
+        3.x's walk and Christensen-Burley return the Color (Lambert)."""
+        method = getattr(node, "subsurface_method", None) or getattr(node, "falloff", "RANDOM_WALK")
+        if self.version < 400 or method not in ("RANDOM_WALK", "RANDOM_WALK_SKIN"):
+            return "MP_SSS_LAMBERT"
+        return "MP_SSS_SKIN" if method == "RANDOM_WALK_SKIN" else "MP_SSS_WALK"
 
     def _normal_input_mode(self):
         """How Cycles treats a BSDF's Normal input in the running Blender:

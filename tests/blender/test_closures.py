@@ -236,6 +236,26 @@ def m_subsurface(nt):
     return sss.outputs[0]
 
 
+def m_principled_subsurface(nt):
+    """The Principled BSDF's subsurface at full weight (4.x: Random Walk
+    through its IOR and roughness; 3.x: its Subsurface Color)."""
+    p = principled(nt, **{"Base Color": rgba(0.8, 0.45, 0.35), "Roughness": 0.5, "Subsurface Weight": 1.0,
+                          "Subsurface": 1.0, "Subsurface Color": rgba(0.8, 0.45, 0.35), "Subsurface Scale": 0.1})
+    # 3.x has no Subsurface Scale: the radius itself.
+    scale = 1.0 if "Subsurface Scale" in p.inputs else 0.1
+    p.inputs["Subsurface Radius"].default_value = (1.0 * scale, 0.35 * scale, 0.2 * scale)
+    return p.outputs[0]
+
+
+def m_subsurface_slab(nt):
+    """Subsurface Scattering (Random Walk, roughness 1, IOR 1.4) of three
+    albedos, for a slab far thicker than its radius."""
+    sss = node(nt, "ShaderNodeSubsurfaceScattering", Color=rgba(0.8, 0.45, 0.15), Scale=0.05)
+    sss.falloff = "RANDOM_WALK"
+    sss.inputs["Radius"].default_value = (1.0, 0.5, 0.25)
+    return sss.outputs[0]
+
+
 def m_toon(component):
     def build(nt):
         t = node(nt, "ShaderNodeBsdfToon", Color=rgba(0.8, 0.5, 0.3), Size=0.5, Smooth=0.1)
@@ -409,6 +429,63 @@ def case_diffuse_roughness(name, threshold=30.0):
     if db_wrong >= threshold:
         failures.append(f"as a Lambert base it reaches {db_wrong:.2f} dB: the case cannot tell")
     return report(name, failures, f"PSNR {db:.2f} dB over {covered} px; as a Lambert base {db_wrong:.2f} dB")
+
+
+def band_bias(cycles, micro, rows=20):
+    """The worst relative difference of mean colour between the renders over
+    bands of `rows` image rows (one band: about one view angle), over the
+    pixels both cover fully."""
+    both = (cycles[..., 3] > 0.999) & (micro[..., 3] > 0.999)
+    worst = 0.0
+    for r0 in range(0, cycles.shape[0], rows):
+        band = np.zeros_like(both)
+        band[r0:r0 + rows] = both[r0:r0 + rows]
+        if band.sum() < 100:
+            continue
+        ref = cycles[band][:, :3].mean(0)
+        worst = max(worst, float(np.max(np.abs(micro[band][:, :3].mean(0) / ref - 1.0))))
+    return worst
+
+
+def case_subsurface_slab(name, threshold=32.0, bias=0.03):
+    """A thick slab of subsurface scattering under a sun, seen in
+    perspective from about 50 degrees off its normal to grazing: from 4.0 on
+    Cycles' walk returns less than its Color seen steeply and more at
+    grazing angles (kernels/mp_subsurface.h); Blender 3.x's returns the
+    Color. Over the slab's pixels: PSNR >= threshold (Cycles' walk is noisy
+    at 256 samples) and each band of rows' mean colour within `bias` of
+    Cycles'; in 4.x a Lambert of the same Color must miss the latter."""
+    scene = ru.reset_scene()
+    ru.add_camera(scene, (0.0, -7.0, 2.2), (0.0, 4.0, -1.0), lens=35.0)
+    bpy.ops.mesh.primitive_cube_add(size=1.0, location=(0.0, 4.0, -3.0))
+    slab = bpy.context.object
+    slab.scale = (14.0, 22.0, 4.0)
+    slab.data.materials.append(material(name, m_subsurface_slab))
+    sun = bpy.data.lights.new("sun", "SUN")
+    sun.energy = 3.0
+    sun.angle = math.radians(2.0)
+    sobj = bpy.data.objects.new("sun", sun)
+    sobj.rotation_euler = (math.radians(25.0), 0.0, math.radians(30.0))
+    scene.collection.objects.link(sobj)
+    scene.world.use_nodes = True
+    next(n for n in scene.world.node_tree.nodes if n.type == "BACKGROUND").inputs["Strength"].default_value = 0.0
+    cycles, micro = render_pair(scene, name)
+    db, covered = covered_psnr(cycles, micro)
+    off = band_bias(cycles, micro)
+    slab.data.materials[0] = material(name + "_lambert", lambda nt: node(
+        nt, "ShaderNodeBsdfDiffuse", Color=rgba(0.8, 0.45, 0.15)).outputs[0])
+    off_lambert = band_bias(cycles, ru.render_passes(scene, "MICROPOLY", W, H, samples=16)["rgba"])
+    failures = []
+    if covered < 0.5 * W * H:
+        failures.append(f"only {covered} covered pixels")
+    if db < threshold:
+        failures.append(f"PSNR {db:.2f} dB < {threshold}")
+    if off > bias:
+        failures.append(f"a band's mean colour is {100 * off:.1f}% off Cycles' (> {100 * bias:.0f}%)")
+    if VERSION >= 400 and off_lambert <= bias:
+        failures.append(f"as Lambert the bands are within {100 * off_lambert:.1f}%: the case cannot tell")
+    return report(name, failures, f"PSNR {db:.2f} dB over {covered} px, bands within {100 * off:.1f}%; "
+                                  f"as Lambert {100 * off_lambert:.1f}%")
 
 
 def case_thin_film(name, metallic, threshold=30.0):
@@ -688,6 +765,8 @@ CASES = {
     "principled_specular_tint": lambda: case_material("principled_specular_tint", m_principled_specular_tint),
     "translucent": lambda: case_material("translucent", m_translucent),
     "subsurface": lambda: case_material("subsurface", m_subsurface),
+    "principled_subsurface": lambda: case_material("principled_subsurface", m_principled_subsurface),
+    "subsurface_slab": lambda: case_subsurface_slab("subsurface_slab"),
     "diffuse_rough": lambda: case_material("diffuse_rough", m_diffuse_rough),
     "principled_diffuse_rough": lambda: case_diffuse_roughness("principled_diffuse_rough"),
     "rerouted_principled": lambda: case_material("rerouted_principled", m_rerouted_principled),
