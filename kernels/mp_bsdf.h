@@ -6,6 +6,7 @@
 
 #include "mp_compat.h"
 #include "mp_ggx_albedo.h"
+#include "mp_sheen_ltc_table.h"
 
 #define MP_BSDF_PI 3.14159265358979f
 
@@ -203,48 +204,76 @@ MP_INLINE float mp_toon(float angle_cos, float size, float smooth) {
   return denom > 0.0f ? is * 0.5f / (MP_BSDF_PI * denom) : 0.0f;
 }
 
-/* Sheen of microfibers (Sheen BSDF's Microfiber and Principled 4.x sheen).
- * Cycles' lobe is an LTC fitted to a volumetric fibre layer (Zeltner et al.
- * 2022). Here its shape is the "Charlie" distribution of Estevez and Kulla
- * 2017, D = (2 + 1/a) sin(theta_h)^(1/a) / (2 pi) with a = roughness^2, with
- * Neubelt and Pettineo's visibility 1 / (4 (nl + nv - nl nv)), and its
- * albedo at each view angle Cycles' own: the Charlie lobe (albedo E, by
- * quadrature, scripts/microfiber_sheen_table.py) is scaled by R / E, R
- * measured from Cycles 4.5 in a furnace (scripts/sheen_albedo_cycles.py).
- * Both on a 9 x 9 grid of nv (rows, 0.02 then 0.125 .. 1) and roughness
- * (columns, 0.05 then 0.125 .. 1), read bilinearly: E first, then R. */
-MP_CONSTANT float mp_microfiber_sheen_table[162] = {3.9337f,2.3146f,1.3820f,1.0206f,0.8375f,0.7312f,0.6642f,0.6195f,0.5882f,0.2294f,0.7300f,0.7482f,0.6634f,0.5958f,0.5481f,0.5146f,0.4907f,0.4734f,0.0037f,0.1925f,0.3945f,0.4334f,0.4314f,0.4209f,0.4102f,0.4012f,0.3939f,0.0000f,0.0431f,0.2041f,0.2844f,0.3165f,0.3289f,0.3336f,0.3351f,0.3352f,0.0000f,0.0073f,0.0989f,0.1819f,0.2296f,0.2561f,0.2716f,0.2811f,0.2873f,0.0000f,0.0008f,0.0428f,0.1103f,0.1616f,0.1960f,0.2189f,0.2346f,0.2458f,0.0000f,0.0000f,0.0153f,0.0609f,0.1077f,0.1450f,0.1727f,0.1932f,0.2085f,0.0000f,0.0000f,0.0037f,0.0280f,0.0650f,0.1010f,0.1313f,0.1553f,0.1740f,0.0000f,0.0000f,0.0002f,0.0077f,0.0313f,0.0628f,0.0935f,0.1198f,0.1414f,
-0.1247f,0.4931f,0.6347f,0.6588f,0.6681f,0.6778f,0.6930f,0.7153f,0.7408f,0.0003f,0.0612f,0.3151f,0.4468f,0.5189f,0.5678f,0.6097f,0.6480f,0.6850f,0.0000f,0.0023f,0.1014f,0.2548f,0.3677f,0.4502f,0.5166f,0.5723f,0.6196f,0.0000f,0.0003f,0.0268f,0.1286f,0.2437f,0.3429f,0.4268f,0.4972f,0.5562f,0.0000f,0.0001f,0.0074f,0.0608f,0.1539f,0.2535f,0.3467f,0.4285f,0.4988f,0.0000f,0.0000f,0.0025f,0.0279f,0.0944f,0.1842f,0.2788f,0.3689f,0.4495f,0.0000f,0.0000f,0.0010f,0.0131f,0.0562f,0.1307f,0.2225f,0.3179f,0.4074f,0.0000f,0.0000f,0.0005f,0.0063f,0.0329f,0.0914f,0.1764f,0.2746f,0.3724f,0.0000f,0.0000f,0.0003f,0.0033f,0.0186f,0.0619f,0.1380f,0.2370f,0.3419f};
+/* The Charlie sheen distribution's directional albedo (Estevez and Kulla
+ * 2017, D = (2 + 1/a) sin(theta_h)^(1/a) / (2 pi) with a = roughness^2,
+ * with Neubelt and Pettineo's visibility 1 / (4 (nl + nv - nl nv))), by
+ * quadrature (scripts/microfiber_sheen_table.py), on a 9 x 9 grid of nv
+ * (rows, 0.02 then 0.125 .. 1) and roughness (columns, 0.05 then 0.125 ..
+ * 1), read bilinearly; it stands in for the velvet lobe's albedo. */
+MP_CONSTANT float mp_charlie_sheen_table[81] = {3.9337f,2.3146f,1.3820f,1.0206f,0.8375f,0.7312f,0.6642f,0.6195f,0.5882f,0.2294f,0.7300f,0.7482f,0.6634f,0.5958f,0.5481f,0.5146f,0.4907f,0.4734f,0.0037f,0.1925f,0.3945f,0.4334f,0.4314f,0.4209f,0.4102f,0.4012f,0.3939f,0.0000f,0.0431f,0.2041f,0.2844f,0.3165f,0.3289f,0.3336f,0.3351f,0.3352f,0.0000f,0.0073f,0.0989f,0.1819f,0.2296f,0.2561f,0.2716f,0.2811f,0.2873f,0.0000f,0.0008f,0.0428f,0.1103f,0.1616f,0.1960f,0.2189f,0.2346f,0.2458f,0.0000f,0.0000f,0.0153f,0.0609f,0.1077f,0.1450f,0.1727f,0.1932f,0.2085f,0.0000f,0.0000f,0.0037f,0.0280f,0.0650f,0.1010f,0.1313f,0.1553f,0.1740f,0.0000f,0.0000f,0.0002f,0.0077f,0.0313f,0.0628f,0.0935f,0.1198f,0.1414f};
 
-MP_INLINE float mp_sheen_table(int base, float nv, float roughness) {
+MP_INLINE float mp_charlie_sheen_albedo(float nv, float roughness) {
   float x = clamp(nv, 0.0f, 1.0f) * 8.0f, y = clamp(roughness, 0.0f, 1.0f) * 8.0f;
   int i = (int)fmin(floor(x), 7.0f), j = (int)fmin(floor(y), 7.0f);
   float fx = x - (float)i, fy = y - (float)j;
-  int k = base + 9 * i + j;
-  return (1.0f - fx) * ((1.0f - fy) * mp_microfiber_sheen_table[k] + fy * mp_microfiber_sheen_table[k + 1]) +
-         fx * ((1.0f - fy) * mp_microfiber_sheen_table[k + 9] + fy * mp_microfiber_sheen_table[k + 10]);
+  int k = 9 * i + j;
+  float e = (1.0f - fx) * ((1.0f - fy) * mp_charlie_sheen_table[k] + fy * mp_charlie_sheen_table[k + 1]) +
+            fx * ((1.0f - fy) * mp_charlie_sheen_table[k + 9] + fy * mp_charlie_sheen_table[k + 10]);
+  return fmin(e, 1.0f);
 }
 
-/* The Charlie lobe's own albedo, at most 1 (it also stands in for the
- * velvet lobe's). */
-MP_INLINE float mp_charlie_sheen_albedo(float nv, float roughness) {
-  return fmin(mp_sheen_table(0, nv, roughness), 1.0f);
+/* Sheen of microfibers (Sheen BSDF's Microfiber and Principled 4.x sheen),
+ * as Cycles evaluates it: a linearly transformed cosine (Zeltner et al.
+ * 2022) in the frame whose x axis T is the view's direction along the
+ * surface, f cos = s z (a / ((a x + b z)^2 + (a y)^2 + z^2))^2 / pi for the
+ * light's direction (x, y, z), with a, b and s (the lobe's directional
+ * albedo) functions of the view's cosine and the roughness. Cycles reads
+ * them from tables of its own; mp_sheen_ltc_table.h holds them as fitted to
+ * Cycles 4.5's renders of the lobe (scripts/sheen_ltc_cycles.py). */
+
+/* Parameter k (0: a, 1: b, 2: s) at view cosine nv and roughness r, read
+ * bilinearly (both axes 0.02, then 1/16 .. 1 in sixteenths). */
+MP_INLINE float mp_sheen_ltc(int k, float nv, float roughness) {
+  float p[2] = {clamp(nv, 0.0f, 1.0f), clamp(roughness, 0.0f, 1.0f)};
+  int cell[2];
+  float t[2];
+  for (int d = 0; d < 2; ++d) {
+    float x = p[d] < 0.0625f ? fmax(p[d] - 0.02f, 0.0f) / (0.0625f - 0.02f) : 16.0f * p[d];
+    cell[d] = (int)fmin(floor(x), 15.0f);
+    t[d] = x - (float)cell[d];
+  }
+  int at = k * 289 + 17 * cell[0] + cell[1];
+  return (1.0f - t[0]) * ((1.0f - t[1]) * mp_sheen_ltc_table[at] + t[1] * mp_sheen_ltc_table[at + 1]) +
+         t[0] * ((1.0f - t[1]) * mp_sheen_ltc_table[at + 17] + t[1] * mp_sheen_ltc_table[at + 18]);
 }
 
-/* The microfiber sheen's albedo: Cycles'. */
-MP_INLINE float mp_microfiber_sheen_albedo(float nv, float roughness) { return mp_sheen_table(81, nv, roughness); }
+/* The microfiber sheen's directional albedo: Cycles'. */
+MP_INLINE float mp_microfiber_sheen_albedo(float nv, float roughness) {
+  return fmax(mp_sheen_ltc(2, nv, roughness), 0.0f);
+}
 
-/* The microfiber sheen lobe times cos: Charlie's shape, Cycles' albedo. */
+/* The microfiber sheen lobe times cos. */
 MP_INLINE float mp_microfiber_sheen(float3 n, float3 l, float3 v, float roughness) {
   float nl = dot(n, l), nv = dot(n, v);
   if (!(nl > 0.0f && nv > 0.0f)) return 0.0f;
-  float a = fmax(roughness * roughness, 1e-3f), inv = 1.0f / a;
-  float3 h = normalize(l + v);
-  float nh = dot(n, h), sin2 = fmax(1.0f - nh * nh, 0.0f);
-  float d = (2.0f + inv) * pow(sin2, 0.5f * inv) * (0.5f / MP_BSDF_PI);
-  float e = mp_sheen_table(0, nv, roughness);
-  float scale = e > 1e-4f ? mp_microfiber_sheen_albedo(nv, roughness) / e : 0.0f;
-  return scale * d * nl / (4.0f * (nl + nv - nl * nv));
+  float a = mp_sheen_ltc(0, nv, roughness), b = mp_sheen_ltc(1, nv, roughness);
+  float s = mp_microfiber_sheen_albedo(nv, roughness);
+  /* Cycles skips a lobe whose transform or albedo vanishes. */
+  if (!(fabs(a) >= 1e-5f && s >= 1e-5f)) return 0.0f;
+  /* T: the view along the surface (any tangent when the view is the normal). */
+  float3 t = v - n * nv;
+  float tt = dot(t, t);
+  if (!(tt > 1e-12f)) {
+    t = cross(n, fabs(n.x) < 0.9f ? MP_F3(1.0f, 0.0f, 0.0f) : MP_F3(0.0f, 1.0f, 0.0f));
+    tt = dot(t, t);
+  }
+  t = t * (1.0f / sqrt(tt));
+  float3 bt = cross(n, t);
+  float x = dot(l, t), y = dot(l, bt), z = nl;
+  float ax = a * x + b * z, ay = a * y;
+  float len2 = ax * ax + ay * ay + z * z;
+  float q = a / len2;
+  return s * z * q * q * (1.0f / MP_BSDF_PI);
 }
 
 #endif

@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""The microfiber sheen lobe's directional albedo (kernels/mp_bsdf.h,
-mp_microfiber_sheen: Charlie distribution with Neubelt-Pettineo visibility)
-by quadrature over the hemisphere, on the 9 x 9 grid of
-mp_microfiber_sheen_table: rows of view cosine 0.02, 0.125 .. 1, columns of
-roughness 0.05, 0.125 .. 1. Prints the table and its initialiser."""
+"""The Charlie sheen lobe's directional albedo (Charlie distribution with
+Neubelt-Pettineo visibility; kernels/mp_bsdf.h, mp_charlie_sheen_table,
+which stands in for the velvet lobe's albedo) by quadrature over the
+hemisphere, on a 9 x 9 grid: rows of view cosine 0.02, 0.125 .. 1, columns
+of roughness 0.05, 0.125 .. 1. Prints the table and its initialiser."""
 import numpy as np
 def charlie(nh, a):
     inv = 1/a; s = np.sqrt(np.maximum(1-nh*nh,0))

@@ -6,9 +6,11 @@ no bounces: every pixel's radiance is the lobe's albedo at that view
 cosine. One render per view cosine; the plane is cut into strips of the 9
 sheen roughnesses (coplanar, so none hides the world from another).
 
-Prints the 9 x 9 table kernels/mp_bsdf.h reads (mp_microfiber_sheen_albedo:
-rows of view cosine 0.02, 0.125 .. 1, columns of roughness 0.05, 0.125 .. 1)
-and its initialiser. Run with a Python that has the bpy module (4.0 or later):
+Prints the 9 x 9 table tests/native/test_closures.cpp holds (rows of view
+cosine 0.02, 0.125 .. 1, columns of roughness 0.05, 0.125 .. 1): the lobe
+the kernels evaluate (fitted to lamp-lit renders by
+scripts/sheen_ltc_cycles.py) must integrate to it. The module also lends
+its scene to that script. Run with a Python that has the bpy module (4.0 or later):
 
   build/bpy-4.5.15/bin/python3 scripts/sheen_albedo_cycles.py
 """
