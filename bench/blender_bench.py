@@ -48,7 +48,8 @@ DEEP = "--deep" in args
 # for it to refract (paths traced through each Suzanne's proxy); film: the
 # Principled BSDF with a 450 nm Thin Film (Blender 4.2 and later); subsurface:
 # the Principled BSDF at Subsurface Weight 1 (4.x: Cycles' random walk's
-# albedo looked up per vertex, kernels/mp_subsurface.h).
+# albedo looked up per vertex, kernels/mp_subsurface.h); sheen: the
+# Principled BSDF at Sheen Weight 1 (4.x: the microfiber LTC lobe).
 MATERIAL = args[args.index("--material") + 1] if "--material" in args else None
 # --engines A,B: only these engines (default: Micropoly, Cycles and EEVEE).
 ENGINES = args[args.index("--engines") + 1].split(",") if "--engines" in args else None
@@ -79,7 +80,7 @@ def bench_material(mat, kind):
             wt.links.new(noise.outputs["Color"], bg.inputs["Color"])
         return
     film = kind == "film"  # Blender 4.2 and later
-    if kind in ("principled", "film", "subsurface"):
+    if kind in ("principled", "film", "subsurface", "sheen"):
         p = nt.nodes.new("ShaderNodeBsdfPrincipled")
         p.inputs["Base Color"].default_value = color
         p.inputs["Roughness"].default_value = 0.3
@@ -87,6 +88,8 @@ def bench_material(mat, kind):
             p.inputs["Thin Film Thickness"].default_value = 450.0
         if kind == "subsurface":
             p.inputs["Subsurface Weight"].default_value = 1.0
+        if kind == "sheen":
+            p.inputs["Sheen Weight"].default_value = 1.0
         nt.links.new(p.outputs[0], out.inputs["Surface"])
         return
     d = nt.nodes.new("ShaderNodeBsdfDiffuse")

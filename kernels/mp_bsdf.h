@@ -6,7 +6,14 @@
 
 #include "mp_compat.h"
 #include "mp_ggx_albedo.h"
+/* Microfiber sheen's table (mp_sheen_ltc_table.h) only where a sheen can
+ * be: the host and material programs. The main program's constant
+ * materials have none, and a large constant table in its shade kernel
+ * costs it 8% on an H100 even unread. */
+#if !defined(__OPENCL_VERSION__) || defined(MP_MATERIAL_PROGRAM)
+#define MP_MICROFIBER_SHEEN 1
 #include "mp_sheen_ltc_table.h"
+#endif
 
 #define MP_BSDF_PI 3.14159265358979f
 
@@ -231,35 +238,44 @@ MP_INLINE float mp_charlie_sheen_albedo(float nv, float roughness) {
  * them from tables of its own; mp_sheen_ltc_table.h holds them as fitted to
  * Cycles 4.5's renders of the lobe (scripts/sheen_ltc_cycles.py). */
 
-/* Parameter k (0: a, 1: b, 2: s) at view cosine nv and roughness r, read
- * bilinearly (both axes 0.02, then 1/16 .. 1 in sixteenths). */
-MP_INLINE float mp_sheen_ltc(int k, float nv, float roughness) {
-  float p[2] = {clamp(nv, 0.0f, 1.0f), clamp(roughness, 0.0f, 1.0f)};
-  int cell[2];
-  float t[2];
-  for (int d = 0; d < 2; ++d) {
-    float x = p[d] < 0.0625f ? fmax(p[d] - 0.02f, 0.0f) / (0.0625f - 0.02f) : 16.0f * p[d];
-    cell[d] = (int)fmin(floor(x), 15.0f);
-    t[d] = x - (float)cell[d];
-  }
-  int at = k * 289 + 17 * cell[0] + cell[1];
-  return (1.0f - t[0]) * ((1.0f - t[1]) * mp_sheen_ltc_table[at] + t[1] * mp_sheen_ltc_table[at + 1]) +
-         t[0] * ((1.0f - t[1]) * mp_sheen_ltc_table[at + 17] + t[1] * mp_sheen_ltc_table[at + 18]);
+#ifdef MP_MICROFIBER_SHEEN
+/* A place on the LTC table's axes (0.02, then 1/16 .. 1 in sixteenths):
+ * its cell (0 .. 15) and the fraction t across it. */
+MP_INLINE int mp_sheen_ltc_cell(float x, float* t) {
+  x = clamp(x, 0.0f, 1.0f);
+  float u = x < 0.0625f ? fmax(x - 0.02f, 0.0f) * (1.0f / (0.0625f - 0.02f)) : 16.0f * x;
+  int i = (int)fmin(floor(u), 15.0f);
+  *t = u - (float)i;
+  return i;
+}
+
+/* Parameter k (0: a, 1: b, 2: s) in the cells at (i, j), read bilinearly. */
+MP_INLINE float mp_sheen_ltc(int k, int i, float ti, int j, float tj) {
+  int at = k * 289 + 17 * i + j;
+  return (1.0f - ti) * ((1.0f - tj) * mp_sheen_ltc_table[at] + tj * mp_sheen_ltc_table[at + 1]) +
+         ti * ((1.0f - tj) * mp_sheen_ltc_table[at + 17] + tj * mp_sheen_ltc_table[at + 18]);
+}
+
+/* The lobe's transform and albedo (a, b, s) at view cosine nv. */
+MP_INLINE float3 mp_microfiber_sheen_ltc(float nv, float roughness) {
+  float ti, tj;
+  int i = mp_sheen_ltc_cell(nv, &ti), j = mp_sheen_ltc_cell(roughness, &tj);
+  return MP_F3(mp_sheen_ltc(0, i, ti, j, tj), mp_sheen_ltc(1, i, ti, j, tj), fmax(mp_sheen_ltc(2, i, ti, j, tj), 0.0f));
 }
 
 /* The microfiber sheen's directional albedo: Cycles'. */
-MP_INLINE float mp_microfiber_sheen_albedo(float nv, float roughness) {
-  return fmax(mp_sheen_ltc(2, nv, roughness), 0.0f);
-}
+MP_INLINE float mp_microfiber_sheen_albedo(float nv, float roughness) { return mp_microfiber_sheen_ltc(nv, roughness).z; }
 
-/* The microfiber sheen lobe times cos. */
-MP_INLINE float mp_microfiber_sheen(float3 n, float3 l, float3 v, float roughness) {
+#endif
+
+/* The microfiber sheen lobe times cos, of transform and albedo ltc = (a, b,
+ * s) (mp_microfiber_sheen_ltc at the view's cosine): shading reads them once
+ * per closure, before its lamps. */
+MP_INLINE float mp_microfiber_sheen_lobe(float3 n, float3 l, float3 v, float3 ltc) {
   float nl = dot(n, l), nv = dot(n, v);
-  if (!(nl > 0.0f && nv > 0.0f)) return 0.0f;
-  float a = mp_sheen_ltc(0, nv, roughness), b = mp_sheen_ltc(1, nv, roughness);
-  float s = mp_microfiber_sheen_albedo(nv, roughness);
+  float a = ltc.x, b = ltc.y, s = ltc.z;
   /* Cycles skips a lobe whose transform or albedo vanishes. */
-  if (!(fabs(a) >= 1e-5f && s >= 1e-5f)) return 0.0f;
+  if (!(nl > 0.0f && nv > 0.0f && fabs(a) >= 1e-5f && s >= 1e-5f)) return 0.0f;
   /* T: the view along the surface (any tangent when the view is the normal). */
   float3 t = v - n * nv;
   float tt = dot(t, t);
@@ -271,9 +287,15 @@ MP_INLINE float mp_microfiber_sheen(float3 n, float3 l, float3 v, float roughnes
   float3 bt = cross(n, t);
   float x = dot(l, t), y = dot(l, bt), z = nl;
   float ax = a * x + b * z, ay = a * y;
-  float len2 = ax * ax + ay * ay + z * z;
-  float q = a / len2;
+  float q = a / (ax * ax + ay * ay + z * z);
   return s * z * q * q * (1.0f / MP_BSDF_PI);
 }
+
+#ifdef MP_MICROFIBER_SHEEN
+/* The same, reading the tables at the view's cosine. */
+MP_INLINE float mp_microfiber_sheen(float3 n, float3 l, float3 v, float roughness) {
+  return mp_microfiber_sheen_lobe(n, l, v, mp_microfiber_sheen_ltc(fmax(dot(n, v), 0.0f), roughness));
+}
+#endif
 
 #endif

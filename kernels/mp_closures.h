@@ -14,7 +14,6 @@
 #define MP_CLOSURES_H
 
 #include "mp_compat.h"
-#include "mp_subsurface.h"
 
 /* Thin film (mp_thin_film.h) costs registers in every shading kernel that
  * compiles it (12% of the Principled BSDF's shade time on an H100), so an
@@ -24,6 +23,17 @@
 #if !defined(__OPENCL_VERSION__) || defined(MP_NODE_USES_THIN_FILM)
 #define MP_THIN_FILM 1
 #endif
+
+/* Subsurface's random-walk table (mp_subsurface.h) likewise: only programs
+ * whose material walks (MP_NODE_USES_SUBSURFACE_WALK) and the host. */
+#if !defined(__OPENCL_VERSION__) || defined(MP_NODE_USES_SUBSURFACE_WALK)
+#define MP_SUBSURFACE_WALK 1
+#endif
+
+/* Subsurface models (MpPrincipled.subsurface_model, mp_add_subsurface_walk). */
+#define MP_SSS_LAMBERT 0 /* 3.x, Christensen-Burley */
+#define MP_SSS_WALK 1    /* 4.x Random Walk */
+#define MP_SSS_SKIN 2    /* 4.x Random Walk (Skin) */
 
 #define MP_MAX_CLOSURES 10
 #define MP_MAX_CLOSURE_NORMALS 4
@@ -177,17 +187,6 @@ MP_INLINE void mp_add_translucent(MpSurface* s, float3 w, int slot) {
  * returns it: Lambert of its Color. */
 MP_INLINE void mp_add_subsurface(MpSurface* s, float3 w, int slot) {
   mp_surface_add(s, mp_closure(MP_CLOSURE_SUBSURFACE, mp_clamp_weight(w), slot, 0.0f, 0.0f));
-}
-/* As a 4.x walk (model MP_SSS_*) returns it: w (Color times the weight
- * above) scaled per channel by the walk's ratio for that Color (albedo), the
- * view's cosine nv to the normal, the entry's GGX roughness and IOR and the
- * radius (mp_subsurface_ratio). */
-MP_INLINE void mp_add_subsurface_walk(MpSurface* s, float3 w, float3 albedo, float3 radius, float nv, float roughness,
-                                      float ior, int model, int slot) {
-  float3 a = mp_clamp_weight(albedo);
-  a = MP_F3(fmin(a.x, 1.0f), fmin(a.y, 1.0f), fmin(a.z, 1.0f));
-  float3 ratio = mp_subsurface_ratio(model, a, radius, nv, roughness, ior);
-  mp_surface_add(s, mp_closure(MP_CLOSURE_SUBSURFACE, mp_clamp_weight(w) * ratio, slot, 0.0f, 0.0f));
 }
 MP_INLINE void mp_add_emission(MpSurface* s, float3 w) { s->emission += w; }
 MP_INLINE void mp_add_transparent(MpSurface* s, float3 w) { s->transparent += mp_clamp_weight(w); }

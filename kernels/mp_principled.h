@@ -12,6 +12,9 @@
 #include "mp_thin_film.h"
 #endif
 #include "mp_world.h"
+#ifdef MP_SUBSURFACE_WALK
+#include "mp_subsurface.h"
+#endif
 
 typedef struct {
   float3 base_color;
@@ -104,12 +107,14 @@ MP_INLINE void mp_add_principled_v4(MpSurface* s, float3 w, const MpPrincipled* 
   float3 tint = mp_clamp_weight(p->specular_tint);
   float3 tangent = mp_rotate_tangent(p->tangent, normal, p->anisotropic_rotation);
   float sheen = fmax(p->sheen, 0.0f);
+#ifdef MP_MICROFIBER_SHEEN
   if (sheen > 1e-5f) {
     float3 sw = sheen * mp_clamp_weight(p->sheen_tint);
     float sr = clamp(p->sheen_roughness, 0.0f, 1.0f);
     mp_add_sheen(s, w * sw, p->slot, sr, MP_SHEEN_MICROFIBER);
     w = w * mp_below(sw * mp_microfiber_sheen_albedo(p->nv, sr));
   }
+#endif
   float coat = fmax(p->coat, 0.0f);
   if (coat > 1e-5f) {
     float eta = fmax(p->coat_ior, 1.0f), cr = clamp(p->coat_roughness, 0.0f, 1.0f);
@@ -177,9 +182,13 @@ MP_INLINE void mp_add_principled_v4(MpSurface* s, float3 w, const MpPrincipled* 
   /* The walk enters through the specular layer's IOR and the squared
    * roughness (Skin: its own Subsurface IOR), as in Cycles. */
   float sss = clamp(p->subsurface, 0.0f, 1.0f);
+#ifdef MP_SUBSURFACE_WALK
   if (sss > 0.0f)
     mp_add_subsurface_walk(s, w * sss * base1, base1, p->subsurface_radius, p->nv, roughness * roughness,
                            p->subsurface_model == MP_SSS_SKIN ? p->subsurface_ior : eta, p->subsurface_model, p->slot);
+#else
+  mp_add_subsurface(s, w * sss * base1, p->slot);
+#endif
   /* Diffuse Roughness (4.3 and later) is EON's Oren-Nayar of the base colour. */
   mp_add_diffuse_eon(s, w * (1.0f - sss) * base, base, p->slot, p->diffuse_roughness);
 }

@@ -43,12 +43,20 @@ MP_INLINE float mp_normal_spread2(float3 n, float3 nu, float3 nv) {
   return isfinite(variance) ? fmin(2.0f * variance, 0.18f) : 0.0f;
 }
 
-/* Widens the surface's GGX lobes by a normal spread^2 (mp_normal_spread2). */
-MP_INLINE void mp_surface_filter_roughness(MpSurface* s, float spread2) {
-  if (!(spread2 > 0.0f)) return;
+/* Readies a surface (normals in camera space) for mp_shade_closures at
+ * camera-space point p: widens its GGX lobes by a normal spread^2
+ * (mp_normal_spread2), and reads each microfiber sheen's transform and
+ * albedo for the view into its f0 (mp_microfiber_sheen_ltc), so that no
+ * table is read per lamp. */
+MP_INLINE void mp_surface_prepare(MpSurface* s, float spread2, float3 p, int ortho) {
+  float3 v = ortho ? MP_F3(0.0f, 0.0f, 1.0f) : normalize(-p);
   for (int i = 0; i < s->count; ++i) {
     MpClosure* c = &s->c[i];
-    if (c->kind != MP_CLOSURE_GLOSSY && c->kind != MP_CLOSURE_CLEARCOAT) continue;
+#ifdef MP_MICROFIBER_SHEEN
+    if (c->kind == MP_CLOSURE_SHEEN && c->fresnel == MP_SHEEN_MICROFIBER)
+      c->f0 = mp_microfiber_sheen_ltc(fabs(dot(s->normal[c->slot], v)), c->a);
+#endif
+    if (!(spread2 > 0.0f) || (c->kind != MP_CLOSURE_GLOSSY && c->kind != MP_CLOSURE_CLEARCOAT)) continue;
     c->a = fmin(sqrt(c->a * c->a + spread2), 1.0f);
     c->b = fmin(sqrt(c->b * c->b + spread2), 1.0f);
   }
@@ -135,7 +143,7 @@ MP_INLINE float mp_sheen_albedo(const MpClosure* c, float nv) {
     float t = 1.0f - clamp(nv, 0.0f, 1.0f);
     return 0.125f * t * t * t;
   }
-  return c->fresnel == MP_SHEEN_ASHIKHMIN ? mp_charlie_sheen_albedo(nv, c->a) : mp_microfiber_sheen_albedo(nv, c->a);
+  return c->fresnel == MP_SHEEN_ASHIKHMIN ? mp_charlie_sheen_albedo(nv, c->a) : c->f0.z;
 }
 MP_INLINE float mp_closure_sheen(const MpClosure* c, float3 n, float3 l, float3 v) {
   if (c->fresnel == MP_SHEEN_PRINCIPLED_V1) {
@@ -144,7 +152,7 @@ MP_INLINE float mp_closure_sheen(const MpClosure* c, float3 n, float3 l, float3 
     return mp_schlick_weight(fmax(dot(l, h), 0.0f)) * fmax(dot(n, l), 0.0f);
   }
   if (c->fresnel == MP_SHEEN_ASHIKHMIN) return mp_velvet(n, l, v, c->a);
-  return mp_microfiber_sheen(n, l, v, c->a);
+  return mp_microfiber_sheen_lobe(n, l, v, c->f0);
 }
 
 /* The direction the view leaves a closed object refracting it (relative
@@ -468,7 +476,7 @@ MP_INLINE float3 mp_shade_material(float3 p, float3 n, int faced, int ortho, con
   pr.retro = flags & 1;
   pr.multiscatter = (flags >> 1) & 1;
   mp_add_principled(&s, one, &pr, n);
-  mp_surface_filter_roughness(&s, spread2);
+  mp_surface_prepare(&s, spread2, p, ortho);
   return mp_shade_closures(p, n, faced, ortho, &s, lights, light_count, world_glossy, shadow, refract);
 }
 

@@ -19,12 +19,8 @@
 #define MP_SUBSURFACE_H
 
 #include "mp_compat.h"
+#include "mp_closures.h"
 #include "mp_subsurface_table.h"
-
-/* Subsurface models (MpClosure.fresnel of a subsurface closure). */
-#define MP_SSS_LAMBERT 0 /* 3.x, Christensen-Burley */
-#define MP_SSS_WALK 1    /* 4.x Random Walk */
-#define MP_SSS_SKIN 2    /* 4.x Random Walk (Skin) */
 
 /* Cycles' smallest radius for a walk: a channel below it is Lambert. */
 #define MP_SSS_MIN_RADIUS 1e-8f
@@ -102,6 +98,18 @@ MP_INLINE float3 mp_subsurface_ratio(int model, float3 albedo, float3 radius, fl
   r.y = radius.y < MP_SSS_MIN_RADIUS ? 1.0f : mp_sss_channel(albedo.y, model, eta_i, eta_t, alpha_i, alpha_t, cos_i, cos_t);
   r.z = radius.z < MP_SSS_MIN_RADIUS ? 1.0f : mp_sss_channel(albedo.z, model, eta_i, eta_t, alpha_i, alpha_t, cos_i, cos_t);
   return r;
+}
+
+/* As a 4.x walk (model MP_SSS_*) returns it: w (Color times the weight
+ * above) scaled per channel by the walk's ratio for that Color (albedo), the
+ * view's cosine nv to the normal, the entry's GGX roughness and IOR and the
+ * radius (mp_subsurface_ratio). */
+MP_INLINE void mp_add_subsurface_walk(MpSurface* s, float3 w, float3 albedo, float3 radius, float nv, float roughness,
+                                      float ior, int model, int slot) {
+  float3 a = mp_clamp_weight(albedo);
+  a = MP_F3(fmin(a.x, 1.0f), fmin(a.y, 1.0f), fmin(a.z, 1.0f));
+  float3 ratio = mp_subsurface_ratio(model, a, radius, nv, roughness, ior);
+  mp_surface_add(s, mp_closure(MP_CLOSURE_SUBSURFACE, mp_clamp_weight(w) * ratio, slot, 0.0f, 0.0f));
 }
 
 #endif

@@ -145,6 +145,7 @@ class NodeCompiler:
         self.helpers = []          # extra functions (Bump heights), emitted before the main two
         self.uses_neighbours = False
         self.uses_thin_film = False
+        self.uses_subsurface_walk = False
         self.displacement_world = False
         self.displacement_bounds = []
         self.groups = []           # the Group nodes whose trees are being compiled, outermost first
@@ -885,6 +886,8 @@ class NodeCompiler:
         if self.uses_thin_film:
             # Ahead of the kernel headers (program_cache.cpp hoists it).
             includes = "#define MP_NODE_USES_THIN_FILM 1\n" + includes
+        if self.uses_subsurface_walk:
+            includes = "#define MP_NODE_USES_SUBSURFACE_WALK 1\n" + includes
         source = includes + "".join(self.helpers) + disp_src + surf_src
         return CompiledMaterial(source, displaces, shades, bound, displaces and self.displacement_world,
                                 alpha=self.transparent, params=self.params)
@@ -1041,6 +1044,7 @@ class NodeCompiler:
             add(f"  mp_add_translucent(s, {weight} * {color}, {slot});")
         elif t == "SUBSURFACE_SCATTERING" and self._subsurface_model(node) != "MP_SSS_LAMBERT":
             # 4.x's random walk: the albedo it returns (kernels/mp_subsurface.h).
+            self.uses_subsurface_walk = True
             radius = f"{self._c(node, 'Radius', default='(float3)(1.0f)')} * {self._f(node, 'Scale', default='1.0f')}"
             add(f"  {{ float3 albedo_ = {color}; mp_add_subsurface_walk(s, {weight} * albedo_, albedo_, {radius}, "
                 f"fabs(mp_view_cos(g, {self._slot_normal(slot)})), clamp({self._f(node, 'Roughness', default='1.0f')}, "
@@ -1154,6 +1158,8 @@ class NodeCompiler:
             "multiscatter": "1" if getattr(node, "distribution", "GGX") == "MULTI_GGX" else "0",
         }
         fields["tangent"] = "(float3)(0.0f)" if self._unlinked_zero(node, "Anisotropic") else self._tangent(node)
+        if fields["subsurface_model"] != "MP_SSS_LAMBERT" and not self._unlinked_zero(node, "Subsurface Weight"):
+            self.uses_subsurface_walk = True
         add = self.fn.lines.append
         add(f"  MpPrincipled {p};")
         for k, v in fields.items():

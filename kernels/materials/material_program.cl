@@ -4,6 +4,8 @@
  * and a changed tree rebuilds only itself. Its kernels run over a whole
  * batch of diced grids and touch only the vertices of the materials that use
  * this program (DeviceMaterial.program[0]). */
+/* Tells the headers they build a material program (mp_bsdf.h). */
+#define MP_MATERIAL_PROGRAM 1
 #include "mp_compat.h"
 #include "mp_patch.h"
 #include "mp_types.h"
@@ -235,7 +237,7 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
   MpShadowQuery shadow = {&maps, n, mp_pixel_footprint(-p.z, f)};
   /* Sharp lobes widened by the normal's spread across the micropolygon
    * (mp_normal_spread2): the grid's normals, final since shade.cl. */
-  mp_surface_filter_roughness(&s, mp_normal_spread2(n, grid_n[gx].xyz, grid_n[gy].xyz));
+  mp_surface_prepare(&s, mp_normal_spread2(n, grid_n[gx].xyz, grid_n[gy].xyz), p, f.ortho);
   MpRefractScene refract = {refract_nodes, refract_tris, refract_roots[object]};
   float3 c = mp_shade_closures(p, n, faced, f.ortho, &s, lights, light_count, world_glossy,
                                use_shadows ? &shadow : 0, refract.root != MP_REFRACT_NONE ? &refract : 0);
