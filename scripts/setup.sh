@@ -20,6 +20,7 @@ packages=(
   python3 python3-dev python3-numpy python3-pytest python3-venv python3-pil util-linux
   clang libclang-rt-14-dev llvm
   blender xvfb xauth libgl1-mesa-dri
+  qemu-user
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -9,7 +9,7 @@ import time
 import bpy
 import numpy as np
 
-from . import export, export_mesh, preferences, viewport
+from . import export, export_mesh, native_module, preferences, viewport
 
 PASSES = (("Depth", 1, "Z", "VALUE"), ("Normal", 3, "XYZ", "VECTOR"))
 
@@ -19,12 +19,15 @@ class FinalRenderers:
     while the device stays the same: its OpenCL context, compiled programs,
     uploaded scene and patch cache carry over, so a second F12 (or the next
     frame of an animation) skips building them. One at a time: Blender runs
-    one final render at a time, and the lock makes sure of it."""
+    one final render at a time, and the lock makes sure of it. The kernel
+    warm-up (warm_up.py) renders on it first, so the first F12 finds it
+    built; an F12 that starts meanwhile waits for the lock."""
 
     def __init__(self):
         self._lock = threading.Lock()
         self._selector = None
         self._renderer = None
+        self._dropped = False
         # Seconds the last final render spent exporting, in the native
         # renderer and writing the render result, and the buckets it was
         # rendered in (the benchmarks and tests read them).
@@ -36,6 +39,7 @@ class FinalRenderers:
         from . import _native
 
         self._lock.acquire()
+        self._dropped = False
         try:
             if self._renderer is None or self._selector != selector:
                 self._renderer = None
@@ -47,6 +51,8 @@ class FinalRenderers:
             raise
 
     def release(self):
+        if self._dropped:
+            self.forget()
         self._lock.release()
 
     def forget(self):
@@ -56,13 +62,25 @@ class FinalRenderers:
         self._selector = None
 
     def drop(self):
-        """Frees the device (at unregister)."""
-        with self._lock:
-            self._renderer = None
-            self._selector = None
+        """Frees the device (at unregister). A render or warm-up still
+        running frees it when it ends: unregistering does not wait for it."""
+        self._dropped = True
+        if self._lock.acquire(blocking=False):
+            self.forget()
+            self._lock.release()
+
+    def reopen(self):
+        """At register: a renderer still held by a render or warm-up that
+        began before the add-on was last disabled is kept after all."""
+        self._dropped = False
 
 
 _final_renderers = FinalRenderers()
+
+
+def final_renderers():
+    """The renderer final renders keep (the kernel warm-up builds it)."""
+    return _final_renderers
 
 
 class MicropolyRenderEngine(bpy.types.RenderEngine):
@@ -183,7 +201,7 @@ class MicropolyRenderEngine(bpy.types.RenderEngine):
         try:
             renderer = _final_renderers.acquire(preferences.device_selector(bpy.context))
         except RuntimeError as e:
-            self.report({"ERROR"}, f"Micropoly: {e}")
+            self.report({"ERROR"}, f"Micropoly: {native_module.device_error(e)}")
             return
         try:
             _final_renderers.last_timings = {"export_s": time.perf_counter() - export_started}
@@ -284,6 +302,7 @@ def _set_pass(layer, name, pixels):
 
 
 def register():
+    _final_renderers.reopen()
     bpy.utils.register_class(MicropolyRenderEngine)
 
 

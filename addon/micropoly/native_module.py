@@ -29,3 +29,14 @@ def alias_wheel_module(package):
         return
     sys.modules[name] = wheel._native
     setattr(sys.modules[package], "_native", wheel._native)
+
+
+def device_error(error):
+    """The message of an error opening a device, with the reason the
+    extension's own CPU device is missing when that is why there is none."""
+    message = str(error)
+    wheel = sys.modules.get("micropoly_native")
+    problem = getattr(wheel, "embedded_cpu_device_problem", None)
+    if problem and "no OpenCL" in message:
+        message += f"; {problem}"
+    return message

@@ -2,10 +2,11 @@
 """Add-on preferences: which OpenCL device renders."""
 
 import atexit
-import threading
 
 import bpy
 from bpy.props import EnumProperty
+
+from . import warm_up
 
 ADDON = __package__
 
@@ -46,31 +47,57 @@ def device_selector(context):
     return "" if value in ("AUTO", "NONE", "") else value
 
 
-def _start_opencl():
-    # Loading the OpenCL drivers and listing their devices is the slowest part
-    # of making the first renderer (about 80 ms with PoCL, out of 90 ms).
-    # Doing it once in the background when the add-on registers means the
-    # first F12 or Rendered viewport does not wait for it; later calls find
-    # the drivers loaded. Failures are left for the render to report.
-    def start():
-        try:
-            from . import _native
+def _start_warm_up():
+    # Loading the OpenCL drivers and building the kernels is the slowest
+    # part of a first render (seconds on the CPU). Done in the background when
+    # the add-on registers, the first F12 or Rendered viewport finds them
+    # built (warm_up.py), and so for the material programs of each file
+    # opened. A thread still inside the drivers when Python shuts down would
+    # be torn down as it takes the GIL back, which can abort the process: it
+    # is stopped and waited for at exit.
+    global _exit_hook
+    from . import engine
 
-            _native.list_devices()
-        except Exception:
-            pass
+    selector = _selector_now()
+    warm_up.start(selector, engine.final_renderers())
+    try:
+        materials = list(bpy.data.materials)
+    except AttributeError:  # Blender's start: the file is not loaded yet
+        materials = []
+    warm_up.add_file_materials(materials, selector, engine.final_renderers())
+    warm_up.show_in_status_bar()
+    if not _exit_hook:
+        atexit.register(warm_up.stop)
+        _exit_hook = True
 
-    thread = threading.Thread(target=start, name="micropoly-opencl-start", daemon=True)
-    thread.start()
-    # A thread still inside the drivers when Python shuts down would be torn
-    # down as it takes the GIL back, which can abort the process: wait for it.
-    atexit.register(thread.join, 10.0)
+
+def _selector_now():
+    try:
+        return device_selector(bpy.context)
+    except Exception:  # preferences not loaded yet
+        return ""
+
+
+@bpy.app.handlers.persistent
+def _file_loaded(*_):
+    from . import engine
+
+    warm_up.add_file_materials(list(bpy.data.materials), _selector_now(), engine.final_renderers())
+    warm_up.show_in_status_bar()
+
+
+_exit_hook = False
 
 
 def register():
     bpy.utils.register_class(MicropolyPreferences)
-    _start_opencl()
+    _start_warm_up()
+    if _file_loaded not in bpy.app.handlers.load_post:
+        bpy.app.handlers.load_post.append(_file_loaded)
 
 
 def unregister():
+    if _file_loaded in bpy.app.handlers.load_post:
+        bpy.app.handlers.load_post.remove(_file_loaded)
+    warm_up.hide_from_status_bar()
     bpy.utils.unregister_class(MicropolyPreferences)

@@ -273,13 +273,16 @@ class ViewportSession:
 
     def _run(self):
         try:
-            from . import _native
+            from . import _native, warm_up
 
+            warm_up.wait()  # it is building what this renderer would build
             renderer = _native.Renderer(self._selector)
             self.device = renderer.device
         except Exception as e:  # no device, kernels that do not build
+            from . import native_module
+
             with self._cond:
-                self._fatal = self._error = str(e)
+                self._fatal = self._error = native_module.device_error(e)
                 self._busy = False
                 self._cond.notify_all()
             return

@@ -4,8 +4,11 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 
+#include "cl/build_context.h"
 #include "cl/device_session.h"
 #include "cl/program_cache.h"
 #include "micropoly/error.h"
@@ -76,7 +79,29 @@ TEST(ProgramCache, KernelBuildFailureIsAClearError) {
     EXPECT_NE(msg.find("line 1:"), std::string::npos) << msg;  // where, in the source as built
     EXPECT_NE(msg.find("'y'"), std::string::npos) << msg;     // what: the undeclared name
     EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line for Blender's report: " << msg;
+    // On a CPU, which processor and what its compiler built for.
+    if (session.device().getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) {
+      std::ifstream in("/proc/cpuinfo");
+      std::stringstream cpuinfo;
+      cpuinfo << in.rdbuf();
+      const std::string model = cpu_model_name(cpuinfo.str());
+      EXPECT_FALSE(model.empty());
+      EXPECT_NE(msg.find("CPU '" + model + "'"), std::string::npos) << msg;
+      const std::string target = pocl_target(session.device().getInfo<CL_DEVICE_VERSION>());
+      if (!target.empty()) EXPECT_NE(msg.find("compiling for " + target), std::string::npos) << msg;
+    }
   }
+}
+
+TEST(ProgramCache, BuildContextReadsTheProcessorAndPoclsTarget) {
+  const std::string cpuinfo =
+      "processor\t: 0\nvendor_id\t: AuthenticAMD\ncpu family\t: 26\nmodel name\t: AMD EPYC 9755 128-Core Processor  \n"
+      "flags\t\t: fpu avx512f\n\nprocessor\t: 1\nmodel name\t: other\n";
+  EXPECT_EQ(cpu_model_name(cpuinfo), "AMD EPYC 9755 128-Core Processor");
+  EXPECT_EQ(cpu_model_name("processor\t: 0\n"), "");
+  EXPECT_EQ(pocl_target("OpenCL 3.0 PoCL HSTR: pthread-x86_64-pc-linux-gnu-skylake-avx512"), "skylake-avx512");
+  EXPECT_EQ(pocl_target("OpenCL 3.0 PoCL HSTR: pthread-x86_64-unknown-linux-gnu-generic"), "generic");
+  EXPECT_EQ(pocl_target("OpenCL 3.0 CUDA"), "");
 }
 
 TEST(ProgramCache, FirstBuildErrorIsOneLineWithoutTheTemporaryFileName) {
@@ -126,8 +151,8 @@ TEST(DeviceChoice, UnknownSelectorsAreRejected) {
 }  // namespace mp
 
 // Which devices get the tile sampler: PoCL on LLVM 14 or older aborts the
-// process compiling it (the pocl-binary-distribution 3.0 wheel the
-// extension carries reports LLVM 14.0.6); other platforms always get it.
+// process compiling it (PyPI's pocl-binary-distribution 3.0, which the
+// extension carried before, reports LLVM 14.0.6); other platforms always get it.
 TEST(TileSamplerGate, FollowsPoclsLlvm) {
   EXPECT_FALSE(mp::compiles_tile_sampler(
       "OpenCL 3.0 PoCL 3.0-rc2  Linux, Release, RELOC, LLVM 14.0.6, SLEEF, DISTRO, POCL_DEBUG"));

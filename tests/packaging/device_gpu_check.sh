@@ -4,7 +4,7 @@
 # opencl_vendors.py) keeps the system's GPU driver beside the CPU device it
 # adds. The driver is registered as its package does (/etc/OpenCL/vendors/
 # nvidia.icd), in a private mount namespace so the machine is left as it
-# was; an empty file laid out as pocl-binary-distribution installs its
+# was; an empty file laid out as the micropoly_pocl wheel installs its
 # library stands in for the carried PoCL (the loader skips it: the carried
 # PoCL itself is tested on the CPU by tests/packaging/test_extension.py). The
 # CLI then lists and renders on the devices the loader finds there.
@@ -14,9 +14,9 @@ cli=$(realpath "$1")
 driver=${2:-/usr/lib/libnvidia-opencl.so}
 here=$(cd "$(dirname "$0")" && pwd)
 work=$(mktemp -d)
-mkdir -p "$work/site/pocl_binary_distribution" "$work/site/pyopencl/.libs"
-touch "$work/site/pocl_binary_distribution/__init__.py"
-touch "$work/site/pyopencl/.libs/libpocl-standin.so"
+mkdir -p "$work/site/micropoly_pocl/lib/x86_64-linux-gnu"
+touch "$work/site/micropoly_pocl/__init__.py"
+touch "$work/site/micropoly_pocl/lib/x86_64-linux-gnu/libpocl.so.2"
 mkdir -p /etc/OpenCL/vendors
 unshare -m --propagation private sh -c "
   mount -t tmpfs none /etc/OpenCL/vendors &&

@@ -3,10 +3,20 @@ module, with Micropoly either from a folder (the developer build's
 addons/, as a legacy add-on) or installed from the extension zip the way
 Preferences > Get Extensions > Install from Disk does.
 
-  python render_demo.py --out OUT.png --report R.json (--addon-dir DIR | --install-zip ZIP)
+  python render_demo.py --out OUT.png --report R.json (--addon-dir DIR | --install-zip ZIP | --installed)
+                        [--viewport]
+
+The demo scene is built (scripts/demo_scene.py --no-render, which enables
+the add-on and so starts its kernel warm-up, addon/micropoly/warm_up.py);
+the warm-up is waited for, as an artist would see it finish in the status
+bar before the first F12; then the scene is rendered twice, each F12 timed
+from Blender's render_init to its render_complete (--once: one F12).
+--installed uses the extension an earlier run installed in the same home.
+--viewport renders no F12 but the scene's first Rendered viewport frame, in
+two sessions one after the other (each makes its renderer anew).
 
 The report says which add-on module rendered, where its native module and
-OpenCL libraries were loaded from, and which devices it saw."""
+OpenCL libraries were loaded from, which devices it saw, and the times."""
 
 import argparse
 import json
@@ -33,6 +43,30 @@ def loaded_libraries():
     return sorted(paths)
 
 
+def viewport_first_frame(module):
+    """Seconds from asking a new Rendered viewport session for the scene to
+    its first image."""
+    import bpy
+
+    export = sys.modules[f"{module}.export"]
+    viewport = sys.modules[f"{module}.viewport"]
+    scene = bpy.context.scene
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    view = viewport.view_from_camera(scene, depsgraph, scene.render.resolution_x, scene.render.resolution_y)
+    session = viewport.ViewportSession("")
+    try:
+        t0 = time.perf_counter()
+        session.request(export.export_scene(depsgraph, view=view), view, scene.micropoly.viewport_samples,
+                        scene.micropoly.viewport_shading_rate)
+        while session.image() is None and session.error() is None and time.perf_counter() - t0 < 600.0:
+            time.sleep(0.005)
+        if session.error():
+            raise RuntimeError(session.error())
+        return time.perf_counter() - t0
+    finally:
+        session.close()
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--out", required=True)
@@ -40,6 +74,9 @@ def main():
     source = parser.add_mutually_exclusive_group(required=True)
     source.add_argument("--addon-dir")
     source.add_argument("--install-zip")
+    source.add_argument("--installed", action="store_true")
+    parser.add_argument("--viewport", action="store_true")
+    parser.add_argument("--once", action="store_true", help="one F12 (under emulation, where each takes a minute)")
     args = parser.parse_args()
 
     import bpy
@@ -50,21 +87,36 @@ def main():
                                                           repo="user_default", enable_on_install=True)
         report["install"] = sorted(result)
         module = "bl_ext.user_default.micropoly"
+    elif args.installed:
+        module = "bl_ext.user_default.micropoly"
     else:
         module = "micropoly"
         os.environ["BLENDER_USER_SCRIPTS"] = os.path.abspath(os.path.join(args.addon_dir, ".."))
         if args.addon_dir not in sys.path:
             sys.path.insert(0, os.path.abspath(args.addon_dir))
     os.environ["MICROPOLY_ADDON_MODULE"] = module
-    sys.argv = [DEMO, "--", os.path.abspath(args.out)]
+    # The demo scene (it enables the add-on, whose kernel warm-up starts),
+    # then the warm-up's end, as the status bar shows it, then the renders.
     t0 = time.perf_counter()
+    sys.argv = [DEMO, "--", os.path.abspath(args.out), "--no-render"]
     runpy.run_path(DEMO, run_name="__main__")
-    # The first render builds the kernels (or reads them from the cache);
-    # a second one in the same process times the renderer alone.
-    t1 = time.perf_counter()
-    bpy.ops.render.render()
-    report["first_render_s"] = t1 - t0
-    report["second_render_s"] = time.perf_counter() - t1
+    warm_up = sys.modules[f"{module}.warm_up"]
+    warm_up.wait(600.0)
+    report["warm_up"] = dict(warm_up.state(), waited_s=time.perf_counter() - t0)
+
+    renders = []
+    bpy.app.handlers.render_init.append(bpy.app.handlers.persistent(lambda *a: renders.append(time.perf_counter())))
+    bpy.app.handlers.render_complete.append(
+        bpy.app.handlers.persistent(lambda *a: renders.append(time.perf_counter())))
+    if args.viewport:
+        report["viewport_first_frames_s"] = [viewport_first_frame(module) for _ in range(2)]
+    else:
+        bpy.ops.render.render(write_still=True)
+        report["first_render_s"] = renders[1] - renders[0]
+        report["first_render_timings"] = dict(sys.modules[f"{module}.engine"].final_renderers().last_timings)
+        if not args.once:
+            bpy.ops.render.render()
+            report["second_render_s"] = renders[3] - renders[2]
 
     addon = sys.modules[module]
     native = sys.modules[f"{module}._native"]

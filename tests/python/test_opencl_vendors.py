@@ -1,6 +1,6 @@
 """The wheel's choice of OpenCL drivers (native/python/micropoly_native/
 opencl_vendors.py), against a fake system registry and a fake
-pocl-binary-distribution install in temporary folders."""
+micropoly_pocl install in temporary folders."""
 
 import importlib.util
 import os
@@ -26,20 +26,35 @@ def vendors(tmp_path, monkeypatch):
     monkeypatch.setenv("OCL_ICD_VENDORS", "")
     monkeypatch.delenv("OCL_ICD_VENDORS")
     monkeypatch.delenv("MICROPOLY_EMBEDDED_POCL", raising=False)
+    # A machine with the linker and C library files PoCL links with.
+    root = tmp_path / "root"
+    for path in ("usr/bin/ld", "usr/lib/gcc/x86_64-linux-gnu/12/crtbegin.o", "usr/lib/x86_64-linux-gnu/libc.so"):
+        (root / path).parent.mkdir(parents=True, exist_ok=True)
+        (root / path).write_text("")
+    monkeypatch.setattr(module, "ROOT", str(root))
     return module, system, tmp_path
 
 
 def install_fake_pocl(tmp_path, monkeypatch):
-    """A site-packages folder laid out as pocl-binary-distribution's wheel."""
+    """A site-packages folder laid out as the micropoly_pocl wheel
+    (scripts/cpu_device_wheel.py)."""
     site = tmp_path / "site"
-    (site / "pocl_binary_distribution").mkdir(parents=True)
-    (site / "pocl_binary_distribution" / "__init__.py").write_text("")
-    (site / "pyopencl" / ".libs").mkdir(parents=True)
-    library = site / "pyopencl" / ".libs" / "libpocl-0123abcd.so"
+    lib = site / "micropoly_pocl" / "lib" / "x86_64-linux-gnu"
+    lib.mkdir(parents=True)
+    (site / "micropoly_pocl" / "__init__.py").write_text("")
+    library = lib / "libpocl.so.2"
     library.write_bytes(b"")
     monkeypatch.syspath_prepend(str(site))
-    sys.modules.pop("pocl_binary_distribution", None)
+    sys.modules.pop("micropoly_pocl", None)
     return str(library)
+
+
+def test_a_package_without_its_library_is_not_a_device(vendors, monkeypatch):
+    module, _, tmp_path = vendors
+    library = install_fake_pocl(tmp_path, monkeypatch)
+    os.remove(library)
+    assert module.register() is None
+    assert "OCL_ICD_VENDORS" not in os.environ
 
 
 def test_no_carried_pocl_leaves_the_loader_alone(vendors, monkeypatch):
@@ -86,3 +101,36 @@ def test_a_user_setting_is_kept(vendors, monkeypatch):
     monkeypatch.setenv("OCL_ICD_VENDORS", "/somewhere/else")
     assert module.register() is None
     assert os.environ["OCL_ICD_VENDORS"] == "/somewhere/else"
+
+
+def test_no_linker_no_carried_pocl(vendors, monkeypatch):
+    """PoCL aborts the process when it cannot link a kernel: without the
+    tools it links with, the carried PoCL is not offered, and the problem
+    names what is missing."""
+    module, _, tmp_path = vendors
+    install_fake_pocl(tmp_path, monkeypatch)
+    assert module.linker_problem() is None
+    os.remove(tmp_path / "root" / "usr" / "bin" / "ld")
+    os.remove(tmp_path / "root" / "usr" / "lib" / "x86_64-linux-gnu" / "libc.so")
+    problem = module.linker_problem()
+    assert "'ld'" in problem and "libc6-dev" in problem and "GCC" not in problem
+    assert module.register() is None
+    assert "OCL_ICD_VENDORS" not in os.environ
+
+
+def test_the_missing_device_message_says_why(monkeypatch):
+    """The add-on's message for "no OpenCL device" carries the reason the
+    wheel left its CPU device out (addon/micropoly/native_module.py)."""
+    import types
+
+    spec = importlib.util.spec_from_file_location(
+        "native_module_under_test", os.path.join(HERE, "..", "..", "addon", "micropoly", "native_module.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    wheel = types.SimpleNamespace(embedded_cpu_device_problem="this machine lacks a linker ('ld', from binutils)")
+    monkeypatch.setitem(sys.modules, "micropoly_native", wheel)
+    message = module.device_error(RuntimeError("no OpenCL device found: install an OpenCL driver"))
+    assert message.startswith("no OpenCL device found") and "lacks a linker ('ld'" in message
+    assert module.device_error(RuntimeError("the OpenCL kernels failed to build")) == "the OpenCL kernels failed to build"
+    wheel.embedded_cpu_device_problem = None
+    assert module.device_error(RuntimeError("no OpenCL device found")) == "no OpenCL device found"

@@ -37,10 +37,9 @@ class DeviceSession {
   bool program_cache_hit() const { return cache_hit_; }
   size_t max_alloc_bytes() const { return max_alloc_; }
   // Whether the program holds the tile sampler (sample_tiles.cl). PoCL
-  // built on LLVM 14 or older (the PoCL binary distribution that CPU-only
-  // installs carry) aborts the process compiling its 16-wide vector code,
-  // so on such a device it is left out and the per-micropolygon sampler
-  // runs instead.
+  // built on LLVM 14 or older (e.g. PyPI's pocl-binary-distribution 3.0)
+  // aborts the process compiling its 16-wide vector code, so on such a
+  // device it is left out and the per-micropolygon sampler runs instead.
   bool tile_sampler() const { return tile_sampler_; }
   // A read-write device buffer of `bytes` (at least 16); an mp::Error that
   // names `what` when the device cannot hold that much in one buffer.

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <unistd.h>
 
+#include "cl/build_context.h"
 #include "cl/embedded_kernels.h"
 #include "micropoly/error.h"
 
@@ -167,7 +168,8 @@ BuiltProgram build_program_cached(const cl::Context& context, const cl::Device& 
       out << log;
       if (out) where = " (compiler log: " + log_file.string() + ")";
     }
-    throw Error("the OpenCL kernels failed to build on " + device.getInfo<CL_DEVICE_NAME>() + ": " +
+    throw Error("the OpenCL kernels failed to build on " + device.getInfo<CL_DEVICE_NAME>() + " (" +
+                build_context(device) + "): " +
                 first_build_error(log) + where);
   }
   if (!file.empty()) {
