@@ -52,6 +52,7 @@ DEEP = "--deep" in args
 # Principled BSDF at Sheen Weight 1 (4.x: the microfiber LTC lobe).
 MATERIAL = args[args.index("--material") + 1] if "--material" in args else None
 # --engines A,B: only these engines (default: Micropoly, Cycles and EEVEE).
+# --f12-only: print the F12 times alone (no breakdown, no export timing).
 ENGINES = args[args.index("--engines") + 1].split(",") if "--engines" in args else None
 W, H = (480, 270) if QUICK else (1920, 1080)
 SAMPLES = 16
@@ -277,6 +278,9 @@ def main():
             results[engine] = time_engine(scene, engine)
         except Exception as e:  # EEVEE needs an OpenGL context some machines lack
             print(f"{engine}: could not render ({e})")
+    if "--f12-only" in args:  # the F12 times alone (bench/cpu_device_bench.py)
+        print(json.dumps({"version": bpy.app.version_string, "width": W, "height": H, "renders": results}))
+        return
     breakdown = f12_breakdown(build_scene())
     faces, export_times = export_time()
     print(f"\nBlender {bpy.app.version_string}, {W}x{H}, {SAMPLES} samples, median of {REPEAT} F12 renders")

@@ -58,6 +58,8 @@ def _start_warm_up():
     global _exit_hook
     from . import engine
 
+    if not warm_up.wanted():
+        return
     selector = _selector_now()
     warm_up.start(selector, engine.final_renderers())
     try:
@@ -82,6 +84,8 @@ def _selector_now():
 def _file_loaded(*_):
     from . import engine
 
+    if not warm_up.wanted():
+        return
     warm_up.add_file_materials(list(bpy.data.materials), _selector_now(), engine.final_renderers())
     warm_up.show_in_status_bar()
 

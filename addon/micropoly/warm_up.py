@@ -17,8 +17,14 @@ reads (Micropoly's program binaries, the driver's compiled kernels), so the
 first Rendered viewport finds them too. A render that starts while it runs
 waits for it rather than building the same things beside it. Blender's
 status bar shows it while it runs (docs/install.md).
+
+It runs where Blender has a user interface. In background mode (command-line
+and farm renders) the render follows at once and builds what it needs
+itself, so the warm-up would only add its own frames: it runs there only
+with MICROPOLY_WARM_UP=1; MICROPOLY_WARM_UP=0 turns it off everywhere.
 """
 
+import os
 import threading
 import time
 
@@ -28,8 +34,9 @@ import numpy as np
 # passes, camera distance). The driver compiles a kernel once per variant of
 # its launch: PoCL one for grids under 65536 work-items and one for larger
 # grids, so a tiny frame and one of an F12's size both render; passes on and
-# off take different resolve kernels.
-FRAMES = ((96, 64, 2, True, 6.0), (960, 540, 2, False, 2.6))
+# off, and fewer or at least 16 samples per pixel, take different resolve
+# kernels.
+FRAMES = ((96, 64, 2, True, 6.0), (960, 540, 4, False, 2.6))
 # Material programs built ahead, at most (each takes a second or more).
 MAX_PROGRAMS = 8
 # A job that failed is tried once more after this pause.
@@ -186,6 +193,14 @@ def _queue(job, selector, renderers):
         thread.start()
 
 
+def wanted():
+    """Whether this Blender builds its kernels ahead (see above)."""
+    import bpy
+
+    setting = os.environ.get("MICROPOLY_WARM_UP", "")
+    return setting == "1" or (setting != "0" and not bpy.app.background)
+
+
 def start(selector, renderers):
     """Starts the warm-up for `selector` on `renderers` (the final renders'
     engine.FinalRenderers, which keeps the renderer it built for the first
@@ -238,26 +253,26 @@ def stop():
 
 
 # ---- Blender's status bar ------------------------------------------------------
+# The workspace's status text: what Blender's own long tasks and modal tools
+# use there. It is set when the step changes (not every second, so that a
+# tool's hints are covered once at most) and cleared at the end.
+_shown = {"text": None}
 
-def _draw_status(self, context):
-    if not running():
-        return
-    self.layout.label(text=f"Micropoly: {_state['step']} ({state()['seconds']:.0f} s)", icon="SORTTIME")
+
+def _status_text():
+    return f"Micropoly: {_state['step']}..." if running() else None
 
 
-def _redraw_status():
-    """A timer: redraws the status bar each second while the warm-up runs,
-    then takes the line away."""
+def _update_status():
+    """A timer on the main thread: shows the warm-up's step while it runs."""
     import bpy
 
-    for window in getattr(bpy.context.window_manager, "windows", []):
-        for area in window.screen.areas:
-            if area.type == "STATUSBAR":
-                area.tag_redraw()
-    if running():
-        return 1.0
-    bpy.types.STATUSBAR_HT_header.remove(_draw_status)
-    return None
+    text = _status_text()
+    if text != _shown["text"]:
+        for window in getattr(bpy.context.window_manager, "windows", []):
+            window.workspace.status_text_set(text)
+        _shown["text"] = text
+    return 0.5 if text is not None else None
 
 
 def show_in_status_bar():
@@ -265,15 +280,16 @@ def show_in_status_bar():
 
     if bpy.app.background or not running():
         return
-    bpy.types.STATUSBAR_HT_header.remove(_draw_status)  # once, whatever registered before
-    bpy.types.STATUSBAR_HT_header.append(_draw_status)
-    if not bpy.app.timers.is_registered(_redraw_status):
-        bpy.app.timers.register(_redraw_status, first_interval=0.5, persistent=True)
+    if not bpy.app.timers.is_registered(_update_status):
+        bpy.app.timers.register(_update_status, first_interval=0.0, persistent=True)
 
 
 def hide_from_status_bar():
     import bpy
 
-    bpy.types.STATUSBAR_HT_header.remove(_draw_status)
-    if bpy.app.timers.is_registered(_redraw_status):
-        bpy.app.timers.unregister(_redraw_status)
+    if bpy.app.timers.is_registered(_update_status):
+        bpy.app.timers.unregister(_update_status)
+    if _shown["text"] is not None:
+        for window in getattr(bpy.context.window_manager, "windows", []):
+            window.workspace.status_text_set(None)
+        _shown["text"] = None

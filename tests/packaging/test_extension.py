@@ -127,7 +127,8 @@ def check_version(version, zip_path, work):
     # The developer build: Debian's libraries, the add-on from BUILD/addons.
     ref_png, ref_json = (os.path.join(work, f"reference-{version}.{e}") for e in ("png", "json"))
     subprocess.run([reference_python, render, "--out", ref_png, "--report", ref_json, "--addon-dir",
-                    os.path.join(BUILD, "addons")], check=True, stdout=subprocess.DEVNULL)
+                    os.path.join(BUILD, "addons")], check=True, stdout=subprocess.DEVNULL,
+                   env=dict(os.environ, MICROPOLY_WARM_UP="1"))
 
     # The extension, with Debian's libraries hidden, in a home of its own
     # (Blender's user folders, caches) and an environment with nothing set.
@@ -206,8 +207,11 @@ def named_by_llvm(cpu):
 def render_extension(python, home, args, extra_env=None, emulate=None):
     """render_demo.py with Debian's libraries hidden, in `home`, optionally
     under QEMU posing as the processor `emulate`; returns (report, seconds)
-    or (None, seconds) after logging the failure."""
-    env = {"HOME": home, "PATH": "/usr/bin:/bin", "LANG": "C.UTF-8", "PYTHONNOUSERSITE": "1", **(extra_env or {})}
+    or (None, seconds) after logging the failure. The kernel warm-up, which
+    the add-on runs where Blender has a window, is asked for in this
+    background Blender (MICROPOLY_WARM_UP=1) unless extra_env says otherwise."""
+    env = {"HOME": home, "PATH": "/usr/bin:/bin", "LANG": "C.UTF-8", "PYTHONNOUSERSITE": "1",
+           "MICROPOLY_WARM_UP": "1", **(extra_env or {})}
     command = [python, os.path.join(HERE, "render_demo.py")] + args
     if emulate:
         command = [QEMU, "-cpu", emulate] + command
@@ -237,13 +241,16 @@ def check_unknown_cpu(version, zip_path, work):
     native_png, native_json = (os.path.join(work, f"kernel-library-{version}.{e}") for e in ("png", "json"))
     native, _ = render_extension(python, os.path.join(work, f"home-{version}"),
                                  ["--out", native_png, "--report", native_json, "--installed", "--once"],
-                                 {"POCL_KERNELLIB_NAME": UNKNOWN_CPU_KERNEL_LIBRARY})
+                                 {"POCL_KERNELLIB_NAME": UNKNOWN_CPU_KERNEL_LIBRARY, "MICROPOLY_WARM_UP": "0"})
     home = os.path.join(work, f"home-unknown-cpu-{version}")
     shutil.rmtree(home, ignore_errors=True)
     os.makedirs(home)
     png, report_json = (os.path.join(work, f"unknown-cpu-{version}.{e}") for e in ("png", "json"))
+    # Without the warm-up: under emulation each build takes minutes, and the
+    # F12 builds what it needs itself.
     report, seconds = render_extension(python, home, ["--out", png, "--report", report_json, "--install-zip",
-                                                      zip_path, "--once"], emulate=UNKNOWN_CPU)
+                                                      zip_path, "--once"], {"MICROPOLY_WARM_UP": "0"},
+                                       emulate=UNKNOWN_CPU)
     log(f"unknown CPU, bpy {version}: emulated install and render in {seconds:.0f} s")
     if native is None or report is None:
         log("FAIL: the extension did not render (natively with its kernel library, or emulated)")
@@ -259,15 +266,11 @@ def check_unknown_cpu(version, zip_path, work):
     if not any(UNKNOWN_CPU_TARGET in name for name, _ in devices):
         log(f"FAIL: the carried PoCL did not choose its target ({UNKNOWN_CPU_TARGET}) from the CPU's features")
         ok = False
-    if report["warm_up"]["error"]:
-        log(f"FAIL: the kernel warm-up stopped: {report['warm_up']['error']}")
-        ok = False
     same = psnr(read_png(native_png), read_png(png))
     developer = psnr(read_png(os.path.join(work, f"reference-{version}.png")), read_png(png))
     log(f"unknown CPU, bpy {version}: PSNR {same:.2f} dB (>= {MIN_PSNR}) against the carried PoCL on this machine's "
         f"CPU with the same kernel library ({UNKNOWN_CPU_KERNEL_LIBRARY}), {developer:.2f} dB (>= 40) against the "
-        f"developer build (avx512 here); kernels built ahead in {report['warm_up']['seconds']:.0f} s, "
-        f"F12 {report['first_render_s']:.0f} s (emulated)")
+        f"developer build (avx512 here); emulated F12 {report['first_render_s']:.0f} s (kernels built)")
     return ok and same >= MIN_PSNR and developer >= 40.0
 
 
