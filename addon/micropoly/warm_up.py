@@ -46,8 +46,8 @@ IMAGE_NODES = {"TEX_IMAGE", "TEX_ENVIRONMENT"}
 
 # The add-on registers again whenever the tests (or a factory reset) re-enable
 # it: one thread at a time works through the jobs queued for the process.
-_state = {"thread": None, "started": 0.0, "finished": 0.0, "step": "", "error": None, "device": "",
-          "jobs": [], "programs_done": set()}
+_state = {"thread": None, "working": False, "started": 0.0, "finished": 0.0, "step": "", "error": None,
+          "device": "", "jobs": [], "programs_done": set()}
 _lock = threading.Lock()
 _cancel = threading.Event()
 
@@ -163,6 +163,7 @@ def _run(selector, renderers):
         while not _cancel.is_set():
             with _lock:
                 if not _state["jobs"]:
+                    _state["working"] = False  # a job queued from now on starts a thread
                     break
                 job = _state["jobs"].pop(0)
             try:
@@ -176,6 +177,9 @@ def _run(selector, renderers):
                 _render(_native, job, selector, renderers)
     except Exception as e:  # no device, a build that failed: the render reports it
         _state["error"] = str(e)
+        with _lock:
+            _state["jobs"].clear()
+            _state["working"] = False
     finally:
         _state["finished"] = time.perf_counter()
 
@@ -183,9 +187,9 @@ def _run(selector, renderers):
 def _queue(job, selector, renderers):
     with _lock:
         _state["jobs"].append(job)
-        thread = _state["thread"]
-        if thread is not None and thread.is_alive():
-            return  # it takes the job before it ends
+        if _state["working"]:
+            return  # the thread takes the job before it ends
+        _state["working"] = True
         _state["started"] = time.perf_counter()
         _state["error"] = None
         thread = threading.Thread(target=_run, args=(selector, renderers), name="micropoly-warm-up", daemon=True)

@@ -113,6 +113,16 @@ def fresh_bpy_venv(version, folder):
     return python
 
 
+def carried_pocl_rendered(report):
+    """Whether the process that wrote `report` (render_demo.py) rendered on
+    the PoCL the extension carries."""
+    carried = report["embedded_cpu_device"]
+    if not carried or not any(os.path.realpath(lib) == os.path.realpath(carried) for lib in report["libraries"]):
+        log("FAIL: the carried PoCL was not the CPU device that rendered")
+        return False
+    return True
+
+
 def check_version(version, zip_path, work):
     ok = True
     reference_python = os.path.join(BUILD, f"bpy-{version}", "bin", "python3")
@@ -158,10 +168,7 @@ def check_version(version, zip_path, work):
         if not any(needed in os.path.basename(lib) for lib in wheel_libs):
             log(f"FAIL: {needed} was not loaded from the wheel (micropoly_native.libs)")
             ok = False
-    carried = report["embedded_cpu_device"]
-    if not carried or not any(os.path.realpath(lib) == os.path.realpath(carried) for lib in report["libraries"]):
-        log("FAIL: the carried PoCL was not the CPU device that rendered")
-        ok = False
+    ok = carried_pocl_rendered(report) and ok
 
     with open(ref_json) as f:
         reference = json.load(f)
@@ -257,11 +264,7 @@ def check_unknown_cpu(version, zip_path, work):
         return False
     devices = [(d["name"], d["version"]) for d in report["devices"]]
     log(f"unknown CPU, bpy {version}: devices {devices}")
-    ok = True
-    carried = report["embedded_cpu_device"]
-    if not carried or not any(os.path.realpath(lib) == os.path.realpath(carried) for lib in report["libraries"]):
-        log("FAIL: the carried PoCL was not the CPU device that rendered")
-        ok = False
+    ok = carried_pocl_rendered(report)
     # The target comes from the features, not from the processor's name.
     if not any(UNKNOWN_CPU_TARGET in name for name, _ in devices):
         log(f"FAIL: the carried PoCL did not choose its target ({UNKNOWN_CPU_TARGET}) from the CPU's features")
