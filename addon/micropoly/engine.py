@@ -36,8 +36,9 @@ class FinalRenderers:
     def acquire(self, selector):
         """The renderer for `selector`, locked until release(); a new one if
         the device changed (the old one is freed first)."""
-        from . import _native
+        from . import _native, warm_up
 
+        warm_up.yield_to_render()  # the job it is on ends first; the jobs after it are dropped
         self._lock.acquire()
         self._dropped = False
         try:

@@ -275,7 +275,7 @@ class ViewportSession:
         try:
             from . import _native, warm_up
 
-            warm_up.wait()  # it is building what this renderer would build
+            warm_up.yield_to_render()  # it is building what this renderer would build
             renderer = _native.Renderer(self._selector)
             self.device = renderer.device
         except Exception as e:  # no device, kernels that do not build

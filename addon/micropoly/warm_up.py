@@ -238,6 +238,18 @@ def wait(timeout=None):
         thread.join(timeout)
 
 
+def yield_to_render():
+    """A render is about to open a renderer: the jobs not yet begun are
+    dropped (the render builds what it needs itself) and the one running is
+    waited for, so that the render neither waits for a queue of material
+    programs nor builds beside it. Nothing when called by the warm-up."""
+    if threading.current_thread() is _state["thread"]:
+        return
+    with _lock:
+        _state["jobs"].clear()
+    wait()
+
+
 def state():
     """What the warm-up did: running, seconds it took (or has taken so far),
     the device, and the error that stopped it, if any."""

@@ -139,3 +139,15 @@ def test_a_device_that_keeps_failing_leaves_its_error(warm_up):
     warm_up.wait(10.0)
     assert "failed to build" in warm_up.state()["error"]
     assert not renderers.lock.locked() and renderers.forgotten == 2
+
+
+def test_a_render_drops_the_queue_and_waits_for_the_job_running(warm_up):
+    gate = threading.Event()
+    renderers = FakeRenderers(gate=gate)
+    warm_up.start("", renderers)
+    for _ in range(3):
+        warm_up._queue((), "", renderers)
+    threading.Timer(0.2, gate.set).start()
+    warm_up.yield_to_render()  # what FinalRenderers.acquire and the viewport call first
+    assert not warm_up.running() and renderers.acquired == 1
+    assert len(renderers.renderer.frames) == len(warm_up.FRAMES)
