@@ -52,22 +52,23 @@ def _start_warm_up():
     # part of a first render (seconds on the CPU). Done in the background when
     # the add-on registers, the first F12 or Rendered viewport finds them
     # built (warm_up.py), and so for the material programs of each file
-    # opened. A thread still inside the drivers when Python shuts down would
+    # opened; where Blender does not warm up (background mode), the drivers
+    # alone are loaded. A thread still inside the drivers when Python shuts down would
     # be torn down as it takes the GIL back, which can abort the process: it
     # is stopped and waited for at exit.
     global _exit_hook
     from . import engine
 
-    if not warm_up.wanted():
-        return
     selector = _selector_now()
-    warm_up.start(selector, engine.final_renderers())
-    try:
-        materials = list(bpy.data.materials)
-    except AttributeError:  # Blender's start: the file is not loaded yet
-        materials = []
-    warm_up.add_file_materials(materials, selector, engine.final_renderers())
-    warm_up.show_in_status_bar()
+    wanted = warm_up.wanted()
+    warm_up.start(selector, engine.final_renderers(), build=wanted)
+    if wanted:
+        try:
+            materials = list(bpy.data.materials)
+        except AttributeError:  # Blender's start: the file is not loaded yet
+            materials = []
+        warm_up.add_file_materials(materials, selector, engine.final_renderers())
+        warm_up.show_in_status_bar()
     if not _exit_hook:
         atexit.register(warm_up.stop)
         _exit_hook = True

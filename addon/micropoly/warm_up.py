@@ -185,8 +185,11 @@ def _run(selector, renderers):
 
 
 def _queue(job, selector, renderers):
+    """Queues `job` (None: none, the thread only loads the drivers) and
+    starts the thread unless it is at work."""
     with _lock:
-        _state["jobs"].append(job)
+        if job is not None:
+            _state["jobs"].append(job)
         if _state["working"]:
             return  # the thread takes the job before it ends
         _state["working"] = True
@@ -205,12 +208,14 @@ def wanted():
     return setting == "1" or (setting != "0" and not bpy.app.background)
 
 
-def start(selector, renderers):
+def start(selector, renderers, build=True):
     """Starts the warm-up for `selector` on `renderers` (the final renders'
     engine.FinalRenderers, which keeps the renderer it built for the first
-    F12) unless one was started already in this process."""
+    F12) unless one was started already in this process. build=False only
+    loads the OpenCL drivers in the background (about 80 ms with PoCL that
+    the first render then does not wait for), where Blender does not warm up."""
     if _state["thread"] is None:
-        _queue((), selector, renderers)
+        _queue(() if build else None, selector, renderers)
 
 
 def add_file_materials(materials, selector, renderers):

@@ -151,3 +151,12 @@ def test_a_render_drops_the_queue_and_waits_for_the_job_running(warm_up):
     warm_up.yield_to_render()  # what FinalRenderers.acquire and the viewport call first
     assert not warm_up.running() and renderers.acquired == 1
     assert len(renderers.renderer.frames) == len(warm_up.FRAMES)
+
+
+def test_drivers_only_builds_nothing(warm_up):
+    loaded = []
+    sys.modules["warm_up_test_pkg._native"].list_devices = lambda: loaded.append(True) or []
+    renderers = FakeRenderers()
+    warm_up.start("", renderers, build=False)
+    warm_up.wait(10.0)
+    assert loaded == [True] and renderers.acquired == 0 and warm_up.state()["error"] is None
