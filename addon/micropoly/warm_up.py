@@ -82,12 +82,12 @@ def scene(native, materials=None, uv_layers=0):
         return s  # a job tried once more
     place = np.diag([1.5, 1.5, 1.5, 1.0]).astype(np.float32)
     place[2, 3] = 0.75
-    uvs = np.zeros((uv_layers, len(CUBE_FACES), 2), dtype=np.float32)
+    # UV maps of zeros where a program reads them (none: an empty array).
     s.add_mesh("cube", CUBE, np.full(6, 4, dtype=np.int32), CUBE_FACES, subdivision=True, object_to_world=place,
-               material=s.material_count - 1, uv_layers=uvs if uv_layers else np.zeros((0, 0, 2), np.float32))
+               material=s.material_count - 1, uv_layers=np.zeros((uv_layers, len(CUBE_FACES), 2), np.float32))
     floor = np.array([[-3, -3, 0], [3, -3, 0], [3, 3, 0], [-3, 3, 0]], dtype=np.float32)
     s.add_mesh("floor", floor, np.array([4], dtype=np.int32), np.arange(4, dtype=np.int32),
-               uv_layers=np.zeros((uv_layers, 4, 2), dtype=np.float32) if uv_layers else np.zeros((0, 0, 2), np.float32))
+               uv_layers=np.zeros((uv_layers, 4, 2), np.float32))
     s.add_light("distant", intensity=3.0, direction=[-0.4, 0.3, -0.87], angle=0.05)
     s.add_light("point", intensity=40.0, position=[-2.0, -2.0, 3.0], radius=0.3)
     s.add_light("spot", intensity=40.0, position=[2.0, -2.0, 3.0], direction=[-0.5, 0.5, -0.7], radius=0.2)
@@ -112,7 +112,7 @@ def file_materials(native, materials):
     on the main thread) not built ahead already, a native Scene holding it
     (and the default material) with the number of UV maps it reads. Trees
     that read images are left to the render, which loads them."""
-    from . import export_materials, node_compiler
+    from . import export_materials
 
     jobs = []
     for material in materials:
@@ -121,16 +121,16 @@ def file_materials(native, materials):
             continue
         if any(node.type in IMAGE_NODES for node in tree.nodes):
             continue
-        try:
-            compiled = node_compiler.compile_material(material, [])
-        except Exception:  # a tree the compiler refuses: the render reports it
-            continue
-        if compiled is None or compiled.source in _state["programs_done"]:
-            continue
-        _state["programs_done"].add(compiled.source)
         s = native.Scene()
         table = export_materials.MaterialTable(s)
-        table.get(material)
+        try:
+            table.get(material)  # compiles its tree, as the export does
+        except Exception:  # a tree the compiler refuses: the render reports it
+            continue
+        sources = set(table.programs) - _state["programs_done"]
+        if not sources:
+            continue  # no program, or one built ahead already
+        _state["programs_done"] |= sources
         jobs.append((s, len(table.uv_names)))
         if len(jobs) == MAX_PROGRAMS:
             break
