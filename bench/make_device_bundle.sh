@@ -11,7 +11,7 @@ for bin in "$build/micropoly-render" "$build/micropoly_tests"; do
   ldd "$bin" | awk '/=> \//{print $3}' | grep -vE '/(libc|libm|libpthread|libdl|librt)\.so' | xargs -r cp -L -t "$out/lib/"
 done
 cp -r tests/scenes "$out/scenes"
-cp bench/shadow_bench.sh bench/occlusion_bench.sh bench/world_bench.sh bench/blur_bench.sh bench/device_env.sh bench/before_after.py bench/before_after_stages.py bench/scenes.py "$out/"
+cp bench/shadow_culling_bench.py bench/identical_images.py bench/shadow_bench.sh bench/occlusion_bench.sh bench/world_bench.sh bench/blur_bench.sh bench/device_env.sh bench/before_after.py bench/before_after_stages.py bench/scenes.py "$out/"
 # An earlier build's CLI for before/after runs (bench/before_after.py), if given.
 [ -n "${BEFORE:-}" ] && cp "$BEFORE" "$out/micropoly-render-before"
 # The benchmark scenes bench/blender_bench.py writes as RIB (--rib-only).

@@ -17,18 +17,22 @@
 #include "mp_bound.h"
 
 /* Root r of a pass over patch_count patches in one or more views: the whole
- * domain of patch r % patch_count in view r / patch_count, no edge rated yet;
- * with an order (the camera's view, for occlusion culling), the patches are
- * taken in it (near to far). */
-inline SubPatch mp_root_subpatch(uint r, uint patch_count, __global const uint* order) {
-  uint p = order ? order[r % patch_count] : r % patch_count;
+ * domain of patch r % patch_count in view r / patch_count, no edge rated yet.
+ * With an order (occlusion culling), the patches are taken in it, near to
+ * far, and a pass over several views (one light's shadow maps) takes each
+ * patch in all its views before the next, so every view's pyramid fills
+ * with the nearest surfaces first. */
+inline SubPatch mp_root_subpatch(uint r, uint patch_count, uint view_count, __global const uint* order) {
+  uint views = max(view_count, 1u);
+  uint p = order ? order[r / views] : r % patch_count;
+  uint view = order ? r % views : r / patch_count;
   SubPatch sp;
   sp.corner[0] = 0.0f; sp.corner[1] = 0.0f;
   sp.corner[2] = 1.0f; sp.corner[3] = 0.0f;
   sp.corner[4] = 1.0f; sp.corner[5] = 1.0f;
   sp.corner[6] = 0.0f; sp.corner[7] = 1.0f;
   sp.patch = p;
-  sp.info = (r / patch_count) << 24;
+  sp.info = view << 24;
   sp.rates = 0u;
   return sp;
 }
@@ -43,10 +47,11 @@ inline FrameParams mp_subpatch_view(const SubPatch* sp, FrameParams f, __global 
 /* ---- breadth-first ------------------------------------------------------ */
 
 /* Initial queue: one whole-domain sub-patch per patch and view. */
-__kernel void bs_init_queue(__global SubPatch* queue, uint n, uint patch_count, __global const uint* order) {
+__kernel void bs_init_queue(__global SubPatch* queue, uint n, uint patch_count, uint view_count,
+                            __global const uint* order) {
   uint i = get_global_id(0);
   if (i >= n) return;
-  queue[i] = mp_root_subpatch(i, patch_count, order);
+  queue[i] = mp_root_subpatch(i, patch_count, view_count, order);
 }
 
 __kernel void bs_breadth_classify(__global SubPatch* queue, uint n,
@@ -134,7 +139,7 @@ __kernel void bs_bounded_step(__global const float4* points, __global const uint
       } else {
         uint r = atomic_inc(&counters[BS_NEXT_ROOT]);
         if (r >= root_limit) break; /* the roots taken so far (occlusion culling takes them in waves) */
-        stack[size++] = mp_root_subpatch(r, patch_count, root_order);
+        stack[size++] = mp_root_subpatch(r, patch_count, view_count, root_order);
       }
     }
     SubPatch sp = stack[--size];

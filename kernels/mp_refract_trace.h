@@ -1,6 +1,6 @@
 /* Refraction through an object's own shape: the paths the view takes
  * through a glass object, traced against a triangle proxy of its surface
- * (native/src/pipeline/refraction_proxy.cpp builds it: the limit surface
+ * (native/src/pipeline/materials/refraction_proxy.cpp builds it: the limit surface
  * tessellated per patch, camera space, in a bounding volume hierarchy).
  * The shading point refracts the view in; each hit on the proxy splits the
  * path by the dielectric Fresnel term (Glass) or passes it all through

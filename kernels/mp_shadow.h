@@ -29,7 +29,7 @@
  * the penumbra with the distance from the occluder as an area light's does.
  *
  * Shared by the kernels (shadow.cl, shade.cl, material programs) and the
- * host (pipeline/shadow_maps.cpp, tests), so both agree on every index. */
+ * host (pipeline/shadows/shadow_maps.cpp, tests), so both agree on every index. */
 #ifndef MP_SHADOW_H
 #define MP_SHADOW_H
 

@@ -93,7 +93,7 @@ typedef struct {
   /* Motion blur (the camera's view only): grid vertices have positions at
    * motion_steps times evenly spread over the shutter; 0: no motion. */
   int motion_steps;
-  /* Buckets (native/src/pipeline/buckets.h): the sample buffer holds pixels
+  /* Buckets (native/src/pipeline/frame/buckets.h): the sample buffer holds pixels
    * from (bucket_x0, bucket_y0) of the crop region on. bx and by place the
    * raster at the bucket's origin (for bound & split's culling); the
    * samplers instead place points with the whole crop region's frame_bx and
@@ -127,6 +127,9 @@ typedef struct {
   int levels;
   int cell_shift;
   int base_w, base_h; /* cells of level 0 */
+  /* Shadow views (mp_page_occluded): where the pages' cells and their
+   * farthest depths start in the pyramid buffer. */
+  uint page_cells, page_farthest;
 } OcclusionParams;
 #define MP_OCCLUSION_MAX_LEVELS 16
 

@@ -1,6 +1,6 @@
 /* The world's map (scene.h, World) and its irradiance harmonics, shared by
  * the kernels (baking, Environment Texture, shading) and the host
- * (pipeline/world_lighting.cpp). Compiles as OpenCL C and C++ (include
+ * (pipeline/world/world_lighting.cpp). Compiles as OpenCL C and C++ (include
  * mp_compat.h first). */
 #ifndef MP_WORLD_H
 #define MP_WORLD_H
@@ -52,7 +52,7 @@ MP_INLINE void mp_sh9_basis(float3 d, float* b) {
  * roughness k / 8 for level k (level 0 the map itself, a mirror), each
  * level equirectangular, coarser as its lobe widens (the split-sum
  * prefiltering of Karis 2013, "Real Shading in Unreal Engine 4").
- * pipeline/world_lighting.cpp fills them; shading reads them between the
+ * pipeline/world/world_lighting.cpp fills them; shading reads them between the
  * two levels around a surface's roughness. */
 #define MP_WORLD_GLOSSY_LEVELS 9
 MP_INLINE int mp_world_glossy_width(int k) { return k == 0 ? 512 : k <= 2 ? 256 : k == 3 ? 128 : k == 4 ? 64 : 32; }

@@ -184,14 +184,10 @@ __kernel void mark_shadow_pages(__global const SubPatch* diceable, uint count, _
  * read there, from the nearest occluder's (the narrowest penumbra, the
  * finest level) to the coarsest; receivers that see no occluder read
  * nothing more. */
-__kernel void mark_soft_shadow_pages(__global const float4* kept_p, __global const float4* kept_n, uint kept,
-                                     FrameParams f, __global const DeviceShadow* shadows,
-                                     __global const DeviceShadowLevel* levels, uint light_count,
-                                     __global const uint* pages, __global const uint* pool,
-                                     __global uchar* requests, float reach) {
-  uint gid = get_global_id(0);
-  if (gid >= kept || kept_p[gid].w == 0.0f) return;
-  float3 p = kept_p[gid].xyz, n = kept_n[gid].xyz;
+inline void mp_mark_soft_vertex(float3 p, float3 n, FrameParams f, __global const DeviceShadow* shadows,
+                                __global const DeviceShadowLevel* levels, uint light_count,
+                                __global const uint* pages, __global const uint* pool, __global uchar* requests,
+                                float reach) {
   MpShadowMaps maps = {shadows, levels, pages, pool};
   for (uint l = 0; l < light_count; ++l) {
     __global const DeviceShadow* sh = shadows + l;
@@ -220,6 +216,35 @@ __kernel void mark_soft_shadow_pages(__global const float4* kept_p, __global con
   }
 }
 
+__kernel void mark_soft_shadow_pages(__global const float4* kept_p, __global const float4* kept_n, uint kept,
+                                     FrameParams f, __global const DeviceShadow* shadows,
+                                     __global const DeviceShadowLevel* levels, uint light_count,
+                                     __global const uint* pages, __global const uint* pool,
+                                     __global uchar* requests, float reach) {
+  uint gid = get_global_id(0);
+  if (gid >= kept || kept_p[gid].w == 0.0f) return;
+  mp_mark_soft_vertex(kept_p[gid].xyz, kept_n[gid].xyz, f, shadows, levels, light_count, pages, pool, requests, reach);
+}
+
+/* The same, straight from a batch's grids: where the first marking's
+ * vertices pass their share of the shadow budget, the second dices the view
+ * again instead of keeping them. */
+__kernel void mark_soft_shadow_pages_grid(__global const SubPatch* diceable, uint count,
+                                          __global const uint* vertex_offsets, FrameParams f,
+                                          __global const float4* grid_p, __global const float4* grid_n,
+                                          __global const DeviceShadow* shadows,
+                                          __global const DeviceShadowLevel* levels, uint light_count,
+                                          __global const uint* pages, __global const uint* pool,
+                                          __global uchar* requests, float reach) {
+  uint gid = get_global_id(0), i, j;
+  SubPatch sp;
+  float2 uv;
+  ulong index;
+  if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
+  mp_mark_soft_vertex(grid_p[index].xyz, grid_n[index].xyz, f, shadows, levels, light_count, pages, pool, requests,
+                      reach);
+}
+
 /* Writes the frame's page-table entries (index, value) into a table filled
  * with zeros: a few thousand entries rather than the whole table. */
 __kernel void set_page_entries(__global const uint2* writes, uint count, __global uint* table) {
@@ -227,11 +252,78 @@ __kernel void set_page_entries(__global const uint2* writes, uint count, __globa
   if (i < count) table[writes[i].x] = writes[i].y;
 }
 
-/* Sets every texel of the listed physical pages to "nothing here". */
-__kernel void clear_shadow_pages(__global const uint* pages, uint texel_count, __global uint* pool) {
+/* Sets every texel of the listed physical pages to "nothing here", and
+ * marks them for occlusion culling's next look (shadow_page_farthest). */
+__kernel void clear_shadow_pages(__global const uint* pages, uint texel_count, __global uint* pool,
+                                 __global uchar* dirty) {
   uint i = get_global_id(0);
   if (i >= texel_count) return;
-  pool[(ulong)pages[i / MP_PAGE_TEXELS] * MP_PAGE_TEXELS + (ulong)(i % MP_PAGE_TEXELS)] = MP_SHADOW_EMPTY;
+  uint page = pages[i / MP_PAGE_TEXELS];
+  pool[(ulong)page * MP_PAGE_TEXELS + (ulong)(i % MP_PAGE_TEXELS)] = MP_SHADOW_EMPTY;
+  if (i % MP_PAGE_TEXELS == 0u) dirty[page] = 1;
+}
+
+/* The farthest depth of each 16 x 16-texel cell of the listed pages that
+ * the shadow pass wrote to since the last look (dirty), and of each page,
+ * into the occlusion pyramid's buffer (mp_page_occluded): one work-group of
+ * 64 per page, a work-item per cell. */
+__kernel __attribute__((reqd_work_group_size(64, 1, 1))) void shadow_page_farthest(
+    __global const uint* pages, uint count, __global const uint* pool, __global uchar* dirty, __global uint* pyramid,
+    uint page_cells, uint page_farthest) {
+  __local uint part[64];
+  uint g = get_group_id(0), l = get_local_id(0);
+  if (g >= count) return;
+  uint page = pages[g];
+  if (!dirty[page]) return; /* the same for the whole group */
+  uint m = 0u;
+  __global const uint* texels = pool + (ulong)page * MP_PAGE_TEXELS + (ulong)((l >> 3) * 16u * MP_PAGE_SIZE + (l & 7u) * 16u);
+  for (uint y = 0; y < 16u; ++y)
+    for (uint x = 0; x < 16u; ++x) m = max(m, texels[y * MP_PAGE_SIZE + x]);
+  pyramid[page_cells + page * 64u + l] = m;
+  part[l] = m;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (uint s = 32u; s > 0u; s >>= 1) {
+    if (l < s) part[l] = max(part[l], part[l + s]);
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+  if (l == 0u) pyramid[page_farthest + page] = part[0], dirty[page] = 0;
+}
+
+/* Each view's occlusion pyramid (mp_page_occluded), one work-group per view:
+ * level 0 names the pages rendered in this pass (physical page + 1, 0
+ * elsewhere), level 1 holds the farthest depth of the 2 x 2 pages below,
+ * each next level the largest of four below. */
+__kernel void shadow_occlusion_build(__global const FrameParams* views, __global const uint* page_table,
+                                     __global uint* pyramid, uint page_farthest) {
+  FrameParams v = views[get_group_id(0)];
+  uint l = get_local_id(0), step = get_local_size(0);
+  int n = v.page_side;
+  uint offset = v.page_mask;
+  for (uint i = l; i < (uint)(n * n); i += step) {
+    int sx = ((int)(i % (uint)n) + v.page_origin_x) & (n - 1), sy = ((int)(i / (uint)n) + v.page_origin_y) & (n - 1);
+    uint e = page_table[v.page_table + (uint)(sy * n + sx)];
+    pyramid[offset + i] = (e & MP_PAGE_RENDER) ? MP_PAGE_PHYSICAL(e) + 1u : 0u;
+  }
+  barrier(CLK_GLOBAL_MEM_FENCE);
+  for (int level = 1; n > 1; n >>= 1, ++level) {
+    int h = n / 2;
+    uint up = offset + (uint)(n * n);
+    for (uint i = l; i < (uint)(h * h); i += step) {
+      int x = (int)(i % (uint)h), y = (int)(i / (uint)h);
+      uint below[4] = {pyramid[offset + (uint)(2 * y * n + 2 * x)], pyramid[offset + (uint)(2 * y * n + 2 * x + 1)],
+                       pyramid[offset + (uint)((2 * y + 1) * n + 2 * x)],
+                       pyramid[offset + (uint)((2 * y + 1) * n + 2 * x + 1)]};
+      uint m = 0u;
+      for (int c = 0; c < 4; ++c) {
+        uint d = below[c];
+        if (level == 1 && d != 0u) d = pyramid[page_farthest + d - 1u];
+        m = max(m, d);
+      }
+      pyramid[up + i] = m;
+    }
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    offset = up;
+  }
 }
 
 /* Raster position (fixed point) and depth of a camera-space point in view v. */
@@ -258,7 +350,7 @@ __kernel __attribute__((reqd_work_group_size(64, 1, 1)))
 void shadow_sample(__global const SubPatch* diceable, uint first, uint count, __global const uint* offsets, uint base,
                    uint total, __global const uint* patch_info, __global const DeviceMaterial* materials, FrameParams f,
                    __global const FrameParams* views, __global const float4* grid_p, __global const float4* grid_c,
-                   __global const uint* page_table, volatile __global uint* pool) {
+                   __global const uint* page_table, volatile __global uint* pool, __global uchar* dirty) {
   uint gid = get_global_id(0);
   if (gid >= total || count == 0u) return;
   uint slot = first + mp_find_grid(offsets + first, count, base + gid);
@@ -307,6 +399,7 @@ void shadow_sample(__global const SubPatch* diceable, uint first, uint count, __
     int sx = ((px0 >> 7) + v.page_origin_x) & (side - 1), sy = ((py0 >> 7) + v.page_origin_y) & (side - 1);
     e = page_table[v.page_table + (uint)(sy * side + sx)];
     if (!(e & MP_PAGE_RENDER)) return;
+    dirty[MP_PAGE_PHYSICAL(e)] = 1;
   }
   for (int py = py0; py <= py1; ++py)
     for (int px = px0; px <= px1; ++px) {
@@ -314,6 +407,7 @@ void shadow_sample(__global const SubPatch* diceable, uint first, uint count, __
         int sx = ((px >> 7) + v.page_origin_x) & (side - 1), sy = ((py >> 7) + v.page_origin_y) & (side - 1);
         e = page_table[v.page_table + (uint)(sy * side + sx)];
         if (!(e & MP_PAGE_RENDER)) continue;
+        dirty[MP_PAGE_PHYSICAL(e)] = 1;
       }
       MpFixed2 s;
       s.x = (long)px * MP_SUBPIXEL_ONE + centre;

@@ -15,8 +15,8 @@ import math
 import bpy
 
 from . import node_textures
+from .node_kinds import FAC_RANGE, FLOAT, VEC
 
-FLOAT, VEC = "float", "float3"
 # Closures a shading point holds (MP_MAX_CLOSURES, kernels/mp_closures.h).
 MAX_CLOSURES = 10
 
@@ -48,9 +48,6 @@ SKY_MODELS = ("NISHITA", "SINGLE_SCATTERING", "MULTIPLE_SCATTERING")
 # 2.5 texels of that map so every bake holds it to within 1%
 # (kernels/textures/mp_tex_sky.h).
 WORLD_SUN_SPREAD = 2.5 * 2.0 * math.pi / 512
-# A texture's Fac stays close to [0, 1]; displacement bounds derived from it
-# take this margin on both sides.
-FAC_RANGE = (-0.25, 1.25)
 
 
 def blender_version():

@@ -170,7 +170,7 @@ def emit(compiler, node):
 
 
 def _inputs(compiler, node, *spec):
-    from .node_compiler import FLOAT, VEC
+    from .node_kinds import FLOAT, VEC
 
     kinds = {"f": FLOAT, "v": VEC}
     return [compiler.by_id(node, ident, kinds[k]) for ident, k in spec]
@@ -182,7 +182,7 @@ def _vector(compiler, node):
 
 
 def emit_checker(compiler, node):
-    from .node_compiler import FLOAT, VEC
+    from .node_kinds import FLOAT, VEC
 
     compiler.headers.add("mp_tex_pattern.h")
     vec = _vector(compiler, node)
@@ -193,7 +193,7 @@ def emit_checker(compiler, node):
 
 
 def emit_brick(compiler, node):
-    from .node_compiler import FLOAT, VEC
+    from .node_kinds import FLOAT, VEC
 
     compiler.headers.add("mp_tex_pattern.h")
     vec = _vector(compiler, node)
@@ -212,7 +212,7 @@ def emit_brick(compiler, node):
 
 
 def emit_gradient(compiler, node):
-    from .node_compiler import FLOAT, VEC
+    from .node_kinds import FLOAT, VEC
 
     compiler.headers.add("mp_tex_pattern.h")
     vec = _vector(compiler, node)
@@ -222,7 +222,7 @@ def emit_gradient(compiler, node):
 
 
 def emit_magic(compiler, node):
-    from .node_compiler import FLOAT, VEC
+    from .node_kinds import FLOAT, VEC
 
     compiler.headers.add("mp_tex_pattern.h")
     vec = _vector(compiler, node)
@@ -237,7 +237,7 @@ def emit_magic(compiler, node):
 
 
 def emit_white_noise(compiler, node):
-    from .node_compiler import FLOAT, VEC
+    from .node_kinds import FLOAT, VEC
 
     compiler.headers.add("mp_tex_pattern.h")
     dims = int(node.noise_dimensions[0]) if node.noise_dimensions[:1] in ("1", "2", "3", "4") else 3
@@ -249,7 +249,7 @@ def emit_white_noise(compiler, node):
 
 
 def emit_gabor(compiler, node):
-    from .node_compiler import FAC_RANGE, FLOAT
+    from .node_kinds import FAC_RANGE, FLOAT
 
     compiler.headers.add("mp_tex_gabor.h")
     vec = _vector(compiler, node)
@@ -267,7 +267,7 @@ def emit_gabor(compiler, node):
 
 
 def emit_blackbody(compiler, node):
-    from .node_compiler import VEC
+    from .node_kinds import VEC
 
     compiler.headers.add("mp_tex_color.h")
     (t,) = _inputs(compiler, node, ("Temperature", "f"))
@@ -281,7 +281,7 @@ def emit_blackbody(compiler, node):
 
 
 def emit_wavelength(compiler, node):
-    from .node_compiler import VEC
+    from .node_kinds import VEC
 
     compiler.headers.add("mp_tex_color.h")
     (lam,) = _inputs(compiler, node, ("Wavelength", "f"))
@@ -290,7 +290,7 @@ def emit_wavelength(compiler, node):
 
 
 def emit_curves(compiler, node):
-    from .node_compiler import FLOAT, VEC
+    from .node_kinds import FLOAT, VEC
 
     compiler.headers.add("mp_tex_color.h")
     if node.type == "CURVE_FLOAT":
@@ -309,7 +309,7 @@ def emit_curves(compiler, node):
 
 
 def emit_bright_contrast(compiler, node):
-    from .node_compiler import VEC
+    from .node_kinds import VEC
 
     compiler.headers.add("mp_tex_color.h")
     color, bright, contrast = _inputs(compiler, node, ("Color", "v"), ("Bright", "f"), ("Contrast", "f"))
@@ -317,7 +317,7 @@ def emit_bright_contrast(compiler, node):
 
 
 def emit_gamma(compiler, node):
-    from .node_compiler import VEC
+    from .node_kinds import VEC
 
     compiler.headers.add("mp_tex_color.h")
     color, gamma = _inputs(compiler, node, ("Color", "v"), ("Gamma", "f"))
@@ -331,7 +331,7 @@ def emit_vector_rotate(compiler, node):
     """Vector Rotate: the Vector about Center, by the type's inputs (Axis and
     Angle, Angle alone, or Rotation as Euler XYZ); an unlinked Vector is
     (0, 0, 0) as in Cycles."""
-    from .node_compiler import VEC
+    from .node_kinds import VEC
 
     compiler.headers.add("mp_vector_rotate.h")
     vec, center, axis, angle, rotation = _inputs(compiler, node, ("Vector", "v"), ("Center", "v"), ("Axis", "v"),

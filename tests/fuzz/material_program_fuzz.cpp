@@ -30,7 +30,7 @@
 #include "cl/device_session.h"
 #include "fuzz_support.h"
 #include "micropoly/error.h"
-#include "pipeline/material_programs.h"
+#include "pipeline/materials/material_programs.h"
 
 namespace {
 

@@ -16,7 +16,7 @@
 
 #include "fuzz_support.h"
 #include "micropoly/error.h"
-#include "pipeline/scene_buffers.h"
+#include "pipeline/device_scene/scene_buffers.h"
 #include "scene_decoder.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -15,8 +15,8 @@
 #include "mp_surface.h"
 #include "mp_grid.h"
 #include "mp_bound.h"
-#include "pipeline/frame_params.h"
-#include "pipeline/scene_buffers.h"
+#include "pipeline/frame/frame_params.h"
+#include "pipeline/device_scene/scene_buffers.h"
 
 namespace mp::test {
 

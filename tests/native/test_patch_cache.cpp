@@ -1,4 +1,4 @@
-// The object-space patch cache (pipeline/patch_cache.h): shapes are built
+// The object-space patch cache (pipeline/device_scene/patch_cache.h): shapes are built
 // once and placed per object, and a placed shape equals the patches the
 // builders make directly in camera space (OpenSubdiv refinement included).
 #include <gtest/gtest.h>
@@ -8,8 +8,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "pipeline/patch_cache.h"
-#include "pipeline/scene_buffers.h"
+#include "pipeline/device_scene/patch_cache.h"
+#include "pipeline/device_scene/scene_buffers.h"
 #include "mp_patch.h"
 #include "scene_fixtures.h"
 

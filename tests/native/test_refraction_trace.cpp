@@ -1,6 +1,6 @@
 // Paths through refracting objects (kernels/mp_refract_trace.h) against
 // Snell's law worked out by hand for a sphere and a box, and the proxy
-// builder (native/src/pipeline/refraction_proxy.cpp) against brute force.
+// builder (native/src/pipeline/materials/refraction_proxy.cpp) against brute force.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,7 +12,7 @@
 #include "mp_compat.h"
 #include "mp_patch.h"
 #include "mp_refract_trace.h"
-#include "pipeline/refraction_proxy.h"
+#include "pipeline/materials/refraction_proxy.h"
 #include "scene_fixtures.h"
 #include "renderer_fixture.h"
 #include "subdiv/patch_buffer.h"

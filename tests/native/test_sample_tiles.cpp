@@ -1,6 +1,6 @@
 // The tile sampler (kernels/sample_tiles.cl) against the per-micropolygon
 // sampler (kernels/sample.cl), and frames rendered in buckets
-// (pipeline/buckets.h) against the whole frame: the same winner for every
+// (pipeline/frame/buckets.h) against the whole frame: the same winner for every
 // sample, so the same image (buckets: bit for bit), on whichever device runs
 // the tests.
 #include <gtest/gtest.h>
@@ -11,7 +11,7 @@
 
 #include "micropoly/error.h"
 #include "micropoly/renderer.h"
-#include "pipeline/buckets.h"
+#include "pipeline/frame/buckets.h"
 #include "renderer_fixture.h"
 #include "scene_fixtures.h"
 

@@ -1,10 +1,10 @@
-// Scene fingerprints (pipeline/scene_fingerprint.h): the scene's changes
+// Scene fingerprints (pipeline/device_scene/scene_fingerprint.h): the scene's changes
 // whenever anything rendered changes, node values included; the shadow
 // maps' (geometry_fingerprint) only when what a shadow view reads does.
 #include <gtest/gtest.h>
 
 #include "micropoly/scene.h"
-#include "pipeline/scene_fingerprint.h"
+#include "pipeline/device_scene/scene_fingerprint.h"
 #include "scene_fixtures.h"
 
 namespace mp::test {

@@ -14,7 +14,7 @@
 #include "micropoly/renderer.h"
 #include "micropoly/settings_util.h"
 #include "mp_shadow.h"
-#include "pipeline/shadow_page_pool.h"
+#include "pipeline/shadows/shadow_page_pool.h"
 #include "renderer_fixture.h"
 #include "scene_fixtures.h"
 
@@ -546,6 +546,76 @@ TEST_F(ShadowRenderTest, AShortBudgetCoarsensShadowsAndKeepsToIt) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("shadow map memory budget"), std::string::npos) << e.what();
   }
+}
+
+}  // namespace
+}  // namespace mp::test
+
+namespace mp::test {
+namespace {
+
+// A stack of `layers` horizontal squares 4 units across, 0.05 apart from
+// height 1 up, that the camera sees (only the top one, from above), lit by
+// a point light of radius 0.2 above them: each layer hides the ones below
+// from the light.
+Scene layer_stack(int layers) {
+  Light lamp;
+  lamp.type = Light::Type::Point;
+  lamp.intensity = 60.0f;
+  lamp.position = glm::vec3(1.0f, 0.5f, 6.0f);
+  lamp.radius = 0.2f;
+  Scene s = floor_scene(lamp);
+  for (int k = 0; k < layers; ++k) {
+    const float z = 1.0f + 0.05f * float(k);
+    Mesh m = polygon({{-2, -2, z}, {2, -2, z}, {2, 2, z}, {-2, 2, z}});
+    m.name = "layer" + std::to_string(k);
+    s.meshes.push_back(m);
+  }
+  return s;
+}
+
+TEST_F(ShadowRenderTest, HiddenLayersAreCulledFromTheLightsViewsWithoutChangingTheImage) {
+  Scene s = layer_stack(48);
+  s.settings.occlusion_culling = false;
+  const RenderResult all = Renderer().render(s);  // fresh renderers: no pages kept from the frame before
+  s.settings.occlusion_culling = true;
+  const RenderResult culled = Renderer().render(s);
+  const RenderResult one = Renderer().render(layer_stack(1));
+  const ShadowStats &a = all.stats.shadows, &c = culled.stats.shadows;
+  ASSERT_GT(a.pages_rendered, 0u);
+  EXPECT_EQ(a.subpatches_occluded, 0u);
+  // Texels keep the nearest depth they see, so what culling leaves out could
+  // not have changed one.
+  EXPECT_EQ(culled.rgba, all.rgba);
+  EXPECT_EQ(c.pages_rendered, a.pages_rendered);
+  EXPECT_LE(c.micropolygons, a.micropolygons);
+  // A GPU takes every root at once and looks at its pyramids between dice
+  // batches only (as in the camera's view): this small scene is one batch.
+  if (Renderer().device().type != "cpu") GTEST_SKIP() << "waves near to far are for CPU devices";
+  EXPECT_GT(c.subpatches_occluded, 0u);
+  // The lights' views dice little more than the top layer.
+  EXPECT_LT(double(c.micropolygons), 0.25 * double(a.micropolygons)) << c.micropolygons << " of " << a.micropolygons;
+  EXPECT_LT(double(c.micropolygons), 1.5 * double(one.stats.shadows.micropolygons))
+      << c.micropolygons << " shadow micropolygons for 48 layers, " << one.stats.shadows.micropolygons << " for one";
+}
+
+TEST_F(ShadowRenderTest, MarkingVerticesKeepToTheirShareOfTheBudget) {
+  // Enough layers that the soft marking's vertices pass an eighth of a
+  // 6 MiB budget: the marking dices the view again rather than keep them,
+  // and the pages (and so the image) are those of an ample budget.
+  Scene s = layer_stack(160);
+  s.settings.occlusion_culling = false;
+  const RenderResult ample = Renderer().render(s);
+  s.settings.shadow_memory_mib = 6.0f;
+  const RenderResult tight = Renderer().render(s);
+  const ShadowStats& t = tight.stats.shadows;
+  EXPECT_EQ(ample.stats.shadows.marking_passes, 0u);
+  EXPECT_GE(t.marking_passes, 1u) << "the kept vertices fitted: the test needs more of them";
+  EXPECT_LE(t.peak_bytes, t.budget_bytes);
+  ASSERT_EQ(t.level_bias, 0);
+  ASSERT_EQ(t.pages_missing, 0u);
+  EXPECT_EQ(t.pages_requested, ample.stats.shadows.pages_requested);
+  EXPECT_EQ(tight.rgba, ample.rgba);
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// The Sky Texture's physical skies (pipeline/sky_nishita.h) through the
+// The Sky Texture's physical skies (sky/sky_nishita.h) through the
 // lookup the kernels run (sky_radiance): what Rayleigh and Mie scattering
 // must give whatever the implementation (a blue zenith, a red sunset, a sky
 // symmetric about the sun), the sun disc's light against the irradiance it
@@ -7,7 +7,7 @@
 
 #include <cmath>
 
-#include "pipeline/sky_nishita.h"
+#include "sky/sky_nishita.h"
 
 namespace mp {
 namespace {

@@ -20,7 +20,7 @@
 
 #include "host_dicer.h"
 #include "mp_blur.h"
-#include "pipeline/frame_params.h"
+#include "pipeline/frame/frame_params.h"
 #include "renderer_fixture.h"
 #include "scene_fixtures.h"
 

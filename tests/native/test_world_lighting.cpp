@@ -1,4 +1,4 @@
-// The world's light as lights (pipeline/world_lighting.h), against
+// The world's light as lights (pipeline/world/world_lighting.h), against
 // analytic results: a uniform world's irradiance and a point-like sun's.
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 
 #include "micropoly/error.h"
 #include "mp_world.h"
-#include "pipeline/world_lighting.h"
+#include "pipeline/world/world_lighting.h"
 
 namespace mp {
 namespace {

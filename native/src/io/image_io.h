@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "micropoly/renderer.h"
+#include "micropoly/render_result.h"
 
 namespace mp {
 

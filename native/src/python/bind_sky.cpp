@@ -1,5 +1,5 @@
 // The Sky Texture node's precomputation for micropoly._native
-// (pipeline/sky_nishita.h): the texture and the sun disc's values that
+// (sky/sky_nishita.h): the texture and the sun disc's values that
 // the add-on's node compiler writes into the world's program.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -8,7 +8,7 @@
 #include <string>
 
 #include "micropoly/error.h"
-#include "pipeline/sky_nishita.h"
+#include "sky/sky_nishita.h"
 
 namespace py = pybind11;
 

@@ -98,6 +98,8 @@ py::dict stats_dict(const RenderStats& s) {
   sh["pages_rendered"] = s.shadows.pages_rendered;
   sh["pages_missing"] = s.shadows.pages_missing;
   sh["micropolygons"] = s.shadows.micropolygons;
+  sh["subpatches_occluded"] = s.shadows.subpatches_occluded;
+  sh["marking_passes"] = s.shadows.marking_passes;
   sh["budget_bytes"] = s.shadows.budget_bytes;
   sh["peak_bytes"] = s.shadows.peak_bytes;
   sh["batches"] = s.shadows.batches;

@@ -1,0 +1,422 @@
+#include "pipeline/device_scene/scene_buffers.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "cl/device_session.h"
+#include "micropoly/error.h"
+
+#include "mp_patch.h"
+
+namespace mp {
+namespace {
+
+void put(float* dst, glm::vec3 v, float w) {
+  dst[0] = v.x, dst[1] = v.y, dst[2] = v.z, dst[3] = w;
+}
+
+DeviceMaterial to_device(const Material& m) {
+  DeviceMaterial d{};
+  float model = m.model == Material::Model::Constant ? MP_MODEL_CONSTANT
+                : m.model == Material::Model::Matte  ? MP_MODEL_MATTE
+                : m.model == Material::Model::Plastic ? MP_MODEL_PLASTIC
+                                                      : MP_MODEL_PRINCIPLED;
+  put(d.color, m.color, model);
+  float avg = std::clamp((m.opacity.x + m.opacity.y + m.opacity.z) / 3.0f, 0.0f, 1.0f);
+  put(d.opacity, m.opacity, avg);
+  d.coeffs[0] = m.ka, d.coeffs[1] = m.kd, d.coeffs[2] = m.ks, d.coeffs[3] = m.roughness;
+  put(d.specular, m.specular_color, 0.0f);
+  put(d.emission, m.emission, 0.0f);
+  d.principled[0] = std::clamp(m.metallic, 0.0f, 1.0f);
+  d.principled[1] = std::max(m.specular, 0.0f);
+  d.principled[2] = m.layered ? 1.0f : 0.0f;
+  d.principled[3] = (m.retro_diffuse ? 1.0f : 0.0f) + (m.multiscatter ? 2.0f : 0.0f);
+  d.program[0] = static_cast<float>(m.program);
+  d.program[1] = m.program >= 0 && m.program_displaces ? 1.0f : 0.0f;
+  d.program[2] = m.program >= 0 && m.program_shades ? 1.0f : 0.0f;
+  d.program[3] = m.program >= 0 && m.program_shades && m.program_alpha ? 1.0f : 0.0f;
+  return d;
+}
+
+// Node values of a material (or the world) appended to the scene's
+// parameter buffer; returns where they start.
+uint32_t append_params(const std::vector<float>& values, const std::string& owner, std::vector<float>& params) {
+  if (params.size() + values.size() > size_t(UINT32_MAX))
+    throw Error(owner + ": the scene's node values exceed 2^32");
+  const uint32_t at = uint32_t(params.size());
+  params.insert(params.end(), values.begin(), values.end());
+  return at;
+}
+
+// Camera <-> object transforms and texture space of one surface.
+DeviceObject to_device_object(const glm::mat4& to_camera, const glm::mat4& to_world, glm::vec3 texspace_location,
+                              glm::vec3 texspace_size, const std::vector<glm::vec3>& points, const ObjectInfo& info) {
+  if (texspace_size == glm::vec3(0.0f) && !points.empty()) {
+    glm::vec3 lo(3e38f), hi(-3e38f);
+    for (const glm::vec3& p : points) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    texspace_location = 0.5f * (lo + hi);
+    texspace_size = 0.5f * (hi - lo);
+  }
+  DeviceObject o{};
+  const glm::mat4 to_object = glm::inverse(to_camera);
+  const glm::mat4 from_world = glm::inverse(to_world);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) {
+      o.to_object[4 * r + c] = to_object[c][r];  // glm is column-major
+      o.to_camera[4 * r + c] = to_camera[c][r];
+      o.to_world[4 * r + c] = to_world[c][r];
+      o.from_world[4 * r + c] = from_world[c][r];
+    }
+  put(o.texspace_location, texspace_location, 0.0f);
+  put(o.texspace_size, texspace_size, 0.0f);
+  for (int k = 0; k < 4; ++k) o.color[k] = info.color[k];
+  o.info[0] = info.pass_index;
+  o.info[1] = info.random;
+  return o;
+}
+
+// Longest a unit object-space vector can become in camera space.
+float max_scale(const glm::mat4& m) {
+  return std::max({glm::length(glm::vec3(m[0])), glm::length(glm::vec3(m[1])), glm::length(glm::vec3(m[2]))});
+}
+
+// Appends an object-space shape's control points and edge curves carried to
+// camera space: points by `to_camera`, the curves' normal halves by its
+// inverse transpose (the kernels normalise them and orient them like the
+// patch, so their scale and sign do not matter).
+void place_positions(const PatchBuffer& shape, const glm::mat4& to_camera, std::vector<glm::vec4>& points,
+                     std::vector<glm::vec4>& curves) {
+  const glm::dmat4 m(to_camera);
+  const glm::dmat3 normal_map = glm::transpose(glm::inverse(glm::dmat3(m)));
+  auto point = [&](const glm::vec4& p) {
+    const glm::dvec4 q = m * glm::dvec4(glm::dvec3(p), 1.0);
+    return glm::vec4(float(q.x), float(q.y), float(q.z), 0.0f);
+  };
+  for (const glm::vec4& p : shape.points) points.push_back(point(p));
+  for (size_t c = 0; c < shape.curves.size(); c += MP_CURVE_FLOAT4S) {
+    for (int k = 0; k < 4; ++k) curves.push_back(point(shape.curves[c + size_t(k)]));
+    for (int k = 4; k < MP_CURVE_FLOAT4S; ++k) {
+      const glm::dvec3 n = normal_map * glm::dvec3(glm::vec3(shape.curves[c + size_t(k)]));
+      curves.emplace_back(float(n.x), float(n.y), float(n.z), 0.0f);
+    }
+  }
+}
+
+// Appends an object-space shape (patch_cache.h) as object `object`: control
+// points and edge curves carried to camera space, edge-curve references
+// rebased, and the object's materials (per face through the patch's
+// primitive id), sidedness and displacement bound filled in.
+void place_shape(const PatchBuffer& shape, const glm::mat4& to_camera, const Mesh* mesh, const BezierPatches* set,
+                 uint32_t object, const Scene& scene, PatchBuffer& out) {
+  const glm::dmat4 m(to_camera);
+  // Shading normals map by the inverse transpose.
+  const glm::dmat3 normal_map = glm::transpose(glm::inverse(glm::dmat3(m)));
+  unsigned flags = object << 8;
+  if (mesh ? mesh->double_sided : set->double_sided) flags |= MP_PATCH_DOUBLE_SIDED;
+  if (!(mesh ? mesh->cast_shadows : set->cast_shadows)) flags |= MP_PATCH_NO_SHADOW;
+  if (!(mesh ? mesh->visible_camera : set->visible_camera)) flags |= MP_PATCH_NO_CAMERA;
+  const int set_material = set ? set->material : 0;
+  // A mirroring transform turns counter-clockwise faces clockwise; the
+  // pipeline flips the geometric normal instead of reordering control points.
+  if (glm::determinant(glm::dmat3(m)) < 0.0) flags |= MP_PATCH_FLIP_ORIENTATION;
+  const float bound_scale = max_scale(to_camera);
+  const size_t first = out.size();
+  const uint32_t curve_base = uint32_t(out.curves.size() / MP_CURVE_FLOAT4S);
+  place_positions(shape, to_camera, out.points, out.curves);
+  for (size_t p = 0; p < shape.size(); ++p) {
+    glm::uvec4 info = shape.info[p];
+    const int material = mesh ? (mesh->face_materials.empty() ? mesh->material : mesh->face_materials[info.w])
+                              : set_material;
+    info.y = unsigned(material);
+    info.z = flags | (info.z & MP_PATCH_SMOOTH_NORMALS);
+    out.info.push_back(info);
+    if (size_t(material) < scene.materials.size()) {
+      const Material& mat = scene.materials[size_t(material)];
+      if (mat.program >= 0 && mat.program_displaces)
+        out.points[(first + p) * MP_PATCH_POINTS].w =
+            mat.displacement_bound * (mat.displacement_bound_world ? 1.0f : bound_scale);  // camera = world units
+    }
+  }
+  for (uint32_t ref : shape.edges) out.edges.push_back(ref == MP_NO_CURVE ? ref : ref + (curve_base << 1));
+  out.uvs.insert(out.uvs.end(), shape.uvs.begin(), shape.uvs.end());
+  for (const glm::vec4& n : shape.normals) {
+    const glm::dvec3 m = normal_map * glm::dvec3(glm::vec3(n));
+    out.normals.emplace_back(float(m.x), float(m.y), float(m.z), 0.0f);
+  }
+}
+
+// Motion blur: every surface's control points and edge curves in camera
+// space at each motion step (its points rebuilt into the same patches where
+// it deforms), and each patch's reach: how far (per camera axis) any of its
+// control points moves away from the shutter centre's, in w of its control
+// points 1 to 3 (MP_PATCH_MOTION_REACH), which bounds keep for culling.
+void place_motion(const Scene& scene, const std::vector<PatchCache::Surface>& surfaces, PatchCache* cache,
+                  HostSceneData& out) {
+  const size_t steps = size_t(scene.motion_steps);
+  out.motion_steps = scene.motion_steps;
+  out.motion_points.reserve(steps * out.patches.points.size());
+  out.motion_curves.reserve(steps * out.patches.curves.size());
+  std::vector<Mesh> moved(scene.meshes.size());
+  for (size_t k = 0; k < steps; ++k) {
+    std::vector<PatchCache::Surface> at_step = surfaces;
+    for (size_t i = 0; i < scene.meshes.size(); ++i)
+      if (!scene.meshes[i].motion_points.empty()) {
+        moved[i] = scene.meshes[i];
+        moved[i].points = scene.meshes[i].motion_points[k];
+        at_step[i].mesh = &moved[i];
+      }
+    const auto shapes = cache->shapes(at_step, out.patches.uv_layers);
+    const glm::mat4& w2c = scene.camera.motion_world_to_camera.empty() ? scene.camera.world_to_camera
+                                                                        : scene.camera.motion_world_to_camera[k];
+    for (size_t i = 0; i < surfaces.size(); ++i) {
+      const Mesh* mesh = surfaces[i].mesh;
+      const glm::mat4& o2w = mesh ? (mesh->motion_object_to_world.empty() ? mesh->object_to_world
+                                                                          : mesh->motion_object_to_world[k])
+                                  : surfaces[i].set->object_to_world;
+      place_positions(*shapes[i], w2c * o2w, out.motion_points, out.motion_curves);
+    }
+    if (out.motion_points.size() != (k + 1) * out.patches.points.size() ||
+        out.motion_curves.size() != (k + 1) * out.patches.curves.size())
+      throw Error("motion step " + std::to_string(k) + " changes the scene's patches (a topology that moves?)");
+  }
+  const size_t n = out.patches.points.size();
+  for (size_t p = 0; p < out.patches.size(); ++p) {
+    glm::vec3 reach(0.0f);
+    for (size_t k = 0; k < steps; ++k)
+      for (size_t c = 0; c < MP_PATCH_POINTS; ++c) {
+        const size_t i = p * MP_PATCH_POINTS + c;
+        reach = glm::max(reach, glm::abs(glm::vec3(out.motion_points[k * n + i]) - glm::vec3(out.patches.points[i])));
+      }
+    for (int a = 0; a < 3; ++a) out.patches.points[p * MP_PATCH_POINTS + 1 + size_t(a)].w = reach[a];
+  }
+}
+
+// The environment light's two records (kernels/mp_shading.h,
+// mp_env_irradiance): camera -> world rotation rows, then the coefficients.
+void put_environment(const Light& l, const glm::mat4& world_to_camera, std::vector<DeviceLight>& out) {
+  DeviceLight r[2]{};
+  put(r[0].color, l.color, float(MP_LIGHT_ENVIRONMENT));
+  r[1].color[3] = float(MP_LIGHT_ENVIRONMENT_DATA);
+  auto slot = [&](int i) -> float& {
+    static_assert(sizeof(DeviceLight) == 24 * sizeof(float), "DeviceLight is 24 floats");
+    float* f = reinterpret_cast<float*>(r);  // floats 4..23 of each record, past its colour
+    return i < 20 ? f[4 + i] : f[28 + (i - 20)];
+  };
+  // world_to_camera is rigid (scaled at most uniformly): its inverse's
+  // linear part is the normalised transpose.
+  glm::mat3 to_camera(world_to_camera);
+  for (int c = 0; c < 3; ++c) to_camera[c] = glm::normalize(to_camera[c]);
+  const glm::mat3 to_world = glm::transpose(to_camera);
+  for (int row = 0; row < 3; ++row)
+    for (int col = 0; col < 3; ++col) slot(3 * row + col) = to_world[col][row];
+  for (size_t k = 0; k < l.irradiance_sh.size() && k < 27; ++k) slot(9 + int(k)) = l.irradiance_sh[k];
+  out.push_back(r[0]);
+  out.push_back(r[1]);
+}
+
+DeviceLight to_device(const Light& l, const glm::mat4& world_to_camera) {
+  DeviceLight d{};
+  int type = l.type == Light::Type::Ambient   ? MP_LIGHT_AMBIENT
+             : l.type == Light::Type::Distant ? MP_LIGHT_DISTANT
+             : l.type == Light::Type::Point   ? MP_LIGHT_POINT
+             : l.type == Light::Type::Spot    ? MP_LIGHT_SPOT
+                                              : MP_LIGHT_AREA;
+  put(d.color, l.color * l.intensity, static_cast<float>(type));
+  put(d.position, glm::vec3(world_to_camera * glm::vec4(l.position, 1.0f)), 1.0f);
+  glm::vec3 dir = glm::vec3(world_to_camera * glm::vec4(l.direction, 0.0f));
+  float len = glm::length(dir);
+  put(d.direction, len > 0.0f ? dir / len : glm::vec3(0, 0, -1), 0.0f);
+  float outer = std::clamp(l.cone_angle, 0.0f, 3.14159265f);
+  float inner = std::clamp(l.cone_angle - l.cone_delta_angle, 0.0f, outer);
+  d.cone[0] = std::cos(outer), d.cone[1] = std::cos(inner), d.cone[2] = l.beam_distribution;
+  // A point or spot light's radius, and whether it is a sphere rather than
+  // a disk facing the lit point (mp_shading.h).
+  const bool sized = l.type == Light::Type::Point || l.type == Light::Type::Spot;
+  d.cone[3] = sized ? l.radius : 0.0f;
+  d.direction[3] = sized && !l.soft_falloff ? 1.0f : 0.0f;
+  if (l.type == Light::Type::Area) {
+    // Half extents in camera space; v completes a right-handed frame with the
+    // emission direction.
+    glm::vec3 n = glm::normalize(glm::vec3(l.direction));
+    glm::vec3 u = l.axis_u - n * glm::dot(l.axis_u, n);
+    u = glm::length(u) > 0.0f ? glm::normalize(u) : glm::normalize(glm::cross(n, glm::vec3(n.z, n.x, n.y)));
+    glm::vec3 v = glm::cross(n, u);
+    glm::vec3 hu = glm::vec3(world_to_camera * glm::vec4(u * (0.5f * l.size_u), 0.0f));
+    glm::vec3 hv = glm::vec3(world_to_camera * glm::vec4(v * (0.5f * l.size_v), 0.0f));
+    put(d.axis_u, hu, l.shape == Light::Shape::Ellipse ? float(MP_AREA_ELLIPSE) : float(MP_AREA_RECTANGLE));
+    put(d.axis_v, hv, 0.0f);
+  }
+  if (l.world_probe) d.axis_u[3] = MP_WORLD_PROBE;
+  return d;
+}
+
+// Each patch's box (camera space): its control points' (Gregory partners
+// included, so the surface lies inside), grown by its displacement bound.
+std::vector<glm::vec4> patch_bounds(const PatchBuffer& patches) {
+  std::vector<glm::vec4> out(2 * patches.size());
+  for (size_t p = 0; p < patches.size(); ++p) {
+    const glm::vec4* cp = &patches.points[p * MP_PATCH_POINTS];
+    glm::vec3 lo(cp[0]), hi(cp[0]);
+    for (int k = 1; k < MP_PATCH_POINTS; ++k) lo = glm::min(lo, glm::vec3(cp[k])), hi = glm::max(hi, glm::vec3(cp[k]));
+    // MP_PATCH_DISPLACEMENT_BOUND and MP_PATCH_MOTION_REACH.
+    const glm::vec3 reach = glm::vec3(cp[0].w) + glm::vec3(cp[1].w, cp[2].w, cp[3].w);
+    out[2 * p] = glm::vec4(lo - reach, 0.0f);
+    out[2 * p + 1] = glm::vec4(hi + reach, 0.0f);
+  }
+  return out;
+}
+
+template <typename T>
+cl::Buffer upload(DeviceSession& session, const std::vector<T>& v) {
+  // allocate() pads to 16 bytes: zero-sized buffers are invalid.
+  cl::Buffer b = session.allocate(v.size() * sizeof(T), "scene data", CL_MEM_READ_ONLY);
+  if (!v.empty()) session.queue().enqueueWriteBuffer(b, CL_FALSE, 0, v.size() * sizeof(T), v.data());
+  return b;
+}
+
+// The writes above do not block: if the upload fails part way, the ones
+// already queued may still read the host arrays, which unwinding is about
+// to free, so the queue is drained before the error goes on.
+template <typename F>
+void upload_or_drain(DeviceSession& session, F&& body) {
+  try {
+    body();
+  } catch (...) {
+    session.queue().drain();
+    throw;
+  }
+}
+
+}  // namespace
+
+std::vector<DeviceLight> device_lights(const std::vector<Light>& lights, const glm::mat4& world_to_camera) {
+  std::vector<DeviceLight> out;
+  for (const Light& l : lights) {
+    if (l.type == Light::Type::Environment)
+      put_environment(l, world_to_camera, out);
+    else
+      out.push_back(to_device(l, world_to_camera));
+  }
+  return out;
+}
+
+HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
+  HostSceneData out;
+  const glm::mat4& w2c = scene.camera.world_to_camera;
+  for (const Mesh& mesh : scene.meshes)
+    out.patches.uv_layers = std::max(out.patches.uv_layers, int(mesh.uv_layers.size()));
+  // Each surface's patches share their edges' curves (patch_edges.h), so
+  // neighbouring patches dice watertight; separate surfaces do not.
+  std::vector<PatchCache::Surface> surfaces;
+  for (const Mesh& mesh : scene.meshes) surfaces.push_back({&mesh, nullptr});
+  for (const BezierPatches& set : scene.bezier_patches) surfaces.push_back({nullptr, &set});
+  PatchCache local;
+  const auto shapes = (cache ? cache : &local)->shapes(surfaces, out.patches.uv_layers);
+  // Reserved once for all surfaces: growing per surface to its exact size
+  // would copy everything placed so far for every object (quadratic in the
+  // object count; thousands of instances took minutes).
+  size_t totals[6] = {};
+  for (const auto& shape : shapes) {
+    totals[0] += shape->points.size(), totals[1] += shape->info.size(), totals[2] += shape->edges.size();
+    totals[3] += shape->curves.size(), totals[4] += shape->uvs.size(), totals[5] += shape->normals.size();
+  }
+  out.patches.points.reserve(totals[0]), out.patches.info.reserve(totals[1]), out.patches.edges.reserve(totals[2]);
+  out.patches.curves.reserve(totals[3]), out.patches.uvs.reserve(totals[4]), out.patches.normals.reserve(totals[5]);
+  out.objects.reserve(surfaces.size());
+  for (size_t i = 0; i < surfaces.size(); ++i) {
+    const Mesh* mesh = surfaces[i].mesh;
+    const BezierPatches* set = surfaces[i].set;
+    const glm::mat4 to_camera = w2c * (mesh ? mesh->object_to_world : set->object_to_world);
+    place_shape(*shapes[i], to_camera, mesh, set, uint32_t(out.objects.size()), scene, out.patches);
+    const glm::mat4& to_world = mesh ? mesh->object_to_world : set->object_to_world;
+    out.objects.push_back(mesh ? to_device_object(to_camera, to_world, mesh->texspace_location, mesh->texspace_size,
+                                                  mesh->points, mesh->info)
+                               : to_device_object(to_camera, to_world, glm::vec3(0.0f), glm::vec3(0.0f),
+                                                  set->control_points, set->info));
+  }
+  if (scene.motion_steps >= 2) place_motion(scene, surfaces, cache ? cache : &local, out);
+  if (scene.materials.empty()) out.materials.push_back(to_device(Material{}));
+  for (const Material& m : scene.materials) {
+    DeviceMaterial d = to_device(m);
+    d.params[0] = append_params(m.program_params, "material '" + m.name + "'", out.params);
+    d.params[1] = uint32_t(m.program_params.size());
+    out.materials.push_back(d);
+  }
+  out.world_params_at = append_params(scene.world.program_params, "the world", out.params);
+  if (out.params.empty()) out.params.push_back(0.0f);  // a buffer of at least one value
+  out.lights = device_lights(scene.lights, w2c);
+  std::vector<bool> refracts(out.materials.size(), false);
+  for (size_t k = 0; k < scene.materials.size(); ++k) {
+    const Material& m = scene.materials[k];
+    refracts[k] = m.program_shades && m.program >= 0 && size_t(m.program) < scene.material_programs.size() &&
+                  program_refracts(scene.material_programs[size_t(m.program)].source, m.program_params);
+  }
+  out.refraction = build_refraction_proxies(out.patches, out.objects.size(), refracts);
+  for (const Image& image : scene.images) {
+    // DeviceImage offsets are 32-bit texel indices (64 GiB of float texels).
+    if (out.texels.size() + image.pixels.size() > size_t(UINT32_MAX))
+      throw Error("image '" + image.name + "': the scene's images exceed 2^32 texels");
+    out.images.push_back(DeviceImage{uint32_t(out.texels.size()), uint32_t(image.width), uint32_t(image.height),
+                                     image.srgb ? 1u : 0u});
+    out.texels.insert(out.texels.end(), image.pixels.begin(), image.pixels.end());
+  }
+  return out;
+}
+
+void upload_lights(DeviceSession& session, const std::vector<Light>& lights, const glm::mat4& world_to_camera,
+                   SceneBuffers& buffers) {
+  const std::vector<DeviceLight> records = device_lights(lights, world_to_camera);
+  upload_or_drain(session, [&] {
+    buffers.lights = upload(session, records);
+    buffers.light_count = static_cast<cl_uint>(records.size());
+    session.queue().finish();  // `records` lives only for the call
+  });
+}
+
+void upload_world_glossy(DeviceSession& session, const std::vector<glm::vec4>& maps, SceneBuffers& buffers) {
+  upload_or_drain(session, [&] {
+    buffers.world_glossy = upload(session, maps);
+    session.queue().finish();  // `maps` is the caller's; the write must end while it lives
+  });
+}
+
+SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data) {
+  SceneBuffers b;
+  // Read by a write that does not block: it must live until the finish below.
+  const std::vector<glm::vec4> no_world_glossy(1, glm::vec4(0.0f));
+  upload_or_drain(session, [&] {
+    b.points = upload(session, data.patches.points);
+    b.patch_info = upload(session, data.patches.info);
+    b.patch_edges = upload(session, data.patches.edges);
+    b.edge_curves = upload(session, data.patches.curves);
+    b.materials = upload(session, data.materials);
+    b.objects = upload(session, data.objects);
+    b.lights = upload(session, data.lights);
+    b.patch_uvs = upload(session, data.patches.uvs);
+    b.patch_normals = upload(session, data.patches.normals);
+    b.host_patch_bounds = patch_bounds(data.patches);  // lives until the queue finishes below
+    b.patch_bounds = upload(session, b.host_patch_bounds);
+    b.images = upload(session, data.images);
+    b.texels = upload(session, data.texels);
+    b.params = upload(session, data.params);
+    b.world_params_at = static_cast<cl_uint>(data.world_params_at);
+    b.world_glossy = upload(session, no_world_glossy);
+    b.motion_points = upload(session, data.motion_points);
+    b.motion_curves = upload(session, data.motion_curves);
+    b.refract_roots = upload(session, data.refraction.roots);
+    b.refract_nodes = upload(session, data.refraction.nodes);
+    b.refract_tris = upload(session, data.refraction.tris);
+    b.motion_steps = static_cast<cl_uint>(data.motion_steps);
+    b.point_count = static_cast<cl_uint>(data.patches.points.size());
+    b.curve_count = static_cast<cl_uint>(data.patches.curves.size());
+    b.uv_layers = static_cast<cl_uint>(data.patches.uv_layers);
+    b.image_count = static_cast<cl_uint>(data.images.size());
+    b.patch_count = static_cast<cl_uint>(data.patches.size());
+    b.light_count = static_cast<cl_uint>(data.lights.size());
+    session.queue().finish();
+  });
+  return b;
+}
+
+}  // namespace mp

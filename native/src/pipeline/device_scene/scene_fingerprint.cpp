@@ -1,0 +1,196 @@
+#include "pipeline/device_scene/scene_fingerprint.h"
+
+#include <cstring>
+#include <type_traits>
+
+namespace mp {
+namespace {
+
+// FNV-1a over 64-bit words (the tail byte by byte): fast enough to run over
+// a million-face mesh in milliseconds. Values are hashed field by field, so
+// struct padding never enters.
+class Hasher {
+ public:
+  void bytes(const void* data, size_t n) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    size_t words = n / 8;
+    for (size_t i = 0; i < words; ++i) {
+      uint64_t w;
+      std::memcpy(&w, p + 8 * i, 8);
+      mix(w);
+    }
+    for (size_t i = words * 8; i < n; ++i) mix(p[i]);
+    mix(n);
+  }
+  template <typename T>
+  void value(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    bytes(&v, sizeof(T));
+  }
+  template <typename T>
+  void values(const std::vector<T>& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    bytes(v.data(), v.size() * sizeof(T));
+  }
+  void text(const std::string& s) { bytes(s.data(), s.size()); }
+  uint64_t result() const { return h_; }
+
+ private:
+  void mix(uint64_t w) { h_ = (h_ ^ w) * 0x100000001b3ull; }
+  uint64_t h_ = 0xcbf29ce484222325ull;
+};
+
+// What a mesh's patches are built from, in object space (patch_cache.h).
+void hash_mesh_shape(Hasher& h, const Mesh& m) {
+  h.value(m.scheme);
+  h.values(m.points);
+  h.values(m.face_vertex_counts);
+  h.values(m.face_vertex_indices);
+  if (m.scheme == SubdivScheme::CatmullClark) {
+    h.values(m.crease_vertices);
+    h.values(m.crease_sharpness);
+    h.values(m.corner_vertices);
+    h.values(m.corner_sharpness);
+    h.values(m.hole_faces);
+    h.value(m.boundary);
+  } else {
+    h.values(m.corner_normals);
+  }
+  h.value(m.uv_layers.size());
+  for (const auto& layer : m.uv_layers) h.values(layer);
+}
+
+}  // namespace
+
+uint64_t mesh_shape_key(const Mesh& m, int uv_layers) {
+  Hasher h;
+  h.value(uint32_t(1));  // meshes and patch sets never share a key
+  h.value(uv_layers);
+  hash_mesh_shape(h, m);
+  return h.result();
+}
+
+uint64_t patch_set_shape_key(const BezierPatches& set, int uv_layers) {
+  Hasher h;
+  h.value(uint32_t(2));
+  h.value(uv_layers);
+  h.values(set.control_points);
+  return h.result();
+}
+
+namespace {
+
+// Surfaces, materials and images (scene_fingerprint and geometry_fingerprint).
+// For shadows only what a shadow view reads of a material counts: its
+// opacity, and the node values of programs that displace or compute the
+// alpha; a colour edited in a material keeps the shadow maps.
+void hash_surfaces(Hasher& h, const Scene& scene, bool shadows_only) {
+  h.value(scene.meshes.size());
+  for (const Mesh& m : scene.meshes) {
+    h.text(m.name);
+    hash_mesh_shape(h, m);
+    h.value(m.material);
+    h.values(m.face_materials);
+    h.value(m.object_to_world);
+    h.value(m.double_sided);
+    h.value(m.texspace_location);
+    h.value(m.texspace_size);
+    h.value(m.visible_camera);
+    h.value(m.cast_shadows);
+    h.value(m.info.color), h.value(m.info.pass_index), h.value(m.info.random);
+    h.value(m.motion_points.size());
+    for (const std::vector<glm::vec3>& step : m.motion_points) h.values(step);
+    h.values(m.motion_object_to_world);
+  }
+  h.value(scene.motion_steps);
+  h.values(scene.shutter_curve);
+  h.values(scene.camera.motion_world_to_camera);
+  h.value(scene.bezier_patches.size());
+  for (const BezierPatches& b : scene.bezier_patches) {
+    h.values(b.control_points);
+    h.value(b.material);
+    h.value(b.object_to_world);
+    h.value(b.double_sided);
+    h.value(b.visible_camera);
+    h.value(b.cast_shadows);
+    h.value(b.info.color), h.value(b.info.pass_index), h.value(b.info.random);
+  }
+  h.value(scene.materials.size());
+  for (const Material& m : scene.materials) {
+    h.value(m.opacity);
+    h.value(m.program), h.value(m.program_displaces), h.value(m.program_shades), h.value(m.displacement_bound);
+    h.value(m.displacement_bound_world), h.value(m.program_alpha);
+    if (!shadows_only || m.program_displaces || m.program_alpha)
+      h.value(m.program_params.size()), h.values(m.program_params);
+    if (shadows_only) continue;
+    h.value(m.model);
+    h.value(m.color);
+    h.value(m.ka), h.value(m.kd), h.value(m.ks), h.value(m.roughness);
+    h.value(m.specular_color), h.value(m.metallic), h.value(m.specular), h.value(m.emission);
+  }
+  h.value(scene.material_programs.size());
+  for (const MaterialProgram& p : scene.material_programs) h.text(p.source);
+  h.value(scene.images.size());
+  for (const Image& im : scene.images) {
+    h.value(im.width), h.value(im.height), h.value(im.srgb);
+    h.values(im.pixels);
+  }
+}
+
+void hash_light(Hasher& h, const Light& l) {
+  h.value(l.type), h.value(l.position), h.value(l.direction);
+  h.value(l.cone_angle), h.value(l.cone_delta_angle), h.value(l.beam_distribution);
+  h.value(l.shape), h.value(l.axis_u), h.value(l.size_u), h.value(l.size_v);
+  h.value(l.cast_shadows), h.value(l.radius), h.value(l.soft_falloff), h.value(l.angle);
+}
+
+}  // namespace
+
+uint64_t geometry_fingerprint(const Scene& scene) {
+  Hasher h;
+  hash_surfaces(h, scene, true);
+  return h.result();
+}
+
+uint64_t shadow_light_key(const Light& light, uint64_t geometry_key, const RenderSettings& settings, float z_top) {
+  Hasher h;
+  h.value(geometry_key);
+  hash_light(h, light);
+  h.value(settings.shadow_shading_rate), h.value(settings.max_grid_size), h.value(settings.max_split_depth);
+  h.value(z_top);
+  return h.result();
+}
+
+uint64_t world_fingerprint(const Scene& scene) {
+  Hasher h;
+  const World& w = scene.world;
+  h.value(w.program);
+  if (w.program >= 0 && size_t(w.program) < scene.material_programs.size())
+    h.text(scene.material_programs[size_t(w.program)].source);
+  h.value(w.program_params.size()), h.values(w.program_params);
+  h.value(w.bake_width), h.value(w.width), h.value(w.height);
+  h.values(w.radiance);
+  h.value(w.camera), h.value(w.diffuse), h.value(w.glossy), h.value(w.cast_shadows);
+  h.value(scene.settings.world_probes);
+  if (w.program >= 0) {  // what its Environment Textures read
+    h.value(scene.images.size());
+    for (const Image& im : scene.images) h.values(im.pixels);
+  }
+  return h.result();
+}
+
+uint64_t scene_fingerprint(const Scene& scene) {
+  Hasher h;
+  // Device light records include the world's (world_lighting.h).
+  h.value(scene.world.present() ? world_fingerprint(scene) : uint64_t(0));
+  h.value(scene.camera.world_to_camera);
+  hash_surfaces(h, scene, false);
+  h.value(scene.lights.size());
+  for (const Light& l : scene.lights) {
+    hash_light(h, l);
+    h.value(l.color), h.value(l.intensity);
+  }
+  return h.result();
+}
+
+}  // namespace mp

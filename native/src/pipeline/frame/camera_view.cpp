@@ -1,0 +1,92 @@
+#include "pipeline/frame/camera_view.h"
+
+#include <algorithm>
+#include <chrono>
+#include <optional>
+
+#include "mp_blur.h"
+
+namespace mp {
+namespace {
+
+// Sub-patches sampled per launch when the caller can cancel.
+constexpr cl_uint kSampleChunk = 256;
+
+}  // namespace
+
+bool render_camera_bucket(MicropolygonPass& pass, const CameraStages& stages, const Scene& scene,
+                          const FrameSetup& frame, const Bucket& bucket, const ShadowInputs& shadows,
+                          uint64_t scene_key, RenderStats& st) {
+  DeviceSession& s = pass.session();
+  FrameProgress& progress = pass.progress();
+  StageTimer& timer = pass.timer();
+  const SceneBuffers& buffers = pass.scene();
+  SampleStage& sample = stages.sample;
+  const FrameParams fb = bucket_frame(frame.params, bucket);
+  std::optional<DeviceSession::Activity> activity(std::in_place, s, "sample");
+  sample.begin_frame(fb, timer, scene.shutter_curve);
+  if (progress.asked()) {
+    s.queue().finish();  // clearing a large sample buffer takes a while: look again
+    progress(0.0f);
+  }
+  PassView view{fb, PassViews{}, PassOcclusion{}};
+  // A blurred occluder hides only part of what lies behind it: culling
+  // against the shutter centre's pinhole depths would lose what the lens
+  // and the other times see past it.
+  if (scene.settings.occlusion_culling && !mp_blur_on(fb)) {
+    activity.emplace(s, "occlusion");
+    OcclusionCulling& occ = stages.occlusion;
+    occ.begin_frame(fb, timer);
+    view.occlusion.pyramid = occ.pyramid();
+    view.occlusion.params = occ.params();
+    view.occlusion.root_order = occ.root_order(buffers.host_patch_bounds, scene_key, fb);
+    view.occlusion.waves = s.info().type == "cpu";
+    sample.mark_occlusion_cells(occ.dirty(), occ.params());
+    view.occlusion.refresh = [&] {
+      if (!progress.cancelled()) occ.refresh(sample.keys(), fb, timer);
+    };
+  }
+  activity.reset();
+
+  ViewTarget target;
+  target.motion = mp_motion_on(fb);
+  target.take = [&](const cl::Buffer& diceable, cl_uint count) {
+    GridBuffers& grids = pass.grids();
+    std::optional<DeviceSession::Activity> step(std::in_place, s, "shade");
+    stages.shade.run(diceable, count, buffers, fb, grids, shadows, timer);
+    stages.programs.shade(diceable, count, buffers, fb, grids, shadows, timer);
+    // The tile sampler takes a batch at once (its lists cover the batch)
+    // and asks between parts of its tiles.
+    step.emplace(s, "sample");
+    const cl_uint chunk = progress.asked() && !sample.tiles() ? kSampleChunk : count;
+    std::function<bool()> ask;
+    if (progress.asked())
+      ask = [&] {
+        s.queue().finish();
+        return progress.again();
+      };
+    for (cl_uint first = 0; first < count && !progress.cancelled(); first += chunk) {
+      sample.run(diceable, first, std::min(chunk, count - first), buffers, fb, grids, timer, ask);
+      if (progress.asked()) {
+        s.queue().finish();
+        progress.again();
+      }
+    }
+    st.subpatches_diced += count;
+    ++st.batches;
+  };
+  const BoundSplitResult bs = pass.run(view, target);
+  st.subpatches_occluded += bs.occluded;
+  if (bs.cancelled) return false;
+
+  activity.emplace(s, "occlusion");
+  st.covered_pixels += stages.occlusion.covered_pixels(sample.keys(), fb, timer, bucket);
+  activity.emplace(s, "resolve");
+  const auto started = std::chrono::steady_clock::now();
+  stages.resolve.run(sample, frame, fb, bucket, scene.settings.filter, scene.settings.filter_width,
+                     scene.settings.depth_and_normal_passes, timer);
+  st.timings_ms.readback += ms_since(started);
+  return true;
+}
+
+}  // namespace mp

@@ -1,0 +1,35 @@
+// The camera's view of one bucket (buckets.h): the micropolygon pass
+// shades and samples each batch into the bucket's sample buffer, culling
+// against the occlusion pyramid those samples build (waves near to far on
+// CPU devices), then the bucket is resolved into the image.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "micropoly/renderer.h"
+#include "pipeline/frame/buckets.h"
+#include "pipeline/frame/frame_params.h"
+#include "pipeline/materials/material_programs.h"
+#include "pipeline/pass/micropolygon_pass.h"
+#include "pipeline/pass/micropolygon_stages.h"
+#include "pipeline/pass/occlusion_culling.h"
+
+namespace mp {
+
+// The stages only the camera's view runs.
+struct CameraStages {
+  ShadeStage& shade;
+  MaterialPrograms& programs;
+  SampleStage& sample;
+  ResolveStage& resolve;
+  OcclusionCulling& occlusion;
+};
+
+// Renders bucket `bucket` of `frame` (shading reads `shadows`) and resolves
+// it; false when the caller cancelled. `scene_key` keys the patches' order.
+bool render_camera_bucket(MicropolygonPass& pass, const CameraStages& stages, const Scene& scene,
+                          const FrameSetup& frame, const Bucket& bucket, const ShadowInputs& shadows,
+                          uint64_t scene_key, RenderStats& stats);
+
+}  // namespace mp

@@ -1,0 +1,172 @@
+#include "pipeline/materials/material_programs.h"
+#include "cl/kernel_args.h"
+
+#include "cl/program_cache.h"
+#include "micropoly/error.h"
+
+#include <algorithm>
+
+namespace mp {
+
+void MaterialPrograms::prepare(const Scene& scene, RenderStats& stats) {
+  ++generation_;
+  active_.clear();
+  displaces_ = false;
+  std::vector<bool> displaces(scene.material_programs.size(), false), shades(displaces), alpha(displaces);
+  for (const Material& m : scene.materials) {
+    if (m.program < 0) continue;
+    displaces[m.program] = displaces[m.program] || m.program_displaces;
+    shades[m.program] = shades[m.program] || m.program_shades;
+    alpha[m.program] = alpha[m.program] || (m.program_shades && m.program_alpha);
+  }
+  for (size_t i = 0; i < scene.material_programs.size(); ++i) {
+    if (!displaces[i] && !shades[i]) continue;
+    active_.push_back({build(scene.material_programs[i], "material '", stats), static_cast<cl_int>(i),
+                       static_cast<bool>(displaces[i]), static_cast<bool>(shades[i]), static_cast<bool>(alpha[i])});
+    displaces_ = displaces_ || displaces[i];
+  }
+  const int w = scene.world.program;
+  world_ = w >= 0 && size_t(w) < scene.material_programs.size()
+               ? build(scene.material_programs[size_t(w)], "world '", stats)
+               : nullptr;
+  evict_unused();
+}
+
+void MaterialPrograms::evict_unused() {
+  std::vector<std::pair<unsigned long long, const std::string*>> spare;
+  for (const auto& [source, built] : built_)
+    if (built->used != generation_) spare.emplace_back(built->used, &source);
+  if (spare.size() <= kSparePrograms) return;
+  std::sort(spare.begin(), spare.end());  // least recently used first
+  std::vector<std::string> evict;
+  for (size_t i = 0; i + kSparePrograms < spare.size(); ++i) evict.push_back(*spare[i].second);
+  for (const std::string& source : evict) built_.erase(source);
+}
+
+MaterialPrograms::Built* MaterialPrograms::build(const MaterialProgram& mp, const char* owner, RenderStats& stats) {
+  auto it = built_.find(mp.source);
+  if (it != built_.end()) {
+    it->second->used = generation_;
+    return it->second.get();
+  }
+  BuiltProgram b;
+  try {
+    b = build_program_cached(session_.context(), session_.device(), assemble_material_program_source(mp.source),
+                             "-cl-std=CL1.2");
+  } catch (const Error& e) {
+    throw Error(owner + mp.name + "': its node tree did not compile: " + e.what());
+  }
+  stats.program_build_ms += b.build_ms;
+  auto built = std::make_unique<Built>();
+  built->program = b.program;
+  built->displace = cl::Kernel(built->program, "displace_grids");
+  built->shade = cl::Kernel(built->program, "shade_program_grids");
+  built->bake_world = cl::Kernel(built->program, "bake_world");
+  built->world_pixels = cl::Kernel(built->program, "world_pixels");
+  built->used = generation_;
+  return built_.emplace(mp.source, std::move(built)).first->second.get();
+}
+
+namespace {
+
+// MP_PROGRAM_INPUT_ARGS (material_program.cl), in its order.
+auto program_inputs(const SceneBuffers& buffers) {
+  return arg_pack(buffers.patch_edges, buffers.patch_uvs, buffers.uv_layers, buffers.images, buffers.image_count,
+                  buffers.texels, buffers.params);
+}
+
+}  // namespace
+
+WorldMap MaterialPrograms::bake_world(const Scene& scene, const SceneBuffers& buffers) {
+  WorldMap map;
+  if (!world_) return map;
+  map.width = std::clamp(scene.world.bake_width, 8, 8192);
+  map.height = map.width / 2;
+  const size_t texels = size_t(map.width) * size_t(map.height);
+  cl::Buffer out = session_.allocate(texels * sizeof(cl_float4), "world map");
+  cl::Kernel& k = world_->bake_world;
+  bind_args(k, cl_uint(map.width), cl_uint(map.height), program_inputs(buffers), buffers.world_params_at, out);
+  DeviceQueue& q = session_.queue();
+  q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(cl_uint(texels)), cl::NDRange(64));
+  std::vector<cl_float4> host(texels);
+  q.enqueueReadBuffer(out, CL_TRUE, 0, texels * sizeof(cl_float4), host.data());
+  map.radiance.resize(texels);
+  for (size_t i = 0; i < texels; ++i) map.radiance[i] = glm::vec3(host[i].s[0], host[i].s[1], host[i].s[2]);
+  return map;
+}
+
+std::vector<float> MaterialPrograms::world_background(const Scene& scene, const SceneBuffers& buffers,
+                                                     const FrameParams& f) {
+  if (!world_) return {};
+  const size_t pixels = size_t(f.width) * size_t(f.height);
+  cl::Buffer out = session_.allocate(pixels * 3 * sizeof(float), "world background");
+  // Camera to world: the inverse of the view's rotation, by rows.
+  const glm::mat3 to_world = glm::inverse(glm::mat3(scene.camera.world_to_camera));
+  cl::Kernel& k = world_->world_pixels;
+  auto row = [&](int r) { return cl_float4{{to_world[0][r], to_world[1][r], to_world[2][r], 0.0f}}; };
+  bind_args(k, f, row(0), row(1), row(2), program_inputs(buffers), buffers.world_params_at, out);
+  DeviceQueue& q = session_.queue();
+  q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(cl_uint(pixels)), cl::NDRange(64));
+  std::vector<float> host(pixels * 3);
+  q.enqueueReadBuffer(out, CL_TRUE, 0, host.size() * sizeof(float), host.data());
+  return host;
+}
+
+namespace {
+
+// The arguments displace_grids and shade_program_grids share (material_program.cl).
+auto grid_args(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+               cl_int program, const GridBuffers& grids) {
+  return arg_pack(diceable, count, scene.patch_info, scene.materials, scene.objects, f, program, grids.p, grids.n,
+                  program_inputs(scene));
+}
+
+}  // namespace
+
+void MaterialPrograms::launch(cl::Kernel& kernel, cl_uint count, GridBuffers& grids, Stage stage, StageTimer& timer) {
+  cl::Event e;
+  session_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64),
+                                        nullptr, &e);
+  timer.add(stage, e);
+}
+
+void MaterialPrograms::displace(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
+                                const FrameParams& f, GridBuffers& grids, StageTimer& timer, bool normals) {
+  if (!displaces_) return;
+  for (Active& a : active_) {
+    if (!a.displaces) continue;
+    cl::Kernel& k = a.built->displace;
+    bind_args(k, grid_args(diceable, count, scene, f, a.index, grids), grids.vertex_offsets);
+    launch(k, count, grids, Stage::Dice, timer);
+  }
+  if (!normals) return;
+  cl::Kernel& k = normals_;
+  bind_args(k, diceable, count, scene.patch_info, scene.materials, f, grids.p, grids.n, grids.vertex_offsets);
+  launch(k, count, grids, Stage::Dice, timer);
+}
+
+void MaterialPrograms::shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
+                             const FrameParams& f, GridBuffers& grids, const ShadowInputs& shadows,
+                             StageTimer& timer) {
+  run_shade(diceable, count, scene, f, grids, shadows, false, timer);
+}
+
+void MaterialPrograms::alpha(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
+                             const FrameParams& f, GridBuffers& grids, StageTimer& timer) {
+  run_shade(diceable, count, scene, f, grids, ShadowInputs{}, true, timer);
+}
+
+void MaterialPrograms::run_shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
+                                 const FrameParams& f, GridBuffers& grids, const ShadowInputs& shadows,
+                                 bool alpha_only, StageTimer& timer) {
+  for (Active& a : active_) {
+    if (!(alpha_only ? a.alpha : a.shades)) continue;
+    cl::Kernel& k = a.built->shade;
+    bind_args(k, grid_args(diceable, count, scene, f, a.index, grids), scene.lights, scene.light_count, grids.c,
+              grids.vertex_offsets, shadows.args(), cl_uint(alpha_only ? 1 : 0), scene.world_glossy,
+              scene.refract_roots, scene.refract_nodes, scene.refract_tris);
+    launch(k, count, grids, Stage::Shade, timer);
+  }
+}
+
+}  // namespace mp

@@ -1,0 +1,81 @@
+// Material programs: each distinct node tree's OpenCL C, built into its own
+// program (kernels/materials/material_program.cl) and kept across frames,
+// so an unchanged tree is never rebuilt and a changed one rebuilds alone
+// (from the on-disk binary cache when it was built before).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "cl/device_session.h"
+#include "micropoly/renderer.h"
+#include "micropoly/scene.h"
+#include "pipeline/frame/frame_params.h"
+#include "pipeline/pass/micropolygon_stages.h"
+#include "pipeline/device_scene/scene_buffers.h"
+#include "pipeline/pass/stage_timer.h"
+#include "pipeline/world/world_lighting.h"
+
+namespace mp {
+
+class MaterialPrograms {
+ public:
+  explicit MaterialPrograms(DeviceSession& session)
+      : session_(session), normals_(session.program(), "displaced_normals") {}
+  // Builds what the scene's materials use; adds the build time to `stats`.
+  void prepare(const Scene& scene, RenderStats& stats);
+  // Displacement of every program that displaces, then (unless a pass
+  // needs positions only) the normals of the displaced grids from their new
+  // vertices.
+  void displace(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+                GridBuffers& grids, StageTimer& timer, bool normals = true);
+  // Shades the vertices whose materials compute their Principled inputs.
+  void shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+             GridBuffers& grids, const ShadowInputs& shadows, StageTimer& timer);
+  // The world program's radiance map (scene.h, World), baked on the device
+  // with the scene's images; empty when the world has no program.
+  WorldMap bake_world(const Scene& scene, const SceneBuffers& buffers);
+  // The world program behind every pixel of the frame (its crop), RGB rows
+  // (world_pixels in material_program.cl); empty without a world program.
+  std::vector<float> world_background(const Scene& scene, const SceneBuffers& buffers, const FrameParams& f);
+  // Only the alpha (grid_c's w) of the vertices whose programs compute it:
+  // what a shadow view needs.
+  void alpha(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+             GridBuffers& grids, StageTimer& timer);
+
+ private:
+  struct Built {
+    cl::Program program;
+    cl::Kernel displace, shade, bake_world, world_pixels;
+    unsigned long long used = 0;  // the last prepare() that used it
+  };
+  // Programs kept beyond those the current scene uses: node values are
+  // parameters (Material::program_params), but a tree whose structure
+  // changes (a link made, a node added, a mode switched) builds a new
+  // program, and keeping them all would grow without limit (about 8 MiB each
+  // on PoCL). A few are kept for scenes that switch back and forth; the rest
+  // are rebuilt from the on-disk binary cache when they return.
+  static constexpr size_t kSparePrograms = 8;
+  void evict_unused();
+  struct Active {
+    Built* built;
+    cl_int index;  // the scene's program index, as DeviceMaterial.program[0]
+    bool displaces, shades, alpha;
+  };
+  Built* build(const MaterialProgram& mp, const char* owner, RenderStats& stats);
+  void launch(cl::Kernel& kernel, cl_uint count, GridBuffers& grids, Stage stage, StageTimer& timer);
+  void run_shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+                 GridBuffers& grids, const ShadowInputs& shadows, bool alpha_only, StageTimer& timer);
+
+  DeviceSession& session_;
+  std::unordered_map<std::string, std::unique_ptr<Built>> built_;  // by source
+  unsigned long long generation_ = 0;                               // prepare() calls
+  std::vector<Active> active_;
+  Built* world_ = nullptr;  // the scene's world program, if any
+  bool displaces_ = false;
+  cl::Kernel normals_;  // displaced_normals, from the main program
+};
+
+}  // namespace mp

@@ -1,0 +1,169 @@
+// Bounded-memory bound & split (Weber, Wimmer & Owens 2015). A fixed pool of
+// workers each processes sub-patches depth-first from its own stack, so a
+// worker never holds more than (split depth limit + 1) sub-patches. Workers
+// that run dry take whole patches from the input, or split children that busy
+// workers handed out through a ring buffer. Diceable sub-patches go to a fixed
+// buffer; when it is full, that batch is diced, shaded and sampled, and bound
+// & split resumes where it stopped. All memory is allocated up front from the
+// budget, so the peak is the budget's allocation, whatever the scene.
+//
+// Each launch runs only as many workers as can have work: those still holding
+// sub-patches, plus room to double, so the active pool ramps up as the split
+// tree widens (a few big patches at first) and a large budget costs no time on
+// scenes that cannot use all its workers.
+#include <algorithm>
+#include <string>
+
+#include "micropoly/error.h"
+#include "pipeline/pass/bound_split.h"
+#include "cl/kernel_args.h"
+
+namespace mp {
+namespace {
+
+// Counter slots, as BS_* in kernels/bound_split.cl.
+enum Counter {
+  kPoolHead = 0, kPoolTail = 1, kNextRoot = 2, kDiceCount = 3, kBusy = 4, kIdle = 5, kMaxBusy = 6, kOccluded = 7,
+  kCounters = 8
+};
+constexpr cl_uint kStepsPerLaunch = 16;  // sub-patches a worker handles per launch
+constexpr size_t kMaxWorkers = size_t(1) << 20;
+// With occlusion culling, the roots (near to far) are taken in waves: a
+// wave's sub-patches are diced, shaded and sampled and the pyramid rebuilt
+// before the next wave is taken, so the nearest surfaces hide the rest early
+// (taken all at once, a launch's thousands of workers would split roots from
+// every depth before anything is sampled). The first wave is one root, each
+// next a quarter larger than the last (with steps of one half, more of each
+// shell of bench/occlusion_bench.py's nested shells was diced beside the
+// part of the one in front that hides it, before that was sampled), and at
+// least kMinWave sub-patches' worth. Each wave costs a partly filled dice
+// batch, so once the pyramid holds a quarter of the scene's sub-patches (as
+// far as the waves so far tell; at most half a batch), a wave that finds
+// less than 1/kWorthwhile of its sub-patches hidden ends the waves and the
+// rest are taken at once. A partly filled batch costs about a millisecond
+// of launches and host round trips on a GPU, more than rasterising a few
+// hidden layers there, so waves are for CPU devices (PassOcclusion::waves);
+// on a GPU the pyramid is rebuilt at the batches' natural ends only.
+constexpr size_t kWorthwhile = 64;
+constexpr cl_uint kMinWave = 64;
+
+void ensure(DeviceSession& s, cl::Buffer& buffer, size_t& held, size_t bytes) {
+  if (held == bytes) return;
+  buffer = cl::Buffer();
+  held = 0;  // until the new buffer exists
+  buffer = s.allocate(bytes, "bound & split workspace");
+  held = bytes;
+}
+
+}  // namespace
+
+BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes, cl_uint dice_capacity,
+                                     BoundedWorkspace& ws) {
+  DeviceSession& s = ctx.session;
+  DeviceQueue& queue = s.queue();
+  const size_t rec = sizeof(SubPatch);
+  const cl_uint stack_depth = static_cast<cl_uint>(ctx.frame.max_depth) + 2;
+  const size_t fixed = static_cast<size_t>(dice_capacity) * rec + kCounters * sizeof(cl_uint);
+  // Per worker: its stack, its stack size and one ring slot.
+  const size_t per_worker = stack_depth * rec + sizeof(cl_uint) + rec;
+  const size_t min_workers = 64;
+  if (budget_bytes < fixed + min_workers * per_worker)
+    throw Error("bound & split memory budget of " + std::to_string(budget_bytes >> 10) + " KiB is too small; it needs at least " +
+                std::to_string((fixed + min_workers * per_worker + 1023) >> 10) + " KiB");
+  size_t workers = std::min(kMaxWorkers, (budget_bytes - fixed) / per_worker);
+  workers = std::max(min_workers, workers / 64 * 64);  // whole work-groups
+  const cl_uint ring_capacity = static_cast<cl_uint>(workers);
+
+  BoundSplitResult result;
+  {
+    ensure(s, ws.stacks, ws.stacks_bytes, workers * stack_depth * rec);
+    ensure(s, ws.sizes, ws.sizes_bytes, workers * sizeof(cl_uint));
+    ensure(s, ws.ring, ws.ring_bytes, static_cast<size_t>(ring_capacity) * rec);
+    ensure(s, ws.diceable, ws.diceable_bytes, static_cast<size_t>(dice_capacity) * rec);
+    ensure(s, ws.counters, ws.counters_bytes, kCounters * sizeof(cl_uint));
+    result.peak_bytes = ws.stacks_bytes + ws.sizes_bytes + ws.ring_bytes + ws.diceable_bytes + ws.counters_bytes;
+    cl_uint zero = 0;
+    queue.enqueueFillBuffer(ws.sizes, zero, 0, workers * sizeof(cl_uint));
+
+    cl::Kernel step(s.program(), "bs_bounded_step");
+    const cl_uint root_count = ctx.root_count();
+    const PassOcclusion& occ = ctx.occlusion;
+    cl_uint root_limit = occ.on() && occ.waves ? std::min<cl_uint>(root_count, 1) : root_count;
+    size_t diced = 0, wave_roots = root_limit, diced_before_wave = 0, occluded_before_wave = 0;
+    auto whole_groups = [&](size_t n) { return std::min(workers, std::max<size_t>(64, (n + 63) / 64 * 64)); };
+    // More workers than a few dice batches' worth would mostly hold work they
+    // cannot hand on until the next flush, so growth stops there.
+    const size_t useful = 4 * static_cast<size_t>(dice_capacity);
+    size_t launch = whole_groups(std::min<size_t>(root_limit, useful));
+    cl_uint head = 0, tail = 0, next_root = 0, dice_count = 0, hungry = static_cast<cl_uint>(launch);
+    for (;;) {
+      cl_uint c[kCounters] = {head, tail, next_root, dice_count, 0, 0, 0, 0};
+      queue.enqueueWriteBuffer(ws.counters, CL_FALSE, 0, sizeof c, c);
+      // The ring's head and tail and (at most as many children as there will
+      // be idle workers) the donation limit change per launch.
+      bind_args(step, ctx.scene.points, ctx.scene.patch_info, ctx.scene.patch_edges, ctx.scene.edge_curves,
+                ctx.scene.patch_bounds, ctx.scene.patch_count, root_limit, occ.on() ? occ.root_order : cl::Buffer(),
+                ctx.frame, ctx.views.views, ctx.views.count, ctx.views.page_masks,
+                occ.on() ? occ.pyramid : cl::Buffer(), occ.params, ws.stacks, ws.sizes, stack_depth, ws.ring,
+                ring_capacity, head, tail, hungry, ws.diceable, dice_capacity, ws.counters, kStepsPerLaunch);
+      cl::Event e;
+      queue.enqueueNDRangeKernel(step, cl::NullRange, cl::NDRange(launch), cl::NDRange(64), nullptr, &e);
+      ctx.timer.add(Stage::BoundSplit, e);
+      ++result.launches;
+      queue.enqueueReadBuffer(ws.counters, CL_TRUE, 0, sizeof c, c);
+      ctx.timer.collect();
+
+      const cl_uint head0 = head;
+      head = std::min(c[kPoolHead], tail);
+      tail = std::min({c[kPoolTail], tail + hungry, head0 + ring_capacity});
+      next_root = std::min(c[kNextRoot], root_limit);
+      dice_count = std::min(c[kDiceCount], dice_capacity);
+      result.occluded += c[kOccluded];
+      const size_t busy = c[kBusy];
+      if (head == tail) head = tail = 0;  // keep ring indices small
+      const bool wave_done = busy == 0 && head == tail && next_root >= root_limit;
+      const bool done = wave_done && root_limit >= root_count;
+      // A wave ends in a flush once it has kMinWave sub-patches to dice (or
+      // it is the last); smaller ones are carried into the next wave.
+      if (dice_count == dice_capacity || (wave_done && dice_count > 0 && (done || dice_count >= kMinWave))) {
+        ctx.sink(ws.diceable, dice_count);
+        diced += dice_count;
+        dice_count = 0;
+        if (!done && occ.on()) occ.refresh();
+      }
+      if (done) break;
+      if (wave_done) {
+        // A quarter more roots than the last wave, and (up to four times the
+        // last) enough for kMinWave sub-patches at the rate per root so far;
+        // or all that are left once a wave tested against a pyramid of a
+        // quarter of the scene's sub-patches (as far as the rate tells; at
+        // most half a batch) found less than 1/kWorthwhile of them hidden.
+        const double per_root = static_cast<double>(diced + result.occluded) / root_limit;
+        const double expected = per_root * root_count;
+        const bool judged = diced_before_wave > 0 &&
+                            static_cast<double>(diced_before_wave) >= std::min(0.5 * dice_capacity, 0.25 * expected);
+        const size_t wave_subpatches = (diced - diced_before_wave) + (result.occluded - occluded_before_wave);
+        const bool worthwhile = !judged || (result.occluded - occluded_before_wave) * kWorthwhile >= wave_subpatches;
+        size_t roots = wave_roots + (wave_roots + 3) / 4;
+        if (diced + result.occluded >= kMinWave)  // a rate measured on enough sub-patches; at most 4x the last
+          roots = std::max(roots, std::min(4 * wave_roots, static_cast<size_t>(double(kMinWave) / per_root)));
+        if (!worthwhile) roots = root_count;
+        wave_roots = std::min<size_t>(roots, root_count - root_limit);
+        root_limit += static_cast<cl_uint>(wave_roots);
+        diced_before_wave = diced;
+        occluded_before_wave = result.occluded;
+      }
+      const size_t pending = (tail - head) + (root_limit - next_root);
+      launch = whole_groups(std::max<size_t>(c[kMaxBusy], std::min(2 * busy + pending, useful)));
+      hungry = static_cast<cl_uint>(launch > busy ? launch - busy : 0);
+      if (ctx.progress && !ctx.progress(0.95f * static_cast<float>(next_root) / static_cast<float>(std::max(root_count, 1u)))) {
+        result.cancelled = true;
+        break;
+      }
+    }
+    queue.finish();
+  }
+  return result;
+}
+
+}  // namespace mp

@@ -1,0 +1,414 @@
+#include "pipeline/pass/micropolygon_stages.h"
+#include "cl/kernel_args.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <thread>
+#include <vector>
+
+#include "micropoly/error.h"
+#include "mp_raster.h"
+
+namespace mp {
+namespace {
+
+cl::Buffer device_buffer(DeviceSession& s, size_t bytes, const char* what) { return s.allocate(bytes, what); }
+
+// memcpy over a few threads: one core copies a 1080p float image out of the
+// pinned buffer in about 3 ms, a fifth of a GPU frame.
+void parallel_copy(void* dst, const void* src, size_t bytes) {
+  const size_t min_chunk = size_t(4) << 20;
+  const size_t threads = std::min<size_t>({std::max(1u, std::thread::hardware_concurrency()), 8, bytes / min_chunk});
+  if (threads <= 1) {
+    std::memcpy(dst, src, bytes);
+    return;
+  }
+  const size_t chunk = (bytes / threads + 63) & ~size_t(63);
+  std::vector<std::thread> pool;
+  for (size_t t = 1; t < threads && t * chunk < bytes; ++t)
+    pool.emplace_back([=] {
+      std::memcpy(static_cast<char*>(dst) + t * chunk, static_cast<const char*>(src) + t * chunk,
+                  std::min(chunk, bytes - t * chunk));
+    });
+  std::memcpy(dst, src, std::min(chunk, bytes));
+  for (auto& th : pool) th.join();
+}
+
+}  // namespace
+
+GridBuffers::GridBuffers(DeviceSession& session, cl_uint cap, int max_grid)
+    : capacity(cap),
+      vertices_per_slot(static_cast<size_t>(max_grid + 1) * static_cast<size_t>(max_grid + 1)) {
+  size_t bytes = capacity * vertices_per_slot * sizeof(cl_float4);
+  p = device_buffer(session, bytes, "grid position buffer");
+  n = device_buffer(session, bytes, "grid normal buffer");
+  c = device_buffer(session, bytes, "grid color buffer");
+  vertex_offsets = device_buffer(session, (capacity + 1) * sizeof(cl_uint), "grid vertex offsets");
+  micropolygon_offsets = device_buffer(session, (capacity + 1) * sizeof(cl_uint), "grid micropolygon offsets");
+}
+
+GridLayoutStage::GridLayoutStage(DeviceSession& session, cl_uint capacity)
+    : session_(session), kernel_(session.program(), "grid_counts") {
+  counts_ = device_buffer(session, 2 * size_t(capacity) * sizeof(cl_uint), "grid counts");
+}
+
+void GridLayoutStage::run(const cl::Buffer& diceable, cl_uint count, const FrameParams& f, GridBuffers& grids,
+                          StageTimer& timer) {
+  grids.vertex_total = 0;
+  grids.micropolygon_offsets_host.assign(count + 1, 0);
+  if (count == 0) return;
+  bind_args(kernel_, diceable, count, f, counts_);
+  cl::Event e;
+  session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(count), cl::NDRange(64), nullptr, &e);
+  timer.add(Stage::Dice, e);
+  // A few thousand numbers: summed on the host, one round trip per batch.
+  counts_host_.resize(2 * size_t(count));
+  session_.queue().enqueueReadBuffer(counts_, CL_TRUE, 0, counts_host_.size() * sizeof(cl_uint), counts_host_.data());
+  vertex_offsets_host_.resize(count + 1);
+  cl_uint vertices = 0, micropolygons = 0;
+  for (cl_uint k = 0; k < count; ++k) {
+    vertex_offsets_host_[k] = vertices;
+    grids.micropolygon_offsets_host[k] = micropolygons;
+    vertices += counts_host_[2 * k];
+    micropolygons += counts_host_[2 * k + 1];
+  }
+  vertex_offsets_host_[count] = vertices;
+  grids.micropolygon_offsets_host[count] = micropolygons;
+  grids.vertex_total = vertices;
+  micropolygons_ += micropolygons;
+  session_.queue().enqueueWriteBuffer(grids.vertex_offsets, CL_TRUE, 0, (count + 1) * sizeof(cl_uint),
+                                      vertex_offsets_host_.data());
+  session_.queue().enqueueWriteBuffer(grids.micropolygon_offsets, CL_TRUE, 0, (count + 1) * sizeof(cl_uint),
+                                      grids.micropolygon_offsets_host.data());
+}
+
+DiceStage::DiceStage(DeviceSession& session)
+    : session_(session),
+      kernel_(session.program(), "dice_grids"),
+      motion_kernel_(session.program(), "dice_motion_positions"),
+      displaced_kernel_(session.program(), "motion_displacement") {}
+
+void GridBuffers::ensure_motion(DeviceSession& session, int steps) {
+  if (steps <= motion_steps) return;
+  motion_p = cl::Buffer();
+  motion_p = device_buffer(session, size_t(steps) * slot_space() * sizeof(cl_float4), "grid motion positions");
+  if (!rest_p()) rest_p = device_buffer(session, slot_space() * sizeof(cl_float4), "grid rest positions");
+  motion_steps = steps;
+}
+
+void DiceStage::run_motion(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+                           GridBuffers& grids, StageTimer& timer) {
+  grids.ensure_motion(session_, int(scene.motion_steps));
+  DeviceQueue& q = session_.queue();
+  // The centre's positions before displacement (for `displaced`).
+  q.enqueueCopyBuffer(grids.p, grids.rest_p, 0, 0, size_t(count) * grids.vertices_per_slot * sizeof(cl_float4));
+  for (cl_uint k = 0; k < scene.motion_steps; ++k) {
+    // Step k's control points and curves follow the steps before it.
+    bind_args(motion_kernel_, diceable, count, scene.motion_points, cl_ulong(size_t(k) * scene.point_count),
+              scene.patch_info, scene.patch_edges, scene.motion_curves, cl_ulong(size_t(k) * scene.curve_count), f,
+              grids.motion_p, cl_ulong(size_t(k) * grids.slot_space()), grids.vertex_offsets);
+    cl::Event e;
+    q.enqueueNDRangeKernel(motion_kernel_, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64), nullptr,
+                           &e);
+    timer.add(Stage::Dice, e);
+  }
+}
+
+void DiceStage::displaced(const cl::Buffer& diceable, cl_uint count, const FrameParams& f, GridBuffers& grids,
+                          StageTimer& timer) {
+  bind_args(displaced_kernel_, diceable, count, f, grids.p, grids.rest_p, grids.motion_p, cl_ulong(grids.slot_space()),
+            cl_int(f.motion_steps), grids.vertex_offsets);
+  cl::Event e;
+  session_.queue().enqueueNDRangeKernel(displaced_kernel_, cl::NullRange, round_up_range(grids.vertex_total),
+                                        cl::NDRange(64), nullptr, &e);
+  timer.add(Stage::Dice, e);
+}
+
+void DiceStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+                    GridBuffers& grids, StageTimer& timer) {
+  bind_args(kernel_, diceable, count, scene.points, scene.patch_info, scene.patch_edges, scene.edge_curves,
+            scene.materials, f, grids.p, grids.n, grids.vertex_offsets);
+  cl::Event e;
+  session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64),
+                                        nullptr, &e);
+  timer.add(Stage::Dice, e);
+}
+
+ShadeStage::ShadeStage(DeviceSession& session) : session_(session), kernel_(session.program(), "shade_grids") {}
+
+void ShadeStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+                     GridBuffers& grids, const ShadowInputs& shadows, StageTimer& timer) {
+  bind_args(kernel_, diceable, count, scene.patch_info, f, grids.p, grids.n, scene.materials, scene.lights,
+            scene.light_count, grids.c, grids.vertex_offsets, scene.patch_normals, shadows.args(), scene.world_glossy,
+            scene.refract_roots, scene.refract_nodes, scene.refract_tris);
+  cl::Event e;
+  session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64),
+                                        nullptr, &e);
+  timer.add(Stage::Shade, e);
+}
+
+SampleStage::SampleStage(DeviceSession& session)
+    : session_(session),
+      kernel_(session.program(), "sample_micropolygons"),
+      blur_kernel_(session.program(), "sample_micropolygons_blur"),
+      clear_(session.program(), "clear_samples"),
+      project_(session.tile_sampler() ? cl::Kernel(session.program(), "project_grids") : cl::Kernel()),
+      bound_runs_(session.tile_sampler() ? cl::Kernel(session.program(), "bound_runs") : cl::Kernel()),
+      tile_kernel_(session.tile_sampler() ? cl::Kernel(session.program(), "sample_tiles") : cl::Kernel()) {
+  totals_ = session.allocate(3 * sizeof(cl_ulong), "sample totals");
+}
+
+void SampleStage::sampled_totals(size_t& micropolygons, double& area_px, size_t& tests) {
+  cl_ulong t[3] = {0, 0, 0};
+  session_.queue().enqueueReadBuffer(totals_, CL_TRUE, 0, sizeof t, t);
+  micropolygons = static_cast<size_t>(t[0]);
+  tests = static_cast<size_t>(t[2]);
+  // The sampler sums twice the area in fixed-point units (mp_raster.h).
+  area_px = static_cast<double>(t[1]) / (2.0 * MP_SUBPIXEL_ONE * MP_SUBPIXEL_ONE);
+}
+
+float warp_shutter_time(float u, const std::vector<float>& curve) {
+  const size_t n = curve.size();
+  if (n < 2) return u;
+  // Segment k spans [k, k + 1] / (n - 1) with openness from curve[k] to curve[k + 1].
+  std::vector<double> area(n, 0.0);
+  for (size_t k = 0; k + 1 < n; ++k) area[k + 1] = area[k] + 0.5 * (double(curve[k]) + double(curve[k + 1]));
+  const double target = std::clamp(double(u), 0.0, 1.0) * area[n - 1];
+  size_t k = size_t(std::upper_bound(area.begin(), area.end(), target) - area.begin());
+  k = std::clamp<size_t>(k, 1, n - 1) - 1;
+  const double a = curve[k], b = curve[k + 1], r = target - area[k];
+  // Area over x in [0, 1] of the segment: a x + (b - a) x^2 / 2 = r.
+  double x;
+  if (std::fabs(b - a) < 1e-12) {
+    x = a > 0.0 ? r / a : 0.0;
+  } else {
+    const double disc = a * a + 2.0 * (b - a) * r;
+    x = (-a + std::sqrt(std::max(disc, 0.0))) / (b - a);
+  }
+  return float((double(k) + std::clamp(x, 0.0, 1.0)) / double(n - 1));
+}
+
+SamplePattern sample_pattern(const FrameParams& f, const std::vector<float>& shutter_curve) {
+  SamplePattern p;
+  p.spp_x = f.spp_x, p.spp_y = f.spp_y, p.seed = f.seed;
+  p.lens = mp_lens_on(f);
+  p.motion = mp_motion_on(f);
+  if (p.motion) p.shutter_curve = shutter_curve;
+  if (p.lens)
+    p.blades = f.aperture_blades, p.radius = f.lens_radius, p.x_scale = f.lens_x_scale,
+    p.rotation = f.aperture_rotation;
+  return p;
+}
+
+void SampleStage::mark_occlusion_cells(const cl::Buffer& dirty, const OcclusionParams& params) {
+  occlusion_dirty_ = dirty;
+  occlusion_ = params;
+}
+
+void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer, const std::vector<float>& shutter_curve) {
+  mark_occlusion_cells(cl::Buffer(), OcclusionParams{});
+  tiles_ = f.planar_colors != 0;
+  const int spp = f.spp_x * f.spp_y;
+  size_t samples = static_cast<size_t>(f.width) * static_cast<size_t>(f.height) * static_cast<size_t>(spp);
+  // The buffers only grow: the viewport alternates a small preview with the
+  // full view, and reallocating (and first touching) the full view's buffers
+  // for every refinement cost it about a tenth of a second on the CPU.
+  if (samples > sample_capacity_) {
+    keys_ = colors_ = normals_ = cl::Buffer();  // release before allocating anew
+    keys_ = device_buffer(session_, samples * sizeof(cl_ulong), "sample depth buffer");
+    colors_ = device_buffer(session_, samples * 3 * sizeof(cl_float), "sample color buffer");
+    normals_ = device_buffer(session_, samples * sizeof(cl_uint), "sample normal buffer");
+    sample_capacity_ = samples;
+  }
+  const SamplePattern pattern = sample_pattern(f, shutter_curve);
+  if (!(pattern == pattern_) || !offsets_()) {
+    // Sample positions, and times and lens positions, of one tile
+    // (kernels/mp_raster.h, mp_blur.h), computed here once.
+    const size_t tile = static_cast<size_t>(MP_SAMPLE_TILE) * MP_SAMPLE_TILE * spp;
+    std::vector<cl_ushort> offsets(tile);
+    // (lx, ly, t, 0) per tile pixel and slot, then each slot's box over the
+    // tile, (lx0, lx1, ly0, ly1) and (t0, t1, 0, 0): the bound the
+    // rasteriser uses per slot. Without lens or motion their values are 0.
+    const bool blur = mp_blur_on(f);
+    std::vector<cl_float4> table(blur ? tile + 2 * size_t(spp) : 1, cl_float4{{0.0f, 0.0f, 0.0f, 0.0f}});
+    for (int s = 0; s < spp && blur; ++s) {
+      table[tile + 2 * s] = cl_float4{{3e38f, -3e38f, 3e38f, -3e38f}};
+      table[tile + 2 * s + 1] = cl_float4{{3e38f, -3e38f, 0.0f, 0.0f}};
+    }
+    for (int ty = 0; ty < MP_SAMPLE_TILE; ++ty)
+      for (int tx = 0; tx < MP_SAMPLE_TILE; ++tx)
+        for (int s = 0; s < spp; ++s) {
+          const size_t i = (static_cast<size_t>(ty) * MP_SAMPLE_TILE + tx) * spp + s;
+          offsets[i] = static_cast<cl_ushort>(mp_sample_offset_packed(tx, ty, s, f));
+          if (!blur) continue;
+          const float2 l = mp_lens_on(f) ? mp_sample_lens(tx, ty, s, f) : float2{0.0f, 0.0f};
+          const float t = mp_motion_on(f) ? warp_shutter_time(mp_sample_time(tx, ty, s, f), shutter_curve) : 0.5f;
+          table[i] = cl_float4{{l.x, l.y, t, 0.0f}};
+          cl_float4& lb = table[tile + 2 * s];
+          cl_float4& tb = table[tile + 2 * s + 1];
+          lb.s[0] = std::min(lb.s[0], l.x), lb.s[1] = std::max(lb.s[1], l.x);
+          lb.s[2] = std::min(lb.s[2], l.y), lb.s[3] = std::max(lb.s[3], l.y);
+          tb.s[0] = std::min(tb.s[0], t), tb.s[1] = std::max(tb.s[1], t);
+        }
+    const int chunks = (spp + 15) / 16;
+    std::vector<cl_ushort> soa(size_t(MP_SAMPLE_TILE) * MP_SAMPLE_TILE * chunks * 32, 0);
+    for (size_t p = 0; p < size_t(MP_SAMPLE_TILE) * MP_SAMPLE_TILE; ++p)
+      for (int s = 0; s < spp; ++s) {
+        const cl_ushort o = offsets[p * spp + s];
+        cl_ushort* chunk = &soa[(p * chunks + s / 16) * 32];
+        chunk[s % 16] = o & 0xffu;
+        chunk[16 + s % 16] = o >> 8;
+      }
+    offsets_soa_ = session_.allocate(soa.size() * sizeof(cl_ushort), "sample pattern", CL_MEM_READ_ONLY);
+    session_.queue().enqueueWriteBuffer(offsets_soa_, CL_TRUE, 0, soa.size() * sizeof(cl_ushort), soa.data());
+    offsets_ = session_.allocate(offsets.size() * sizeof(cl_ushort), "sample pattern", CL_MEM_READ_ONLY);
+    session_.queue().enqueueWriteBuffer(offsets_, CL_TRUE, 0, offsets.size() * sizeof(cl_ushort), offsets.data());
+    blur_ = session_.allocate(table.size() * sizeof(cl_float4), "sample times and lens positions", CL_MEM_READ_ONLY);
+    session_.queue().enqueueWriteBuffer(blur_, CL_TRUE, 0, table.size() * sizeof(cl_float4), table.data());
+    pattern_ = pattern;
+  }
+  cl_ulong zero = 0;
+  session_.queue().enqueueFillBuffer(totals_, zero, 0, 3 * sizeof zero);
+  bind_args(clear_, keys_, static_cast<cl_ulong>(samples));
+  cl::Event e;
+  session_.queue().enqueueNDRangeKernel(clear_, cl::NullRange, round_up_range(samples, 256), cl::NDRange(256), nullptr,
+                                        &e);
+  timer.add(Stage::Sample, e);
+}
+
+void SampleStage::run(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
+                      const FrameParams& f, GridBuffers& grids, StageTimer& timer,
+                      const std::function<bool()>& keep_going) {
+  if (count == 0) return;
+  // The run's micropolygons, numbered within the batch by its layout.
+  const cl_uint base = grids.micropolygon_offsets_host[first];
+  const cl_uint total = grids.micropolygon_offsets_host[first + count] - base;
+  if (total == 0) return;
+  if (tiles_) {
+    run_tiles(diceable, first, count, scene, f, grids, timer, keep_going);
+    return;
+  }
+  cl::Kernel& k = mp_blur_on(f) ? blur_kernel_ : kernel_;
+  // Pass 0 finds each sample's nearest key; pass 1 lets its owner write.
+  for (cl_uint pass = 0; pass < 2; ++pass) {
+    // Motion positions: any valid buffer when there are none.
+    bind_args(k, diceable, first, count, grids.micropolygon_offsets, base, total, scene.patch_info, f, grids.p,
+              grids.c, grids.n, offsets_, pass, keys_, colors_, normals_, totals_, occlusion_dirty_, occlusion_, blur_,
+              grids.motion_p() ? grids.motion_p : grids.p, cl_ulong(grids.slot_space()));
+    cl::Event e;
+    session_.queue().enqueueNDRangeKernel(k, cl::NullRange, round_up_range(total), cl::NDRange(64), nullptr, &e);
+    timer.add(Stage::Sample, e);
+  }
+}
+
+ResolveStage::ResolveStage(DeviceSession& session)
+    : session_(session),
+      scalar_kernel_(session.program(), "resolve_pixels"),
+      planar_kernel_(session.program(), "resolve_pixels_planar") {
+  use_pinned_ = !session.device().getInfo<CL_DEVICE_HOST_UNIFIED_MEMORY>();
+}
+
+ResolveStage::~ResolveStage() {
+  if (pinned_ptr_) {
+    try {
+      session_.queue().enqueueUnmapMemObject(pinned_, pinned_ptr_);
+      session_.queue().finish();
+    } catch (const cl::Error&) {
+      // The context goes away with the session; nothing else to release.
+    }
+  }
+}
+
+void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, const FrameParams& fb, const Bucket& b,
+                       PixelFilter filter, float filter_width, bool passes, StageTimer& timer) {
+  const FrameParams& f = frame.params;
+  size_t pixels = static_cast<size_t>(f.width) * static_cast<size_t>(f.height);
+  if (pixels != pixels_) {
+    rgba_ = cl::Buffer(), depth_ = cl::Buffer(), normal_ = cl::Buffer();
+    rgba_ = session_.allocate(pixels * sizeof(cl_float4), "image buffer");
+    depth_ = session_.allocate(pixels * sizeof(cl_float), "depth pass buffer");
+    normal_ = session_.allocate(pixels * 3 * sizeof(cl_float), "normal pass buffer");
+    pixels_ = pixels;
+  }
+  int type = filter == PixelFilter::Box        ? MP_FILTER_BOX
+             : filter == PixelFilter::Gaussian ? MP_FILTER_GAUSSIAN
+             : filter == PixelFilter::Triangle ? MP_FILTER_TRIANGLE
+                                               : MP_FILTER_BLACKMAN_HARRIS;
+  auto row = [&](int i) {
+    glm::vec3 r = glm::vec3(frame.camera_to_world[0][i], frame.camera_to_world[1][i], frame.camera_to_world[2][i]);
+    return cl_float4{{r.x, r.y, r.z, 0.0f}};
+  };
+  filter_width = std::max(filter_width, 1e-3f);
+  const SamplePattern pattern = sample_pattern(f);
+  if (type != weights_type_ || filter_width != weights_width_ || !(pattern == weights_pattern_)) {
+    const int reach = mp_filter_reach(filter_width), side = 2 * reach + 1;
+    const int spp = f.spp_x * f.spp_y;
+    const size_t count = size_t(MP_SAMPLE_TILE) * MP_SAMPLE_TILE * side * side * spp;
+    use_weights_ = count * sizeof(float) <= (size_t(64) << 20);
+    std::vector<float> w(use_weights_ ? count : 1, 0.0f);
+    if (use_weights_) {
+      size_t i = 0;
+      for (int ty = 0; ty < MP_SAMPLE_TILE; ++ty)
+        for (int tx = 0; tx < MP_SAMPLE_TILE; ++tx)
+          for (int dy = -reach; dy <= reach; ++dy)
+            for (int dx = -reach; dx <= reach; ++dx) {
+              int nx = (tx + dx) & (MP_SAMPLE_TILE - 1), ny = (ty + dy) & (MP_SAMPLE_TILE - 1);
+              for (int s = 0; s < spp; ++s) {
+                uint o = mp_sample_offset_packed(nx, ny, s, f);
+                float sx = float(dx) + float(o & 0xffu) / MP_SUBPIXEL_ONE - 0.5f;
+                float sy = float(dy) + float(o >> 8) / MP_SUBPIXEL_ONE - 0.5f;
+                w[i++] = mp_filter_weight(type, sx, sy, filter_width);
+              }
+            }
+    }
+    weights_ = session_.allocate(w.size() * sizeof(float), "pixel filter weights", CL_MEM_READ_ONLY);
+    session_.queue().enqueueWriteBuffer(weights_, CL_TRUE, 0, w.size() * sizeof(float), w.data());
+    weights_type_ = type, weights_width_ = filter_width, weights_pattern_ = pattern;
+  }
+  // The 16-lane kernel for planar colors of 16 samples or more; below that
+  // the scalar one, which PoCL vectorises across pixels instead.
+  cl::Kernel& k = fb.planar_colors && fb.spp_x * fb.spp_y >= 16 ? planar_kernel_ : scalar_kernel_;
+  bind_args(k, fb, type, filter_width, samples.offsets(), weights_, use_weights_ ? 1 : 0, samples.keys(),
+            samples.colors(), samples.normals(), row(0), row(1), row(2), rgba_, depth_, normal_, passes ? 1 : 0,
+            cl_int4{{b.x0 - b.sx0, b.y0 - b.sy0, b.x1 - b.sx0, b.y1 - b.sy0}}, cl_int2{{b.sx0, b.sy0}},
+            cl_int(f.width));
+  size_t gx = ((static_cast<size_t>(b.x1 - b.x0) + 7) / 8) * 8, gy = ((static_cast<size_t>(b.y1 - b.y0) + 7) / 8) * 8;
+  cl::Event e;
+  session_.queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(gx, gy), cl::NDRange(8, 8), nullptr, &e);
+  timer.add(Stage::Resolve, e);
+}
+
+void ResolveStage::read_back(const FrameSetup& frame, bool passes, RenderResult& out) {
+  const FrameParams& f = frame.params;
+  const size_t pixels = static_cast<size_t>(f.width) * static_cast<size_t>(f.height);
+  out.width = f.width;
+  out.height = f.height;
+  out.rgba.resize(pixels * 4);
+  const size_t rgba_bytes = pixels * sizeof(cl_float4);
+  if (use_pinned_) {
+    if (pinned_bytes_ != rgba_bytes) {
+      if (pinned_ptr_) session_.queue().enqueueUnmapMemObject(pinned_, pinned_ptr_);
+      pinned_ = session_.allocate(rgba_bytes, "image readback buffer", CL_MEM_READ_WRITE | CL_MEM_ALLOC_HOST_PTR);
+      pinned_ptr_ = static_cast<float*>(
+          session_.queue().enqueueMapBuffer(pinned_, CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0, rgba_bytes));
+      pinned_bytes_ = rgba_bytes;
+    }
+    session_.queue().enqueueReadBuffer(rgba_, CL_FALSE, 0, rgba_bytes, pinned_ptr_);
+  } else {
+    session_.queue().enqueueReadBuffer(rgba_, CL_FALSE, 0, rgba_bytes, out.rgba.data());
+  }
+  if (!passes) {
+    out.depth.clear();
+    out.normal.clear();
+  } else {
+    out.depth.resize(pixels);
+    out.normal.resize(pixels * 3);
+    session_.queue().enqueueReadBuffer(depth_, CL_FALSE, 0, pixels * sizeof(cl_float), out.depth.data());
+    session_.queue().enqueueReadBuffer(normal_, CL_FALSE, 0, pixels * 3 * sizeof(cl_float), out.normal.data());
+  }
+  session_.queue().finish();
+  if (use_pinned_) parallel_copy(out.rgba.data(), pinned_ptr_, rgba_bytes);
+}
+
+}  // namespace mp

@@ -1,0 +1,202 @@
+// The stages after bound & split, run once per batch of diceable
+// sub-patches: dice -> shade -> sample, then resolve once per bucket
+// (buckets.h). Grids live in fixed slots of (max_grid+1)^2 vertices.
+#pragma once
+
+#include <functional>
+#include <vector>
+
+#include "cl/device_session.h"
+#include "cl/kernel_args.h"
+#include "micropoly/renderer.h"
+#include "pipeline/frame/buckets.h"
+#include "pipeline/frame/frame_params.h"
+#include "pipeline/device_scene/scene_buffers.h"
+#include "pipeline/pass/stage_timer.h"
+
+namespace mp {
+
+// What the per-tile sample tables (positions, lens positions) and the
+// resolve's filter weights depend on.
+struct SamplePattern {
+  int spp_x = 0, spp_y = 0;
+  cl_uint seed = 0;
+  int lens = 0, motion = 0, blades = 0;
+  float radius = 0, x_scale = 0, rotation = 0;
+  std::vector<float> shutter_curve;  // with motion (Scene::shutter_curve)
+  bool operator==(const SamplePattern& o) const {
+    return spp_x == o.spp_x && spp_y == o.spp_y && seed == o.seed && lens == o.lens && motion == o.motion &&
+           blades == o.blades && radius == o.radius && x_scale == o.x_scale && rotation == o.rotation &&
+           shutter_curve == o.shutter_curve;
+  }
+};
+SamplePattern sample_pattern(const FrameParams& f, const std::vector<float>& shutter_curve = {});
+
+
+// A time in the shutter as a shutter curve opens it: uniform times [0, 1]
+// through the inverse of the curve's cumulative openness (piecewise linear
+// curve, so a piecewise quadratic CDF; solved per segment). Monotonic, so
+// strata of times stay strata.
+float warp_shutter_time(float u, const std::vector<float>& curve);
+
+struct GridBuffers {
+  GridBuffers(DeviceSession& session, cl_uint capacity, int max_grid);
+  cl::Buffer p, n, c;  // float4 per grid vertex
+  cl_uint capacity;    // sub-patches per batch
+  size_t vertices_per_slot;
+  // Motion blur: positions at each motion step (step k from k * slot_space()),
+  // and the centre's positions before displacement; made on first use.
+  cl::Buffer motion_p, rest_p;
+  int motion_steps = 0;
+  size_t slot_space() const { return size_t(capacity) * vertices_per_slot; }
+  void ensure_motion(DeviceSession& session, int steps);
+  // The batch's layout (GridLayoutStage): each grid's first vertex and first
+  // micropolygon, then the batch's totals (count + 1 uints each). The
+  // micropolygon offsets are kept on the host too, to size sample launches.
+  cl::Buffer vertex_offsets, micropolygon_offsets;
+  cl_uint vertex_total = 0;
+  std::vector<cl_uint> micropolygon_offsets_host;
+};
+
+// Counts each grid's vertices and micropolygons and sums them into offsets,
+// so that dice, shade and sample launch one work-item per vertex or
+// micropolygon rather than per fixed slot.
+class GridLayoutStage {
+ public:
+  GridLayoutStage(DeviceSession& session, cl_uint capacity);
+  void run(const cl::Buffer& diceable, cl_uint count, const FrameParams& f, GridBuffers& grids, StageTimer& timer);
+  void begin_frame() { micropolygons_ = 0; }
+  size_t micropolygons() const { return micropolygons_; }  // diced this frame
+
+ private:
+  DeviceSession& session_;
+  cl::Kernel kernel_;
+  cl::Buffer counts_;                 // vertices and micropolygons per grid, interleaved
+  std::vector<cl_uint> counts_host_, vertex_offsets_host_;
+  size_t micropolygons_ = 0;
+};
+
+// The shadow maps that shading reads (kernels/mp_shadow.h; built by
+// ShadowMaps): none unless `enabled`.
+struct ShadowInputs {
+  bool enabled = false;
+  cl::Buffer shadows, levels, pages, pool;
+  // As the kernels take them (MP_SHADOW_INPUT_ARGS order): whether
+  // enabled, then the four buffers.
+  auto args() const { return arg_pack(cl_uint(enabled ? 1 : 0), shadows, levels, pages, pool); }
+};
+
+class DiceStage {
+ public:
+  explicit DiceStage(DeviceSession& session);
+  void run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+           GridBuffers& grids, StageTimer& timer);
+  // Motion blur: the same grids' positions at every motion step
+  // (grids.motion_p). Run before displacement: `displaced` then moves them
+  // by what displacement added at the shutter centre.
+  void run_motion(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+                  GridBuffers& grids, StageTimer& timer);
+  void displaced(const cl::Buffer& diceable, cl_uint count, const FrameParams& f, GridBuffers& grids,
+                 StageTimer& timer);
+
+ private:
+  DeviceSession& session_;
+  cl::Kernel kernel_, motion_kernel_, displaced_kernel_;
+};
+
+class ShadeStage {
+ public:
+  explicit ShadeStage(DeviceSession& session);
+  void run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+           GridBuffers& grids, const ShadowInputs& shadows, StageTimer& timer);
+
+ private:
+  DeviceSession& session_;
+  cl::Kernel kernel_;
+};
+
+class SampleStage {
+ public:
+  explicit SampleStage(DeviceSession& session);
+  // Makes the sample buffers (key, color, normal per sample) fit the frame,
+  // reusing them when the size is unchanged, and clears them. A frame with
+  // planar sample colors (FrameParams.planar_colors, set by the renderer) is
+  // sampled by screen tiles (sample_tiles.cl), else one work-item per
+  // micropolygon (sample.cl).
+  void begin_frame(const FrameParams& f, StageTimer& timer, const std::vector<float>& shutter_curve = {});
+  bool tiles() const { return tiles_; }
+  // Samples the grids of diceable sub-patches [first, first + count).
+  // `keep_going` (optional): asked between parts of the work (the tile
+  // sampler's launches of kTileChunk tiles); false stops sampling the batch.
+  void run(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+           GridBuffers& grids, StageTimer& timer, const std::function<bool()>& keep_going = {});
+  // From now until the next begin_frame, the depth pass marks the level-0
+  // cells of the occlusion pyramid (mp_occlusion.h) it writes in `dirty`.
+  void mark_occlusion_cells(const cl::Buffer& dirty, const OcclusionParams& params);
+  const cl::Buffer& keys() const { return keys_; }
+  const cl::Buffer& colors() const { return colors_; }
+  const cl::Buffer& normals() const { return normals_; }
+  const cl::Buffer& offsets() const { return offsets_; }
+  // Micropolygons rasterised this frame and their total screen area in
+  // pixels (front faces only when back faces are culled), and the samples
+  // tested against their edges in the depth pass (blocking read).
+  void sampled_totals(size_t& micropolygons, double& area_px, size_t& tests);
+
+ private:
+  DeviceSession& session_;
+  // The tile sampler (sample_tiles.cpp): projects the grids, sorts them
+  // into per-tile lists on the host, then samples each tile.
+  void run_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
+                 const FrameParams& f, GridBuffers& grids, StageTimer& timer, const std::function<bool()>& keep_going);
+  cl::Kernel kernel_, blur_kernel_;  // pinhole samples; samples with times and lens positions
+  cl::Kernel clear_;
+  cl::Kernel project_, bound_runs_, tile_kernel_;
+  bool tiles_ = false;
+  cl::Buffer projected_, rects_, tile_ids_, tile_starts_, tile_entries_;
+  size_t projected_bytes_ = 0, rect_bytes_ = 0, tile_bytes_ = 0, start_bytes_ = 0, entry_bytes_ = 0;
+  std::vector<cl_int> rects_host_;
+  std::vector<cl_uint> tile_counts_, tile_ids_host_, tile_starts_host_, tile_entries_host_;
+  cl::Buffer occlusion_dirty_;
+  OcclusionParams occlusion_{};
+  cl::Buffer keys_, colors_, normals_, offsets_, blur_, totals_;
+  // The sample offsets of `offsets_` for the tile sampler's 16-lane tests:
+  // per tile pixel, chunks of 16 x offsets then 16 y offsets.
+  cl::Buffer offsets_soa_;
+  size_t sample_capacity_ = 0;  // samples the buffers hold (they only grow)
+  SamplePattern pattern_;
+};
+
+class ResolveStage {
+ public:
+  explicit ResolveStage(DeviceSession& session);
+  ~ResolveStage();
+  ResolveStage(const ResolveStage&) = delete;
+  ResolveStage& operator=(const ResolveStage&) = delete;
+  // Resolves bucket b's pixels (its samples in `samples`, of frame fb) into
+  // the image of `frame`; Depth and Normal only if `passes`.
+  void run(const SampleStage& samples, const FrameSetup& frame, const FrameParams& fb, const Bucket& b,
+           PixelFilter filter, float filter_width, bool passes, StageTimer& timer);
+  // Reads the image (and the passes) back once every bucket is resolved.
+  void read_back(const FrameSetup& frame, bool passes, RenderResult& out);
+
+ private:
+  DeviceSession& session_;
+  cl::Kernel scalar_kernel_, planar_kernel_;  // sample colors sample by sample, or planar (mp_sample.h)
+  cl::Buffer rgba_, depth_, normal_;
+  size_t pixels_ = 0;
+  // Filter weights per tile position, neighbour and sample (see resolve.cl),
+  // rebuilt when the filter or the sampling pattern changes.
+  cl::Buffer weights_;
+  bool use_weights_ = false;
+  int weights_type_ = -1;
+  SamplePattern weights_pattern_;
+  float weights_width_ = 0;
+  // On discrete GPUs the image is read back through a pinned (page-locked)
+  // staging buffer, which the driver copies into at full bus speed.
+  bool use_pinned_ = false;
+  cl::Buffer pinned_;
+  float* pinned_ptr_ = nullptr;
+  size_t pinned_bytes_ = 0;
+};
+
+}  // namespace mp

@@ -1,0 +1,262 @@
+#include "pipeline/shadows/shadow_layout.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "mp_shadow.h"
+#include "pipeline/device_scene/scene_fingerprint.h"
+
+namespace mp {
+namespace {
+
+float max_scale(const glm::mat4& m) {
+  return std::max({glm::length(glm::vec3(m[0])), glm::length(glm::vec3(m[1])), glm::length(glm::vec3(m[2]))});
+}
+
+void grow(WorldBounds& b, const std::vector<glm::vec3>& points, const glm::mat4& to_world, float pad) {
+  if (points.empty()) return;
+  glm::vec3 lo(1e30f), hi(-1e30f);
+  for (const glm::vec3& p : points) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  for (int k = 0; k < 8; ++k) {
+    glm::vec3 c((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
+    glm::vec3 w = glm::vec3(to_world * glm::vec4(c, 1.0f));
+    b.lo = glm::min(b.lo, w - glm::vec3(pad));
+    b.hi = glm::max(b.hi, w + glm::vec3(pad));
+  }
+}
+
+// How far displacement can move an object's surface, in world units.
+float displacement_reach(const Scene& scene, int material, const std::vector<int>& face_materials,
+                         const glm::mat4& to_world) {
+  float reach = 0.0f;
+  auto add = [&](int i) {
+    if (i < 0 || size_t(i) >= scene.materials.size()) return;
+    const Material& m = scene.materials[size_t(i)];
+    if (m.program >= 0 && m.program_displaces)
+      reach = std::max(reach, m.displacement_bound * (m.displacement_bound_world ? 1.0f : max_scale(to_world)));
+  };
+  add(material);
+  for (int i : face_materials) add(i);
+  return reach;
+}
+
+// Rows of a light's basis (x, y, z) in world space; the light looks down -z.
+glm::dmat3 basis_looking(glm::dvec3 forward) {
+  glm::dvec3 z = -glm::normalize(forward);
+  glm::dvec3 ref = std::abs(z.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0);
+  glm::dvec3 x = glm::normalize(glm::cross(ref, z));
+  glm::dvec3 y = glm::cross(z, x);
+  return glm::transpose(glm::dmat3(x, y, z));  // rows x, y, z
+}
+
+glm::dmat3 light_basis(const Light& l) {
+  if (l.type == Light::Type::Point) return glm::dmat3(1.0);
+  glm::dvec3 n = glm::dvec3(l.direction);
+  if (!(glm::length(n) > 0.0)) n = glm::dvec3(0, 0, -1);
+  if (l.type != Light::Type::Area) return basis_looking(n);
+  n = glm::normalize(n);
+  glm::dvec3 u = glm::dvec3(l.axis_u) - n * glm::dot(glm::dvec3(l.axis_u), n);
+  if (!(glm::length(u) > 0.0)) return basis_looking(n);
+  glm::dvec3 x = glm::normalize(u), z = -n, y = glm::cross(z, x);
+  return glm::transpose(glm::dmat3(x, y, z));
+}
+
+// Row-major 3x4 (rows of m, translation t) into 12 floats.
+void put_rows(float* out, const glm::dmat3& m, const glm::dvec3& t) {
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) out[4 * r + c] = float(m[c][r]);
+    out[4 * r + 3] = float(t[r]);
+  }
+}
+
+// A cube face's rotation (light space -> face view), from mp_cube_face_view.
+glm::dmat3 face_rotation(int face) {
+  glm::dmat3 m;
+  for (int c = 0; c < 3; ++c) {
+    float3 e(c == 0 ? 1.0f : 0.0f, c == 1 ? 1.0f : 0.0f, c == 2 ? 1.0f : 0.0f);
+    m[c] = glm::dvec3(mp_cube_face_view(face, e));
+  }
+  return m;
+}
+
+FrameParams shadow_view_base(const FrameParams& camera, const RenderSettings& s) {
+  FrameParams v = camera;
+  v.has_view = 1;
+  v.view_kind = MP_VIEW_SHADOW;
+  v.micropoly_edge = std::sqrt(std::max(s.shadow_shading_rate, 1e-3f));
+  v.ribbon = 1.0f;
+  v.backface_culling = 0;
+  v.normal_pass = 0;
+  v.spp_x = v.spp_y = 1;
+  v.crop_x0 = v.crop_y0 = 0;
+  v.lens_radius = 0.0f;  // lights see through pinholes,
+  v.motion_steps = 0;    // the shutter centre's scene
+  return v;
+}
+
+}  // namespace
+
+WorldBounds world_bounds(const Scene& scene) {
+  WorldBounds b;
+  for (const Mesh& m : scene.meshes)
+    grow(b, m.points, m.object_to_world, displacement_reach(scene, m.material, m.face_materials, m.object_to_world));
+  for (const BezierPatches& p : scene.bezier_patches)
+    grow(b, p.control_points, p.object_to_world, displacement_reach(scene, p.material, {}, p.object_to_world));
+  return b;
+}
+
+void ShadowLayout::page_position(const ShadowMapInfo& m, int sx, int sy, int32_t* x, int32_t* y) const {
+  *x = m.page_x + ((sx - m.origin_x) & (m.side - 1));
+  *y = m.page_y + ((sy - m.origin_y) & (m.side - 1));
+}
+
+ShadowLayout make_shadow_layout(const Scene& scene, const std::vector<Light>& lights, const FrameSetup& frame,
+                                const WorldBounds& bounds, uint64_t geometry_key) {
+  ShadowLayout out;
+  const RenderSettings& s = scene.settings;
+  const FrameParams& f = frame.params;
+  out.shadows.resize(lights.size());
+  out.light_keys.assign(lights.size(), 0);
+  out.own_bias.assign(lights.size(), 0);
+  for (DeviceShadow& d : out.shadows) d = DeviceShadow{}, d.kind = MP_SHADOW_NONE, d.cone_cos = -2.0f;
+  if (!s.shadows || bounds.empty()) return out;
+
+  const glm::dmat4 c2w = glm::inverse(glm::dmat4(scene.camera.world_to_camera));
+  const glm::dmat3 c2w_linear(c2w);
+  const glm::dvec3 camera_position(c2w[3]);
+  const glm::dvec3 lo(bounds.lo), hi(bounds.hi);
+  const double diagonal = glm::length(hi - lo);
+  auto corner = [&](int k) { return glm::dvec3((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z); };
+  // Pixel footprints the scene's receivers can have: from its depth range in the camera.
+  double dmin = 1e300, dmax = -1e300;
+  for (int k = 0; k < 8; ++k) {
+    double d = -(glm::dmat4(scene.camera.world_to_camera) * glm::dvec4(corner(k), 1.0)).z;
+    dmin = std::min(dmin, d), dmax = std::max(dmax, d);
+  }
+  dmin = std::max(dmin, double(std::max(f.clip_near, 1e-6f)));
+  dmax = std::clamp(dmax, dmin, double(f.clip_far));
+  const float fp_lo = mp_pixel_footprint(float(dmin), f), fp_hi = mp_pixel_footprint(float(dmax), f);
+  const FrameParams base = shadow_view_base(f, s);
+
+  for (size_t i = 0; i < lights.size(); ++i) {
+    const Light& l = lights[i];
+    if (!l.cast_shadows || l.type == Light::Type::Ambient) continue;
+    if (l.type == Light::Type::Spot && !(l.cone_angle > 0.0f)) continue;
+    DeviceShadow& d = out.shadows[i];
+    const glm::dmat3 basis = light_basis(l);
+    const glm::dmat3 r = basis * c2w_linear;
+    const bool sun = l.type == Light::Type::Distant;
+    const glm::dvec3 origin = sun ? glm::dvec3(0.0) : glm::dvec3(l.position);
+    const glm::dvec3 t = basis * (camera_position - origin);
+    put_rows(d.to_light, r, t);
+    d.page_table = out.table_entries;
+    // A world probe's shadow is as soft as a wide region of the sky: its
+    // penumbrae span many texels of the level the footprint asks for, so
+    // it is rendered two levels (16x fewer texels) coarser.
+    out.own_bias[i] = l.world_probe ? kWorldProbeLevelBias : 0;
+    d.level_bias = out.own_bias[i];
+    d.cone_cos = l.type == Light::Type::Spot ? std::cos(std::clamp(l.cone_angle, 0.0f, 3.14159265f)) : -2.0f;
+    d.one_sided = l.type == Light::Type::Area ? 1u : 0u;
+    if (sun) {
+      d.kind = MP_SHADOW_SUN;
+      d.shape = l.angle > 0.0f ? MP_SHADOW_SHAPE_DISK : MP_SHADOW_SHAPE_POINT;
+      d.size[0] = std::tan(0.5f * std::min(l.angle, 3.1f));
+      // The scene in the light's space: depth counts down from its top.
+      glm::dvec3 llo(1e300), lhi(-1e300);
+      for (int k = 0; k < 8; ++k) {
+        glm::dvec3 q = basis * corner(k);
+        llo = glm::min(llo, q), lhi = glm::max(lhi, q);
+      }
+      const double margin = 1e-3 * diagonal + 1e-6;
+      d.z_top = float(lhi.z + margin);
+      const float depth_range = float(lhi.z - llo.z + 2.0 * margin);
+      int l_lo = mp_sun_level_for(fp_lo), l_hi = mp_sun_level_for(fp_hi) + kMaxShadowLevelBias;
+      if (d.shape != MP_SHADOW_SHAPE_POINT)
+        l_hi = std::max(l_hi, mp_ceil_log2(std::max(d.size[0] * depth_range / MP_SHADOW_SEARCH_TEXELS, 1e-30f)));
+      l_lo = std::max(l_lo, l_hi - (MP_MAX_SUN_LEVELS - 1));
+      d.level0 = l_lo;
+      d.levels = uint32_t(l_hi - l_lo + 1);
+      d.level_records = uint32_t(out.levels.size());
+      const glm::dvec2 camera_light(t.x, t.y);
+      for (int lv = l_lo; lv <= l_hi; ++lv) {
+        const double texel = std::ldexp(1.0, lv), page = texel * MP_PAGE_SIZE;
+        const int32_t ax = int32_t(std::floor(camera_light.x / page)) - MP_MAP_PAGES / 2;
+        const int32_t ay = int32_t(std::floor(camera_light.y / page)) - MP_MAP_PAGES / 2;
+        DeviceShadowLevel rec{};
+        rec.offset[0] = float(-ax * page);
+        rec.offset[1] = float(-ay * page);
+        rec.texel = float(texel);
+        rec.page_table = out.table_entries;
+        rec.origin_x = ax & (MP_MAP_PAGES - 1);
+        rec.origin_y = ay & (MP_MAP_PAGES - 1);
+        out.levels.push_back(rec);
+        ShadowMapInfo m;
+        m.light = int(i);
+        m.map_id = lv;
+        m.table = out.table_entries;
+        m.side = MP_MAP_PAGES;
+        m.origin_x = rec.origin_x, m.origin_y = rec.origin_y;
+        m.page_x = ax, m.page_y = ay;
+        m.coarseness = lv - l_lo;
+        FrameParams& v = m.view = base;
+        put_rows(v.view, r, glm::dvec3(t.x - ax * page, t.y - ay * page, t.z - double(d.z_top)));
+        v.ortho = 1;
+        v.ax = v.ay = float(1.0 / texel);
+        v.bx = v.by = 0.0f;
+        v.width = v.height = MP_MAP_TEXELS;
+        v.clip_near = 0.0f;
+        v.clip_far = depth_range;
+        v.page_table = m.table;
+        v.page_side = m.side;
+        v.page_origin_x = m.origin_x, v.page_origin_y = m.origin_y;
+        out.maps.push_back(m);
+        out.table_entries += uint32_t(MP_MAP_PAGES * MP_MAP_PAGES);
+      }
+    } else {
+      d.kind = MP_SHADOW_CUBE;
+      d.levels = MP_CUBE_MIPS;
+      if (l.type == Light::Type::Area) {
+        d.shape = l.shape == Light::Shape::Ellipse ? MP_SHADOW_SHAPE_ELLIPSE : MP_SHADOW_SHAPE_RECTANGLE;
+        d.size[0] = 0.5f * l.size_u, d.size[1] = 0.5f * l.size_v;
+        if (!(std::max(d.size[0], d.size[1]) > 0.0f)) d.shape = MP_SHADOW_SHAPE_POINT;
+      } else {
+        d.shape = l.radius > 0.0f ? MP_SHADOW_SHAPE_DISK : MP_SHADOW_SHAPE_POINT;
+        d.size[0] = d.size[1] = l.radius;
+      }
+      const float near = float(std::max(1e-5 * diagonal, 1e-7));
+      for (int face = 0; face < 6; ++face) {
+        const glm::dmat3 fr = face_rotation(face);
+        for (int mip = 0; mip < MP_CUBE_MIPS; ++mip) {
+          ShadowMapInfo m;
+          m.light = int(i);
+          m.map_id = face * MP_CUBE_MIPS + mip;
+          m.table = out.table_entries + uint32_t(face) * MP_CUBE_FACE_ENTRIES + mp_cube_mip_entries(mip);
+          m.side = MP_MAP_PAGES >> mip;
+          m.coarseness = mip;
+          FrameParams& v = m.view = base;
+          put_rows(v.view, fr * r, fr * t);
+          v.ortho = 0;
+          v.ax = v.ay = v.bx = v.by = 0.5f * float(mp_cube_mip_texels(mip));
+          v.width = v.height = mp_cube_mip_texels(mip);
+          v.clip_near = near;
+          v.clip_far = 3.0e38f;
+          v.eye_epsilon = 0.5f * near;
+          v.page_table = m.table;
+          v.page_side = m.side;
+          v.page_origin_x = v.page_origin_y = 0;
+          out.maps.push_back(m);
+        }
+      }
+      out.table_entries += 6u * MP_CUBE_FACE_ENTRIES;
+    }
+    out.light_keys[i] = shadow_light_key(l, geometry_key, s, d.z_top);
+    ++out.shadowed_lights;
+  }
+  return out;
+}
+
+void set_shadow_level_bias(ShadowLayout& layout, int bias) {
+  for (size_t i = 0; i < layout.shadows.size(); ++i) layout.shadows[i].level_bias = layout.own_bias[i] + bias;
+}
+
+}  // namespace mp

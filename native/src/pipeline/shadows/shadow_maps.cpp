@@ -1,0 +1,518 @@
+#include "pipeline/shadows/shadow_maps.h"
+
+#include <algorithm>
+#include <numeric>
+#include <string>
+#include <unordered_set>
+
+#include "cl/kernel_args.h"
+#include "micropoly/error.h"
+#include "mp_shadow.h"
+#include "pipeline/pass/occlusion_culling.h"
+#include "pipeline/device_scene/scene_fingerprint.h"
+
+namespace mp {
+// Host vectors written to the device here live only for the call, so every
+// write blocks until the device has the data.
+namespace {
+
+constexpr size_t kPageBytes = size_t(MP_PAGE_TEXELS) * sizeof(cl_uint);
+// What a page costs in all: its texels, its cells' and its own farthest
+// depths and its dirty byte (occlusion culling), its slot in the list of
+// pages to clear and its page-table write.
+constexpr size_t kPageCost = kPageBytes + (64 + 1) * sizeof(cl_uint) + sizeof(cl_uint) + 1 + sizeof(cl_uint2);
+// A kept marking vertex: its position and normal.
+constexpr size_t kKeptVertexBytes = 2 * sizeof(cl_float4);
+// The marking pass dices the camera's view this many times coarser (in
+// micropolygon edge) than the frame: its vertices mark the pages around
+// them, and need to be close only next to a page.
+constexpr float kMarkCoarsening = 8.0f;
+
+// Each marking vertex's box reaches its neighbours: one coarse micropolygon edge.
+cl_float mark_reach(const FrameParams& coarse) { return coarse.micropoly_edge; }
+
+}  // namespace
+
+ShadowMaps::ShadowMaps(DeviceSession& session)
+    : session_(session),
+      mark_(session.program(), "mark_shadow_pages"),
+      mark_soft_(session.program(), "mark_soft_shadow_pages"),
+      mark_soft_grid_(session.program(), "mark_soft_shadow_pages_grid"),
+      clear_(session.program(), "clear_shadow_pages"),
+      set_entries_(session.program(), "set_page_entries"),
+      sample_(session.program(), "shadow_sample"),
+      farthest_(session.program(), "shadow_page_farthest"),
+      occlusion_build_(session.program(), "shadow_occlusion_build") {}
+
+void ShadowMaps::upload_records(const ShadowLayout& layout) {
+  DeviceQueue& q = session_.queue();
+  session_.reserve(inputs_.shadows, records_capacity_, layout.shadows.size() * sizeof(DeviceShadow), "shadow records");
+  session_.reserve(inputs_.levels, levels_capacity_, layout.levels.size() * sizeof(DeviceShadowLevel),
+       "shadow level records");
+  q.enqueueWriteBuffer(inputs_.shadows, CL_TRUE, 0, layout.shadows.size() * sizeof(DeviceShadow),
+                       layout.shadows.data());
+  if (!layout.levels.empty())
+    q.enqueueWriteBuffer(inputs_.levels, CL_TRUE, 0, layout.levels.size() * sizeof(DeviceShadowLevel),
+                         layout.levels.data());
+}
+
+bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, MicropolygonPass& pass, bool keep,
+                      std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries, ShadowStats& stats) {
+  StageTimer& timer = pass.timer();
+  StageTimer::Redirect to(timer, Stage::ShadowMark);
+  const auto started = std::chrono::steady_clock::now();
+  DeviceQueue& q = session_.queue();
+  const size_t n = layout.table_entries;
+  session_.reserve(requests_, requests_capacity_, n, "shadow page requests");
+  q.enqueueFillBuffer(requests_, cl_uchar(0), 0, n);
+  FrameParams coarse = frame.params;
+  coarse.micropoly_edge *= kMarkCoarsening;
+  const cl_uint light_count = cl_uint(layout.shadows.size());
+  GridBuffers& grids = pass.grids();
+  kept_vertices_ = 0;
+  kept_overflow_ = false;
+  ViewTarget target;
+  // The soft marking's search compares with the displaced surface's tangent plane.
+  target.normals = keep;
+  target.take = [&, keep](const cl::Buffer& diceable, cl_uint count) mutable {
+    const cl_uint vertices = grids.vertex_total;
+    ++stats.batches;
+    // The kept vertices stay within their share of the budget: past it the
+    // soft marking dices the view again instead (mark_soft).
+    if (keep && size_t(kept_vertices_) + vertices > kept_limit_) keep = false, kept_overflow_ = true;
+    if (keep) keep_room(size_t(kept_vertices_) + vertices);
+    bind_args(mark_, diceable, count, grids.vertex_offsets, vertices, coarse, grids.p, grids.n, inputs_.shadows,
+              inputs_.levels, light_count, requests_, mark_reach(coarse), cl_uint(keep), kept_vertices_,
+              keep ? kept_p_ : grids.p, keep ? kept_n_ : grids.n);  // unwritten when not kept
+    cl::Event e;
+    q.enqueueNDRangeKernel(mark_, cl::NullRange, round_up_range(vertices), cl::NDRange(64), nullptr, &e);
+    timer.add(Stage::ShadowMark, e);
+    if (keep) kept_vertices_ += vertices;
+  };
+  if (pass.run(PassView{coarse, PassViews{}, PassOcclusion{}}, target).cancelled) return false;
+  collect_requests(layout, keys, entries);
+  stats.mark_wall_ms += ms_since(started);
+  return true;
+}
+
+bool ShadowMaps::mark_soft(const ShadowLayout& layout, const FrameSetup& frame, MicropolygonPass& pass,
+                           std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries, ShadowStats& stats) {
+  StageTimer& timer = pass.timer();
+  StageTimer::Redirect to(timer, Stage::ShadowMark);
+  const auto started = std::chrono::steady_clock::now();
+  DeviceQueue& q = session_.queue();
+  FrameParams coarse = frame.params;
+  coarse.micropoly_edge *= kMarkCoarsening;
+  // The soft marking adds to the first's requests.
+  const cl_uint light_count = cl_uint(layout.shadows.size());
+  auto launch = [&](cl::Kernel& k, cl_uint vertices) {
+    cl::Event e;
+    q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(vertices), cl::NDRange(64), nullptr, &e);
+    timer.add(Stage::ShadowMark, e);
+  };
+  if (kept_overflow_) {
+    // More vertices than the budget keeps: the view is diced again, as the
+    // first marking diced it, and marked batch by batch.
+    ++stats.marking_passes;
+    GridBuffers& grids = pass.grids();
+    ViewTarget target;
+    target.take = [&](const cl::Buffer& diceable, cl_uint count) {
+      ++stats.batches;
+      if (grids.vertex_total == 0) return;
+      bind_args(mark_soft_grid_, diceable, count, grids.vertex_offsets, coarse, grids.p, grids.n, inputs_.shadows,
+                inputs_.levels, light_count, inputs_.pages, inputs_.pool, requests_, mark_reach(coarse));
+      launch(mark_soft_grid_, grids.vertex_total);
+    };
+    if (pass.run(PassView{coarse, PassViews{}, PassOcclusion{}}, target).cancelled) return false;
+  } else if (kept_vertices_ > 0) {
+    bind_args(mark_soft_, kept_p_, kept_n_, kept_vertices_, coarse, inputs_.shadows, inputs_.levels, light_count,
+              inputs_.pages, inputs_.pool, requests_, mark_reach(coarse));
+    launch(mark_soft_, kept_vertices_);
+  }
+  collect_requests(layout, keys, entries);
+  stats.mark_wall_ms += ms_since(started);
+  return true;
+}
+
+void ShadowMaps::keep_room(size_t vertices) {
+  if (vertices <= kept_capacity_) return;
+  const size_t grown = std::max(vertices, std::min(kept_capacity_ + kept_capacity_ / 2, kept_limit_));
+  cl::Buffer p = session_.allocate(grown * sizeof(cl_float4), "shadow marking vertices");
+  cl::Buffer nrm = session_.allocate(grown * sizeof(cl_float4), "shadow marking normals");
+  if (kept_vertices_ > 0) {
+    session_.queue().enqueueCopyBuffer(kept_p_, p, 0, 0, size_t(kept_vertices_) * sizeof(cl_float4));
+    session_.queue().enqueueCopyBuffer(kept_n_, nrm, 0, 0, size_t(kept_vertices_) * sizeof(cl_float4));
+  }
+  kept_p_ = p;
+  kept_n_ = nrm;
+  kept_capacity_ = grown;
+}
+
+void ShadowMaps::collect_requests(const ShadowLayout& layout, std::vector<ShadowPageKey>& keys,
+                                  std::vector<uint32_t>& entries) {
+  const size_t n = layout.table_entries;
+  std::vector<uint8_t> requested(n);
+  session_.queue().enqueueReadBuffer(requests_, CL_TRUE, 0, n, requested.data());
+  // Coarser maps first: a budget too short for everything keeps them.
+  std::vector<size_t> order(layout.maps.size());
+  std::iota(order.begin(), order.end(), size_t(0));
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return layout.maps[a].coarseness > layout.maps[b].coarseness; });
+  keys.clear();
+  entries.clear();
+  for (size_t i : order) {
+    const ShadowMapInfo& m = layout.maps[i];
+    for (int sy = 0; sy < m.side; ++sy)
+      for (int sx = 0; sx < m.side; ++sx) {
+        const uint32_t e = m.table + uint32_t(sy * m.side + sx);
+        if (!requested[e]) continue;
+        ShadowPageKey k;
+        k.light = layout.light_keys[size_t(m.light)];
+        k.map = m.map_id;
+        layout.page_position(m, sx, sy, &k.x, &k.y);
+        keys.push_back(k);
+        entries.push_back(e);
+      }
+  }
+}
+
+void ShadowMaps::write_table(size_t entries, const std::vector<cl_uint2>& writes) {
+  DeviceQueue& q = session_.queue();
+  session_.reserve(inputs_.pages, pages_capacity_, entries * sizeof(cl_uint), "shadow page tables");
+  q.enqueueFillBuffer(inputs_.pages, cl_uint(0), 0, entries * sizeof(cl_uint));
+  if (writes.empty()) return;
+  session_.reserve(writes_, writes_capacity_, writes.size() * sizeof(cl_uint2), "shadow page-table writes");
+  q.enqueueWriteBuffer(writes_, CL_TRUE, 0, writes.size() * sizeof(cl_uint2), writes.data());
+  bind_args(set_entries_, writes_, cl_uint(writes.size()), inputs_.pages);
+  q.enqueueNDRangeKernel(set_entries_, cl::NullRange, round_up_range(cl_uint(writes.size())), cl::NDRange(64));
+}
+
+void ShadowMaps::ensure_pool(uint32_t pages) {
+  if (pages <= pool_pages_) return;
+  const uint32_t grown = std::max(pages, std::min<uint32_t>(pool_pages_ + pool_pages_ / 2, uint32_t(pool_.capacity())));
+  cl::Buffer bigger = session_.allocate(size_t(grown) * kPageBytes, "shadow map page pool");
+  cl::Buffer dirty = session_.allocate(size_t(grown), "shadow page marks");
+  // Pages kept from earlier frames move along.
+  if (pool_pages_ > 0)
+    session_.queue().enqueueCopyBuffer(inputs_.pool, bigger, 0, 0, size_t(pool_pages_) * kPageBytes);
+  inputs_.pool = bigger;
+  dirty_ = dirty;
+  pool_pages_ = grown;
+}
+
+const cl::Buffer& ShadowMaps::light_order(int light, const FrameParams& v, const SceneBuffers& buffers,
+                                          uint64_t scene_key) {
+  static const cl::Buffer none;
+  if (orders_.size() <= size_t(light)) orders_.resize(size_t(light) + 1);
+  LightOrder& o = orders_[size_t(light)];
+  uint64_t key = scene_key ^ 0x9e3779b97f4a7c15ull;
+  for (float x : v.view) key = (key ^ uint64_t(as_uint(x))) * 0x100000001b3ull;
+  key = (key ^ uint64_t(v.ortho)) * 0x100000001b3ull;
+  if (o.order() && o.key == key) return o.order;
+  o = LightOrder{};
+  const size_t patches = buffers.host_patch_bounds.size() / 2;
+  const size_t bytes = std::max<size_t>(patches, 1) * sizeof(cl_uint);
+  size_t held = 0;
+  for (const LightOrder& other : orders_) held += other.bytes;
+  if (held + bytes > orders_limit_) return none;
+  const std::vector<cl_uint> order = view_near_to_far_order(buffers.host_patch_bounds, v);
+  o.order = session_.allocate(bytes, "shadow patch order", CL_MEM_READ_ONLY);
+  if (!order.empty())
+    session_.queue().enqueueWriteBuffer(o.order, CL_TRUE, 0, order.size() * sizeof(cl_uint), order.data());
+  o.bytes = bytes;
+  o.key = key;
+  return o.order;
+}
+
+bool ShadowMaps::render_views(const std::vector<FrameParams>& views, const std::vector<int>& lights,
+                              const std::vector<uint8_t>& masks, const FrameSetup& frame, MicropolygonPass& pass,
+                              ShadowStats& stats, bool culling, cl_uint fresh_pages) {
+  StageTimer& timer = pass.timer();
+  const SceneBuffers& buffers = pass.scene();
+  DeviceQueue& q = session_.queue();
+  session_.reserve(masks_, masks_capacity_, masks.size(), "shadow page masks");
+  if (!masks.empty()) q.enqueueWriteBuffer(masks_, CL_TRUE, 0, masks.size(), masks.data());
+  // The pyramids (laid out as the masks), then every pool page's cells and
+  // farthest depth (mp_page_occluded).
+  const cl_uint page_cells = cl_uint(masks.size()), page_farthest = page_cells + pool_pages_ * 64u;
+  if (culling)
+    session_.reserve(pyramid_, pyramid_capacity_, (size_t(page_farthest) + pool_pages_) * sizeof(cl_uint),
+                     "shadow occlusion pyramids");
+  const FrameParams& f = frame.params;
+  GridBuffers& grids = pass.grids();
+  // Depth only, into the pages: opacity decides which texels a surface
+  // covers; normals are not needed.
+  ViewTarget target;
+  target.normals = false;
+  target.opacity = true;
+  size_t written = 0;  // micropolygons rasterised in the current pass
+  target.take = [&](const cl::Buffer& diceable, cl_uint count) {
+    ++stats.batches;
+    const cl_uint base = grids.micropolygon_offsets_host[0];
+    const cl_uint total = grids.micropolygon_offsets_host[count] - base;
+    written += total;
+    if (total == 0) return;
+    bind_args(sample_, diceable, cl_uint(0), count, grids.micropolygon_offsets, base, total, buffers.patch_info,
+              buffers.materials, f, views_, grids.p, grids.c, inputs_.pages, inputs_.pool, dirty_);
+    cl::Event e;
+    q.enqueueNDRangeKernel(sample_, cl::NullRange, round_up_range(total), cl::NDRange(64), nullptr, &e);
+    timer.add(Stage::Sample, e);
+  };
+  for (size_t first = 0; first < views.size();) {
+    // A pass takes up to MP_MAX_PASS_VIEWS views; with culling, one light's
+    // only, whose patches it takes near to far from that light.
+    size_t count = 1;
+    while (first + count < views.size() && count < MP_MAX_PASS_VIEWS &&
+           (!culling || lights[first + count] == lights[first]))
+      ++count;
+    session_.reserve(views_, views_capacity_, MP_MAX_PASS_VIEWS * sizeof(FrameParams), "shadow views");
+    q.enqueueWriteBuffer(views_, CL_TRUE, 0, count * sizeof(FrameParams), views.data() + first);
+    PassViews views_of_pass;
+    views_of_pass.views = views_;
+    views_of_pass.count = cl_uint(count);
+    views_of_pass.page_masks = masks_;
+    PassOcclusion occlusion;
+    if (culling) {
+      // The pyramids start from the cleared pages (all empty) and follow
+      // what the pass writes: after each dice batch, the farthest depth of
+      // the pages it wrote to, then every view's pyramid.
+      occlusion.pyramid = pyramid_;
+      occlusion.params.levels = 1;
+      occlusion.params.page_cells = page_cells;
+      occlusion.params.page_farthest = page_farthest;
+      occlusion.root_order = light_order(lights[first], views[first], buffers, scene_key_);
+      occlusion.waves = session_.info().type == "cpu" && occlusion.root_order();
+      // A look at the pages costs a pass over those written since the last
+      // and over every view's pyramid: it is taken when the micropolygons
+      // written since make an eighth of the pass' so far, so a pass of
+      // thousands of small batches (a sun's coarse levels over a large
+      // scene) looks a few dozen times, and the first batches, which hide
+      // the most, at once.
+      written = 0;
+      size_t looked_at = 0;
+      occlusion.refresh = [&, count, looked_at]() mutable {
+        if (looked_at > 0 && (written - looked_at) * 8 < written) return;
+        looked_at = std::max<size_t>(written, 1);
+        cl::Event e1, e2;
+        bind_args(farthest_, clear_list_, fresh_pages, inputs_.pool, dirty_, pyramid_, page_cells, page_farthest);
+        q.enqueueNDRangeKernel(farthest_, cl::NullRange, cl::NDRange(size_t(fresh_pages) * 64), cl::NDRange(64),
+                               nullptr, &e1);
+        bind_args(occlusion_build_, views_, inputs_.pages, pyramid_, page_farthest);
+        q.enqueueNDRangeKernel(occlusion_build_, cl::NullRange, cl::NDRange(count * 64), cl::NDRange(64), nullptr, &e2);
+        timer.add(Stage::Occlusion, e1);
+        timer.add(Stage::Occlusion, e2);
+      };
+      occlusion.refresh();
+    }
+    const BoundSplitResult r = pass.run(PassView{f, views_of_pass, occlusion}, target);
+    stats.subpatches_occluded += r.occluded;
+    if (r.cancelled) return false;
+    first += count;
+  }
+  return true;
+}
+
+bool ShadowMaps::render(const Scene& scene, const std::vector<Light>& lights, const FrameSetup& frame,
+                        MicropolygonPass& pass, ShadowStats& stats) {
+  const SceneBuffers& buffers = pass.scene();
+  stats = ShadowStats{};
+  const RenderSettings& settings = scene.settings;
+  stats.budget_bytes = size_t(double(settings.shadow_memory_mib) * 1048576.0);
+  inputs_.enabled = false;
+  if (!settings.shadows || buffers.patch_count == 0) return true;
+  scene_key_ = geometry_fingerprint(scene);
+  ShadowLayout layout = make_shadow_layout(scene, lights, frame, world_bounds(scene), scene_key_);
+  if (layout.shadowed_lights == 0) {
+    pool_.clear();
+    return true;
+  }
+  stats.lights = layout.shadowed_lights;
+
+  bool soft = false;
+  if (settings.soft_shadow_pages)
+    for (const DeviceShadow& d : layout.shadows)
+      soft = soft || (d.kind != MP_SHADOW_NONE && d.shape != MP_SHADOW_SHAPE_POINT);
+
+  // The budget holds the page tables, the requests, the page masks (at most
+  // a third of the tables) and, with culling, their pyramids, the views and
+  // the lights' records first; then the soft marking's kept vertices take up
+  // to an eighth and the lights' patch orders (culling) up to a sixteenth;
+  // pages take the rest. Every part stays within its share, so the whole
+  // never exceeds the budget. A budget too short for culling's parts and
+  // sixteen pages renders the lights' views without culling.
+  const size_t masks = size_t(layout.table_entries) * 4 / 3;
+  size_t fixed = size_t(layout.table_entries) * (sizeof(cl_uint) + 1) + masks +
+                 MP_MAX_PASS_VIEWS * sizeof(FrameParams) + layout.shadows.size() * sizeof(DeviceShadow) +
+                 layout.levels.size() * sizeof(DeviceShadowLevel);
+  const size_t kept_share = soft ? stats.budget_bytes / 8 : 0;
+  const bool culling = settings.occlusion_culling && fixed + kept_share + masks * sizeof(cl_uint) +
+                                                            stats.budget_bytes / 16 + 16 * kPageCost <=
+                                                        stats.budget_bytes;
+  const size_t orders_share = culling ? stats.budget_bytes / 16 : 0;
+  if (culling) fixed += masks * sizeof(cl_uint);
+  if (stats.budget_bytes < fixed + kept_share + orders_share + 16 * kPageCost)
+    throw Error("the shadow map memory budget of " + std::to_string(settings.shadow_memory_mib) + " MiB is too small for " +
+                std::to_string(layout.shadowed_lights) + " shadowed lights: it needs at least " +
+                std::to_string((fixed + kept_share + orders_share + 16 * kPageCost + 1048575) >> 20) + " MiB");
+  kept_limit_ = kept_share / kKeptVertexBytes;
+  orders_limit_ = orders_share;
+  if (kept_capacity_ > kept_limit_) kept_p_ = kept_n_ = cl::Buffer(), kept_capacity_ = 0;
+  for (LightOrder& o : orders_)
+    if (o.bytes > orders_limit_) o = LightOrder{};
+  const size_t capacity = (stats.budget_bytes - fixed - kept_share - orders_share) / kPageCost;
+  if (pool_.capacity() != capacity) {
+    pool_.set_capacity(capacity);
+    if (pool_pages_ > capacity) {
+      // A smaller budget: the pool buffer goes, and its pages with it.
+      pool_.clear();
+      inputs_.pool = dirty_ = cl::Buffer();
+      pool_pages_ = 0;
+    }
+  }
+  std::unordered_set<uint64_t> present;
+  if (settings.keep_shadow_pages)
+    for (uint64_t k : layout.light_keys)
+      if (k) present.insert(k);
+  pool_.keep_only(present);
+
+  // First: hard shadows' pages and soft shadows' first search round's; a
+  // budget too short for them coarsens every light.
+  std::vector<ShadowPageKey> keys;
+  std::vector<uint32_t> entries;
+  for (int bias = 0;; ++bias) {
+    set_shadow_level_bias(layout, bias);
+    upload_records(layout);
+    if (!mark(layout, frame, pass, soft, keys, entries, stats)) return false;
+    stats.level_bias = bias;
+    if (keys.size() <= capacity || bias >= kMaxShadowLevelBias) break;
+  }
+  if (!allocate_and_render(layout, keys, entries, frame, pass, stats, culling)) return false;
+  // Then, where those maps show occluders near a receiver, the pages soft
+  // shadows' second round and filters read there.
+  if (soft) {
+    if (!mark_soft(layout, frame, pass, keys, entries, stats)) return false;
+    if (!allocate_and_render(layout, keys, entries, frame, pass, stats, culling)) return false;
+  }
+  inputs_.enabled = true;
+  stats.pages_requested = keys.size();
+  stats.per_light.clear();
+  for (size_t l = 0; l < lights.size(); ++l) {
+    if (layout.shadows[l].kind == MP_SHADOW_NONE) continue;
+    const uint32_t entries_of_light = layout.shadows[l].kind == MP_SHADOW_SUN
+                                          ? layout.shadows[l].levels * uint32_t(MP_MAP_PAGES * MP_MAP_PAGES)
+                                          : 6u * MP_CUBE_FACE_ENTRIES;
+    stats.per_light.push_back({int(l), light_pages_[l], light_pages_[l] * kPageBytes + entries_of_light * sizeof(cl_uint)});
+  }
+  size_t orders = 0;
+  for (const LightOrder& o : orders_) orders += o.bytes;
+  stats.peak_bytes = size_t(pool_pages_) * (kPageBytes + 1) + pages_capacity_ + requests_capacity_ +
+                     masks_capacity_ + pyramid_capacity_ + views_capacity_ + records_capacity_ + levels_capacity_ +
+                     clear_capacity_ + writes_capacity_ + kept_capacity_ * kKeptVertexBytes + orders;
+  return true;
+}
+
+bool ShadowMaps::allocate_and_render(const ShadowLayout& layout, const std::vector<ShadowPageKey>& keys,
+                                     const std::vector<uint32_t>& entries, const FrameSetup& frame,
+                                     MicropolygonPass& pass, ShadowStats& stats, bool culling) {
+  StageTimer& timer = pass.timer();
+  const auto started = std::chrono::steady_clock::now();
+  struct AddWall {
+    double& to;
+    std::chrono::steady_clock::time_point from;
+    ~AddWall() { to += ms_since(from); }
+  } add_wall{stats.render_wall_ms, started};
+  std::vector<ShadowPagePool::Grant> grants;
+  pool_.grant(keys, grants);
+
+  // Page tables: the granted pages, marked for rendering where new.
+  std::vector<uint32_t> table(layout.table_entries, 0u);
+  std::vector<uint32_t> fresh;
+  std::vector<cl_uint2> writes;
+  writes.reserve(keys.size());
+  stats.pages_missing = 0;
+  for (size_t i = 0; i < keys.size(); ++i) {
+    const ShadowPagePool::Grant& g = grants[i];
+    if (g.physical == ShadowPagePool::kNone) {
+      ++stats.pages_missing;
+      continue;
+    }
+    table[entries[i]] = g.physical | MP_PAGE_RESIDENT | (g.render ? MP_PAGE_RENDER : 0u);
+    writes.push_back({{entries[i], table[entries[i]]}});
+    if (g.render) fresh.push_back(g.physical);
+  }
+  stats.pages_rendered += fresh.size();
+
+  // Resident pages per light: a light's page-table entries follow its first.
+  light_pages_.assign(layout.shadows.size(), 0);
+  for (const cl_uint2& w : writes)
+    for (size_t l = layout.shadows.size(); l-- > 0;)
+      if (layout.shadows[l].kind != MP_SHADOW_NONE && w.s[0] >= layout.shadows[l].page_table) {
+        ++light_pages_[l];
+        break;
+      }
+
+  DeviceQueue& q = session_.queue();
+  ensure_pool(pool_.extent());
+  write_table(table.size(), writes);
+  if (fresh.empty()) return true;
+
+  // The views of maps with pages to render, and their page masks.
+  std::vector<FrameParams> views;
+  std::vector<int> view_lights;
+  std::vector<uint8_t> masks;
+  for (const ShadowMapInfo& m : layout.maps) {
+    const int n = m.side;
+    size_t any = 0;
+    std::vector<uint8_t> level(size_t(n) * size_t(n), 0);
+    for (int ry = 0; ry < n; ++ry)
+      for (int rx = 0; rx < n; ++rx) {
+        const int sx = (rx + m.origin_x) & (n - 1), sy = (ry + m.origin_y) & (n - 1);
+        if (table[m.table + uint32_t(sy * n + sx)] & MP_PAGE_RENDER) level[size_t(ry) * n + rx] = 1, ++any;
+      }
+    if (!any) continue;
+    FrameParams v = m.view;
+    v.page_mask = uint32_t(masks.size());
+    masks.insert(masks.end(), level.begin(), level.end());
+    for (int s = n; s > 1; s >>= 1) {
+      const int h = s / 2;
+      std::vector<uint8_t> up(size_t(h) * size_t(h), 0);
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < h; ++x)
+          up[size_t(y) * h + x] = level[size_t(2 * y) * s + 2 * x] | level[size_t(2 * y) * s + 2 * x + 1] |
+                                  level[size_t(2 * y + 1) * s + 2 * x] | level[size_t(2 * y + 1) * s + 2 * x + 1];
+      masks.insert(masks.end(), up.begin(), up.end());
+      level.swap(up);
+    }
+    views.push_back(v);
+    view_lights.push_back(m.light);
+  }
+  stats.views += views.size();
+  if (culling) {
+    // Each light's views together: a culling pass takes one light's.
+    std::vector<size_t> by_light(views.size());
+    std::iota(by_light.begin(), by_light.end(), size_t(0));
+    std::stable_sort(by_light.begin(), by_light.end(),
+                     [&](size_t a, size_t b) { return view_lights[a] < view_lights[b]; });
+    std::vector<FrameParams> sorted_views;
+    std::vector<int> sorted_lights;
+    for (size_t i : by_light) sorted_views.push_back(views[i]), sorted_lights.push_back(view_lights[i]);
+    views.swap(sorted_views);
+    view_lights.swap(sorted_lights);
+  }
+
+  StageTimer::Redirect to(timer, Stage::ShadowBoundSplit);
+  session_.reserve(clear_list_, clear_capacity_, fresh.size() * sizeof(cl_uint), "shadow page list");
+  q.enqueueWriteBuffer(clear_list_, CL_TRUE, 0, fresh.size() * sizeof(cl_uint), fresh.data());
+  const cl_uint texels = cl_uint(fresh.size() * MP_PAGE_TEXELS);
+  bind_args(clear_, clear_list_, texels, inputs_.pool, dirty_);
+  cl::Event e;
+  q.enqueueNDRangeKernel(clear_, cl::NullRange, round_up_range(texels, 256), cl::NDRange(256), nullptr, &e);
+  timer.add(Stage::ShadowSample, e);
+  pass.layout().begin_frame();
+  if (!render_views(views, view_lights, masks, frame, pass, stats, culling, cl_uint(fresh.size())))
+    return false;
+  stats.micropolygons += pass.layout().micropolygons();
+  return true;
+}
+
+}  // namespace mp

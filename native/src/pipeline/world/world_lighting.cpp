@@ -1,0 +1,308 @@
+#include "pipeline/world/world_lighting.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "mp_world.h"
+
+namespace mp {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+float luminance(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+// Solid angle of a texel in row y: the band's area over the columns.
+double texel_solid_angle(int width, int height, int y) {
+  const double lo = kPi * (double(y) / height - 0.5), hi = kPi * (double(y + 1) / height - 0.5);
+  return (std::sin(hi) - std::sin(lo)) * 2.0 * kPi / width;
+}
+
+std::array<float, 9> sh_basis(const glm::vec3& d) {
+  std::array<float, 9> b;
+  mp_sh9_basis(d, b.data());
+  return b;
+}
+
+// Energy (luminance times solid angle) per texel, summed over rectangles.
+struct EnergyTable {
+  int w, h;
+  std::vector<double> sum;  // (w + 1) x (h + 1), inclusive prefix sums
+  explicit EnergyTable(const WorldMap& m) : w(m.width), h(m.height), sum(size_t(w + 1) * size_t(h + 1), 0.0) {
+    for (int y = 0; y < h; ++y) {
+      const double sa = texel_solid_angle(w, h, y);
+      for (int x = 0; x < w; ++x)
+        at(x + 1, y + 1) = at(x, y + 1) + at(x + 1, y) - at(x, y) + luminance(m.radiance[size_t(y) * w + x]) * sa;
+    }
+  }
+  double& at(int x, int y) { return sum[size_t(y) * size_t(w + 1) + size_t(x)]; }
+  double rect(int x0, int y0, int x1, int y1) { return at(x1, y1) - at(x0, y1) - at(x1, y0) + at(x0, y0); }
+};
+
+struct Rect {
+  int x0, y0, x1, y1;
+};
+
+}  // namespace
+
+glm::vec3 world_map_direction(int width, int height, float x, float y) {
+  return mp_env_equirect_direction((x + 0.5f) / float(width), (y + 0.5f) / float(height));
+}
+
+glm::vec2 world_map_uv(const glm::vec3& d) { return mp_env_equirect_uv(d); }
+
+std::array<glm::vec3, 9> world_irradiance_sh(const WorldMap& map) {
+  std::array<glm::dvec3, 9> acc{};
+  for (int y = 0; y < map.height; ++y) {
+    const double sa = texel_solid_angle(map.width, map.height, y);
+    for (int x = 0; x < map.width; ++x) {
+      const glm::dvec3 l = glm::dvec3(map.radiance[size_t(y) * map.width + x]) * sa;
+      const auto b = sh_basis(world_map_direction(map.width, map.height, float(x), float(y)));
+      for (int k = 0; k < 9; ++k) acc[size_t(k)] += l * double(b[size_t(k)]);
+    }
+  }
+  // The cosine lobe's convolution: A_0 = pi, A_1 = 2pi/3, A_2 = pi/4; over pi.
+  const double band[3] = {1.0, 2.0 / 3.0, 0.25};
+  std::array<glm::vec3, 9> out;
+  for (int k = 0; k < 9; ++k) out[size_t(k)] = glm::vec3(acc[size_t(k)] * band[k == 0 ? 0 : k < 4 ? 1 : 2]);
+  return out;
+}
+
+glm::vec3 eval_irradiance_sh(const std::array<glm::vec3, 9>& sh, const glm::vec3& n) {
+  const auto b = sh_basis(n);
+  glm::vec3 e(0.0f);
+  for (int k = 0; k < 9; ++k) e += sh[size_t(k)] * b[size_t(k)];
+  return glm::max(e, glm::vec3(0.0f));
+}
+
+std::vector<WorldRegion> median_cut(const WorldMap& map, int regions) {
+  std::vector<WorldRegion> out;
+  if (map.width <= 0 || map.height <= 0 || regions <= 0) return out;
+  EnergyTable table(map);
+  std::vector<Rect> rects{{0, 0, map.width, map.height}};
+  // Split the region of most energy until there are enough: equal light
+  // per region as in Debevec's cut, without needing a power of two.
+  while (int(rects.size()) < regions) {
+    size_t best = rects.size();
+    double best_energy = 0.0;
+    for (size_t i = 0; i < rects.size(); ++i) {
+      const Rect& r = rects[i];
+      if (r.x1 - r.x0 < 2 && r.y1 - r.y0 < 2) continue;
+      const double e = table.rect(r.x0, r.y0, r.x1, r.y1);
+      if (best == rects.size() || e > best_energy) best = i, best_energy = e;
+    }
+    if (best == rects.size()) break;
+    Rect r = rects[best];
+    // Along the side that is longer on the sphere (columns shrink by the
+    // cosine of the latitude), at the energy median.
+    const double mid_lat = kPi * ((r.y0 + r.y1) * 0.5 / map.height - 0.5);
+    const double wide = (r.x1 - r.x0) * (2.0 * kPi / map.width) * std::cos(mid_lat);
+    const double tall = (r.y1 - r.y0) * (kPi / map.height);
+    const bool split_x = (wide >= tall && r.x1 - r.x0 >= 2) || r.y1 - r.y0 < 2;
+    const double half = 0.5 * table.rect(r.x0, r.y0, r.x1, r.y1);
+    Rect a = r, b = r;
+    if (split_x) {
+      int cut = r.x0 + 1;
+      while (cut < r.x1 - 1 && table.rect(r.x0, r.y0, cut, r.y1) < half) ++cut;
+      a.x1 = b.x0 = cut;
+    } else {
+      int cut = r.y0 + 1;
+      while (cut < r.y1 - 1 && table.rect(r.x0, r.y0, r.x1, cut) < half) ++cut;
+      a.y1 = b.y0 = cut;
+    }
+    rects[best] = a;
+    rects.push_back(b);
+  }
+  for (const Rect& r : rects) {
+    WorldRegion g;
+    glm::dvec3 light(0.0), dir(0.0), flat_dir(0.0);
+    double sa_total = 0.0;
+    for (int y = r.y0; y < r.y1; ++y) {
+      const double sa = texel_solid_angle(map.width, map.height, y);
+      for (int x = r.x0; x < r.x1; ++x) {
+        const glm::vec3 c = map.radiance[size_t(y) * map.width + x];
+        const glm::dvec3 d(world_map_direction(map.width, map.height, float(x), float(y)));
+        light += glm::dvec3(c) * sa;
+        dir += d * (double(luminance(c)) * sa);
+        flat_dir += d * sa;
+        sa_total += sa;
+      }
+    }
+    const glm::dvec3 use = glm::length(dir) > 0.0 ? dir : flat_dir;
+    g.light = glm::vec3(light);
+    g.direction = glm::length(use) > 0.0 ? glm::vec3(glm::normalize(use)) : glm::vec3(0.0f, 0.0f, 1.0f);
+    g.solid_angle = float(sa_total);
+    out.push_back(g);
+  }
+  return out;
+}
+
+std::vector<Light> world_lights(const WorldMap& map, const World& world, int probes) {
+  std::vector<Light> out;
+  if (map.width <= 0 || map.height <= 0) return out;
+  if (world.cast_shadows && probes > 0) {
+    for (const WorldRegion& r : median_cut(map, probes)) {
+      if (!(luminance(r.light) > 0.0f)) continue;
+      Light l;
+      l.type = Light::Type::Distant;
+      l.world_probe = true;
+      l.color = r.light;
+      l.intensity = 1.0f;
+      l.direction = -r.direction;  // the way its light travels
+      l.cast_shadows = true;
+      // The disk of the region's solid angle, Omega = 2pi (1 - cos(half)),
+      // as the sun's angle that softens its shadow; at most 90 degrees,
+      // past which a shadow map's blur no longer follows the region.
+      const double c = std::clamp(1.0 - double(r.solid_angle) / (2.0 * kPi), -1.0, 1.0);
+      l.angle = float(std::min(2.0 * std::acos(c), kPi / 2.0));
+      out.push_back(l);
+    }
+  }
+  Light env;
+  env.type = Light::Type::Environment;
+  env.color = glm::vec3(world.diffuse, world.glossy, 0.0f);
+  env.cast_shadows = false;
+  const auto sh = world_irradiance_sh(map);
+  env.irradiance_sh.reserve(27);
+  for (const glm::vec3& c : sh) env.irradiance_sh.insert(env.irradiance_sh.end(), {c.x, c.y, c.z});
+  out.push_back(env);
+  return out;
+}
+
+WorldMap given_world_map(const World& world) {
+  WorldMap map;
+  map.width = world.width, map.height = world.height;
+  const size_t texels = size_t(world.width) * size_t(world.height);
+  map.radiance.resize(texels);
+  for (size_t i = 0; i < texels; ++i)
+    map.radiance[i] = glm::max(glm::vec3(world.radiance[4 * i], world.radiance[4 * i + 1], world.radiance[4 * i + 2]),
+                               glm::vec3(0.0f));
+  return map;
+}
+
+namespace {
+
+glm::vec3 map_texel(const WorldMap& m, int x, int y) {
+  x = ((x % m.width) + m.width) % m.width;  // longitude wraps
+  y = std::clamp(y, 0, m.height - 1);
+  return m.radiance[size_t(y) * size_t(m.width) + size_t(x)];
+}
+
+glm::vec3 map_lookup(const WorldMap& m, const glm::vec3& d) {
+  const glm::vec2 uv = world_map_uv(d);
+  const float x = uv.x * m.width - 0.5f, y = uv.y * m.height - 0.5f;
+  const int x0 = int(std::floor(x)), y0 = int(std::floor(y));
+  const float fx = x - float(x0), fy = y - float(y0);
+  return glm::mix(glm::mix(map_texel(m, x0, y0), map_texel(m, x0 + 1, y0), fx),
+                  glm::mix(map_texel(m, x0, y0 + 1), map_texel(m, x0 + 1, y0 + 1), fx), fy);
+}
+
+// The map and its box-filtered halvings, down to 8 texels wide.
+std::vector<WorldMap> map_mips(const WorldMap& map) {
+  std::vector<WorldMap> mips{map};
+  while (mips.back().width >= 16 && mips.back().height >= 2) {
+    const WorldMap& a = mips.back();
+    WorldMap b;
+    b.width = a.width / 2, b.height = a.height / 2;
+    b.radiance.resize(size_t(b.width) * size_t(b.height));
+    for (int y = 0; y < b.height; ++y)
+      for (int x = 0; x < b.width; ++x)
+        b.radiance[size_t(y) * b.width + x] =
+            0.25f * (map_texel(a, 2 * x, 2 * y) + map_texel(a, 2 * x + 1, 2 * y) + map_texel(a, 2 * x, 2 * y + 1) +
+                     map_texel(a, 2 * x + 1, 2 * y + 1));
+    mips.push_back(std::move(b));
+  }
+  return mips;
+}
+
+// Radiance at direction d from the mip chain at fractional level `lod`.
+glm::vec3 mip_lookup(const std::vector<WorldMap>& mips, const glm::vec3& d, float lod) {
+  lod = std::clamp(lod, 0.0f, float(mips.size() - 1));
+  const int a = int(lod), b = std::min(a + 1, int(mips.size()) - 1);
+  return glm::mix(map_lookup(mips[size_t(a)], d), map_lookup(mips[size_t(b)], d), lod - float(a));
+}
+
+// A frame around unit n: two unit tangents.
+void tangent_frame(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
+  const glm::vec3 up = std::fabs(n.z) < 0.999f ? glm::vec3(0.0f, 0.0f, 1.0f) : glm::vec3(1.0f, 0.0f, 0.0f);
+  t = glm::normalize(glm::cross(up, n));
+  b = glm::cross(n, t);
+}
+
+}  // namespace
+
+std::vector<glm::vec4> world_glossy_maps(const WorldMap& map) {
+  std::vector<glm::vec4> out(size_t(mp_world_glossy_offset(MP_WORLD_GLOSSY_LEVELS)), glm::vec4(0.0f));
+  if (map.width <= 0 || map.height <= 0) return out;
+  const std::vector<WorldMap> mips = map_mips(map);
+  // The source's texel solid angle at the equator, mip 0.
+  const double texel0 = (2.0 * kPi / map.width) * (kPi / map.height);
+  for (int k = 0; k < MP_WORLD_GLOSSY_LEVELS; ++k) {
+    // Narrow lobes read finer mips with few samples (the fine levels hold
+    // most of the texels); wide ones take more.
+    const int kSamples = k <= 2 ? 16 : k == 3 ? 32 : 64;
+    const int w = mp_world_glossy_width(k), h = w / 2;
+    glm::vec4* level = out.data() + mp_world_glossy_offset(k);
+    const float roughness = float(k) / float(MP_WORLD_GLOSSY_LEVELS - 1);
+    const double alpha = std::max(double(roughness) * roughness, 1e-4), a2 = alpha * alpha;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const glm::vec3 n = world_map_direction(w, h, float(x), float(y));
+        glm::vec3 c(0.0f);
+        if (k == 0) {
+          // The map resampled, averaged over the level texel's footprint.
+          c = mip_lookup(mips, n, float(std::log2(std::max(double(map.width) / w, 1.0))));
+        } else {
+          glm::vec3 t, b;
+          tangent_frame(n, t, b);
+          glm::dvec3 sum(0.0);
+          double weight = 0.0;
+          for (int i = 0; i < kSamples; ++i) {
+            // Hammersley point i: (i + 1/2) / N and the radical inverse of i.
+            const double u1 = (i + 0.5) / kSamples;
+            double u2 = 0.0, f = 0.5;
+            for (int bits = i; bits; bits >>= 1, f *= 0.5) u2 += f * (bits & 1);
+            // GGX half vector (Walter et al. 2007), mirrored about it.
+            const double phi = 2.0 * kPi * u1;
+            const double cos_h = std::sqrt((1.0 - u2) / (1.0 + (a2 - 1.0) * u2));
+            const double sin_h = std::sqrt(std::max(0.0, 1.0 - cos_h * cos_h));
+            const glm::dvec3 hv = glm::dvec3(t) * (sin_h * std::cos(phi)) + glm::dvec3(b) * (sin_h * std::sin(phi)) +
+                                  glm::dvec3(n) * cos_h;
+            const glm::dvec3 l = 2.0 * cos_h * hv - glm::dvec3(n);
+            const double nl = glm::dot(glm::dvec3(n), l);
+            if (nl <= 0.0) continue;
+            // pdf(l) = D(h) cos_h / (4 l.h) = D(h) / 4 with view = normal.
+            const double q = cos_h * cos_h * (a2 - 1.0) + 1.0;
+            const double pdf = a2 / (kPi * q * q) / 4.0;
+            const double lat_cos = std::max(std::sqrt(std::max(0.0, 1.0 - l.z * l.z)), 1e-3);
+            const double lod = 0.5 * std::log2(1.0 / (kSamples * pdf) / (texel0 * lat_cos)) + 1.0;
+            sum += glm::dvec3(mip_lookup(mips, glm::vec3(l), float(lod))) * nl;
+            weight += nl;
+          }
+          if (weight > 0.0) c = glm::vec3(sum / weight);
+        }
+        level[size_t(y) * w + x] = glm::vec4(c, 1.0f);
+      }
+  }
+  return out;
+}
+
+std::vector<float> world_background(const WorldMap& map, const FrameSetup& frame, const Camera& camera) {
+  const FrameParams& f = frame.params;
+  std::vector<float> out(size_t(f.width) * size_t(f.height) * 3, 0.0f);
+  if (map.width <= 0 || map.height <= 0) return out;
+  const glm::mat3 to_world = glm::inverse(glm::mat3(camera.world_to_camera));
+  for (int y = 0; y < f.height; ++y)
+    for (int x = 0; x < f.width; ++x) {
+      // The raster mapping inverted at the pixel's centre (mp_types.h,
+      // FrameParams): a perspective ray through it, or the view axis.
+      glm::vec3 d(0.0f, 0.0f, -1.0f);
+      if (!f.ortho) d = glm::vec3((x + 0.5f - f.bx) / f.ax, (y + 0.5f - f.by) / f.ay, -1.0f);
+      const glm::vec3 c = map_lookup(map, to_world * d);
+      float* o = &out[(size_t(y) * size_t(f.width) + size_t(x)) * 3];
+      o[0] = c.x, o[1] = c.y, o[2] = c.z;
+    }
+  return out;
+}
+
+}  // namespace mp
