@@ -48,7 +48,7 @@ DEEP = "--deep" in args
 # for it to refract (paths traced through each Suzanne's proxy); film: the
 # Principled BSDF with a 450 nm Thin Film (Blender 4.2 and later); subsurface:
 # the Principled BSDF at Subsurface Weight 1 (4.x: Cycles' random walk's
-# albedo looked up per vertex, kernels/mp_subsurface.h); sheen: the
+# albedo looked up per vertex, kernels/closures/mp_subsurface.h); sheen: the
 # Principled BSDF at Sheen Weight 1 (4.x: the microfiber LTC lobe).
 MATERIAL = args[args.index("--material") + 1] if "--material" in args else None
 # --engines A,B: only these engines (default: Micropoly, Cycles and EEVEE).

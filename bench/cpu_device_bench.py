@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """F12 on the CPU OpenCL devices side by side: Debian's PoCL (the developer
-build's device), the PoCL the extension carries (scripts/cpu_device_wheel.py),
+build's device), the PoCL the extension carries (scripts/build/cpu_device_wheel.py),
 that same PoCL held to the target a processor with AVX2 but not AVX-512
 gets, and optionally another PoCL library (e.g. PyPI's pocl-binary-
 distribution 3.0, the extension's device before). Each configuration is one

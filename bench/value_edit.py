@@ -11,7 +11,7 @@ renderer reported.
       --python bench/value_edit.py -- [--renders 12]
 
 Run it against an older build by pointing MICROPOLY_ADDON_DIR at that
-build's add-on folder (docs/performance.md, "Node values as parameters").
+build's add-on folder (bench/results/history.md, "Node values as parameters").
 """
 
 import json

@@ -72,7 +72,7 @@ case "$mode" in
     echo "== rendering the demo scene through headless Blender"
     rm -f demo.png
     BLENDER_USER_SCRIPTS="$here/build/install" blender -b --factory-startup --python-exit-code 1 \
-      --python scripts/demo_scene.py -- "$here/demo.png" 2>&1 | grep -E "wrote|Error|error" || true
+      --python scripts/build/demo_scene.py -- "$here/demo.png" 2>&1 | grep -E "wrote|Error|error" || true
     [ -s demo.png ] || { echo "the demo render failed" >&2; exit 1; }
     echo "== and the Utah teapot through the command line renderer"
     build/install/bin/micropoly-render tests/scenes/teapot.rib -o teapot.png --spp 16 --stats teapot-stats.json

@@ -9,79 +9,26 @@ import time
 import bpy
 import numpy as np
 
-from . import export, export_mesh, native_module, preferences, viewport
+from . import export, export_mesh, final_renderers, native_module, preferences, viewport
 
 PASSES = (("Depth", 1, "Z", "VALUE"), ("Normal", 3, "XYZ", "VECTOR"))
 
 
-class FinalRenderers:
-    """The native renderer of final renders, kept from one F12 to the next
-    while the device stays the same: its OpenCL context, compiled programs,
-    uploaded scene and patch cache carry over, so a second F12 (or the next
-    frame of an animation) skips building them. One at a time: Blender runs
-    one final render at a time, and the lock makes sure of it. The kernel
-    warm-up (warm_up.py) renders on it first, so the first F12 finds it
-    built; an F12 that starts meanwhile waits for the lock."""
-
-    def __init__(self):
-        self._lock = threading.Lock()
-        self._selector = None
-        self._renderer = None
-        self._dropped = False
-        # Seconds the last final render spent exporting, in the native
-        # renderer and writing the render result, and the buckets it was
-        # rendered in (the benchmarks and tests read them).
-        self.last_timings = {}
-
-    def acquire(self, selector):
-        """The renderer for `selector`, locked until release(); a new one if
-        the device changed (the old one is freed first)."""
-        from . import _native, warm_up
-
-        warm_up.yield_to_render()  # the job it is on ends first; the jobs after it are dropped
-        self._lock.acquire()
-        self._dropped = False
-        try:
-            if self._renderer is None or self._selector != selector:
-                self._renderer = None
-                self._renderer = _native.Renderer(selector)
-                self._selector = selector
-            return self._renderer
-        except BaseException:
-            self._lock.release()
-            raise
-
-    def release(self):
-        if self._dropped:
-            self.forget()
-        self._lock.release()
-
-    def forget(self):
-        """Called while acquired, after a render failed: the next render
-        starts from a new renderer."""
-        self._renderer = None
-        self._selector = None
-
-    def drop(self):
-        """Frees the device (at unregister). A render or warm-up still
-        running frees it when it ends: unregistering does not wait for it."""
-        self._dropped = True
-        if self._lock.acquire(blocking=False):
-            self.forget()
-            self._lock.release()
-
-    def reopen(self):
-        """At register: a renderer still held by a render or warm-up that
-        began before the add-on was last disabled is kept after all."""
-        self._dropped = False
+# The renderer final renders keep (final_renderers.py); tests read it here.
+_final_renderers = final_renderers.shared()
 
 
-_final_renderers = FinalRenderers()
-
-
-def final_renderers():
-    """The renderer final renders keep (the kernel warm-up builds it)."""
-    return _final_renderers
+def _shadow_degrades(shadows):
+    """What keeping the shadow maps within their memory budget cost this
+    frame, for the status line (docs/pipeline.md, "Pools and their budgets")."""
+    notes = []
+    if shadows.get("level_bias"):
+        notes.append(f"{shadows['level_bias']} levels coarser to fit")
+    if shadows.get("pages_missing"):
+        notes.append(f"{shadows['pages_missing']:,} pages left out")
+    if shadows.get("marking_passes"):
+        notes.append("marking diced twice to fit")
+    return f" ({', '.join(notes)})" if notes else ""
 
 
 class MicropolyRenderEngine(bpy.types.RenderEngine):
@@ -252,7 +199,8 @@ class MicropolyRenderEngine(bpy.types.RenderEngine):
         mib = stats["bound_split_peak_bytes"] / 2**20
         shadows = stats["shadows"]
         shadow_note = (f"shadow maps {shadows['pages_requested']:,} pages, {shadows['peak_bytes'] / 2**20:.0f} of "
-                       f"{shadows['budget_bytes'] / 2**20:.0f} MiB | " if shadows["lights"] else "")
+                       f"{shadows['budget_bytes'] / 2**20:.0f} MiB{_shadow_degrades(shadows)} | "
+                       if shadows["lights"] else "")
         hidden = (f"{stats['subpatches_occluded']:,} hidden sub-patches culled | "
                   if stats["subpatches_occluded"] else "")
         buckets = f"{stats['buckets']} buckets | " if stats["buckets"] > 1 else ""

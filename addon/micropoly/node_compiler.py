@@ -17,7 +17,7 @@ import bpy
 from . import node_textures
 from .node_kinds import FAC_RANGE, FLOAT, VEC
 
-# Closures a shading point holds (MP_MAX_CLOSURES, kernels/mp_closures.h).
+# Closures a shading point holds (MP_MAX_CLOSURES, kernels/closures/mp_closures.h).
 MAX_CLOSURES = 10
 
 MATH_OPS = ["ADD", "SUBTRACT", "MULTIPLY", "DIVIDE", "MULTIPLY_ADD", "POWER", "LOGARITHM", "SQRT", "INVERSE_SQRT",
@@ -1040,7 +1040,7 @@ class NodeCompiler:
         elif t == "BSDF_TRANSLUCENT":
             add(f"  mp_add_translucent(s, {weight} * {color}, {slot});")
         elif t == "SUBSURFACE_SCATTERING" and self._subsurface_model(node) != "MP_SSS_LAMBERT":
-            # 4.x's random walk: the albedo it returns (kernels/mp_subsurface.h).
+            # 4.x's random walk: the albedo it returns (kernels/closures/mp_subsurface.h).
             self.uses_subsurface_walk = True
             radius = f"{self._c(node, 'Radius', default='(float3)(1.0f)')} * {self._f(node, 'Scale', default='1.0f')}"
             add(f"  {{ float3 albedo_ = {color}; mp_add_subsurface_walk(s, {weight} * albedo_, albedo_, {radius}, "
@@ -1106,14 +1106,14 @@ class NodeCompiler:
 
     def _note_thin_film(self, node):
         """A Thin Film Thickness that is linked or above 0 makes the program
-        compile the film's code (kernels/mp_closures.h, MP_THIN_FILM)."""
+        compile the film's code (kernels/closures/mp_closures.h, MP_THIN_FILM)."""
         thin = node.inputs.get("Thin Film Thickness")
         if thin is not None and (thin.is_linked or float(thin.default_value) > 0.0):
             self.uses_thin_film = True
 
     def emit_principled(self, node, weight):
         """Principled BSDF: every input, in the running Blender's layout
-        (kernels/mp_principled.h)."""
+        (kernels/closures/mp_principled.h)."""
         v4 = self.version >= 400
         f, c = self._f, self._c
         slot = self._normal_slot(node)
@@ -1166,7 +1166,7 @@ class NodeCompiler:
         add(f"  mp_add_principled(s, {weight}, &{p}, {n});")
 
     def _subsurface_model(self, node):
-        """How a subsurface closure returns light (kernels/mp_subsurface.h):
+        """How a subsurface closure returns light (kernels/closures/mp_subsurface.h):
         from 4.0 on Cycles' random walk enters through a rough boundary and
         returns less or more than its Color with the view's angle; Blender
         3.x's walk and Christensen-Burley return the Color (Lambert)."""

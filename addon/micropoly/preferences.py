@@ -6,7 +6,7 @@ import atexit
 import bpy
 from bpy.props import EnumProperty
 
-from . import warm_up
+from . import final_renderers, warm_up
 
 ADDON = __package__
 
@@ -57,17 +57,15 @@ def _start_warm_up():
     # be torn down as it takes the GIL back, which can abort the process: it
     # is stopped and waited for at exit.
     global _exit_hook
-    from . import engine
-
     selector = _selector_now()
     wanted = warm_up.wanted()
-    warm_up.start(selector, engine.final_renderers(), build=wanted)
+    warm_up.start(selector, final_renderers.shared(), build=wanted)
     if wanted:
         try:
             materials = list(bpy.data.materials)
         except AttributeError:  # Blender's start: the file is not loaded yet
             materials = []
-        warm_up.add_file_materials(materials, selector, engine.final_renderers())
+        warm_up.add_file_materials(materials, selector, final_renderers.shared())
         warm_up.show_in_status_bar()
     if not _exit_hook:
         atexit.register(warm_up.stop)
@@ -83,11 +81,9 @@ def _selector_now():
 
 @bpy.app.handlers.persistent
 def _file_loaded(*_):
-    from . import engine
-
     if not warm_up.wanted():
         return
-    warm_up.add_file_materials(list(bpy.data.materials), _selector_now(), engine.final_renderers())
+    warm_up.add_file_materials(list(bpy.data.materials), _selector_now(), final_renderers.shared())
     warm_up.show_in_status_bar()
 
 

@@ -11,7 +11,7 @@ subdivision surface and a polygon floor under a sun, point, spot, area and
 ambient light, all with soft shadows), with the material programs of the
 open file's materials (those that read no image; at most MAX_PROGRAMS), and
 again when a file is opened. It renders on the renderer final renders keep
-(engine.FinalRenderers), so the first F12 finds its programs built and its
+(final_renderers.FinalRenderers), so the first F12 finds its programs built and its
 kernels loaded; what it builds also lands in the caches every later renderer
 reads (Micropoly's program binaries, the driver's compiled kernels), so the
 first Rendered viewport finds them too. A render that starts while it runs
@@ -210,7 +210,7 @@ def wanted():
 
 def start(selector, renderers, build=True):
     """Starts the warm-up for `selector` on `renderers` (the final renders'
-    engine.FinalRenderers, which keeps the renderer it built for the first
+    final_renderers.FinalRenderers, which keeps the renderer it built for the first
     F12) unless one was started already in this process. build=False only
     loads the OpenCL drivers in the background (about 80 ms with PoCL that
     the first render then does not wait for), where Blender does not warm up."""

@@ -6,14 +6,14 @@
  * this program (DeviceMaterial.program[0]). */
 /* Tells the headers they build a material program (mp_bsdf.h). */
 #define MP_MATERIAL_PROGRAM 1
-#include "mp_compat.h"
-#include "mp_patch.h"
-#include "mp_types.h"
-#include "mp_shading.h"
-#include "mp_shade_closures.h"
-#include "mp_patch_eval.h"
-#include "mp_surface.h"
-#include "mp_grid.h"
+#include "core/mp_compat.h"
+#include "geometry/mp_patch.h"
+#include "core/mp_types.h"
+#include "closures/mp_shading.h"
+#include "closures/mp_shade_closures.h"
+#include "geometry/mp_patch_eval.h"
+#include "geometry/mp_surface.h"
+#include "geometry/mp_grid.h"
 #include "materials/mp_node_lib.h"
 #include "textures/mp_tex_image.h"
 

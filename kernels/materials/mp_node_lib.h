@@ -8,11 +8,11 @@
 #ifndef MP_NODE_LIB_H
 #define MP_NODE_LIB_H
 
-#include "mp_compat.h"
-#include "mp_patch.h"
-#include "mp_types.h"
-#include "mp_closures.h"
-#include "mp_principled.h"
+#include "core/mp_compat.h"
+#include "geometry/mp_patch.h"
+#include "core/mp_types.h"
+#include "closures/mp_closures.h"
+#include "closures/mp_principled.h"
 #include "textures/mp_vector_rotate.h"
 
 /* What the nodes can read at a shading point. Object-space position and

@@ -16,7 +16,7 @@
 #ifndef MP_BLENDER_HASH_H
 #define MP_BLENDER_HASH_H
 
-#include "mp_compat.h"
+#include "core/mp_compat.h"
 
 /* ---- lookup3 building blocks -------------------------------------------- */
 

@@ -22,7 +22,7 @@
 #ifndef MP_TEX_COLOR_H
 #define MP_TEX_COLOR_H
 
-#include "mp_compat.h"
+#include "core/mp_compat.h"
 
 #ifdef __OPENCL_VERSION__
 #define MP_CL_TABLE __constant

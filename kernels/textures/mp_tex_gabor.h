@@ -12,7 +12,7 @@
 #ifndef MP_TEX_GABOR_H
 #define MP_TEX_GABOR_H
 
-#include "mp_compat.h"
+#include "core/mp_compat.h"
 #include "textures/mp_blender_hash.h"
 
 #define MP_GABOR_2D 0

@@ -8,7 +8,7 @@
 #ifndef MP_TEX_IMAGE_H
 #define MP_TEX_IMAGE_H
 
-#include "mp_world.h" /* the Environment Texture's projections */
+#include "closures/mp_world.h" /* the Environment Texture's projections */
 
 #define MP_IMAGE_LINEAR 0
 #define MP_IMAGE_CLOSEST 1

@@ -18,7 +18,7 @@
 #ifndef MP_TEX_PATTERN_H
 #define MP_TEX_PATTERN_H
 
-#include "mp_compat.h"
+#include "core/mp_compat.h"
 #include "textures/mp_blender_hash.h"
 
 #define MP_PT_2PI 6.28318530717958647692f

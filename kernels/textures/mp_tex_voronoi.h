@@ -12,7 +12,7 @@
 #ifndef MP_TEX_VORONOI_H
 #define MP_TEX_VORONOI_H
 
-#include "mp_compat.h"
+#include "core/mp_compat.h"
 #include "textures/mp_blender_hash.h"
 #include "textures/mp_tex_noise.h"
 

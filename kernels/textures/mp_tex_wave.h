@@ -6,7 +6,7 @@
 #ifndef MP_TEX_WAVE_H
 #define MP_TEX_WAVE_H
 
-#include "mp_compat.h"
+#include "core/mp_compat.h"
 #include "textures/mp_tex_noise.h"
 
 #define MP_WAVE_BANDS 0

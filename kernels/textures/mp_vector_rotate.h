@@ -7,7 +7,7 @@
 #ifndef MP_VECTOR_ROTATE_H
 #define MP_VECTOR_ROTATE_H
 
-#include "mp_compat.h"
+#include "core/mp_compat.h"
 
 /* Rotation by Euler angles, X first, then Y, then Z (Blender's XYZ order). */
 MP_INLINE float3 mp_nl_euler_rotate(float3 v, float3 r, int inverse) {

@@ -451,7 +451,7 @@ def case_subsurface_slab(name, threshold=32.0, bias=0.03):
     """A thick slab of subsurface scattering under a sun, seen in
     perspective from about 50 degrees off its normal to grazing: from 4.0 on
     Cycles' walk returns less than its Color seen steeply and more at
-    grazing angles (kernels/mp_subsurface.h); Blender 3.x's returns the
+    grazing angles (kernels/closures/mp_subsurface.h); Blender 3.x's returns the
     Color. Over the slab's pixels: PSNR >= threshold (Cycles' walk is noisy
     at 256 samples) and each band of rows' mean colour within `bias` of
     Cycles'; in 4.x a Lambert of the same Color must miss the latter."""

@@ -37,7 +37,7 @@ def main():
 
     warm_up.wait()
     os.environ["MICROPOLY_CL_FAULT"] = "launch:1:CL_OUT_OF_RESOURCES@shade"
-    engine.final_renderers().drop()
+    engine._final_renderers.drop()
     try:
         ru.render_passes(scene, "MICROPOLY", 64, 48, samples=4)
         message = None

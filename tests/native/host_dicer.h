@@ -8,13 +8,13 @@
 #include <functional>
 #include <vector>
 
-#include "mp_compat.h"
-#include "mp_patch.h"
-#include "mp_types.h"
-#include "mp_patch_eval.h"
-#include "mp_surface.h"
-#include "mp_grid.h"
-#include "mp_bound.h"
+#include "core/mp_compat.h"
+#include "geometry/mp_patch.h"
+#include "core/mp_types.h"
+#include "geometry/mp_patch_eval.h"
+#include "geometry/mp_surface.h"
+#include "geometry/mp_grid.h"
+#include "geometry/mp_bound.h"
 #include "pipeline/frame/frame_params.h"
 #include "pipeline/device_scene/scene_buffers.h"
 

@@ -1,10 +1,10 @@
 // A Blender 4.x Principled BSDF at its defaults (Base Color 0.8, Roughness
 // 0.5, IOR 1.5, no coat, sheen, transmission or film), seen head-on, for
-// host tests of kernels/mp_principled.h to change what they test.
+// host tests of kernels/closures/mp_principled.h to change what they test.
 #pragma once
 
-#include "mp_compat.h"
-#include "mp_principled.h"
+#include "core/mp_compat.h"
+#include "closures/mp_principled.h"
 
 inline MpPrincipled principled_defaults() {
   MpPrincipled p{};

@@ -1,14 +1,14 @@
-// The closures' BSDFs (kernels/mp_bsdf.h), the Principled BSDF's layers
-// (kernels/mp_principled.h) and closure lighting (kernels/mp_shade_closures.h)
+// The closures' BSDFs (kernels/closures/mp_bsdf.h), the Principled BSDF's layers
+// (kernels/closures/mp_principled.h) and closure lighting (kernels/closures/mp_shade_closures.h)
 // on the host, against quadrature and textbook identities.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
-#include "mp_compat.h"
-#include "mp_types.h"
-#include "mp_shade_closures.h"
+#include "core/mp_compat.h"
+#include "core/mp_types.h"
+#include "closures/mp_shade_closures.h"
 #include "principled_fixture.h"
 
 namespace {
@@ -73,7 +73,7 @@ TEST(Closures, GgxReflectionConservesEnergy) {
       const double e = hemisphere([&](float3 l) { return double(mp_ggx_reflect(n, tx, ty, l, v, a, a)) * l.z; }, 512);
       EXPECT_LE(e, 1.01) << r << " " << nv;
       if (r <= 0.2f && nv >= 0.6f) EXPECT_GT(e, 0.95) << r << " " << nv;
-      // The albedo table (scripts/ggx_albedo_table.py, integrating over half
+      // The albedo table (scripts/tables/ggx_albedo_table.py, integrating over half
       // vectors) agrees with this quadrature of the kernel's lobe.
       const float2 ab = mp_ggx_albedo(r, nv);
       EXPECT_NEAR(e, ab.x + ab.y, 0.02) << r << " " << nv;
@@ -175,7 +175,7 @@ TEST(Closures, ToonIsNormalisedOverItsCone) {
 
 // The microfiber sheen lobe (Cycles' LTC, fitted to lamp-lit renders of it)
 // integrated over the hemisphere against its albedo measured another way:
-// Cycles 4.5 in a white furnace (scripts/sheen_albedo_cycles.py; rows of view
+// Cycles 4.5 in a white furnace (scripts/tables/sheen_albedo_cycles.py; rows of view
 // cosine 0.02, 0.125 .. 1, columns of roughness 0.05, 0.125 .. 1).
 TEST(Closures, MicrofiberSheenLobeIntegratesToCyclesFurnaceAlbedo) {
   const float furnace[81] = {

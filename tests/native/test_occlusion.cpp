@@ -1,4 +1,4 @@
-// Occlusion culling (kernels/mp_occlusion.h): images with culling on and off
+// Occlusion culling (kernels/stages/mp_occlusion.h): images with culling on and off
 // are the same, sample for sample, while hidden sub-patches are not diced.
 #include <gtest/gtest.h>
 

@@ -10,7 +10,7 @@
 
 #include "pipeline/device_scene/patch_cache.h"
 #include "pipeline/device_scene/scene_buffers.h"
-#include "mp_patch.h"
+#include "geometry/mp_patch.h"
 #include "scene_fixtures.h"
 
 namespace mp::test {

@@ -15,9 +15,9 @@
 #include <opensubdiv/far/patchTable.h>
 
 #include "micropoly/error.h"
-#include "mp_compat.h"
-#include "mp_patch.h"
-#include "mp_patch_eval.h"
+#include "core/mp_compat.h"
+#include "geometry/mp_patch.h"
+#include "geometry/mp_patch_eval.h"
 #include "subdiv/patch_buffer.h"
 #include "subdiv/subdiv_refinement.h"
 

@@ -11,9 +11,9 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "micropoly/error.h"
-#include "mp_compat.h"
-#include "mp_patch.h"
-#include "mp_patch_eval.h"
+#include "core/mp_compat.h"
+#include "geometry/mp_patch.h"
+#include "geometry/mp_patch_eval.h"
 #include "subdiv/patch_buffer.h"
 
 namespace {

@@ -1,4 +1,4 @@
-// Paths through refracting objects (kernels/mp_refract_trace.h) against
+// Paths through refracting objects (kernels/geometry/mp_refract_trace.h) against
 // Snell's law worked out by hand for a sphere and a box, and the proxy
 // builder (native/src/pipeline/materials/refraction_proxy.cpp) against brute force.
 #include <gtest/gtest.h>
@@ -9,9 +9,9 @@
 #include <random>
 #include <vector>
 
-#include "mp_compat.h"
-#include "mp_patch.h"
-#include "mp_refract_trace.h"
+#include "core/mp_compat.h"
+#include "geometry/mp_patch.h"
+#include "geometry/mp_refract_trace.h"
 #include "pipeline/materials/refraction_proxy.h"
 #include "scene_fixtures.h"
 #include "renderer_fixture.h"

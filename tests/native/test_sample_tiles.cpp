@@ -1,5 +1,5 @@
-// The tile sampler (kernels/sample_tiles.cl) against the per-micropolygon
-// sampler (kernels/sample.cl), and frames rendered in buckets
+// The tile sampler (kernels/stages/sample_tiles.cl) against the per-micropolygon
+// sampler (kernels/stages/sample.cl), and frames rendered in buckets
 // (pipeline/frame/buckets.h) against the whole frame: the same winner for every
 // sample, so the same image (buckets: bit for bit), on whichever device runs
 // the tests.

@@ -1,12 +1,12 @@
-// Shading arithmetic that host and kernels share (kernels/mp_shading.h),
+// Shading arithmetic that host and kernels share (kernels/closures/mp_shading.h),
 // against the C++ library.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "mp_compat.h"
-#include "mp_types.h"
-#include "mp_shading.h"
+#include "core/mp_compat.h"
+#include "core/mp_types.h"
+#include "closures/mp_shading.h"
 
 namespace {
 

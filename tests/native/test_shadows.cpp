@@ -1,4 +1,4 @@
-// Shadows (kernels/mp_shadow.h): the host-side bookkeeping and map math,
+// Shadows (kernels/shadow/mp_shadow.h): the host-side bookkeeping and map math,
 // and renders measured against geometry: an orthographic camera looks
 // straight down at a floor under an occluder it does not see (visible_camera
 // false), so the floor shows the whole shadow, whose size, place and
@@ -13,7 +13,7 @@
 #include "micropoly/error.h"
 #include "micropoly/renderer.h"
 #include "micropoly/settings_util.h"
-#include "mp_shadow.h"
+#include "shadow/mp_shadow.h"
 #include "pipeline/shadows/shadow_page_pool.h"
 #include "renderer_fixture.h"
 #include "scene_fixtures.h"

@@ -1,7 +1,7 @@
 // Blender 4.x's random-walk subsurface as Micropoly shades it
-// (kernels/mp_subsurface.h): Lambert scaled by what Cycles' walk returns
+// (kernels/closures/mp_subsurface.h): Lambert scaled by what Cycles' walk returns
 // from a thick slab, read from a table measured on a grid of albedo, view
-// cosine, entry roughness and IOR (scripts/subsurface_albedo_cycles.py).
+// cosine, entry roughness and IOR (scripts/tables/subsurface_albedo_cycles.py).
 //
 // The reference values below were measured from Cycles 4.5 in separate
 // renders, at IORs, albedos and view angles off the table's grid: a slab of
@@ -14,8 +14,8 @@
 #include <cmath>
 #include <limits>
 
-#include "mp_compat.h"
-#include "mp_subsurface.h"
+#include "core/mp_compat.h"
+#include "closures/mp_subsurface.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// Thin-film interference (kernels/mp_thin_film.h) against the textbook
+// Thin-film interference (kernels/closures/mp_thin_film.h) against the textbook
 // wave-optics result: each wavelength's Airy reflectance of the film,
 // r = (r12 + r23 e^{i delta}) / (1 + r12 r23 e^{i delta}) per polarisation,
 // summed against the CIE colour matching functions (the Wavelength node's
@@ -12,9 +12,9 @@
 #include <complex>
 #include <limits>
 
-#include "mp_compat.h"
-#include "mp_types.h"
-#include "mp_shade_closures.h"
+#include "core/mp_compat.h"
+#include "core/mp_types.h"
+#include "closures/mp_shade_closures.h"
 #include "principled_fixture.h"
 #include "textures/mp_tex_color.h"
 

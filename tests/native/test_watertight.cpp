@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "host_dicer.h"
-#include "mp_blur.h"
+#include "stages/mp_blur.h"
 #include "pipeline/frame/frame_params.h"
 #include "renderer_fixture.h"
 #include "scene_fixtures.h"

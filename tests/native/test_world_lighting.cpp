@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "micropoly/error.h"
-#include "mp_world.h"
+#include "closures/mp_world.h"
 #include "pipeline/world/world_lighting.h"
 
 namespace mp {

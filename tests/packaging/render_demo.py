@@ -1,4 +1,4 @@
-"""Renders the demo scene (scripts/demo_scene.py) in a Python that has the bpy
+"""Renders the demo scene (scripts/build/demo_scene.py) in a Python that has the bpy
 module, with Micropoly either from a folder (the developer build's
 addons/, as a legacy add-on) or installed from the extension zip the way
 Preferences > Get Extensions > Install from Disk does.
@@ -6,7 +6,7 @@ Preferences > Get Extensions > Install from Disk does.
   python render_demo.py --out OUT.png --report R.json (--addon-dir DIR | --install-zip ZIP | --installed)
                         [--viewport]
 
-The demo scene is built (scripts/demo_scene.py --no-render, which enables
+The demo scene is built (scripts/build/demo_scene.py --no-render, which enables
 the add-on and so starts its kernel warm-up, addon/micropoly/warm_up.py);
 the warm-up is waited for, as an artist would see it finish in the status
 bar before the first F12; then the scene is rendered twice, each F12 timed

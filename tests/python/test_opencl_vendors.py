@@ -37,7 +37,7 @@ def vendors(tmp_path, monkeypatch):
 
 def install_fake_pocl(tmp_path, monkeypatch):
     """A site-packages folder laid out as the micropoly_pocl wheel
-    (scripts/cpu_device_wheel.py)."""
+    (scripts/build/cpu_device_wheel.py)."""
     site = tmp_path / "site"
     lib = site / "micropoly_pocl" / "lib" / "x86_64-linux-gnu"
     lib.mkdir(parents=True)

@@ -39,7 +39,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import soak_series  # noqa: E402
 
 WARMUP, WINDOW = 20, 50
-# Bounds (bench/results/soak_cli.txt): on PoCL the resident set after the
+# Bounds (bench/results/pocl/soak_cli.txt): on PoCL the resident set after the
 # warm-up moves by well under a MiB; GPU memory as nvidia-smi reports it is
 # counted in whole MiB. A leak of one 160 x 120 RGBA float image per render
 # (300 KiB) adds 39 MiB between the windows and 300 KiB per render to the slope.

@@ -41,7 +41,7 @@ import soak_series  # noqa: E402
 
 WIDTH, HEIGHT = 160, 120
 WARMUP, WINDOW = 20, 50
-# Bounds: on PoCL (bench/results/soak_f12.txt) the series' noise about its
+# Bounds: on PoCL (bench/results/pocl/soak_f12.txt) the series' noise about its
 # fitted line is 1-1.6 MiB, which puts the slope's standard error near
 # 2.3 KiB per render over 180 renders; the bounds sit well above that and
 # well below the 300 KiB per render of the smallest leak they must catch

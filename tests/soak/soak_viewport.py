@@ -45,7 +45,7 @@ import soak_scene  # noqa: E402
 import soak_series  # noqa: E402
 
 WARMUP, WINDOW = 20, 50
-# Bounds: the series' noise on PoCL (bench/results/soak_viewport.txt) is
+# Bounds: the series' noise on PoCL (bench/results/pocl/soak_viewport.txt) is
 # 4-5 MiB about its fitted line, which puts the slope's standard error near
 # 6-7 KiB per cycle over 180 cycles; the smallest
 # leak they must catch is one RGBA float image of the drawing region per

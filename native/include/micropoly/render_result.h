@@ -22,7 +22,7 @@ struct StageTimings {
   double occlusion = 0;  // building the occlusion pyramid (and counting covered pixels)
 };
 
-// Shadow maps of one light (kernels/mp_shadow.h).
+// Shadow maps of one light (kernels/shadow/mp_shadow.h).
 struct ShadowLightStats {
   int light = 0;          // index in Scene::lights
   size_t pages = 0;       // pages its receivers use this frame

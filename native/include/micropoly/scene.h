@@ -159,7 +159,7 @@ struct Image {
 // Area lights are rectangles or ellipses centred on `position`, with
 // `size_u` along `axis_u` and `size_v` along direction x axis_u.
 // Shadows (every type but ambient, with cast_shadows): shadow maps made by
-// the pipeline itself (kernels/mp_shadow.h), soft by the light's size:
+// the pipeline itself (kernels/shadow/mp_shadow.h), soft by the light's size:
 // `radius` for point and spot lights, `angle` (the angular diameter) for
 // distant lights, the area for area lights. A point or spot light with a
 // radius is a disk of that radius facing the lit point, as Cycles' point
@@ -244,8 +244,8 @@ struct Camera {
 enum class PixelFilter { Box, Gaussian, Triangle, BlackmanHarris };
 enum class BoundSplitMethod { Bounded, Breadth };
 // The sample stage: screen tiles, one work-item owning each tile's samples
-// (kernels/sample_tiles.cl, made for CPUs), or one work-item per
-// micropolygon with atomics (kernels/sample.cl, made for GPUs). Both give
+// (kernels/stages/sample_tiles.cl, made for CPUs), or one work-item per
+// micropolygon with atomics (kernels/stages/sample.cl, made for GPUs). Both give
 // the same image; Auto picks by the device's type.
 enum class Sampler { Auto, Tiles, Micropolygons };
 
@@ -265,7 +265,7 @@ struct RenderSettings {
   bool backface_culling = true;                // for single-sided surfaces
   bool depth_and_normal_passes = true;         // resolve and return Depth and Normal
   bool normal_pass = true;                     // with them, samples keep normals (Depth needs none)
-  // Shadow maps (kernels/mp_shadow.h): on for lights that cast shadows; the
+  // Shadow maps (kernels/shadow/mp_shadow.h): on for lights that cast shadows; the
   // device memory their pages, page tables and requests may take; the area
   // of a shadow view's micropolygons in texels of its map.
   bool shadows = true;
@@ -280,7 +280,7 @@ struct RenderSettings {
   // marking made, coarser near contact (the viewport's preview pass).
   bool soft_shadow_pages = true;
   // Bound & split drops sub-patches hidden behind what earlier dice batches
-  // sampled (kernels/mp_occlusion.h); the image is the same either way.
+  // sampled (kernels/stages/mp_occlusion.h); the image is the same either way.
   bool occlusion_culling = true;
   // The world's light is shadowed through this many probe directions
   // (world_lighting.h), each a soft-shadowed distant light.

@@ -6,7 +6,7 @@ OpenCL ICD loader among them; drivers are not in it. Before the module
 loads, opencl_vendors.register() points that loader at the system's
 drivers plus, where the system has no PoCL of its own, the CPU device of
 the micropoly_pocl wheel installed beside this one (Debian's PoCL,
-scripts/cpu_device_wheel.py), so a machine without any OpenCL driver still
+scripts/build/cpu_device_wheel.py), so a machine without any OpenCL driver still
 renders on its CPU (docs/install.md).
 """
 

@@ -6,7 +6,7 @@ that OCL_ICD_VENDORS names. A machine with no OpenCL driver has nothing
 there; one with an NVIDIA or AMD driver has that driver's file. So this
 module writes a folder of its own holding the system's files plus one for
 the CPU device the extension carries (the micropoly_pocl wheel: Debian 12's
-PoCL with LLVM 15, relocatable, scripts/cpu_device_wheel.py), and names it
+PoCL with LLVM 15, relocatable, scripts/build/cpu_device_wheel.py), and names it
 in OCL_ICD_VENDORS before the native module first calls the loader.
 
 Left alone: an OCL_ICD_VENDORS the user set, and a system that has a PoCL

@@ -96,8 +96,9 @@ std::string assemble_program_source() {
   const std::map<std::string, std::string> files = embedded_files();
   std::string source;
   for (const auto& [name, text] : files) {
-    // Top-level kernels only: folders hold headers and material programs.
-    if (name.find('/') == std::string::npos && name.size() > 3 && name.compare(name.size() - 3, 3, ".cl") == 0) {
+    // The stages' kernels only: the other folders hold headers and the
+    // material programs (built apart, program_cache.h).
+    if (name.rfind("stages/", 0) == 0 && name.size() > 3 && name.compare(name.size() - 3, 3, ".cl") == 0) {
       source += "/* ---- " + name + " ---- */\n";
       source += expand_includes(text, files, 0);
     }

@@ -19,7 +19,7 @@
 #include "io/texture_io.h"
 #include "micropoly/error.h"
 #include "rib/rib_file.h"
-#include "mp_patch.h"
+#include "geometry/mp_patch.h"
 #include "rib/rib_parser.h"
 #include "rib/rib_program_check.h"
 

@@ -9,7 +9,7 @@
 
 #include "micropoly/error.h"
 #include "micropoly/scene.h"
-#include "mp_patch.h"
+#include "geometry/mp_patch.h"
 
 namespace mp {
 namespace {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "mp_types.h"
+#include "core/mp_types.h"
 #include "textures/mp_tex_sky.h"
 
 namespace mp {

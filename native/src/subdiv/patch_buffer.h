@@ -1,5 +1,5 @@
 // Host-side patch buffers: every surface type is turned into device patches
-// (layout in kernels/mp_patch.h) by one of the append_* builders below.
+// (layout in kernels/geometry/mp_patch.h) by one of the append_* builders below.
 #pragma once
 
 #include <cstdint>
@@ -13,14 +13,14 @@ namespace mp {
 struct PatchBuffer {
   std::vector<glm::vec4> points;  // MP_PATCH_POINTS per patch, already transformed
   std::vector<glm::uvec4> info;   // PatchInfo per patch (type, material, flags, prim id)
-  std::vector<uint32_t> edges;    // MP_EDGE_REFS curve references per patch (kernels/mp_patch.h)
+  std::vector<uint32_t> edges;    // MP_EDGE_REFS curve references per patch (kernels/geometry/mp_patch.h)
   std::vector<glm::vec4> curves;  // MP_CURVE_FLOAT4S float4 per shared edge curve
   // UV maps: uv_layers x 2 float4 per patch, the corner UVs of each layer
-  // (MP_PATCH_UV_* in kernels/mp_patch.h). Set uv_layers before appending.
+  // (MP_PATCH_UV_* in kernels/geometry/mp_patch.h). Set uv_layers before appending.
   int uv_layers = 0;
   std::vector<glm::vec4> uvs;
   // Smooth shading normals at the patch's corners (0,0), (1,0), (1,1), (0,1),
-  // 4 per patch (MP_PATCH_NORMALS in kernels/mp_patch.h); zero for patches
+  // 4 per patch (MP_PATCH_NORMALS in kernels/geometry/mp_patch.h); zero for patches
   // shaded with their own surface normal.
   std::vector<glm::vec4> normals;
   size_t size() const { return info.size(); }

@@ -18,11 +18,11 @@
 #include <unordered_map>
 #include <vector>
 
-#include "mp_compat.h"
-#include "mp_patch.h"
-#include "mp_types.h"
-#include "mp_patch_eval.h"
-#include "mp_surface.h"
+#include "core/mp_compat.h"
+#include "geometry/mp_patch.h"
+#include "core/mp_types.h"
+#include "geometry/mp_patch_eval.h"
+#include "geometry/mp_surface.h"
 #include "subdiv/patch_buffer.h"
 
 namespace mp {

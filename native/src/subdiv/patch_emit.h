@@ -10,7 +10,7 @@
 
 #include "micropoly/error.h"
 #include "micropoly/scene.h"
-#include "mp_patch.h"
+#include "geometry/mp_patch.h"
 #include "subdiv/patch_buffer.h"
 
 namespace mp::subdiv_detail {

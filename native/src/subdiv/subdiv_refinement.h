@@ -1,5 +1,5 @@
 // OpenSubdiv's adaptive refinement of a Catmull-Clark mesh and the
-// conversion of its patches into the device layout (kernels/mp_patch.h).
+// conversion of its patches into the device layout (kernels/geometry/mp_patch.h).
 // append_subdiv_patches emits one device patch per Far patch, in patch table
 // order (arrays, then patches), which is what the tests rely on to compare
 // against OpenSubdiv's own evaluation of the same table.

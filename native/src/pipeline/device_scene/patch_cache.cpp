@@ -6,7 +6,7 @@
 #include <mutex>
 #include <thread>
 
-#include "mp_patch.h"
+#include "geometry/mp_patch.h"
 #include "pipeline/device_scene/scene_fingerprint.h"
 
 namespace mp {

@@ -7,7 +7,7 @@
 #include "cl/device_session.h"
 #include "micropoly/error.h"
 
-#include "mp_patch.h"
+#include "geometry/mp_patch.h"
 
 namespace mp {
 namespace {
@@ -192,7 +192,7 @@ void place_motion(const Scene& scene, const std::vector<PatchCache::Surface>& su
   }
 }
 
-// The environment light's two records (kernels/mp_shading.h,
+// The environment light's two records (kernels/closures/mp_shading.h,
 // mp_env_irradiance): camera -> world rotation rows, then the coefficients.
 void put_environment(const Light& l, const glm::mat4& world_to_camera, std::vector<DeviceLight>& out) {
   DeviceLight r[2]{};

@@ -5,7 +5,7 @@
 
 #include "cl/cl.h"
 #include "micropoly/scene.h"
-#include "mp_types.h"
+#include "core/mp_types.h"
 #include "pipeline/device_scene/patch_cache.h"
 #include "pipeline/materials/refraction_proxy.h"
 #include "subdiv/patch_buffer.h"
@@ -45,12 +45,12 @@ std::vector<DeviceLight> device_lights(const std::vector<Light>& lights, const g
 struct SceneBuffers {
   cl::Buffer points;      // float4 x MP_PATCH_POINTS per patch
   cl::Buffer patch_info;  // uint4 per patch
-  cl::Buffer patch_edges;  // MP_EDGE_REFS uints per patch (kernels/mp_patch.h)
+  cl::Buffer patch_edges;  // MP_EDGE_REFS uints per patch (kernels/geometry/mp_patch.h)
   cl::Buffer edge_curves;  // MP_CURVE_FLOAT4S float4 per shared edge curve
   cl::Buffer materials;
   cl::Buffer objects;
   cl::Buffer lights;
-  cl::Buffer patch_uvs;   // 2 float4 per patch and UV layer (kernels/mp_patch.h)
+  cl::Buffer patch_uvs;   // 2 float4 per patch and UV layer (kernels/geometry/mp_patch.h)
   cl::Buffer patch_normals;  // 4 float4 per patch: smooth shading normals at its corners
   cl::Buffer patch_bounds;   // 2 float4 per patch: camera-space box of its net, displacement included
   std::vector<glm::vec4> host_patch_bounds;  // the same on the host (occlusion culling's root order)
@@ -58,9 +58,9 @@ struct SceneBuffers {
   cl::Buffer texels;      // float4
   cl::Buffer params;      // float: HostSceneData::params
   cl_uint world_params_at = 0;
-  cl::Buffer world_glossy;  // float4: the world's glossy maps (kernels/mp_world.h), or one zero texel
+  cl::Buffer world_glossy;  // float4: the world's glossy maps (kernels/closures/mp_world.h), or one zero texel
   cl::Buffer motion_points, motion_curves;  // HostSceneData's (one float4 when there is no motion)
-  cl::Buffer refract_roots, refract_nodes, refract_tris;  // RefractionProxies (kernels/mp_refract_trace.h)
+  cl::Buffer refract_roots, refract_nodes, refract_tris;  // RefractionProxies (kernels/geometry/mp_refract_trace.h)
   cl_uint motion_steps = 0;
   cl_uint point_count = 0, curve_count = 0;  // float4s of one step
   cl_uint patch_count = 0;

@@ -18,7 +18,7 @@ uint64_t scene_fingerprint(const Scene& scene);
 uint64_t world_fingerprint(const Scene& scene);
 
 // What the scene's shadow maps' contents depend on besides each light
-// (kernels/mp_shadow.h): the surfaces in world space, with their materials'
+// (kernels/shadow/mp_shadow.h): the surfaces in world space, with their materials'
 // displacement and opacity and the images displacement can read. Not the
 // camera, and not the lights.
 uint64_t geometry_fingerprint(const Scene& scene);

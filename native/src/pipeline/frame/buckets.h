@@ -11,7 +11,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "mp_types.h"
+#include "core/mp_types.h"
 
 namespace mp {
 

@@ -4,7 +4,7 @@
 #include <chrono>
 #include <optional>
 
-#include "mp_blur.h"
+#include "stages/mp_blur.h"
 
 namespace mp {
 namespace {

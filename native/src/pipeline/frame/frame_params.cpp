@@ -63,7 +63,7 @@ FrameSetup make_frame_setup(const Scene& scene) {
   f.crop_y0 = out.crop_y0;
   f.frame_bx = f.bx, f.frame_by = f.by;  // one bucket: the whole crop region
   f.bucket_x0 = f.bucket_y0 = 0;
-  // A thin lens for perspective cameras (kernels/mp_blur.h).
+  // A thin lens for perspective cameras (kernels/stages/mp_blur.h).
   const bool lens = !ortho && cam.lens_radius > 0.0f;
   f.lens_radius = lens ? cam.lens_radius : 0.0f;
   f.lens_x_scale = lens ? 1.0f / cam.aperture_ratio : 1.0f;

@@ -4,7 +4,7 @@
 #include <glm/glm.hpp>
 
 #include "micropoly/scene.h"
-#include "mp_types.h"
+#include "core/mp_types.h"
 
 namespace mp {
 

@@ -22,8 +22,8 @@
 #include "pipeline/device_scene/scene_fingerprint.h"
 #include "pipeline/shadows/shadow_maps.h"
 #include "pipeline/world/world_lighting.h"
-#include "mp_blur.h"
-#include "mp_raster.h"
+#include "stages/mp_blur.h"
+#include "stages/mp_raster.h"
 
 namespace mp {
 namespace {

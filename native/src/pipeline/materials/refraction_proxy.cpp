@@ -5,12 +5,12 @@
 #include <cstdio>
 #include <numeric>
 
-#include "mp_compat.h"
-#include "mp_patch.h"
-#include "mp_types.h"
-#include "mp_patch_eval.h"
-#include "mp_surface.h"
-#include "mp_refract_trace.h"
+#include "core/mp_compat.h"
+#include "geometry/mp_patch.h"
+#include "core/mp_types.h"
+#include "geometry/mp_patch_eval.h"
+#include "geometry/mp_surface.h"
+#include "geometry/mp_refract_trace.h"
 
 namespace mp {
 

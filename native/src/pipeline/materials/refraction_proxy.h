@@ -1,6 +1,6 @@
 // Triangle proxies of refracting objects, for the paths Glass, Refraction
 // and Principled Transmission follow through their object's own shape
-// (kernels/mp_refract_trace.h holds the layout and the traversal).
+// (kernels/geometry/mp_refract_trace.h holds the layout and the traversal).
 #pragma once
 
 #include <cstdint>

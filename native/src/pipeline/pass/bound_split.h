@@ -1,5 +1,5 @@
 // Bound & split strategies. Both hand batches of diceable sub-patches
-// (SubPatch records, kernels/mp_types.h) to a sink, which dices, shades and
+// (SubPatch records, kernels/core/mp_types.h) to a sink, which dices, shades and
 // samples them before bound & split continues.
 #pragma once
 

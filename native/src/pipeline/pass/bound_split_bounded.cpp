@@ -21,7 +21,7 @@
 namespace mp {
 namespace {
 
-// Counter slots, as BS_* in kernels/bound_split.cl.
+// Counter slots, as BS_* in kernels/stages/bound_split.cl.
 enum Counter {
   kPoolHead = 0, kPoolTail = 1, kNextRoot = 2, kDiceCount = 3, kBusy = 4, kIdle = 5, kMaxBusy = 6, kOccluded = 7,
   kCounters = 8

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "micropoly/error.h"
-#include "mp_raster.h"
+#include "stages/mp_raster.h"
 
 namespace mp {
 namespace {
@@ -224,7 +224,7 @@ void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer, const std
   const SamplePattern pattern = sample_pattern(f, shutter_curve);
   if (!(pattern == pattern_) || !offsets_()) {
     // Sample positions, and times and lens positions, of one tile
-    // (kernels/mp_raster.h, mp_blur.h), computed here once.
+    // (kernels/stages/mp_raster.h, mp_blur.h), computed here once.
     const size_t tile = static_cast<size_t>(MP_SAMPLE_TILE) * MP_SAMPLE_TILE * spp;
     std::vector<cl_ushort> offsets(tile);
     // (lx, ly, t, 0) per tile pixel and slot, then each slot's box over the

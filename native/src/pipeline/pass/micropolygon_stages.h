@@ -76,7 +76,7 @@ class GridLayoutStage {
   size_t micropolygons_ = 0;
 };
 
-// The shadow maps that shading reads (kernels/mp_shadow.h; built by
+// The shadow maps that shading reads (kernels/shadow/mp_shadow.h; built by
 // ShadowMaps): none unless `enabled`.
 struct ShadowInputs {
   bool enabled = false;

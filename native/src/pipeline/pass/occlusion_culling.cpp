@@ -5,7 +5,7 @@
 #include <limits>
 #include <numeric>
 
-#include "mp_bound.h"
+#include "geometry/mp_bound.h"
 
 namespace mp {
 namespace {

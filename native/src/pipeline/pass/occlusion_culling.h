@@ -1,4 +1,4 @@
-// Occlusion culling of the camera's view (kernels/mp_occlusion.h): a
+// Occlusion culling of the camera's view (kernels/stages/mp_occlusion.h): a
 // max-depth pyramid rebuilt from the sample buffer between dice batches, and
 // the patches' order near to far, so the first batches fill the pyramid with
 // what hides the rest. Bound & split tests every sub-patch against it.
@@ -10,7 +10,7 @@
 #include <glm/glm.hpp>
 
 #include "cl/device_session.h"
-#include "mp_types.h"
+#include "core/mp_types.h"
 #include "pipeline/frame/buckets.h"
 #include "pipeline/pass/stage_timer.h"
 

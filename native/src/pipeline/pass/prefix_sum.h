@@ -1,4 +1,4 @@
-// Exclusive prefix sum of a device uint array (kernels/scan.cl).
+// Exclusive prefix sum of a device uint array (kernels/stages/scan.cl).
 #pragma once
 
 #include <memory>

@@ -1,4 +1,4 @@
-// The sample stage by screen tiles (kernels/sample_tiles.cl), for CPUs: the
+// The sample stage by screen tiles (kernels/stages/sample_tiles.cl), for CPUs: the
 // grids of a dice batch are projected and their runs of micropolygons
 // bounded on the device, sorted into per-tile lists here (a counting sort
 // over some ten thousand runs: cheaper than a device sort's launches, and it
@@ -6,10 +6,10 @@
 // then each non-empty tile is sampled by one work-item.
 #include <algorithm>
 
-#include "mp_compat.h"
-#include "mp_types.h"
-#include "mp_grid.h"
-#include "mp_raster.h"
+#include "core/mp_compat.h"
+#include "core/mp_types.h"
+#include "geometry/mp_grid.h"
+#include "stages/mp_raster.h"
 #include "pipeline/pass/micropolygon_stages.h"
 #include "cl/kernel_args.h"
 

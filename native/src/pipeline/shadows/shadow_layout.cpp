@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "mp_shadow.h"
+#include "shadow/mp_shadow.h"
 #include "pipeline/device_scene/scene_fingerprint.h"
 
 namespace mp {

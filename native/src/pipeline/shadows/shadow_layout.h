@@ -1,4 +1,4 @@
-// How a frame's lights lay out their shadow maps (kernels/mp_shadow.h):
+// How a frame's lights lay out their shadow maps (kernels/shadow/mp_shadow.h):
 // each light's space, its maps (a sun's clipmap levels around the camera,
 // a local light's cube faces and mips), where each map's page table starts,
 // and the view that renders a map. Pure host work, no OpenCL.
@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "micropoly/scene.h"
-#include "mp_types.h"
+#include "core/mp_types.h"
 #include "pipeline/frame/frame_params.h"
 
 namespace mp {

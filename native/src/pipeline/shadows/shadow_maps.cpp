@@ -7,7 +7,7 @@
 
 #include "cl/kernel_args.h"
 #include "micropoly/error.h"
-#include "mp_shadow.h"
+#include "shadow/mp_shadow.h"
 #include "pipeline/pass/occlusion_culling.h"
 #include "pipeline/device_scene/scene_fingerprint.h"
 

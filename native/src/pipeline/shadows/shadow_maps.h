@@ -1,4 +1,4 @@
-// Shadow maps on the device (kernels/mp_shadow.h, kernels/shadow.cl). Each
+// Shadow maps on the device (kernels/shadow/mp_shadow.h, kernels/stages/shadow.cl). Each
 // frame, before the camera's view:
 //  1. the lights' layout (shadow_layout.h) and records go to the device;
 //  2. a coarse pass over the camera's view (bound & split, dicing and

@@ -1,4 +1,4 @@
-// The physical pages of the shadow maps (kernels/mp_shadow.h): a pool of
+// The physical pages of the shadow maps (kernels/shadow/mp_shadow.h): a pool of
 // fixed capacity from which each frame's requested pages get a page, kept
 // between frames so that a page whose light and geometry have not changed
 // is not rendered again (the viewport's redraws). Pure host bookkeeping.

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "mp_world.h"
+#include "closures/mp_world.h"
 
 namespace mp {
 namespace {

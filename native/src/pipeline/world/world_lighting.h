@@ -9,7 +9,7 @@
 // distant light with the region's direction and a soft shadow as wide as
 // the region. A shaded point's world light is its irradiance times the
 // probes' visibility there, weighted by how much light each probe's region
-// gives that normal (kernels/mp_shading.h).
+// gives that normal (kernels/closures/mp_shading.h).
 #pragma once
 
 #include <array>
@@ -35,7 +35,7 @@ glm::vec2 world_map_uv(const glm::vec3& d);
 // The map's irradiance over pi as 9 coefficients per channel (order l = 0,
 // then m = -1, 0, 1 of l = 1, then m = -2..2 of l = 2), world space.
 std::array<glm::vec3, 9> world_irradiance_sh(const WorldMap& map);
-// E(n) / pi from those coefficients: what kernels/mp_shading.h computes.
+// E(n) / pi from those coefficients: what kernels/closures/mp_shading.h computes.
 glm::vec3 eval_irradiance_sh(const std::array<glm::vec3, 9>& sh, const glm::vec3& n);
 
 // A region of the median cut: its light (integral of radiance over its
@@ -53,7 +53,7 @@ std::vector<WorldRegion> median_cut(const WorldMap& map, int regions);
 // environment light.
 std::vector<Light> world_lights(const WorldMap& map, const World& world, int probes);
 
-// The world's glossy maps (kernels/mp_world.h, MP_WORLD_GLOSSY_LEVELS):
+// The world's glossy maps (kernels/closures/mp_world.h, MP_WORLD_GLOSSY_LEVELS):
 // level 0 the map resampled, level k the map convolved with the GGX lobe of
 // roughness k / 8 around each direction (view = normal = the direction, as
 // the split-sum approximation assumes), by filtered importance sampling

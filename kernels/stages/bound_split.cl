@@ -1,0 +1,178 @@
+/* Bound & split, in two strategies that make the same decisions (mp_bound.h)
+ * and therefore reach the same set of diceable sub-patches:
+ *
+ *  - breadth-first (Patney & Owens 2008): every iteration classifies the whole
+ *    queue, then prefix sums compact the diceable sub-patches and the split
+ *    children into new arrays. Memory grows with the widest level.
+ *  - bounded (Weber, Wimmer & Owens 2015): a fixed pool of workers, each
+ *    processing sub-patches depth-first from a stack of its own; split
+ *    children are handed to idle workers through a small ring buffer. Memory
+ *    is fixed by the number of workers and the stack depth. */
+#include "core/mp_compat.h"
+#include "geometry/mp_patch.h"
+#include "core/mp_types.h"
+#include "geometry/mp_patch_eval.h"
+#include "geometry/mp_surface.h"
+#include "geometry/mp_grid.h"
+#include "geometry/mp_bound.h"
+
+/* Root r of a pass over patch_count patches in one or more views: the whole
+ * domain of patch r % patch_count in view r / patch_count, no edge rated yet.
+ * With an order (occlusion culling), the patches are taken in it, near to
+ * far, and a pass over several views (one light's shadow maps) takes each
+ * patch in all its views before the next, so every view's pyramid fills
+ * with the nearest surfaces first. */
+inline SubPatch mp_root_subpatch(uint r, uint patch_count, uint view_count, __global const uint* order) {
+  uint views = max(view_count, 1u);
+  uint p = order ? order[r / views] : r % patch_count;
+  uint view = order ? r % views : r / patch_count;
+  SubPatch sp;
+  sp.corner[0] = 0.0f; sp.corner[1] = 0.0f;
+  sp.corner[2] = 1.0f; sp.corner[3] = 0.0f;
+  sp.corner[4] = 1.0f; sp.corner[5] = 1.0f;
+  sp.corner[6] = 0.0f; sp.corner[7] = 1.0f;
+  sp.patch = p;
+  sp.info = view << 24;
+  sp.rates = 0u;
+  return sp;
+}
+
+/* The view a sub-patch belongs to: the pass's own (f), or one of several
+ * (shadow maps) by the view index in its info. */
+inline FrameParams mp_subpatch_view(const SubPatch* sp, FrameParams f, __global const FrameParams* views,
+                                    uint view_count) {
+  return view_count > 0u ? views[MP_INFO_VIEW(sp->info)] : f;
+}
+
+/* ---- breadth-first ------------------------------------------------------ */
+
+/* Initial queue: one whole-domain sub-patch per patch and view. */
+__kernel void bs_init_queue(__global SubPatch* queue, uint n, uint patch_count, uint view_count,
+                            __global const uint* order) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  queue[i] = mp_root_subpatch(i, patch_count, view_count, order);
+}
+
+__kernel void bs_breadth_classify(__global SubPatch* queue, uint n,
+                                  __global const float4* points, __global const uint* patch_info,
+                                  __global const uint* edges, __global const float4* curves,
+                                  __global const float4* patch_bounds, FrameParams f,
+                                  __global const FrameParams* views, uint view_count,
+                                  __global const uchar* page_masks, __global const uint* occlusion,
+                                  OcclusionParams occ, volatile __global uint* occluded, __global uint* decision,
+                                  __global uint* dice_flag, __global uint* split_flag) {
+  uint i = get_global_id(0);
+  if (i > n) return;
+  if (i == n) { /* a zero past the end, so the exclusive scans end in the totals */
+    dice_flag[n] = 0u;
+    split_flag[n] = 0u;
+    return;
+  }
+  SubPatch sp = queue[i];
+  uint d = mp_classify(points, patch_info, edges, curves, patch_bounds, &sp, mp_subpatch_view(&sp, f, views, view_count),
+                       page_masks, occlusion, occ);
+  uint action = MP_DECISION_ACTION(d);
+  if (d == MP_CULL_OCCLUDED) atomic_inc(occluded);
+  queue[i] = sp; /* with the edge rates measured here */
+  decision[i] = d;
+  dice_flag[i] = action == MP_DICE ? 1u : 0u;
+  split_flag[i] = action >= MP_SPLIT_U ? 1u : 0u;
+}
+
+/* After the exclusive scans: dice_flag holds dice offsets, split_flag split offsets. */
+__kernel void bs_breadth_scatter(__global const SubPatch* queue, uint n, __global const uint* decision,
+                                 __global const uint* dice_offset, __global const uint* split_offset,
+                                 __global SubPatch* next_queue, __global SubPatch* diceable) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  uint d = decision[i];
+  uint action = MP_DECISION_ACTION(d);
+  SubPatch sp = queue[i];
+  if (action == MP_DICE) {
+    sp.info = MP_DICED_INFO(sp.info, d);
+    diceable[dice_offset[i]] = sp;
+  } else if (action >= MP_SPLIT_U) {
+    SubPatch a, b;
+    mp_split(&sp, action, &a, &b);
+    next_queue[2 * split_offset[i]] = a;
+    next_queue[2 * split_offset[i] + 1] = b;
+  }
+}
+
+/* ---- bounded memory -------------------------------------------------------- */
+
+/* Counters shared by all workers (one small buffer). */
+#define BS_POOL_HEAD 0   /* next ring index to take */
+#define BS_POOL_TAIL 1   /* next ring index to write */
+#define BS_NEXT_ROOT 2   /* next input root (patch and view) to take */
+#define BS_DICE_COUNT 3  /* diceable sub-patches written */
+#define BS_BUSY 4        /* workers left with work after this launch */
+#define BS_IDLE 5        /* workers that ran out of work in this launch */
+#define BS_MAX_BUSY 6    /* 1 + highest index of a worker left with work */
+#define BS_OCCLUDED 7    /* sub-patches culled by occlusion */
+#define BS_COUNTERS 8
+
+__kernel void bs_bounded_step(__global const float4* points, __global const uint* patch_info,
+                              __global const uint* edges, __global const float4* curves,
+                              __global const float4* patch_bounds, uint patch_count, uint root_limit,
+                              __global const uint* root_order, FrameParams f,
+                              __global const FrameParams* views, uint view_count, __global const uchar* page_masks,
+                              __global const uint* occlusion, OcclusionParams occ,
+                              __global SubPatch* stacks, __global uint* stack_sizes, uint stack_depth,
+                              __global SubPatch* ring, uint ring_capacity,
+                              uint ring_head0, uint ring_tail0, uint donate_limit,
+                              __global SubPatch* diceable, uint dice_capacity,
+                              volatile __global uint* counters, uint steps) {
+  uint w = get_global_id(0);
+  __global SubPatch* stack = stacks + (ulong)w * stack_depth;
+  uint size = stack_sizes[w];
+  for (uint step = 0; step < steps; ++step) {
+    /* Once this batch of diceable sub-patches is full, stop before doing work
+     * that would only be repeated after the flush. */
+    if (counters[BS_DICE_COUNT] >= dice_capacity) break;
+    if (size == 0u) {
+      /* Refill: first from work that others handed out, then from the input. */
+      uint r = atomic_inc(&counters[BS_POOL_HEAD]);
+      if (r < ring_tail0) {
+        stack[size++] = ring[r % ring_capacity];
+      } else {
+        uint r = atomic_inc(&counters[BS_NEXT_ROOT]);
+        if (r >= root_limit) break; /* the roots taken so far (occlusion culling takes them in waves) */
+        stack[size++] = mp_root_subpatch(r, patch_count, view_count, root_order);
+      }
+    }
+    SubPatch sp = stack[--size];
+    uint d = mp_classify(points, patch_info, edges, curves, patch_bounds, &sp,
+                         mp_subpatch_view(&sp, f, views, view_count), page_masks, occlusion, occ);
+    uint action = MP_DECISION_ACTION(d);
+    if (d == MP_CULL_OCCLUDED) atomic_inc(&counters[BS_OCCLUDED]);
+    if (action == MP_DICE) {
+      uint slot = atomic_inc(&counters[BS_DICE_COUNT]);
+      if (slot >= dice_capacity) {
+        stack[size++] = sp; /* batch full: keep it for after the flush */
+        break;
+      }
+      sp.info = MP_DICED_INFO(sp.info, d);
+      diceable[slot] = sp;
+    } else if (action >= MP_SPLIT_U) {
+      SubPatch a, b;
+      mp_split(&sp, action, &a, &b);
+      int donated = 0;
+      if (donate_limit > 0u) {
+        /* Ring entries written now become visible to takers in the next launch
+         * only, so takers never read a slot that is still being written. */
+        uint t = atomic_inc(&counters[BS_POOL_TAIL]);
+        if (t - ring_tail0 < donate_limit && t - ring_head0 < ring_capacity) {
+          ring[t % ring_capacity] = b;
+          donated = 1;
+        }
+      }
+      if (!donated) stack[size++] = b;
+      stack[size++] = a;
+    }
+  }
+  stack_sizes[w] = size;
+  atomic_inc(&counters[size > 0u ? BS_BUSY : BS_IDLE]);
+  if (size > 0u) atomic_max(&counters[BS_MAX_BUSY], w + 1u);
+}

@@ -1,0 +1,113 @@
+/* Dice: evaluate each diceable sub-patch at the vertices of its stitched
+ * grid (mp_grid.h: edge vertices shared with the neighbours, a regular grid
+ * inside), with smooth normals from the surface derivatives. Grids live in
+ * fixed-size slots of (max_grid+1)^2 vertices. */
+#include "core/mp_compat.h"
+#include "geometry/mp_patch.h"
+#include "core/mp_types.h"
+#include "geometry/mp_patch_eval.h"
+#include "geometry/mp_surface.h"
+#include "geometry/mp_grid.h"
+
+__kernel void dice_grids(__global const SubPatch* diceable, uint count,
+                         __global const float4* points, __global const uint* patch_info,
+                         __global const uint* edges, __global const float4* curves,
+                         __global const DeviceMaterial* materials, FrameParams f, __global float4* grid_p,
+                         __global float4* grid_n, __global const uint* vertex_offsets) {
+  uint gid = get_global_id(0), i, j;
+  SubPatch sp;
+  float2 uv;
+  ulong index;
+  if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
+  float3 p, dpdu, dpdv;
+  mp_surface_point(points, patch_info, edges, curves, sp.patch, uv.x, uv.y, &p, &dpdu, &dpdv);
+  uint flags = patch_info[4 * (ulong)sp.patch + 2];
+  /* Displaced materials move shared edge vertices along the edge's own normal
+   * (watertight); others shade with the patch's normal, which keeps polygon
+   * faces flat. */
+  float3 n = materials[patch_info[4 * (ulong)sp.patch + 1]].program[1] > 0.0f
+                 ? mp_surface_normal(points, patch_info, edges, curves, sp.patch, uv.x, uv.y, dpdu, dpdv)
+                 : mp_patch_normal(points + (ulong)sp.patch * MP_PATCH_POINTS, patch_info[4 * (ulong)sp.patch], uv.x,
+                                   uv.y, dpdu, dpdv);
+  if (flags & MP_PATCH_FLIP_ORIENTATION) n = -n;
+  grid_p[index] = (float4)(p, 1.0f);
+  grid_n[index] = (float4)(n, 0.0f);
+}
+
+/* Vertices and micropolygons of each diceable sub-patch's grid (interleaved
+ * in `counts`), which the host sums into the offsets that size the dice,
+ * shade and sample launches. */
+__kernel void grid_counts(__global const SubPatch* diceable, uint count, FrameParams f, __global uint* counts) {
+  uint k = get_global_id(0);
+  if (k >= count) return;
+  SubPatch sp = diceable[k];
+  MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
+  counts[2 * (ulong)k] = mp_grid_vertices(&g);
+  counts[2 * (ulong)k + 1] = mp_grid_micropolygons(&g);
+}
+
+/* Normals of displaced grids, from the displaced vertices (differences
+ * between each vertex's neighbours along u and v, mp_grid_neighbours;
+ * one-sided on the grid's border), oriented like the
+ * surface normal they replace. Where the differences vanish (a collapsed
+ * grid edge) the undisplaced normal stays. Runs after every material's
+ * displacement (material_program.cl). */
+__kernel void displaced_normals(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
+                                __global const DeviceMaterial* materials, FrameParams f,
+                                __global const float4* grid_p, __global float4* grid_n,
+                                __global const uint* vertex_offsets) {
+  uint gid = get_global_id(0), i, j;
+  SubPatch sp;
+  float2 uv;
+  ulong index;
+  if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
+  if (!(materials[patch_info[4 * (ulong)sp.patch + 1]].program[1] > 0.0f)) return;
+  MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
+  ulong base = index - mp_slot(&g, i, j); /* slot (0, 0) of this grid */
+  uint xm, xp, ym, yp;
+  mp_grid_neighbours(&g, i, j, &xm, &xp, &ym, &yp);
+  float3 du = grid_p[base + xp].xyz - grid_p[base + xm].xyz;
+  float3 dv = grid_p[base + yp].xyz - grid_p[base + ym].xyz;
+  float3 n = cross(du, dv);
+  float len = length(n);
+  float3 old = grid_n[index].xyz;
+  if (!(len > 1e-12f * dot(du, du) + 1e-30f)) return;
+  n /= len;
+  grid_n[index] = (float4)(dot(n, old) < 0.0f ? -n : n, 0.0f);
+}
+
+/* Motion blur: the positions of the same grid vertices at one motion step,
+ * from that step's control points and edge curves (the same patches, moved),
+ * (points + point_offset, curves + curve_offset) into grid_p + out_offset.
+ * The same (u, v) and the same edge rates as the shutter centre's grid, so
+ * shared edges stay shared at every step. */
+__kernel void dice_motion_positions(__global const SubPatch* diceable, uint count, __global const float4* points,
+                                    ulong point_offset, __global const uint* patch_info, __global const uint* edges,
+                                    __global const float4* curves, ulong curve_offset, FrameParams f,
+                                    __global float4* grid_p, ulong out_offset, __global const uint* vertex_offsets) {
+  uint gid = get_global_id(0), i, j;
+  SubPatch sp;
+  float2 uv;
+  ulong index;
+  if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
+  float3 p, dpdu, dpdv;
+  mp_surface_point(points + point_offset, patch_info, edges, curves + curve_offset, sp.patch, uv.x, uv.y, &p, &dpdu,
+                   &dpdv);
+  grid_p[out_offset + index] = (float4)(p, 1.0f);
+}
+
+/* Motion blur of displaced grids: the displacement the shutter centre's
+ * grid received (grid_p - rest) moves each step's vertex alike (a
+ * translation: the surface's turn during the shutter does not turn it). */
+__kernel void motion_displacement(__global const SubPatch* diceable, uint count, FrameParams f,
+                                  __global const float4* grid_p, __global const float4* rest, __global float4* steps,
+                                  ulong stride, int step_count, __global const uint* vertex_offsets) {
+  uint gid = get_global_id(0), i, j;
+  SubPatch sp;
+  float2 uv;
+  ulong index;
+  if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
+  float4 d = grid_p[index] - rest[index];
+  if (d.x == 0.0f && d.y == 0.0f && d.z == 0.0f) return;
+  for (int k = 0; k < step_count; ++k) steps[(ulong)k * stride + index] += (float4)(d.xyz, 0.0f);
+}

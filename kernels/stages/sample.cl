@@ -1,0 +1,361 @@
+/* Sample: a software rasteriser for micropolygons. Each work-item takes one
+ * micropolygon (two triangles of a quad of a stitched grid, mp_grid.h; one of
+ * them empty where the quad has collapsed into a triangle), finds the
+ * jittered samples it covers with fixed-point edge functions, and resolves visibility per sample
+ * with a 64-bit atomic minimum of (depth, micropolygon id) (the visibility
+ * buffer trick of Karis et al. 2021, Nanite). A second pass, run after the
+ * first has finished, lets the one micropolygon whose key won each sample write
+ * its color and normal, so the result never depends on execution order. */
+#pragma OPENCL EXTENSION cl_khr_int64_base_atomics : enable
+#pragma OPENCL EXTENSION cl_khr_int64_extended_atomics : enable
+#include "core/mp_compat.h"
+#include "geometry/mp_patch.h"
+#include "core/mp_types.h"
+#include "core/mp_hash.h"
+#include "stages/mp_raster.h"
+#include "geometry/mp_grid.h"
+#include "stages/mp_occlusion.h"
+#include "stages/mp_sample.h"
+
+#define MP_PASS_DEPTH 0u
+#define MP_PASS_ATTRIBUTES 1u
+
+/* Sample s of pixel (px, py), covered by triangle t at barycentrics (la,
+ * lb, lc): within the clip range and the stochastic opacity, the depth pass
+ * keeps the nearest key and the attribute pass lets its owner write.
+ * cover: the micropolygon's opacity and its held-out share (Holdout). */
+inline void mp_sample_write(const MpTriangle* t, float la, float lb, float lc, int px, int py, int s, int spp,
+                            uint mp_id, float2 cover, FrameParams f, uint pass, volatile __global ulong* keys,
+                            __global float* colors, __global uint* normals) {
+  float d;
+  if (!mp_triangle_depth(t, la, lb, lc, f, &d)) return;
+  if (!mp_opacity_keeps(mp_id, px, py, s, cover.x, f)) return;
+  ulong pixel = (ulong)py * (ulong)f.width + (ulong)px, index = pixel * (ulong)spp + (ulong)s;
+  ulong key = mp_sample_key(d, mp_id);
+  if (pass == MP_PASS_DEPTH) {
+    if (key < keys[index]) atom_min(&keys[index], key);
+  } else if (keys[index] == key) {
+    float3 col, nrm;
+    mp_triangle_attributes(t, la, lb, lc, d, f, &col, &nrm);
+    mp_store_color(colors, pixel, s, spp, mp_sample_color(col, cover.y), f);
+    if (f.normal_pass) normals[index] = mp_encode_normal(normalize(nrm));
+  }
+}
+
+/* Rasterises the quad v[0..3]'s triangles that `keep` selects
+ * (mp_setup_quad). */
+inline void mp_raster_quad(const MpRasterVertex* v, uint keep, uint mp_id, float2 cover, FrameParams f,
+                           __global const ushort* offsets, uint pass, volatile __global ulong* keys,
+                           __global float* colors, __global uint* normals, uint* tests) {
+  MpTriangle tris[2];
+  mp_setup_quad(v, keep, tris);
+  long xmin = min(min(v[0].p.x, v[1].p.x), min(v[2].p.x, v[3].p.x)), xmax = max(max(v[0].p.x, v[1].p.x), max(v[2].p.x, v[3].p.x));
+  long ymin = min(min(v[0].p.y, v[1].p.y), min(v[2].p.y, v[3].p.y)), ymax = max(max(v[0].p.y, v[1].p.y), max(v[2].p.y, v[3].p.y));
+  int px0 = (int)max(xmin >> MP_SUBPIXEL_BITS, (long)0), px1 = (int)min(xmax >> MP_SUBPIXEL_BITS, (long)f.width - 1);
+  int py0 = (int)max(ymin >> MP_SUBPIXEL_BITS, (long)0), py1 = (int)min(ymax >> MP_SUBPIXEL_BITS, (long)f.height - 1);
+  int spp = f.spp_x * f.spp_y;
+  for (int py = py0; py <= py1; ++py)
+    for (int px = px0; px <= px1; ++px)
+      for (int s = 0; s < spp; ++s) {
+        MpFixed2 q = mp_sample_position(px, py, s, spp, f, offsets);
+        if (q.x < xmin || q.x > xmax || q.y < ymin || q.y > ymax) continue;
+        ++*tests;
+        float la, lb, lc;
+        int k = mp_quad_covers(tris, q, &la, &lb, &lc);
+        if (k >= 0)
+          mp_sample_write(&tris[k], la, lb, lc, px, py, s, spp, mp_id, cover, f, pass, keys, colors, normals);
+      }
+}
+
+/* Grows the raster box by view-space point p seen from every lens position
+ * of the box bx (x range) by (y range); 0 where p is behind the lens. */
+inline int mp_blur_box(float3 p, float2 bx, float2 by, FrameParams f, float* box) {
+  float x0, x1, y0, y1;
+  if (f.ortho) {
+    x0 = x1 = f.ax * p.x + f.frame_bx, y0 = y1 = f.ay * p.y + f.frame_by;
+  } else {
+    float d = -p.z;
+    if (!(d > 0.0f)) return 0;
+    float inv = 1.0f / d, k = 1.0f / f.focus_distance - inv;
+    x0 = f.ax * (p.x * inv + bx.x * k) + f.frame_bx, x1 = f.ax * (p.x * inv + bx.y * k) + f.frame_bx;
+    y0 = f.ay * (p.y * inv + by.x * k) + f.frame_by, y1 = f.ay * (p.y * inv + by.y * k) + f.frame_by;
+  }
+  box[0] = fmin(box[0], fmin(x0, x1)), box[1] = fmax(box[1], fmax(x0, x1));
+  box[2] = fmin(box[2], fmin(y0, y1)), box[3] = fmax(box[3], fmax(y0, y1));
+  return 1;
+}
+
+/* Motion steps a work-item keeps in registers per vertex; with more, the
+ * positions are read from the grid's step buffer at each test. */
+#define MP_BLUR_LOCAL_STEPS 3
+/* A quad whose whole blurred bound covers at most this many pixels has all
+ * the samples of those pixels tested, with no bound per sample slot (which
+ * costs more than it saves on so few). */
+#ifndef MP_BLUR_SMALL_PIXELS
+#define MP_BLUR_SMALL_PIXELS 9
+#endif
+
+/* Position at time t of vertex i (mp_motion_position over its steps, from
+ * registers when they are there). */
+inline float3 mp_blur_position(int i, float t, int steps, const float4* p, float4 ps[4][MP_BLUR_LOCAL_STEPS],
+                               __global const float4* pm, const ulong* idx, ulong stride) {
+  if (!steps) return p[i].xyz;
+  if (steps > MP_BLUR_LOCAL_STEPS) return mp_motion_position(pm + idx[i], stride, steps, t).xyz;
+  float w;
+  int k = mp_motion_segment(t, steps, &w);
+  return (ps[i][k] + w * (ps[i][k + 1] - ps[i][k])).xyz;
+}
+
+/* One sample of a blurred quad: its four vertices at the sample's time and
+ * lens position, a cheap box rejection, then the fixed-point edge tests. */
+inline void mp_blur_sample(int px, int py, int s, int spp, MpFixed2 sq, float4 e, int steps, const float4* p,
+                           float4 ps[4][MP_BLUR_LOCAL_STEPS], __global const float4* pm, const ulong* idx, ulong stride,
+                           float8* still, const float4* c, const float4* n, uint keep, uint mp_id, float2 cover,
+                           FrameParams f, uint pass, volatile __global ulong* keys, __global float* colors,
+                           __global uint* normals) {
+  float3 q[4];
+  MpRasterVertex v[4];
+  for (int i = 0; i < 4; ++i) {
+    float rx, ry, inv_d;
+    if (!steps) {
+      /* Without motion the lens alone moves the vertex: two multiply-adds. */
+      rx = still[i].s0 + e.x * still[i].s2, ry = still[i].s1 + e.y * still[i].s3, inv_d = still[i].s4;
+      if (!(fabs(rx) < MP_RASTER_GUARD && fabs(ry) < MP_RASTER_GUARD)) return;
+      v[i].p = mp_sample_fixed(rx, ry, f);
+      v[i].inv_d = inv_d;
+      continue;
+    }
+    q[i] = mp_blur_position(i, e.z, steps, p, ps, pm, idx, stride);
+    if (f.ortho) {
+      rx = f.ax * q[i].x + f.frame_bx, ry = f.ay * q[i].y + f.frame_by, inv_d = -q[i].z;
+    } else if (!mp_project_lens(q[i], (float2)(e.x, e.y), f, &rx, &ry, &inv_d)) {
+      return;
+    }
+    if (!(fabs(rx) < MP_RASTER_GUARD && fabs(ry) < MP_RASTER_GUARD)) return;
+    v[i].p = mp_sample_fixed(rx, ry, f);
+    v[i].inv_d = inv_d;
+  }
+  /* Most samples of a slot's bound miss the quad where it is at their time. */
+  if (sq.x < min(min(v[0].p.x, v[1].p.x), min(v[2].p.x, v[3].p.x)) ||
+      sq.x > max(max(v[0].p.x, v[1].p.x), max(v[2].p.x, v[3].p.x)) ||
+      sq.y < min(min(v[0].p.y, v[1].p.y), min(v[2].p.y, v[3].p.y)) ||
+      sq.y > max(max(v[0].p.y, v[1].p.y), max(v[2].p.y, v[3].p.y)))
+    return;
+  for (int i = 0; i < 4; ++i) {
+    float w = f.ortho ? 1.0f : v[i].inv_d;
+    v[i].c_over_d = c[i].xyz * w;
+    v[i].n_over_d = n[i].xyz * w;
+  }
+  MpTriangle tris[2];
+  mp_setup_quad(v, keep, tris);
+  float la, lb, lc;
+  int t = mp_quad_covers(tris, sq, &la, &lb, &lc);
+  if (t >= 0) mp_sample_write(&tris[t], la, lb, lc, px, py, s, spp, mp_id, cover, f, pass, keys, colors, normals);
+}
+
+/* Grows the raster box by vertex i over the times [t0, t1] (its positions
+ * there and at the steps between: straight lines in between stay straight
+ * in perspective) seen from every lens position of the box (bx, by). */
+inline int mp_blur_path_box(int i, float t0, float t1, float2 bx, float2 by, int steps, const float4* p,
+                            float4 ps[4][MP_BLUR_LOCAL_STEPS], __global const float4* pm, const ulong* idx,
+                            ulong stride, FrameParams f, float* box) {
+  if (!steps) return mp_blur_box(p[i].xyz, bx, by, f, box);
+  int ok = mp_blur_box(mp_blur_position(i, t0, steps, p, ps, pm, idx, stride), bx, by, f, box) &&
+           mp_blur_box(mp_blur_position(i, t1, steps, p, ps, pm, idx, stride), bx, by, f, box);
+  for (int k = 1; k + 1 < steps && ok; ++k) {
+    float tk = (float)k / (float)(steps - 1);
+    if (tk > t0 && tk < t1) ok = mp_blur_box(mp_blur_position(i, tk, steps, p, ps, pm, idx, stride), bx, by, f, box);
+  }
+  return ok;
+}
+
+/* The quad as samples that carry times and lens positions see it
+ * (mp_blur.h): each sample moves the four vertices to its own time and lens
+ * position before the same fixed-point edge tests, so shared vertices move
+ * alike in every sample and the grid stays watertight in each. Which
+ * samples are tested: where the quad's whole blurred bound (all times, the
+ * whole aperture) covers few pixels (MP_BLUR_SMALL_PIXELS), every sample of
+ * those pixels;
+ * else each sample slot s apart, over the quad's bound for the times and
+ * lens positions its slot takes (the table's box of slot s after the tile's
+ * entries: (lx0, lx1, ly0, ly1), (t0, t1)). Triangles keep the shutter
+ * centre's culling (`keep`); attributes are the centre's (shading once per
+ * grid vertex). Motion positions: pm[idx[i] + k * stride] for step k. */
+inline void mp_raster_quad_blur(const float4* p, __global const float4* pm, const ulong* idx, ulong stride,
+                                const float4* c, const float4* n, uint keep, uint mp_id, float2 cover, FrameParams f,
+                                __global const ushort* offsets, __global const float4* table, uint pass,
+                                volatile __global ulong* keys, __global float* colors, __global uint* normals,
+                                uint* tests) {
+  int spp = f.spp_x * f.spp_y;
+  int steps = mp_motion_on(f) ? f.motion_steps : 0;
+  float4 ps[4][MP_BLUR_LOCAL_STEPS];
+  if (steps && steps <= MP_BLUR_LOCAL_STEPS)
+    for (int i = 0; i < 4; ++i)
+      for (int k = 0; k < steps; ++k) ps[i][k] = pm[idx[i] + (ulong)k * stride];
+  /* Without motion (a lens only; mp_project_lens): each vertex's pinhole
+   * raster position, its raster shift per unit of lens offset, and 1/d. */
+  float8 still[4];
+  if (!steps)
+    for (int i = 0; i < 4; ++i) {
+      float inv = 1.0f / (-p[i].z), k = 1.0f / f.focus_distance - inv;
+      still[i] = (float8)(f.ax * p[i].x * inv + f.frame_bx, f.ay * p[i].y * inv + f.frame_by, f.ax * k, f.ay * k, inv, 0.0f,
+                          0.0f, 0.0f);
+    }
+  __global const float4* slot_boxes = table + MP_SAMPLE_TILE * MP_SAMPLE_TILE * spp;
+  /* The whole bound: every time, the whole aperture. */
+  float rx = mp_lens_on(f) ? f.lens_radius * f.lens_x_scale : 0.0f, ry = mp_lens_on(f) ? f.lens_radius : 0.0f;
+  float whole[4] = {3.0e38f, -3.0e38f, 3.0e38f, -3.0e38f};
+  int ok = 1;
+  for (int i = 0; i < 4 && ok; ++i)
+    ok = mp_blur_path_box(i, 0.0f, 1.0f, (float2)(-rx, rx), (float2)(-ry, ry), steps, p, ps, pm, idx, stride, f,
+                          whole);
+  if (!ok) return;
+  int small = ((int)floor(whole[1]) - (int)floor(whole[0]) + 1) * ((int)floor(whole[3]) - (int)floor(whole[2]) + 1) <=
+              MP_BLUR_SMALL_PIXELS;
+  for (int s = 0; s < (small ? 1 : spp); ++s) {
+    float box[4] = {whole[0], whole[1], whole[2], whole[3]};
+    if (!small) {
+      float4 lb = slot_boxes[2 * s], tb = slot_boxes[2 * s + 1];
+      box[0] = box[2] = 3.0e38f, box[1] = box[3] = -3.0e38f;
+      for (int i = 0; i < 4 && ok; ++i)
+        ok = mp_blur_path_box(i, tb.x, tb.y, (float2)(lb.x, lb.y), (float2)(lb.z, lb.w), steps, p, ps, pm, idx,
+                              stride, f, box);
+      if (!ok) return;
+    }
+    /* One fixed-point unit of slack for the rounding of positions. */
+    MpFixed2 lo = mp_sample_fixed(box[0], box[2], f), hi = mp_sample_fixed(box[1], box[3], f);
+    long fx0 = lo.x - 1, fx1 = hi.x + 1, fy0 = lo.y - 1, fy1 = hi.y + 1;
+    int px0 = (int)max(fx0 >> MP_SUBPIXEL_BITS, (long)0), px1 = (int)min(fx1 >> MP_SUBPIXEL_BITS, (long)f.width - 1);
+    int py0 = (int)max(fy0 >> MP_SUBPIXEL_BITS, (long)0), py1 = (int)min(fy1 >> MP_SUBPIXEL_BITS, (long)f.height - 1);
+    for (int py = py0; py <= py1; ++py)
+      for (int px = px0; px <= px1; ++px) {
+        int tx = (px + f.crop_x0) & (MP_SAMPLE_TILE - 1), ty = (py + f.crop_y0) & (MP_SAMPLE_TILE - 1);
+        for (int k = small ? 0 : s; k < (small ? spp : s + 1); ++k) {
+          MpFixed2 sq = mp_sample_position(px, py, k, spp, f, offsets);
+          if (sq.x < fx0 || sq.x > fx1 || sq.y < fy0 || sq.y > fy1) continue;
+          ++*tests;
+          mp_blur_sample(px, py, k, spp, sq, table[(ty * MP_SAMPLE_TILE + tx) * spp + k], steps, p, ps, pm, idx,
+                         stride, still, c, n, keep, mp_id, cover, f, pass, keys, colors, normals);
+        }
+      }
+  }
+}
+
+/* Micropolygons that reach the rasteriser and their total screen area, summed
+ * per work-group in local memory (one atomic per group): the dicing density
+ * the benchmarks report as micropolygons per pixel of surface; and the
+ * samples tested against micropolygon edges (inside a micropolygon's
+ * bound): the rasteriser's work per sample, which blur multiplies. Counted
+ * in the depth pass. */
+inline void mp_count_sampled(uint l, long area2, uint tests, uint pass, volatile __global ulong* totals,
+                             __local ulong* area_sum, __local uint* count_sum, __local uint* test_sum) {
+  area_sum[l] = (ulong)area2;
+  count_sum[l] = area2 > 0 ? 1u : 0u;
+  test_sum[l] = tests;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (uint s = 32u; s > 0u; s >>= 1) {
+    if (l < s) {
+      area_sum[l] += area_sum[l + s];
+      count_sum[l] += count_sum[l + s];
+      test_sum[l] += test_sum[l + s];
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+  if (pass == MP_PASS_DEPTH && l == 0u && count_sum[0] > 0u) {
+    atom_add(&totals[0], (ulong)count_sum[0]);
+    atom_add(&totals[1], area_sum[0]);
+    atom_add(&totals[2], (ulong)test_sum[0]);
+  }
+}
+
+/* Marks the occlusion cells under the micropolygon's raster bound. */
+inline void mp_mark_occlusion_cells(__global uchar* dirty, OcclusionParams o, FrameParams f, MpFixed2 a, MpFixed2 b,
+                                    MpFixed2 c, MpFixed2 d) {
+  long xmin = min(min(a.x, b.x), min(c.x, d.x)), xmax = max(max(a.x, b.x), max(c.x, d.x));
+  long ymin = min(min(a.y, b.y), min(c.y, d.y)), ymax = max(max(a.y, b.y), max(c.y, d.y));
+  mp_mark_occlusion_rect(dirty, o, f, xmin >> MP_SUBPIXEL_BITS, ymin >> MP_SUBPIXEL_BITS, xmax >> MP_SUBPIXEL_BITS,
+                         ymax >> MP_SUBPIXEL_BITS);
+}
+
+/* The sampler's body for one work-item; `blur` (a constant in each kernel
+ * below) picks the stochastic path, so the pinhole kernel carries none of
+ * its code. */
+#define MP_SAMPLE_ARGS                                                                                                 \
+  __global const SubPatch *diceable, uint first, uint count, __global const uint *offsets, uint base, uint total,    \
+      __global const uint *patch_info, FrameParams f, __global const float4 *grid_p, __global const float4 *grid_c,   \
+      __global const float4 *grid_n, __global const ushort *sample_offsets, uint pass, volatile __global ulong *keys, \
+      __global float *colors, __global uint *normals, volatile __global ulong *totals,                               \
+      __global uchar *occlusion_dirty, OcclusionParams occ, __global const float4 *sample_table,                      \
+      __global const float4 *grid_pm, ulong motion_stride
+#define MP_SAMPLE_PASS                                                                                                 \
+  diceable, first, count, offsets, base, total, patch_info, f, grid_p, grid_c, grid_n, sample_offsets, pass, keys,    \
+      colors, normals, totals, occlusion_dirty, occ, sample_table, grid_pm, motion_stride
+
+/* One work-item per micropolygon of grids [first, first + count): `offsets`
+ * holds each grid of the batch's first micropolygon (from the batch's
+ * layout, GridLayoutStage), `base` is the first of these grids' and `total`
+ * their number. A work-item finds its grid by binary search, so no
+ * work-item idles on an unused grid slot. */
+inline void mp_sample(MP_SAMPLE_ARGS, __local ulong* area_sum, __local uint* count_sum, __local uint* test_sum,
+                      const int blur) {
+  uint stride = (uint)f.max_grid + 1u;
+  uint gid = get_global_id(0);
+  int live = gid < total && count > 0u;
+  uint slot = first, m = 0u;
+  SubPatch sp;
+  MpGridShape g;
+  uint q[4];
+  if (live) {
+    slot = first + mp_find_grid(offsets + first, count, base + gid);
+    m = base + gid - offsets[slot];
+    sp = diceable[slot];
+    g = mp_grid_shape(&sp, (uint)f.max_grid);
+    live = mp_grid_micropolygon(&g, m, q);
+  }
+  MpRasterVertex v[4]; /* counter-clockwise in (u, v) */
+  float4 vp[4], vc[4], vn[4];
+  ulong grid_base = (ulong)slot * stride * stride;
+  if (live) {
+    int ok = 1;
+    for (int k = 0; k < 4; ++k) {
+      ulong idx = grid_base + q[k];
+      vp[k] = grid_p[idx], vc[k] = grid_c[idx], vn[k] = grid_n[idx];
+      v[k] = mp_raster_vertex(vp[k], vc[k], vn[k], f, &ok);
+    }
+    live = ok;
+  }
+  uint keep = 0u;
+  long area2 = 0;
+  if (live) {
+    keep = mp_quad_facing(v[0].p, v[1].p, v[2].p, v[3].p, patch_info[4 * (ulong)sp.patch + 2], f, &area2);
+  }
+  uint tests = 0u;
+  if (keep) {
+    uint mp_id = mp_micropolygon_id(mp_grid_id(&sp), m);
+    float2 cover = (float2)(mp_quad_opacity(vc[0].w, vc[1].w, vc[2].w, vc[3].w),
+                            mp_quad_opacity(vn[0].w, vn[1].w, vn[2].w, vn[3].w));
+    if (pass == MP_PASS_DEPTH && occlusion_dirty) mp_mark_occlusion_cells(occlusion_dirty, occ, f, v[0].p, v[1].p, v[2].p, v[3].p);
+    if (blur) {
+      ulong idx[4];
+      for (int k = 0; k < 4; ++k) idx[k] = grid_base + q[k];
+      mp_raster_quad_blur(vp, grid_pm, idx, motion_stride, vc, vn, keep, mp_id, cover, f, sample_offsets, sample_table, pass,
+                          keys, colors, normals, &tests);
+    } else {
+      mp_raster_quad(v, keep, mp_id, cover, f, sample_offsets, pass, keys, colors, normals, &tests);
+    }
+  }
+  mp_count_sampled(get_local_id(0), area2, tests, pass, totals, area_sum, count_sum, test_sum);
+}
+
+__kernel __attribute__((reqd_work_group_size(64, 1, 1))) void sample_micropolygons(MP_SAMPLE_ARGS) {
+  __local ulong area_sum[64];
+  __local uint count_sum[64], test_sum[64];
+  mp_sample(MP_SAMPLE_PASS, area_sum, count_sum, test_sum, 0);
+}
+
+/* Samples with times and lens positions (mp_blur.h). */
+__kernel __attribute__((reqd_work_group_size(64, 1, 1))) void sample_micropolygons_blur(MP_SAMPLE_ARGS) {
+  __local ulong area_sum[64];
+  __local uint count_sum[64], test_sum[64];
+  mp_sample(MP_SAMPLE_PASS, area_sum, count_sum, test_sum, 1);
+}

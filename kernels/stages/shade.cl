@@ -1,0 +1,80 @@
+/* Shade every diced grid vertex (Reyes shades before sampling, so the
+ * rasteriser only interpolates colors). */
+#include "core/mp_compat.h"
+#include "geometry/mp_patch.h"
+#include "core/mp_types.h"
+#include "closures/mp_shading.h"
+#include "closures/mp_shade_closures.h"
+#include "geometry/mp_grid.h"
+
+__kernel void shade_grids(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
+                          FrameParams f, __global const float4* grid_p, __global float4* grid_n,
+                          __global const DeviceMaterial* materials, __global const DeviceLight* lights,
+                          uint light_count, __global float4* grid_c, __global const uint* vertex_offsets,
+                          __global const float4* patch_normals, uint use_shadows,
+                          __global const DeviceShadow* shadows, __global const DeviceShadowLevel* shadow_levels,
+                          __global const uint* shadow_pages, __global const uint* shadow_pool,
+                          __global const float4* world_glossy, __global const uint* refract_roots,
+                          __global const float4* refract_nodes, __global const float4* refract_tris) {
+  uint gid = get_global_id(0), i, j;
+  SubPatch sp;
+  float2 uv;
+  ulong index;
+  if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
+  DeviceMaterial m = materials[patch_info[4 * (ulong)sp.patch + 1]];
+  float3 p = grid_p[index].xyz, n = grid_n[index].xyz;
+  /* Shadows compare with the surface's own tangent plane (mp_shadow.h). */
+  MpShadowMaps maps = {shadows, shadow_levels, shadow_pages, shadow_pool};
+  MpShadowQuery shadow = {&maps, n, mp_pixel_footprint(-p.z, f)};
+  /* Smooth-shaded polygons: their interpolated normal replaces the surface's
+   * for shading, node programs and the Normal pass (w = 1: already faced).
+   * Displaced surfaces keep the normal of their displaced grid. */
+  int faced = 0;
+  /* The surface itself faces away from the viewer. */
+  int away = dot(n, f.ortho ? (float3)(0.0f, 0.0f, 1.0f) : -p) < 0.0f;
+  int smooth = (patch_info[4 * (ulong)sp.patch + 2] & MP_PATCH_SMOOTH_NORMALS) && !(m.program[1] > 0.0f);
+  if (smooth) {
+    float3 ns = mp_face_shading_normal(patch_normals, sp.patch, uv.x, uv.y, n, p, f.ortho);
+    if (dot(ns, ns) > 0.0f) {
+      /* w, for node programs: 1 faced, 2 faced and the surface itself faces
+       * away (Backfacing). They replace it by the held-out share the sampler
+       * reads (material_program.cl); for other materials it stays 0. */
+      float flag = away ? 2.0f : 1.0f;
+      grid_n[index] = (float4)(ns, m.program[2] > 0.0f ? flag : 0.0f);
+      n = ns, faced = 1;
+    }
+  }
+  if (m.program[2] > 0.0f) return; /* shaded by its node program (material_program.cl) */
+  /* The normal one step along u and v (mp_normal_spread2). Smooth-shaded
+   * polygons take their neighbours' interpolated normals from the patch
+   * (their grid normals are being replaced by this kernel), the rest the
+   * grid's, which this kernel leaves alone. */
+  MpGridShape shape = mp_grid_shape(&sp, (uint)f.max_grid);
+  uint here = mp_slot(&shape, i, j), sx, sy;
+  mp_grid_steps(&shape, i, j, &sx, &sy);
+  ulong gx = index - here + sx, gy = index - here + sy;
+  /* Past the contour by less than a micropolygon: the side in front (not
+   * for smooth-shaded polygons, whose neighbours' normals this kernel is
+   * replacing). */
+  if (!smooth && away && mp_grid_beside_contour(grid_p, grid_n, index - here, &shape, i, j, f.ortho))
+    faced = 1;
+  float3 nx, ny;
+  if (!smooth) {
+    nx = grid_n[gx].xyz, ny = grid_n[gy].xyz;
+  } else {
+    uint stride = (uint)f.max_grid + 1u;
+    float2 uvx = uv, uvy = uv;
+    mp_slot_uv(&sp, &shape, sx % stride, sx / stride, &uvx);
+    mp_slot_uv(&sp, &shape, sy % stride, sy / stride, &uvy);
+    nx = mp_face_shading_normal(patch_normals, sp.patch, uvx.x, uvx.y, shadow.normal, grid_p[gx].xyz, f.ortho);
+    ny = mp_face_shading_normal(patch_normals, sp.patch, uvy.x, uvy.y, shadow.normal, grid_p[gy].xyz, f.ortho);
+    if (!(dot(nx, nx) > 0.0f)) nx = n; /* a patch without smooth normals there */
+    if (!(dot(ny, ny) > 0.0f)) ny = n;
+  }
+  float spread2 = mp_normal_spread2(n, nx, ny);
+  MpRefractScene refract = {refract_nodes, refract_tris,
+                            refract_roots[MP_PATCH_OBJECT(patch_info[4 * (ulong)sp.patch + 2])]};
+  float3 c = mp_shade_material(p, n, faced, f.ortho, &m, lights, light_count, world_glossy, use_shadows ? &shadow : 0,
+                               spread2, refract.root != MP_REFRACT_NONE ? &refract : 0);
+  grid_c[index] = (float4)(c, m.opacity[3]);
+}

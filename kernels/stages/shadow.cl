@@ -1,0 +1,428 @@
+/* Shadow maps (mp_shadow.h): marking the pages the camera needs, clearing
+ * pages before they are rendered, and rasterising the lights' views into
+ * their pages (depth only). The views themselves go through the same bound
+ * & split, dicing and displacement as the camera's (bound_split.cl,
+ * dice.cl, material programs), several views in one pass. */
+#include "core/mp_compat.h"
+#include "geometry/mp_patch.h"
+#include "core/mp_types.h"
+#include "core/mp_hash.h"
+#include "geometry/mp_patch_eval.h"
+#include "geometry/mp_surface.h"
+#include "stages/mp_raster.h"
+#include "geometry/mp_grid.h"
+#include "geometry/mp_bound.h"
+#include "shadow/mp_shadow.h"
+
+/* Texels of margin around a receiver's box when marking: soft shadows'
+ * filters read up to MP_SHADOW_SEARCH_TEXELS from a receiver, hard shadows'
+ * the bilinear texels around it; a texel more for rounding. */
+MP_INLINE float mp_mark_margin(const MP_GLOBAL DeviceShadow* sh) {
+  return sh->shape == MP_SHADOW_SHAPE_POINT ? 2.0f : MP_SHADOW_SEARCH_TEXELS + 2.0f;
+}
+
+inline void mp_mark_rect(__global uchar* requests, uint table, int side, int origin_x, int origin_y, float x0, float y0,
+                         float x1, float y1) {
+  float last = (float)(side * MP_PAGE_SIZE - 1);
+  if (x1 < 0.0f || y1 < 0.0f || x0 > last || y0 > last) return;
+  int px0 = (int)fmax(x0, 0.0f) >> 7, px1 = (int)fmin(x1, last) >> 7;
+  int py0 = (int)fmax(y0, 0.0f) >> 7, py1 = (int)fmin(y1, last) >> 7;
+  for (int py = py0; py <= py1; ++py)
+    for (int px = px0; px <= px1; ++px) {
+      int sx = (px + origin_x) & (side - 1), sy = (py + origin_y) & (side - 1);
+      requests[table + (uint)(sy * side + sx)] = (uchar)1;
+    }
+}
+
+/* The nearest and farthest face depth a light-space box can have (a face
+ * depth is at least a point's distance over sqrt(3)). */
+inline void mp_box_depths(float3 lo, float3 hi, float* near_depth, float* far_depth) {
+  *far_depth = length(fmax(fabs(lo), fabs(hi)));
+  *near_depth = fmax(length(fmax(fmax(lo, -hi), MP_F3(0.0f, 0.0f, 0.0f))) * 0.57735027f, 1e-20f);
+}
+
+/* The levels (sun: indices from level0; cube: mips) that receivers in the
+ * light-space box [lo, hi] with pixel footprint s read for hard shadows. */
+inline void mp_base_levels(__global const DeviceShadow* sh, float3 lo, float3 hi, float s, int* first, int* last) {
+  if (sh->kind == MP_SHADOW_SUN) {
+    *first = *last = mp_sun_level_for(s) + sh->level_bias - sh->level0;
+    return;
+  }
+  float dn, df;
+  mp_box_depths(lo, hi, &dn, &df);
+  *first = mp_cube_mip_for(s, df) + sh->level_bias;
+  *last = mp_cube_mip_for(s, dn) + sh->level_bias;
+}
+
+/* The levels the first round of a soft light's blocker search reads there
+ * (mp_blocker_round), no finer than the base levels. */
+inline void mp_probe_levels(__global const DeviceShadow* sh, float3 lo, float3 hi, int base_first, int base_last,
+                            int* first, int* last) {
+  float radius = mp_light_shape_radius(sh);
+  int a, b;
+  if (sh->kind == MP_SHADOW_SUN) {
+    float s_near = fmax(sh->z_top - hi.z, 0.0f), s_far = fmax(sh->z_top - lo.z, 0.0f);
+    a = mp_ceil_log2(fmax(radius * s_near / MP_SHADOW_SEARCH_TEXELS, 1e-30f)) - sh->level0;
+    b = mp_ceil_log2(fmax(radius * s_far / MP_SHADOW_SEARCH_TEXELS, 1e-30f)) - sh->level0;
+  } else {
+    float dn, df, texels = radius * MP_SHADOW_SEARCH_SCALE / MP_SHADOW_SEARCH_TEXELS * (float)(MP_MAP_TEXELS / 2);
+    mp_box_depths(lo, hi, &dn, &df);
+    a = mp_ceil_log2(fmax(texels / df, 1e-30f));
+    b = mp_ceil_log2(fmax(texels / dn, 1e-30f));
+  }
+  *first = max(a, base_first);
+  *last = max(b, base_last);
+}
+
+/* Marks the pages of levels [first, last] under the light-space box [lo,
+ * hi], grown by the margin the light's filters need. */
+inline void mp_mark_levels(__global const DeviceShadow* sh, __global const DeviceShadowLevel* levels, float3 lo, float3 hi,
+                           int first, int last, __global uchar* requests) {
+  int count = mp_shadow_level_count(sh);
+  first = clamp(first, 0, count - 1);
+  last = clamp(last, 0, count - 1);
+  float margin = mp_mark_margin(sh);
+  if (sh->kind == MP_SHADOW_SUN) {
+    for (int i = first; i <= last; ++i) {
+      __global const DeviceShadowLevel* lv = levels + sh->level_records + (uint)i;
+      float k = 1.0f / lv->texel;
+      mp_mark_rect(requests, lv->page_table, MP_MAP_PAGES, lv->origin_x, lv->origin_y,
+                   (lo.x + lv->offset[0]) * k - margin, (lo.y + lv->offset[1]) * k - margin,
+                   (hi.x + lv->offset[0]) * k + margin, (hi.y + lv->offset[1]) * k + margin);
+    }
+    return;
+  }
+  float dn, df;
+  mp_box_depths(lo, hi, &dn, &df);
+  for (int m = first; m <= last; ++m) {
+    float texels = (float)mp_cube_mip_texels(m);
+    /* The margin as scene units at the box's far side. */
+    float grow = margin * df * 2.0f / texels;
+    float3 e = MP_F3(grow, grow, grow);
+    for (int face = 0; face < 6; ++face) {
+      float x0, y0, x1, y1;
+      if (!mp_cube_face_box(face, lo - e, hi + e, texels, &x0, &y0, &x1, &y1)) continue;
+      mp_mark_rect(requests, sh->page_table + (uint)face * MP_CUBE_FACE_ENTRIES + mp_cube_mip_entries(m),
+                   MP_MAP_PAGES >> m, 0, 0, x0, y0, x1, y1);
+    }
+  }
+}
+
+/* Whether receivers in the light-space box [lo, hi] can get light at all:
+ * not behind an area light, nor (by the box's bounding sphere: its angle
+ * from the axis, less its angular radius, exceeds the cone's) outside a
+ * spot's cone. */
+inline int mp_box_lit(__global const DeviceShadow* sh, float3 lo, float3 hi) {
+  if (sh->one_sided && lo.z >= 0.0f) return 0;
+  if (sh->cone_cos > -1.5f) {
+    float3 c = 0.5f * (lo + hi);
+    float dist = length(c), rad = 0.5f * length(hi - lo);
+    if (dist > rad) {
+      float cos_axis = -c.z / dist, sin_axis = sqrt(fmax(1.0f - cos_axis * cos_axis, 0.0f));
+      float sin_spread = rad / dist, cos_spread = sqrt(fmax(1.0f - sin_spread * sin_spread, 0.0f));
+      if (cos_axis < cos_spread && cos_axis * cos_spread + sin_axis * sin_spread < sh->cone_cos) return 0;
+    }
+  }
+  return 1;
+}
+
+/* The grid vertex a marking work-item handles, its light-space box (reach
+ * pixels wide around it) for light sh and its pixel footprint; 0 for a
+ * vertex behind the camera or one the light cannot reach. */
+inline int mp_marking_box(__global const DeviceShadow* sh, float3 p, FrameParams f, float reach, float3* q, float3* lo,
+                          float3* hi, float* s) {
+  float d = -p.z;
+  if (!f.ortho && !(d > 0.0f)) return 0;
+  *s = mp_pixel_footprint(d, f);
+  float r = reach * *s;
+  *q = mp_xform_point(sh->to_light, p);
+  *lo = *q - MP_F3(r, r, r);
+  *hi = *q + MP_F3(r, r, r);
+  return sh->kind == MP_SHADOW_SUN || mp_box_lit(sh, *lo, *hi);
+}
+
+/* First marking, for every light with shadow maps (one work-item per grid
+ * vertex of a coarse camera pass, displaced): the pages of the level (mip)
+ * whose texels are no larger than the vertex's pixel footprint (mp_shadow.h)
+ * for hard shadows, and of the first blocker search round's levels for soft
+ * ones, under a box around the vertex reaching its neighbours (`reach`
+ * pixels). Where soft shadows follow (`keep`), the vertex and its normal
+ * are kept at keep_base + its index for their marking (w = 0: no vertex). */
+__kernel void mark_shadow_pages(__global const SubPatch* diceable, uint count, __global const uint* vertex_offsets,
+                                uint vertex_total, FrameParams f, __global const float4* grid_p,
+                                __global const float4* grid_n, __global const DeviceShadow* shadows,
+                                __global const DeviceShadowLevel* levels, uint light_count,
+                                __global uchar* requests, float reach, uint keep, uint keep_base,
+                                __global float4* kept_p, __global float4* kept_n) {
+  uint gid = get_global_id(0), i, j;
+  SubPatch sp;
+  float2 uv;
+  ulong index;
+  int valid = mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index);
+  if (keep && gid < vertex_total) {
+    kept_p[keep_base + gid] = valid ? (float4)(grid_p[index].xyz, 1.0f) : (float4)(0.0f);
+    kept_n[keep_base + gid] = valid ? grid_n[index] : (float4)(0.0f);
+  }
+  if (!valid) return;
+  float3 p = grid_p[index].xyz;
+  for (uint l = 0; l < light_count; ++l) {
+    __global const DeviceShadow* sh = shadows + l;
+    if (sh->kind == MP_SHADOW_NONE) continue;
+    float3 q, lo, hi;
+    float s;
+    if (!mp_marking_box(sh, p, f, reach, &q, &lo, &hi, &s)) continue;
+    int first, last;
+    mp_base_levels(sh, lo, hi, s, &first, &last);
+    if (sh->shape != MP_SHADOW_SHAPE_POINT) mp_probe_levels(sh, lo, hi, first, last, &first, &last);
+    mp_mark_levels(sh, levels, lo, hi, first, last, requests);
+  }
+}
+
+/* Second marking, for soft shadows, on the maps the first rendered (one
+ * work-item per vertex the first kept): where a vertex's first search round
+ * finds occluders, the levels the second round and the penumbra filter can
+ * read there, from the nearest occluder's (the narrowest penumbra, the
+ * finest level) to the coarsest; receivers that see no occluder read
+ * nothing more. */
+inline void mp_mark_soft_vertex(float3 p, float3 n, FrameParams f, __global const DeviceShadow* shadows,
+                                __global const DeviceShadowLevel* levels, uint light_count,
+                                __global const uint* pages, __global const uint* pool, __global uchar* requests,
+                                float reach) {
+  MpShadowMaps maps = {shadows, levels, pages, pool};
+  for (uint l = 0; l < light_count; ++l) {
+    __global const DeviceShadow* sh = shadows + l;
+    if (sh->kind == MP_SHADOW_NONE || sh->shape == MP_SHADOW_SHAPE_POINT) continue;
+    float3 q, lo, hi;
+    float s;
+    if (!mp_marking_box(sh, p, f, reach, &q, &lo, &hi, &s)) continue;
+    float3 nq = mp_xform_dir(sh->to_light, n);
+    int base = mp_shadow_base_level(sh, q, s);
+    MpLightShape shape = mp_light_shape(sh, q);
+    uint plane_key = 0xffffffffu;
+    MpReceiverPlane plane;
+    float s1 = mp_first_search_scale(sh, q), found, sum, nearest;
+    int count_levels = mp_shadow_level_count(sh);
+    if (mp_blocker_round(&maps, sh, &shape, q, nq, mp_shadow_bias_texels(sh, q, nq), base, 0, s1, &plane_key, &plane,
+                         &found, &sum, &nearest) >= count_levels ||
+        !(found > 0.0f))
+      continue;
+    float radius = mp_light_shape_radius(sh);
+    float s2 = fmin(s1, 2.0f * sum / found);
+    int second = mp_shadow_level_for_size(sh, q, radius * s2, MP_SHADOW_SEARCH_TEXELS, base);
+    int finest = (int)floor(mp_filter_level(sh, q, radius * nearest));
+    int first, last;
+    mp_base_levels(sh, lo, hi, s, &first, &last);
+    mp_mark_levels(sh, levels, lo, hi, max(first, min(finest, second)), count_levels - 1, requests);
+  }
+}
+
+__kernel void mark_soft_shadow_pages(__global const float4* kept_p, __global const float4* kept_n, uint kept,
+                                     FrameParams f, __global const DeviceShadow* shadows,
+                                     __global const DeviceShadowLevel* levels, uint light_count,
+                                     __global const uint* pages, __global const uint* pool,
+                                     __global uchar* requests, float reach) {
+  uint gid = get_global_id(0);
+  if (gid >= kept || kept_p[gid].w == 0.0f) return;
+  mp_mark_soft_vertex(kept_p[gid].xyz, kept_n[gid].xyz, f, shadows, levels, light_count, pages, pool, requests, reach);
+}
+
+/* The same, straight from a batch's grids: where the first marking's
+ * vertices pass their share of the shadow budget, the second dices the view
+ * again instead of keeping them. */
+__kernel void mark_soft_shadow_pages_grid(__global const SubPatch* diceable, uint count,
+                                          __global const uint* vertex_offsets, FrameParams f,
+                                          __global const float4* grid_p, __global const float4* grid_n,
+                                          __global const DeviceShadow* shadows,
+                                          __global const DeviceShadowLevel* levels, uint light_count,
+                                          __global const uint* pages, __global const uint* pool,
+                                          __global uchar* requests, float reach) {
+  uint gid = get_global_id(0), i, j;
+  SubPatch sp;
+  float2 uv;
+  ulong index;
+  if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
+  mp_mark_soft_vertex(grid_p[index].xyz, grid_n[index].xyz, f, shadows, levels, light_count, pages, pool, requests,
+                      reach);
+}
+
+/* Writes the frame's page-table entries (index, value) into a table filled
+ * with zeros: a few thousand entries rather than the whole table. */
+__kernel void set_page_entries(__global const uint2* writes, uint count, __global uint* table) {
+  uint i = get_global_id(0);
+  if (i < count) table[writes[i].x] = writes[i].y;
+}
+
+/* Sets every texel of the listed physical pages to "nothing here", and
+ * marks them for occlusion culling's next look (shadow_page_farthest). */
+__kernel void clear_shadow_pages(__global const uint* pages, uint texel_count, __global uint* pool,
+                                 __global uchar* dirty) {
+  uint i = get_global_id(0);
+  if (i >= texel_count) return;
+  uint page = pages[i / MP_PAGE_TEXELS];
+  pool[(ulong)page * MP_PAGE_TEXELS + (ulong)(i % MP_PAGE_TEXELS)] = MP_SHADOW_EMPTY;
+  if (i % MP_PAGE_TEXELS == 0u) dirty[page] = 1;
+}
+
+/* The farthest depth of each 16 x 16-texel cell of the listed pages that
+ * the shadow pass wrote to since the last look (dirty), and of each page,
+ * into the occlusion pyramid's buffer (mp_page_occluded): one work-group of
+ * 64 per page, a work-item per cell. */
+__kernel __attribute__((reqd_work_group_size(64, 1, 1))) void shadow_page_farthest(
+    __global const uint* pages, uint count, __global const uint* pool, __global uchar* dirty, __global uint* pyramid,
+    uint page_cells, uint page_farthest) {
+  __local uint part[64];
+  uint g = get_group_id(0), l = get_local_id(0);
+  if (g >= count) return;
+  uint page = pages[g];
+  if (!dirty[page]) return; /* the same for the whole group */
+  uint m = 0u;
+  __global const uint* texels = pool + (ulong)page * MP_PAGE_TEXELS + (ulong)((l >> 3) * 16u * MP_PAGE_SIZE + (l & 7u) * 16u);
+  for (uint y = 0; y < 16u; ++y)
+    for (uint x = 0; x < 16u; ++x) m = max(m, texels[y * MP_PAGE_SIZE + x]);
+  pyramid[page_cells + page * 64u + l] = m;
+  part[l] = m;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (uint s = 32u; s > 0u; s >>= 1) {
+    if (l < s) part[l] = max(part[l], part[l + s]);
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+  if (l == 0u) pyramid[page_farthest + page] = part[0], dirty[page] = 0;
+}
+
+/* Each view's occlusion pyramid (mp_page_occluded), one work-group per view:
+ * level 0 names the pages rendered in this pass (physical page + 1, 0
+ * elsewhere), level 1 holds the farthest depth of the 2 x 2 pages below,
+ * each next level the largest of four below. */
+__kernel void shadow_occlusion_build(__global const FrameParams* views, __global const uint* page_table,
+                                     __global uint* pyramid, uint page_farthest) {
+  FrameParams v = views[get_group_id(0)];
+  uint l = get_local_id(0), step = get_local_size(0);
+  int n = v.page_side;
+  uint offset = v.page_mask;
+  for (uint i = l; i < (uint)(n * n); i += step) {
+    int sx = ((int)(i % (uint)n) + v.page_origin_x) & (n - 1), sy = ((int)(i / (uint)n) + v.page_origin_y) & (n - 1);
+    uint e = page_table[v.page_table + (uint)(sy * n + sx)];
+    pyramid[offset + i] = (e & MP_PAGE_RENDER) ? MP_PAGE_PHYSICAL(e) + 1u : 0u;
+  }
+  barrier(CLK_GLOBAL_MEM_FENCE);
+  for (int level = 1; n > 1; n >>= 1, ++level) {
+    int h = n / 2;
+    uint up = offset + (uint)(n * n);
+    for (uint i = l; i < (uint)(h * h); i += step) {
+      int x = (int)(i % (uint)h), y = (int)(i / (uint)h);
+      uint below[4] = {pyramid[offset + (uint)(2 * y * n + 2 * x)], pyramid[offset + (uint)(2 * y * n + 2 * x + 1)],
+                       pyramid[offset + (uint)((2 * y + 1) * n + 2 * x)],
+                       pyramid[offset + (uint)((2 * y + 1) * n + 2 * x + 1)]};
+      uint m = 0u;
+      for (int c = 0; c < 4; ++c) {
+        uint d = below[c];
+        if (level == 1 && d != 0u) d = pyramid[page_farthest + d - 1u];
+        m = max(m, d);
+      }
+      pyramid[up + i] = m;
+    }
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    offset = up;
+  }
+}
+
+/* Raster position (fixed point) and depth of a camera-space point in view v. */
+inline int mp_shadow_vertex(float4 p, FrameParams v, MpFixed2* r, float* inv_d) {
+  float3 q = mp_to_view(p.xyz, v);
+  float d = -q.z;
+  if (!v.ortho && !(d > 0.0f)) return 0;
+  float inv = v.ortho ? 1.0f : 1.0f / d;
+  float rx = v.ax * q.x * inv + v.bx, ry = v.ay * q.y * inv + v.by;
+  if (!(fabs(rx) < MP_RASTER_GUARD && fabs(ry) < MP_RASTER_GUARD)) return 0;
+  r->x = mp_to_fixed(rx);
+  r->y = mp_to_fixed(ry);
+  *inv_d = v.ortho ? d : inv; /* interpolated linearly in raster space */
+  return 1;
+}
+
+/* One work-item per micropolygon of grids [first, first + count) of a
+ * shadow pass (the layout of sample.cl's sample_micropolygons): samples at
+ * texel centres of the micropolygon's view, kept in the pages this frame
+ * renders, with a 32-bit atomic minimum of the depth (positive floats order
+ * as their bits do). Opacity below one keeps a matching fraction of texels,
+ * as the camera's samples do. */
+__kernel __attribute__((reqd_work_group_size(64, 1, 1)))
+void shadow_sample(__global const SubPatch* diceable, uint first, uint count, __global const uint* offsets, uint base,
+                   uint total, __global const uint* patch_info, __global const DeviceMaterial* materials, FrameParams f,
+                   __global const FrameParams* views, __global const float4* grid_p, __global const float4* grid_c,
+                   __global const uint* page_table, volatile __global uint* pool, __global uchar* dirty) {
+  uint gid = get_global_id(0);
+  if (gid >= total || count == 0u) return;
+  uint slot = first + mp_find_grid(offsets + first, count, base + gid);
+  uint m = base + gid - offsets[slot];
+  SubPatch sp = diceable[slot];
+  MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
+  uint q[4];
+  if (!mp_grid_micropolygon(&g, m, q)) return;
+  FrameParams v = views[MP_INFO_VIEW(sp.info)];
+  uint stride = (uint)f.max_grid + 1u;
+  ulong grid_base = (ulong)slot * stride * stride;
+  MpFixed2 r[4];
+  float w[4];
+  for (int k = 0; k < 4; ++k)
+    if (!mp_shadow_vertex(grid_p[grid_base + q[k]], v, &r[k], &w[k])) return;
+  MpEdgeTriangle tris[2];
+  tris[0] = mp_edge_triangle(r[0], r[1], r[2]);
+  tris[1] = mp_edge_triangle(r[0], r[2], r[3]);
+  float tw[2][3] = {{w[0], tris[0].swapped ? w[2] : w[1], tris[0].swapped ? w[1] : w[2]},
+                    {w[0], tris[1].swapped ? w[3] : w[2], tris[1].swapped ? w[2] : w[3]}};
+  long xmin = min(min(r[0].x, r[1].x), min(r[2].x, r[3].x)), xmax = max(max(r[0].x, r[1].x), max(r[2].x, r[3].x));
+  long ymin = min(min(r[0].y, r[1].y), min(r[2].y, r[3].y)), ymax = max(max(r[0].y, r[1].y), max(r[2].y, r[3].y));
+  const long centre = MP_SUBPIXEL_ONE / 2;
+  int px0 = (int)max((xmin - centre + MP_SUBPIXEL_ONE - 1) >> MP_SUBPIXEL_BITS, (long)0);
+  int px1 = (int)min((xmax - centre) >> MP_SUBPIXEL_BITS, (long)v.width - 1);
+  int py0 = (int)max((ymin - centre + MP_SUBPIXEL_ONE - 1) >> MP_SUBPIXEL_BITS, (long)0);
+  int py1 = (int)min((ymax - centre) >> MP_SUBPIXEL_BITS, (long)v.height - 1);
+  if (px0 > px1 || py0 > py1) return;
+  /* Opacity: the material's, or per vertex where its node program computes
+   * one (material_program.cl, run for alpha only in shadow passes). */
+  __global const DeviceMaterial* mat = materials + patch_info[4 * (ulong)sp.patch + 1];
+  float opacity = mat->program[3] > 0.0f ? mp_quad_opacity(grid_c[grid_base + q[0]].w, grid_c[grid_base + q[1]].w,
+                                                            grid_c[grid_base + q[2]].w, grid_c[grid_base + q[3]].w)
+                                         : mat->opacity[3];
+  uint mp_id = 0u;
+  if (opacity < 1.0f) {
+    mp_id = mp_hash32(sp.patch);
+    for (int k = 0; k < 8; ++k) mp_id = mp_hash_combine(mp_id, as_uint(sp.corner[k]));
+    mp_id = mp_hash_combine(mp_id, m);
+  }
+  int side = v.page_side;
+  /* Most micropolygons lie within one page: one table lookup for all. */
+  int one_page = (px0 >> 7) == (px1 >> 7) && (py0 >> 7) == (py1 >> 7);
+  uint e = 0u;
+  if (one_page) {
+    int sx = ((px0 >> 7) + v.page_origin_x) & (side - 1), sy = ((py0 >> 7) + v.page_origin_y) & (side - 1);
+    e = page_table[v.page_table + (uint)(sy * side + sx)];
+    if (!(e & MP_PAGE_RENDER)) return;
+    dirty[MP_PAGE_PHYSICAL(e)] = 1;
+  }
+  for (int py = py0; py <= py1; ++py)
+    for (int px = px0; px <= px1; ++px) {
+      if (!one_page) {
+        int sx = ((px >> 7) + v.page_origin_x) & (side - 1), sy = ((py >> 7) + v.page_origin_y) & (side - 1);
+        e = page_table[v.page_table + (uint)(sy * side + sx)];
+        if (!(e & MP_PAGE_RENDER)) continue;
+        dirty[MP_PAGE_PHYSICAL(e)] = 1;
+      }
+      MpFixed2 s;
+      s.x = (long)px * MP_SUBPIXEL_ONE + centre;
+      s.y = (long)py * MP_SUBPIXEL_ONE + centre;
+      float la, lb, lc;
+      int t = 0;
+      if (!mp_edge_triangle_covers(&tris[0], s, &la, &lb, &lc)) {
+        t = 1;
+        if (!mp_edge_triangle_covers(&tris[1], s, &la, &lb, &lc)) continue;
+      }
+      float iw = la * tw[t][0] + lb * tw[t][1] + lc * tw[t][2];
+      float d = v.ortho ? iw : 1.0f / iw;
+      if (!(d >= v.clip_near && d <= v.clip_far)) continue;
+      uint texel = (uint)((py & 127) * MP_PAGE_SIZE + (px & 127));
+      if (opacity < 1.0f && mp_hash_unit(mp_hash_combine(mp_id, (uint)(py * v.width + px))) >= opacity) continue;
+      atomic_min(&pool[(ulong)MP_PAGE_PHYSICAL(e) * MP_PAGE_TEXELS + texel], as_uint(d));
+    }
+}
