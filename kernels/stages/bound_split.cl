@@ -111,19 +111,26 @@ __kernel void bs_breadth_scatter(__global const SubPatch* queue, uint n, __globa
 #define BS_IDLE 5        /* workers that ran out of work in this launch */
 #define BS_MAX_BUSY 6    /* 1 + highest index of a worker left with work */
 #define BS_OCCLUDED 7    /* sub-patches culled by occlusion */
-#define BS_COUNTERS 8
+/* What the host sets for each launch, read-only during it (so the
+ * kernel's arguments stay bound from one launch to the next): */
+#define BS_RING_HEAD0 8  /* the ring's head and tail as the launch starts */
+#define BS_RING_TAIL0 9
+#define BS_DONATE 10     /* children a launch may hand out (its idle workers) */
+#define BS_ROOT_LIMIT 11 /* the roots taken so far (occlusion culling takes them in waves) */
+#define BS_COUNTERS 12
 
 __kernel void bs_bounded_step(__global const float4* points, __global const uint* patch_info,
                               __global const uint* edges, __global const float4* curves,
-                              __global const float4* patch_bounds, uint patch_count, uint root_limit,
+                              __global const float4* patch_bounds, uint patch_count,
                               __global const uint* root_order, FrameParams f,
                               __global const FrameParams* views, uint view_count, __global const uchar* page_masks,
                               __global const uint* occlusion, OcclusionParams occ,
                               __global SubPatch* stacks, __global uint* stack_sizes, uint stack_depth,
                               __global SubPatch* ring, uint ring_capacity,
-                              uint ring_head0, uint ring_tail0, uint donate_limit,
                               __global SubPatch* diceable, uint dice_capacity,
                               volatile __global uint* counters, uint steps) {
+  const uint ring_head0 = counters[BS_RING_HEAD0], ring_tail0 = counters[BS_RING_TAIL0];
+  const uint donate_limit = counters[BS_DONATE], root_limit = counters[BS_ROOT_LIMIT];
   uint w = get_global_id(0);
   __global SubPatch* stack = stacks + (ulong)w * stack_depth;
   uint size = stack_sizes[w];

@@ -56,6 +56,7 @@ MP_INLINE int mp_page_occluded(const MP_GLOBAL uint* pyramid, OcclusionParams o,
         continue;
       }
       if (e == 0u) continue; /* a page this pass does not render */
+      if (pyramid[o.page_farthest + e - 1u] < near_bits) continue; /* the whole page is in front */
       const MP_GLOBAL uint* cells = pyramid + o.page_cells + (e - 1u) * 64u;
       int cx0 = x == x0 ? (tx0 >> 4) & 7 : 0, cx1 = x == x1 ? (tx1 >> 4) & 7 : 7;
       int cy0 = y == y0 ? (ty0 >> 4) & 7 : 0, cy1 = y == y1 ? (ty1 >> 4) & 7 : 7;

@@ -405,9 +405,10 @@ void shadow_sample(__global const SubPatch* diceable, uint first, uint count, __
     for (int px = px0; px <= px1; ++px) {
       if (!one_page) {
         int sx = ((px >> 7) + v.page_origin_x) & (side - 1), sy = ((py >> 7) + v.page_origin_y) & (side - 1);
+        uint was = e;
         e = page_table[v.page_table + (uint)(sy * side + sx)];
         if (!(e & MP_PAGE_RENDER)) continue;
-        dirty[MP_PAGE_PHYSICAL(e)] = 1;
+        if (e != was) dirty[MP_PAGE_PHYSICAL(e)] = 1;
       }
       MpFixed2 s;
       s.x = (long)px * MP_SUBPIXEL_ONE + centre;

@@ -24,7 +24,7 @@ namespace {
 // Counter slots, as BS_* in kernels/stages/bound_split.cl.
 enum Counter {
   kPoolHead = 0, kPoolTail = 1, kNextRoot = 2, kDiceCount = 3, kBusy = 4, kIdle = 5, kMaxBusy = 6, kOccluded = 7,
-  kCounters = 8
+  kRingHead0 = 8, kRingTail0 = 9, kDonate = 10, kRootLimit = 11, kCounters = 12
 };
 constexpr cl_uint kStepsPerLaunch = 16;  // sub-patches a worker handles per launch
 constexpr size_t kMaxWorkers = size_t(1) << 20;
@@ -85,9 +85,14 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
     cl_uint zero = 0;
     queue.enqueueFillBuffer(ws.sizes, zero, 0, workers * sizeof(cl_uint));
 
-    cl::Kernel step(s.program(), "bs_bounded_step");
-    const cl_uint root_count = ctx.root_count();
     const PassOcclusion& occ = ctx.occlusion;
+    cl::Kernel step(s.program(), "bs_bounded_step");
+    bind_args(step, ctx.scene.points, ctx.scene.patch_info, ctx.scene.patch_edges, ctx.scene.edge_curves,
+              ctx.scene.patch_bounds, ctx.scene.patch_count, occ.on() ? occ.root_order : cl::Buffer(), ctx.frame,
+              ctx.views.views, ctx.views.count, ctx.views.page_masks, occ.on() ? occ.pyramid : cl::Buffer(),
+              occ.params, ws.stacks, ws.sizes, stack_depth, ws.ring, ring_capacity, ws.diceable, dice_capacity,
+              ws.counters, kStepsPerLaunch);
+    const cl_uint root_count = ctx.root_count();
     cl_uint root_limit = occ.on() && occ.waves ? std::min<cl_uint>(root_count, 1) : root_count;
     size_t diced = 0, wave_roots = root_limit, diced_before_wave = 0, occluded_before_wave = 0;
     auto whole_groups = [&](size_t n) { return std::min(workers, std::max<size_t>(64, (n + 63) / 64 * 64)); };
@@ -97,15 +102,11 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
     size_t launch = whole_groups(std::min<size_t>(root_limit, useful));
     cl_uint head = 0, tail = 0, next_root = 0, dice_count = 0, hungry = static_cast<cl_uint>(launch);
     for (;;) {
-      cl_uint c[kCounters] = {head, tail, next_root, dice_count, 0, 0, 0, 0};
+      // The counters, and what changes per launch: the ring's head and tail,
+      // the donation limit (at most as many children as there will be idle
+      // workers) and the roots taken so far.
+      cl_uint c[kCounters] = {head, tail, next_root, dice_count, 0, 0, 0, 0, head, tail, hungry, root_limit};
       queue.enqueueWriteBuffer(ws.counters, CL_FALSE, 0, sizeof c, c);
-      // The ring's head and tail and (at most as many children as there will
-      // be idle workers) the donation limit change per launch.
-      bind_args(step, ctx.scene.points, ctx.scene.patch_info, ctx.scene.patch_edges, ctx.scene.edge_curves,
-                ctx.scene.patch_bounds, ctx.scene.patch_count, root_limit, occ.on() ? occ.root_order : cl::Buffer(),
-                ctx.frame, ctx.views.views, ctx.views.count, ctx.views.page_masks,
-                occ.on() ? occ.pyramid : cl::Buffer(), occ.params, ws.stacks, ws.sizes, stack_depth, ws.ring,
-                ring_capacity, head, tail, hungry, ws.diceable, dice_capacity, ws.counters, kStepsPerLaunch);
       cl::Event e;
       queue.enqueueNDRangeKernel(step, cl::NullRange, cl::NDRange(launch), cl::NDRange(64), nullptr, &e);
       ctx.timer.add(Stage::BoundSplit, e);

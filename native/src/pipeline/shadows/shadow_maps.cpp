@@ -272,7 +272,11 @@ bool ShadowMaps::render_views(const std::vector<FrameParams>& views, const std::
     views_of_pass.count = cl_uint(count);
     views_of_pass.page_masks = masks_;
     PassOcclusion occlusion;
-    if (culling) {
+    // Culling pays where a light's views take their patches near to far:
+    // without an order (the orders passed their share of the budget) the
+    // pass renders as without culling.
+    const cl::Buffer& order = culling ? light_order(lights[first], views[first], buffers, scene_key_) : cl::Buffer();
+    if (order()) {
       // The pyramids start from the cleared pages (all empty) and follow
       // what the pass writes: after each dice batch, the farthest depth of
       // the pages it wrote to, then every view's pyramid.
@@ -280,8 +284,8 @@ bool ShadowMaps::render_views(const std::vector<FrameParams>& views, const std::
       occlusion.params.levels = 1;
       occlusion.params.page_cells = page_cells;
       occlusion.params.page_farthest = page_farthest;
-      occlusion.root_order = light_order(lights[first], views[first], buffers, scene_key_);
-      occlusion.waves = session_.info().type == "cpu" && occlusion.root_order();
+      occlusion.root_order = order;
+      occlusion.waves = session_.info().type == "cpu";
       // A look at the pages costs a pass over those written since the last
       // and over every view's pyramid: it is taken when the micropolygons
       // written since make an eighth of the pass' so far, so a pass of
