@@ -26,7 +26,7 @@ import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-DEMO = os.path.join(HERE, "..", "..", "scripts", "demo_scene.py")
+DEMO = os.path.join(HERE, "..", "..", "scripts", "build", "demo_scene.py")
 
 
 def loaded_libraries():
