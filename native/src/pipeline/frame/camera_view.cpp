@@ -50,6 +50,7 @@ bool render_camera_bucket(MicropolygonPass& pass, const CameraStages& stages, co
 
   ViewTarget target;
   target.motion = mp_motion_on(fb);
+  target.dice_activity = "dice";
   target.take = [&](const cl::Buffer& diceable, cl_uint count) {
     GridBuffers& grids = pass.grids();
     std::optional<DeviceSession::Activity> step(std::in_place, s, "shade");

@@ -14,7 +14,8 @@ BoundSplitResult MicropolygonPass::run(const PassView& view, const ViewTarget& t
   // Dicing is the same for every view; the target makes the difference.
   DiceSink sink = [&](const cl::Buffer& diceable, cl_uint count) {
     if (progress_.cancelled()) return;
-    std::optional<DeviceSession::Activity> activity(std::in_place, session_, "dice");
+    std::optional<DeviceSession::Activity> activity;
+    if (target.dice_activity) activity.emplace(session_, target.dice_activity);
     stages_.layout.run(diceable, count, f, grids, timer_);
     stages_.dice.run(diceable, count, scene_, f, grids, timer_);
     if (target.motion) stages_.dice.run_motion(diceable, count, scene_, f, grids, timer_);

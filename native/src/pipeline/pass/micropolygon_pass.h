@@ -26,6 +26,9 @@ struct ViewTarget {
   bool motion = false;   // positions at every motion step (the camera's blurred view)
   bool normals = true;   // displacement keeps the displaced normals
   bool opacity = false;  // materials' alpha programs run (a light's views)
+  // The phase a device error while dicing is reported in (DeviceSession's
+  // activities), or none: the lights' views report their bound & split.
+  const char* dice_activity = nullptr;
   // Called per batch: `count` diced sub-patches at the start of `diceable`,
   // their grids in the pass' GridBuffers.
   std::function<void(const cl::Buffer& diceable, cl_uint count)> take;
