@@ -113,7 +113,7 @@ def main():
     else:
         bpy.ops.render.render(write_still=True)
         report["first_render_s"] = renders[1] - renders[0]
-        report["first_render_timings"] = dict(sys.modules[f"{module}.engine"].final_renderers().last_timings)
+        report["first_render_timings"] = dict(sys.modules[f"{module}.engine"]._final_renderers.last_timings)
         if not args.once:
             bpy.ops.render.render()
             report["second_render_s"] = renders[3] - renders[2]
