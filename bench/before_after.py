@@ -19,10 +19,11 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import scenes  # noqa: E402
 
 
-def run_frames(cli, rib, out, device, repeat):
-    """The stats of each frame of one `micropoly-render --repeat` run."""
+def run_frames(cli, rib, out, device, repeat, extra=()):
+    """The stats of each frame of one `micropoly-render --repeat` run
+    (`extra`: more of the CLI's options)."""
     stats = os.path.join(out, "stats.json")
-    cmd = [cli, rib, "-o", os.path.join(out, "image.png"), "--stats", stats, "--repeat", str(repeat)]
+    cmd = [cli, rib, "-o", os.path.join(out, "image.png"), "--stats", stats, "--repeat", str(repeat)] + list(extra)
     if device:
         cmd += ["--device", device]
     proc = subprocess.run(cmd, capture_output=True, text=True)

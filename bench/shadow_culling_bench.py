@@ -16,21 +16,15 @@ import json
 import os
 import re
 import statistics
-import subprocess
+import sys
 import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import before_after  # noqa: E402
 
 
 def frames(cli, rib, out, device, repeat, spp):
-    stats = os.path.join(out, "stats.json")
-    cmd = [cli, rib, "-o", os.path.join(out, "image.png"), "--stats", stats, "--repeat", str(repeat),
-           "--spp", str(spp), "--fresh-shadows"]
-    if device:
-        cmd += ["--device", device]
-    p = subprocess.run(cmd, capture_output=True, text=True)
-    if p.returncode:
-        raise SystemExit(f"{' '.join(cmd)} failed: {p.stderr.strip()}")
-    runs = json.load(open(stats))
-    return runs if isinstance(runs, list) else [runs]
+    return before_after.run_frames(cli, rib, out, device, repeat, ["--spp", str(spp), "--fresh-shadows"])
 
 
 def main():

@@ -1,6 +1,6 @@
 #include "pipeline/materials/material_programs.h"
-#include "cl/kernel_args.h"
 
+#include "cl/kernel_args.h"
 #include "cl/program_cache.h"
 #include "micropoly/error.h"
 

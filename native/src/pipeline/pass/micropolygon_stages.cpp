@@ -1,5 +1,4 @@
 #include "pipeline/pass/micropolygon_stages.h"
-#include "cl/kernel_args.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,6 +6,7 @@
 #include <thread>
 #include <vector>
 
+#include "cl/kernel_args.h"
 #include "micropoly/error.h"
 #include "stages/mp_raster.h"
 

@@ -1,10 +1,10 @@
 #include "pipeline/pass/occlusion_culling.h"
-#include "cl/kernel_args.h"
 
 #include <algorithm>
 #include <limits>
 #include <numeric>
 
+#include "cl/kernel_args.h"
 #include "geometry/mp_bound.h"
 
 namespace mp {

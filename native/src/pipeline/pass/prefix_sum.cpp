@@ -1,4 +1,5 @@
 #include "pipeline/pass/prefix_sum.h"
+
 #include "cl/kernel_args.h"
 
 namespace mp {
