@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Texture and colour nodes beyond those node_compiler handles itself.
+"""Pattern textures and colour nodes.
 
-emit(compiler, node) returns the node's outputs as node_compiler's emit does
-({output identifier: (expr, kind, range)}), or None for a node this module
-does not know.
+Each function takes the NodeCompiler and the node and returns the node's
+outputs by socket identifier as (expression, kind, value range or None);
+NODES maps node types to them (node_registry.py).
 
 Nodes: Checker, Brick, Gradient, Magic, White Noise and Gabor (Blender 4.3+)
 Textures (kernels/textures/mp_tex_pattern.h, mp_tex_gabor.h); Blackbody,
@@ -160,13 +160,14 @@ def _default_mapping(node):
             and not m.use_min and not m.use_max)
 
 
-def emit(compiler, node):
-    handler = _HANDLERS.get(node.type)
-    if handler is None:
-        return None
-    if node.type.startswith("TEX_") and not _default_mapping(node):
-        compiler.warn(node, "its texture mapping (node properties) is not supported; it is ignored")
-    return handler(compiler, node)
+def _mapping_warned(handler):
+    """handler, after a warning where the texture's own mapping (in the
+    node's properties) is not the identity: it is not supported."""
+    def emit(compiler, node):
+        if node.type.startswith("TEX_") and not _default_mapping(node):
+            compiler.warn(node, "its texture mapping (node properties) is not supported; it is ignored")
+        return handler(compiler, node)
+    return emit
 
 
 def _inputs(compiler, node, *spec):
@@ -357,3 +358,5 @@ _HANDLERS = {
     "GAMMA": emit_gamma,
     "VECTOR_ROTATE": emit_vector_rotate,
 }
+# The node types this family compiles (node_registry.py).
+NODES = {t: _mapping_warned(h) for t, h in _HANDLERS.items()}
