@@ -11,6 +11,8 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
+import cycles_references
+
 
 _registered = []
 
@@ -306,10 +308,12 @@ def _load_exr(path, height, width):
     return px
 
 
-def render_passes(scene, engine, width, height, samples=16, transparent=True):
+def render_passes(scene, engine, width, height, samples=16, transparent=True, cycles_data=False):
     """Renders and returns dict(rgba=(H,W,4), depth=(H,W), normal=(H,W,3)),
     rows top first, as float arrays. Blender 5.0 replaced the compositor's
-    scene node tree; there only rgba is read back (depth and normal are None)."""
+    scene node tree; there only rgba is read back (depth and normal are None).
+    Cycles' depth and normal are kept (with its stored reference) only where
+    a test asks for them with cycles_data; otherwise they are None."""
     scene.render.engine = engine
     scene.render.resolution_x, scene.render.resolution_y = width, height
     scene.render.resolution_percentage = 100
@@ -321,6 +325,24 @@ def render_passes(scene, engine, width, height, samples=16, transparent=True):
     view_layer.use_pass_normal = True
     scene.display_settings.display_device = "sRGB"
     scene.view_settings.view_transform = "Standard"
+    reference = None
+    if engine == "CYCLES":
+        # Cycles' passes are rendered once per scene and Blender version
+        # and kept with the tests (cycles_references.py).
+        reference = cycles_references.Reference(scene, width, height, transparent)
+        stored = reference.load()
+        if stored is not None:
+            return stored
+    result = _render_passes(scene, engine, width, height)
+    if reference is not None:
+        if not cycles_data:
+            result["depth"] = result["normal"] = None
+        result = cycles_references.as_stored(result)
+        reference.store(result)
+    return result
+
+
+def _render_passes(scene, engine, width, height):
     folder = tempfile.mkdtemp(prefix=f"mp-{engine.lower()}-")
     if not hasattr(scene, "node_tree"):
         scene.render.image_settings.file_format = "OPEN_EXR"

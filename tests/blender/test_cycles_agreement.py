@@ -45,7 +45,7 @@ def light(scene, kind, location=(2.0, -4.0, 3.0), target=(0.0, 0.0, 0.0), energy
 
 def compare(name, scene, checks):
     ru.setup_cycles(scene, samples=CYCLES_SAMPLES)
-    cycles = ru.render_passes(scene, "CYCLES", W, H)
+    cycles = ru.render_passes(scene, "CYCLES", W, H, cycles_data=True)
     micro = ru.render_passes(scene, "MICROPOLY", W, H, samples=16)
     a, b = cycles["rgba"][..., 3], micro["rgba"][..., 3]
     both = (a > 0.999) & (b > 0.999)

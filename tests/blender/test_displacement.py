@@ -109,7 +109,7 @@ def render_both(scene, w=W, h=H, samples=16, cycles_samples=16):
     # renderers (this file is about displacement; test_shadows.py about shadows).
     ru.setup_cycles(scene, samples=cycles_samples)
     mp = ru.render_passes(scene, "MICROPOLY", w, h, samples=samples)
-    cy = ru.render_passes(scene, "CYCLES", w, h, samples=cycles_samples)
+    cy = ru.render_passes(scene, "CYCLES", w, h, samples=cycles_samples, cycles_data=True)
     return mp, cy
 
 
