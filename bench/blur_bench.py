@@ -16,7 +16,7 @@ Default: F12 of each by Micropoly (PoCL) and by Cycles (the same settings,
 its default light paths and adaptive subdivision at 1 px), one render each,
 interleaved; wall times and ratios printed.
 --rib-only: writes the three as RIB (bench/out/blur_*.rib) for the CLI's
-per-stage timings and sample-test counts (bench/blur_bench.sh)."""
+per-stage timings and sample-test counts (bench/bench.py blur)."""
 
 import math
 import os

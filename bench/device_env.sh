@@ -1,6 +1,10 @@
-# Sourced by the bundle's benchmark scripts (bench/make_device_bundle.sh):
-# the bundled libraries, and on a GPU machine NVIDIA's OpenCL driver, which
-# is installed there but not registered; writes the device to $OUT/device.txt.
+# Sourced in the bundle's folder before its runs (bench/make_device_bundle.sh,
+# docs/performance.md): the bundled libraries, and with DEVICE=gpu (the
+# default) NVIDIA's OpenCL driver, which is installed there but not
+# registered; writes the device to $OUT/device.txt (OUT: /tmp/bench).
+DEVICE=${DEVICE:-gpu}
+OUT=${OUT:-/tmp/bench}
+mkdir -p "$OUT"
 export LD_LIBRARY_PATH=$PWD/lib
 if [ "$DEVICE" = gpu ]; then
   mkdir -p /tmp/icd && echo /usr/lib/libnvidia-opencl.so > /tmp/icd/nvidia.icd

@@ -11,8 +11,10 @@ for bin in "$build/micropoly-render" "$build/micropoly_tests"; do
   ldd "$bin" | awk '/=> \//{print $3}' | grep -vE '/(libc|libm|libpthread|libdl|librt)\.so' | xargs -r cp -L -t "$out/lib/"
 done
 cp -r tests/scenes "$out/scenes"
-cp bench/shadow_culling_bench.py bench/identical_images.py bench/shadow_bench.sh bench/occlusion_bench.sh bench/world_bench.sh bench/blur_bench.sh bench/device_env.sh bench/before_after.py bench/before_after_stages.py bench/scenes.py "$out/"
-# An earlier build's CLI for before/after runs (bench/before_after.py), if given.
+# The runner and its suites (bench/bench.py), the image comparison and the
+# environment the GPU machine needs (device_env.sh).
+cp bench/bench.py bench/suites.py bench/scenes.py bench/identical_images.py bench/device_env.sh "$out/"
+# An earlier build's CLI for before/after runs (bench.py --before), if given.
 [ -n "${BEFORE:-}" ] && cp "$BEFORE" "$out/micropoly-render-before"
 # The benchmark scenes bench/blender_bench.py writes as RIB (--rib-only).
 [ -d bench/out ] && cp bench/out/*.rib "$out/" 2>/dev/null || true

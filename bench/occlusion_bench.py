@@ -22,8 +22,8 @@ Scenes, 1920x1080:
 
 --rib-only writes bench/out/shells_{1,4,16,64}.rib, shells_out_{1,16,64}.rib,
 layers_point.rib, layers_sun.rib and bench/out/field_2000.rib
-(--only NAME,NAME: those alone) for the CLI (bench/occlusion_bench.sh
-renders them, with and without culling, on PoCL and on a GPU). Without it:
+(--only NAME,NAME: those alone) for the CLI (bench/bench.py occlusion and
+culling render them, on PoCL and on a GPU). Without it:
 F12 of one scene (--scene shells, shells_out, layers_point or layers_sun;
 shells N = --shells, default 16; --percent of 1920x1080, default 100) with
 Micropoly, culling on and off, and Cycles (default light paths, 16 samples,

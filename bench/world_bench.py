@@ -15,7 +15,7 @@ Default: F12 of world_hdri by Micropoly on its default device and by Cycles
 (direct light only, as in the tests, and its default light paths), 16
 samples each, one run each, wall time printed.
 --rib-only: writes the three scenes as RIB (bench/out/world_*.rib) for the
-CLI's per-stage timings (bench/world_bench.sh)."""
+CLI's per-stage timings (bench/bench.py world)."""
 
 import math
 import os
