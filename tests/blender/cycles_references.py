@@ -171,9 +171,11 @@ def _mesh(mesh, out):
 
 
 def _node_tree(tree, out, seen):
-    if tree is None or tree.name in seen:
+    # By identity, not name: every material's and world's own tree is
+    # called "Shader Nodetree".
+    if tree is None or tree.as_pointer() in seen:
         return
-    seen.add(tree.name)
+    seen.add(tree.as_pointer())
     out.append(f"tree {tree.name}")
     for node in sorted(tree.nodes, key=lambda n: n.name):
         out.append(f"node {node.name} {node.bl_idname}")
@@ -297,7 +299,10 @@ class Reference:
         dump = os.environ.get(MODE_VARIABLE + "_DUMP")
         if dump:  # a folder to write fingerprints into, to see why two differ
             os.makedirs(dump, exist_ok=True)
-            with open(os.path.join(dump, self.key + ".txt"), "w") as f:
+            path = os.path.join(dump, self.key + ".txt")
+            while os.path.exists(path):
+                path = path[:-4] + "+.txt"
+            with open(path, "w") as f:
                 f.write(text)
         self.folder = os.path.join(ROOT, bpy.app.version_string.split(" ")[0],
                                    os.path.splitext(os.path.basename(self.script))[0])
