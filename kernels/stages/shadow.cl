@@ -147,21 +147,23 @@ inline int mp_marking_box(__global const DeviceShadow* sh, float3 p, FrameParams
  * for hard shadows, and of the first blocker search round's levels for soft
  * ones, under a box around the vertex reaching its neighbours (`reach`
  * pixels). Where soft shadows follow (`keep`), the vertex and its normal
- * are kept at keep_base + its index for their marking (w = 0: no vertex). */
+ * are kept at keep_base + its index for their marking, three floats each
+ * (24 bytes a vertex: more of them fit the budget's share; an x that is
+ * NaN: no vertex there). */
 __kernel void mark_shadow_pages(__global const SubPatch* diceable, uint count, __global const uint* vertex_offsets,
                                 uint vertex_total, FrameParams f, __global const float4* grid_p,
                                 __global const float4* grid_n, __global const DeviceShadow* shadows,
                                 __global const DeviceShadowLevel* levels, uint light_count,
                                 __global uchar* requests, float reach, uint keep, uint keep_base,
-                                __global float4* kept_p, __global float4* kept_n) {
+                                __global float* kept_p, __global float* kept_n) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   float2 uv;
   ulong index;
   int valid = mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index);
   if (keep && gid < vertex_total) {
-    kept_p[keep_base + gid] = valid ? (float4)(grid_p[index].xyz, 1.0f) : (float4)(0.0f);
-    kept_n[keep_base + gid] = valid ? grid_n[index] : (float4)(0.0f);
+    vstore3(valid ? grid_p[index].xyz : (float3)(NAN, 0.0f, 0.0f), keep_base + gid, kept_p);
+    vstore3(valid ? grid_n[index].xyz : (float3)(0.0f), keep_base + gid, kept_n);
   }
   if (!valid) return;
   float3 p = grid_p[index].xyz;
@@ -216,14 +218,16 @@ inline void mp_mark_soft_vertex(float3 p, float3 n, FrameParams f, __global cons
   }
 }
 
-__kernel void mark_soft_shadow_pages(__global const float4* kept_p, __global const float4* kept_n, uint kept,
+__kernel void mark_soft_shadow_pages(__global const float* kept_p, __global const float* kept_n, uint kept,
                                      FrameParams f, __global const DeviceShadow* shadows,
                                      __global const DeviceShadowLevel* levels, uint light_count,
                                      __global const uint* pages, __global const uint* pool,
                                      __global uchar* requests, float reach) {
   uint gid = get_global_id(0);
-  if (gid >= kept || kept_p[gid].w == 0.0f) return;
-  mp_mark_soft_vertex(kept_p[gid].xyz, kept_n[gid].xyz, f, shadows, levels, light_count, pages, pool, requests, reach);
+  if (gid >= kept) return;
+  float3 p = vload3(gid, kept_p);
+  if (isnan(p.x)) return;
+  mp_mark_soft_vertex(p, vload3(gid, kept_n), f, shadows, levels, light_count, pages, pool, requests, reach);
 }
 
 /* The same, straight from a batch's grids: where the first marking's

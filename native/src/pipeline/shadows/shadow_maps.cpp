@@ -22,7 +22,8 @@ constexpr size_t kPageBytes = size_t(MP_PAGE_TEXELS) * sizeof(cl_uint);
 // pages to clear and its page-table write.
 constexpr size_t kPageCost = kPageBytes + (64 + 1) * sizeof(cl_uint) + sizeof(cl_uint) + 1 + sizeof(cl_uint2);
 // A kept marking vertex: its position and normal.
-constexpr size_t kKeptVertexBytes = 2 * sizeof(cl_float4);
+constexpr size_t kKeptVectorBytes = 3 * sizeof(cl_float);  // packed (vstore3), position and normal alike
+constexpr size_t kKeptVertexBytes = 2 * kKeptVectorBytes;
 // The marking pass dices the camera's view this many times coarser (in
 // micropolygon edge) than the frame: its vertices mark the pages around
 // them, and need to be close only next to a page.
@@ -137,11 +138,11 @@ bool ShadowMaps::mark_soft(const ShadowLayout& layout, const FrameSetup& frame, 
 void ShadowMaps::keep_room(size_t vertices) {
   if (vertices <= kept_capacity_) return;
   const size_t grown = std::max(vertices, std::min(kept_capacity_ + kept_capacity_ / 2, kept_limit_));
-  cl::Buffer p = session_.allocate(grown * sizeof(cl_float4), "shadow marking vertices");
-  cl::Buffer nrm = session_.allocate(grown * sizeof(cl_float4), "shadow marking normals");
+  cl::Buffer p = session_.allocate(grown * kKeptVectorBytes, "shadow marking vertices");
+  cl::Buffer nrm = session_.allocate(grown * kKeptVectorBytes, "shadow marking normals");
   if (kept_vertices_ > 0) {
-    session_.queue().enqueueCopyBuffer(kept_p_, p, 0, 0, size_t(kept_vertices_) * sizeof(cl_float4));
-    session_.queue().enqueueCopyBuffer(kept_n_, nrm, 0, 0, size_t(kept_vertices_) * sizeof(cl_float4));
+    session_.queue().enqueueCopyBuffer(kept_p_, p, 0, 0, size_t(kept_vertices_) * kKeptVectorBytes);
+    session_.queue().enqueueCopyBuffer(kept_n_, nrm, 0, 0, size_t(kept_vertices_) * kKeptVectorBytes);
   }
   kept_p_ = p;
   kept_n_ = nrm;
