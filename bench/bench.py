@@ -74,8 +74,8 @@ def mib(x):
 def report(suite, cases, builds, times, stages, last):
     two = len(builds) == 2
     print(f"| case | build | frame ms | {' | '.join(stages)} | micropolygons | shadow micropolygons | "
-          f"micropolygons per pixel of surface | bound & split MiB peak | shadows MiB peak / budget | buckets |" + (" after / before |" if two else ""))
-    print("|---|---|---|" + "---|" * len(stages) + "---|---|---|---|---|---|" + ("---|" if two else ""))
+          f"micropolygons per pixel of surface | bound & split MiB peak | shadows MiB peak / budget | marking passes | buckets |" + (" after / before |" if two else ""))
+    print("|---|---|---|" + "---|" * len(stages) + "---|---|---|---|---|---|---|" + ("---|" if two else ""))
     frame = {}
     for case in cases:
         for build, _ in builds:
@@ -92,7 +92,8 @@ def report(suite, cases, builds, times, stages, last):
             print(f"| {case.name} | {build} | {frame[key]:.2f} | " + " | ".join(f"{x:.2f}" for x in stage_ms) +
                   f" | {s['micropolygons']:,} | {sh['micropolygons']:,} | "
                   f"{s['micropolygons_sampled'] / max(s['sampled_area_px'], 1e-9):.2f} | {mib(s['bound_split_peak_bytes']):.1f} | "
-                  f"{mib(sh['peak_bytes']):.1f} / {mib(sh['budget_bytes']):.0f} | {s['buckets']} |" + ratio)
+                  f"{mib(sh['peak_bytes']):.1f} / {mib(sh['budget_bytes']):.0f} | {sh.get('marking_passes', 0)} | "
+                  f"{s['buckets']} |" + ratio)
     names = {c.name for c in cases}
     for a, b in suite.ratios:
         if a in names and b in names:
