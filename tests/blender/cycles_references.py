@@ -290,13 +290,13 @@ class Reference:
     def __init__(self, scene, width, height, transparent):
         self.script = _calling_script()
         self.path = None
-        if self.script is None:
-            return
+        dump = os.environ.get(MODE_VARIABLE + "_DUMP")
+        if self.script is None or (_mode() == "off" and not dump):
+            return  # nothing to read or store: no fingerprint to compute
         with open(self.script, "rb") as f:
             self.script_sha = hashlib.sha256(f.read()).hexdigest()
         text = f"{fingerprint(scene)}\nsize {width}x{height} transparent={transparent}\nscript {self.script_sha}"
         self.key = hashlib.sha256(text.encode()).hexdigest()[:24]
-        dump = os.environ.get(MODE_VARIABLE + "_DUMP")
         if dump:  # a folder to write fingerprints into, to see why two differ
             os.makedirs(dump, exist_ok=True)
             path = os.path.join(dump, self.key + ".txt")
