@@ -141,32 +141,14 @@ inline int mp_marking_box(__global const DeviceShadow* sh, float3 p, FrameParams
   return sh->kind == MP_SHADOW_SUN || mp_box_lit(sh, *lo, *hi);
 }
 
-/* First marking, for every light with shadow maps (one work-item per grid
- * vertex of a coarse camera pass, displaced): the pages of the level (mip)
- * whose texels are no larger than the vertex's pixel footprint (mp_shadow.h)
- * for hard shadows, and of the first blocker search round's levels for soft
- * ones, under a box around the vertex reaching its neighbours (`reach`
- * pixels). Where soft shadows follow (`keep`), the vertex and its normal
- * are kept at keep_base + its index for their marking, three floats each
- * (24 bytes a vertex: more of them fit the budget's share; an x that is
- * NaN: no vertex there). */
-__kernel void mark_shadow_pages(__global const SubPatch* diceable, uint count, __global const uint* vertex_offsets,
-                                uint vertex_total, FrameParams f, __global const float4* grid_p,
-                                __global const float4* grid_n, __global const DeviceShadow* shadows,
-                                __global const DeviceShadowLevel* levels, uint light_count,
-                                __global uchar* requests, float reach, uint keep, uint keep_base,
-                                __global float* kept_p, __global float* kept_n) {
-  uint gid = get_global_id(0), i, j;
-  SubPatch sp;
-  float2 uv;
-  ulong index;
-  int valid = mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index);
-  if (keep && gid < vertex_total) {
-    vstore3(valid ? grid_p[index].xyz : (float3)(NAN, 0.0f, 0.0f), keep_base + gid, kept_p);
-    vstore3(valid ? grid_n[index].xyz : (float3)(0.0f), keep_base + gid, kept_n);
-  }
-  if (!valid) return;
-  float3 p = grid_p[index].xyz;
+/* Marks, for every light with shadow maps, the pages around a camera-space
+ * receiver p: the level (mip) whose texels are no larger than its pixel
+ * footprint (mp_shadow.h) for hard shadows, and the first blocker search
+ * round's levels for soft ones, under a box around it reaching its
+ * neighbours (`reach` pixels). */
+inline void mp_mark_vertex(float3 p, FrameParams f, __global const DeviceShadow* shadows,
+                           __global const DeviceShadowLevel* levels, uint light_count, __global uchar* requests,
+                           float reach) {
   for (uint l = 0; l < light_count; ++l) {
     __global const DeviceShadow* sh = shadows + l;
     if (sh->kind == MP_SHADOW_NONE) continue;
@@ -180,8 +162,145 @@ __kernel void mark_shadow_pages(__global const SubPatch* diceable, uint count, _
   }
 }
 
+/* The camera's coarse depth (marking_depth.h): one work-item per
+ * micropolygon of a coarse camera batch. A micropolygon of an opaque
+ * material writes, at every level-0 cell centre of `o` it covers, its
+ * farthest corner's depth plus a sixteenth of its longest edge, with a
+ * 32-bit atomic minimum (positive floats order as their bits do). The
+ * margin stands for the finer surface that the flat coarse micropolygon cuts
+ * across (the chord of a surface curving away from the camera lies in front
+ * of it): an arc of radius R bulges L^2 / 8R beyond its chord L, at most
+ * L / 16 wherever a coarse micropolygon turns through less than about 30
+ * degrees, so only what lies beyond counts as hidden. Materials with alpha or
+ * opacity below one hide nothing here: what shows through their holes needs
+ * its pages. */
+__kernel __attribute__((reqd_work_group_size(64, 1, 1)))
+void marking_depth(__global const SubPatch* diceable, uint count, __global const uint* offsets, uint total,
+                   __global const uint* patch_info, __global const DeviceMaterial* materials, FrameParams f,
+                   __global const float4* grid_p, OcclusionParams o, volatile __global uint* depth) {
+  uint gid = get_global_id(0);
+  if (gid >= total || count == 0u) return;
+  uint first = offsets[0];
+  uint slot = mp_find_grid(offsets, count, first + gid);
+  uint m = first + gid - offsets[slot];
+  SubPatch sp = diceable[slot];
+  __global const DeviceMaterial* mat = materials + patch_info[4 * (ulong)sp.patch + 1];
+  if (mat->program[3] > 0.0f || mat->opacity[3] < 1.0f) return;
+  MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
+  uint q[4];
+  if (!mp_grid_micropolygon(&g, m, q)) return;
+  uint stride = (uint)f.max_grid + 1u;
+  ulong grid_base = (ulong)slot * stride * stride;
+  float3 v[4];
+  float2 r[4];
+  float far_depth = 0.0f;
+  for (int k = 0; k < 4; ++k) {
+    v[k] = mp_to_view(grid_p[grid_base + q[k]].xyz, f);
+    /* Nearer than the clip range, it is not drawn and hides nothing. */
+    if (!mp_view_point_usable(v[k], f) || !(-v[k].z >= f.clip_near)) return;
+    r[k] = mp_project_view(v[k], f);
+    far_depth = fmax(far_depth, -v[k].z);
+  }
+  float edge = 0.0f;
+  for (int k = 0; k < 4; ++k) edge = fmax(edge, length(v[(k + 1) & 3] - v[k]));
+  uint bits = as_uint(far_depth + edge * (1.0f / 16.0f));
+  float cell = (float)(1 << o.cell_shift), half_cell = 0.5f * cell;
+  float xmin = fmin(fmin(r[0].x, r[1].x), fmin(r[2].x, r[3].x)), xmax = fmax(fmax(r[0].x, r[1].x), fmax(r[2].x, r[3].x));
+  float ymin = fmin(fmin(r[0].y, r[1].y), fmin(r[2].y, r[3].y)), ymax = fmax(fmax(r[0].y, r[1].y), fmax(r[2].y, r[3].y));
+  if (!(xmax >= 0.0f && ymax >= 0.0f && xmin <= (float)f.width && ymin <= (float)f.height)) return;
+  int cx0 = max((int)ceil((fmax(xmin, -cell) - half_cell) / cell), 0);
+  int cx1 = min((int)floor((fmin(xmax, (float)f.width + cell) - half_cell) / cell), o.base_w - 1);
+  int cy0 = max((int)ceil((fmax(ymin, -cell) - half_cell) / cell), 0);
+  int cy1 = min((int)floor((fmin(ymax, (float)f.height + cell) - half_cell) / cell), o.base_h - 1);
+  for (int cy = cy0; cy <= cy1; ++cy)
+    for (int cx = cx0; cx <= cx1; ++cx) {
+      float2 c = MP_F2((float)cx * cell + half_cell, (float)cy * cell + half_cell);
+      /* Inside either triangle (0, 1, 2), (0, 2, 3), whichever way round,
+       * or within a thousandth of a pixel of it: a centre on the edge two
+       * triangles share must not fall between them by rounding. */
+      int inside = 0;
+      for (int t = 0; t < 2 && !inside; ++t) {
+        float2 v3[3] = {r[0], r[t + 1], r[t + 2]};
+        int pos = 1, neg = 1;
+        for (int k = 0; k < 3; ++k) {
+          float2 a = v3[k], b = v3[k == 2 ? 0 : k + 1];
+          float e = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+          float slack = 1e-3f * (fabs(b.x - a.x) + fabs(b.y - a.y));
+          pos = pos && e >= -slack;
+          neg = neg && e <= slack;
+        }
+        inside = pos || neg;
+      }
+      if (inside) atomic_min(depth + (uint)(cy * o.base_w + cx), bits);
+    }
+}
+
+/* Whether a marking vertex at camera-space p may be seen by the camera:
+ * unless the coarse depth (marking_depth) holds something nearer at every
+ * cell centre within a cell of it. A vertex of a seen surface finds its own
+ * micropolygons there (their depth with its margin is at least its own); one
+ * beside a silhouette finds the farther side. A vertex outside the frame
+ * matters only within its box's reach (`reach` pixels) of the frame, and is
+ * tested against the frame's edge there; vertices with no depth to test
+ * against (o.levels 0, or at the eye) count as seen. */
+inline int mp_marking_seen(float3 p, FrameParams f, __global const uint* depth, OcclusionParams o, float reach) {
+  if (o.levels <= 0) return 1;
+  float3 v = mp_to_view(p, f);
+  if (!mp_view_point_usable(v, f)) return 1;
+  float2 r = mp_project_view(v, f);
+  if (!(r.x >= -reach && r.y >= -reach && r.x <= (float)f.width + reach && r.y <= (float)f.height + reach)) return 0;
+  float cell = (float)(1 << o.cell_shift);
+  int cx = clamp((int)floor(r.x / cell), 0, o.base_w - 1), cy = clamp((int)floor(r.y / cell), 0, o.base_h - 1);
+  uint near_bits = as_uint(-v.z * (1.0f - 1.0f / 65536.0f));
+  for (int y = max(cy - 1, 0); y <= min(cy + 1, o.base_h - 1); ++y)
+    for (int x = max(cx - 1, 0); x <= min(cx + 1, o.base_w - 1); ++x)
+      if (depth[y * o.base_w + x] >= near_bits) return 1;
+  return 0;
+}
+
+/* The first marking from a coarse camera batch's grids (one work-item per
+ * grid vertex, displaced): the vertex is kept at keep_base + its index
+ * where `keep` is set, three floats for its position and, with `keep_n`,
+ * three for its normal (an x that is NaN: no vertex there), for the marking
+ * that follows the coarse depth (mark_kept_shadow_pages) and the soft one;
+ * where `mark` is set, it marks its pages now, if the coarse depth (`o`
+ * levels above 0) says it may be seen. */
+__kernel void mark_shadow_pages(__global const SubPatch* diceable, uint count, __global const uint* vertex_offsets,
+                                uint vertex_total, FrameParams f, __global const float4* grid_p,
+                                __global const float4* grid_n, __global const DeviceShadow* shadows,
+                                __global const DeviceShadowLevel* levels, uint light_count,
+                                __global uchar* requests, float reach, uint mark, uint keep, uint keep_n,
+                                uint keep_base, __global float* kept_p, __global float* kept_n,
+                                __global const uint* depth, OcclusionParams o) {
+  uint gid = get_global_id(0), i, j;
+  SubPatch sp;
+  float2 uv;
+  ulong index;
+  int valid = mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index);
+  if (keep && gid < vertex_total) {
+    vstore3(valid ? grid_p[index].xyz : (float3)(NAN, 0.0f, 0.0f), keep_base + gid, kept_p);
+    if (keep_n) vstore3(valid ? grid_n[index].xyz : (float3)(0.0f), keep_base + gid, kept_n);
+  }
+  if (!valid || !mark) return;
+  float3 p = grid_p[index].xyz;
+  if (mp_marking_seen(p, f, depth, o, reach)) mp_mark_vertex(p, f, shadows, levels, light_count, requests, reach);
+}
+
+/* The first marking from the kept vertices, once the coarse depth is
+ * complete: only those the camera may see mark pages. */
+__kernel void mark_kept_shadow_pages(__global const float* kept_p, uint kept, FrameParams f,
+                                     __global const DeviceShadow* shadows, __global const DeviceShadowLevel* levels,
+                                     uint light_count, __global uchar* requests, float reach,
+                                     __global const uint* depth, OcclusionParams o) {
+  uint gid = get_global_id(0);
+  if (gid >= kept) return;
+  float3 p = vload3(gid, kept_p);
+  if (isnan(p.x) || !mp_marking_seen(p, f, depth, o, reach)) return;
+  mp_mark_vertex(p, f, shadows, levels, light_count, requests, reach);
+}
+
 /* Second marking, for soft shadows, on the maps the first rendered (one
- * work-item per vertex the first kept): where a vertex's first search round
+ * work-item per vertex the first kept that the camera may see): where a vertex's first search round
  * finds occluders, the levels the second round and the penumbra filter can
  * read there, from the nearest occluder's (the narrowest penumbra, the
  * finest level) to the coarsest; receivers that see no occluder read
@@ -222,11 +341,12 @@ __kernel void mark_soft_shadow_pages(__global const float* kept_p, __global cons
                                      FrameParams f, __global const DeviceShadow* shadows,
                                      __global const DeviceShadowLevel* levels, uint light_count,
                                      __global const uint* pages, __global const uint* pool,
-                                     __global uchar* requests, float reach) {
+                                     __global uchar* requests, float reach, __global const uint* depth,
+                                     OcclusionParams o) {
   uint gid = get_global_id(0);
   if (gid >= kept) return;
   float3 p = vload3(gid, kept_p);
-  if (isnan(p.x)) return;
+  if (isnan(p.x) || !mp_marking_seen(p, f, depth, o, reach)) return;
   mp_mark_soft_vertex(p, vload3(gid, kept_n), f, shadows, levels, light_count, pages, pool, requests, reach);
 }
 
@@ -239,12 +359,14 @@ __kernel void mark_soft_shadow_pages_grid(__global const SubPatch* diceable, uin
                                           __global const DeviceShadow* shadows,
                                           __global const DeviceShadowLevel* levels, uint light_count,
                                           __global const uint* pages, __global const uint* pool,
-                                          __global uchar* requests, float reach) {
+                                          __global uchar* requests, float reach,
+                                          __global const uint* depth, OcclusionParams o) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   float2 uv;
   ulong index;
   if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
+  if (!mp_marking_seen(grid_p[index].xyz, f, depth, o, reach)) return;
   mp_mark_soft_vertex(grid_p[index].xyz, grid_n[index].xyz, f, shadows, levels, light_count, pages, pool, requests,
                       reach);
 }

@@ -40,6 +40,7 @@ struct ShadowStats {
   size_t micropolygons = 0;       // diced for the lights' views
   size_t subpatches_occluded = 0; // sub-patches of the lights' views culled as hidden behind what the pages hold
   size_t marking_passes = 0;      // markings that diced the view again: its vertices passed their share of the budget
+  size_t marking_occluded = 0;    // sub-patches of the markings' coarse camera view culled as hidden by its depth
   size_t budget_bytes = 0;        // RenderSettings::shadow_memory_mib
   size_t peak_bytes = 0;          // shadow map device memory held: pages, page tables, requests, masks, views
   size_t batches = 0;             // dice batches of the markings and the lights' views

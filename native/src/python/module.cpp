@@ -100,6 +100,7 @@ py::dict stats_dict(const RenderStats& s) {
   sh["micropolygons"] = s.shadows.micropolygons;
   sh["subpatches_occluded"] = s.shadows.subpatches_occluded;
   sh["marking_passes"] = s.shadows.marking_passes;
+  sh["marking_occluded"] = s.shadows.marking_occluded;
   sh["budget_bytes"] = s.shadows.budget_bytes;
   sh["peak_bytes"] = s.shadows.peak_bytes;
   sh["batches"] = s.shadows.batches;

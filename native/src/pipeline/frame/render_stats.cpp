@@ -68,6 +68,7 @@ std::string RenderStats::to_json() const {
        ", \"micropolygons\": " + std::to_string(sh.micropolygons) +
        ", \"subpatches_occluded\": " + std::to_string(sh.subpatches_occluded) +
        ", \"marking_passes\": " + std::to_string(sh.marking_passes) +
+       ", \"marking_occluded\": " + std::to_string(sh.marking_occluded) +
        ", \"budget_bytes\": " + std::to_string(sh.budget_bytes) + ", \"peak_bytes\": " + std::to_string(sh.peak_bytes) +
        ", \"batches\": " + std::to_string(sh.batches) + ", \"mark_wall_ms\": " + num(sh.mark_wall_ms) +
        ", \"render_wall_ms\": " + num(sh.render_wall_ms) + ", \"per_light\": [";

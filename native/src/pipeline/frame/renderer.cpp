@@ -225,7 +225,12 @@ void Renderer::Impl::render_frame(const Scene& scene, RenderResult& out, const P
   // The lights' views first: shading the camera's view reads their maps.
   auto shadows_started = std::chrono::steady_clock::now();
   std::optional<DeviceSession::Activity> activity(std::in_place, s, "shadows");
-  bool going = d.shadow_maps.render(scene, lights, frame, pass, st.shadows);
+  // The marking culls the camera's view as the camera does: near to far,
+  // not under motion blur or depth of field (camera_view.cpp).
+  cl::Buffer camera_order;
+  if (scene.settings.shadows && scene.settings.occlusion_culling && !mp_blur_on(frame.params))
+    camera_order = d.occlusion.root_order(buffers.host_patch_bounds, d.scene_key, frame.params);
+  bool going = d.shadow_maps.render(scene, lights, frame, pass, camera_order, st.shadows);
   activity.reset();
   st.timings_ms.shadows_wall = ms_since(shadows_started);
   // Then the camera's view, bucket by bucket within the sample budget.

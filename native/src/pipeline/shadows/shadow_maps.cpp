@@ -21,9 +21,8 @@ constexpr size_t kPageBytes = size_t(MP_PAGE_TEXELS) * sizeof(cl_uint);
 // depths and its dirty byte (occlusion culling), its slot in the list of
 // pages to clear and its page-table write.
 constexpr size_t kPageCost = kPageBytes + (64 + 1) * sizeof(cl_uint) + sizeof(cl_uint) + 1 + sizeof(cl_uint2);
-// A kept marking vertex: its position and normal.
+// A kept marking vertex: its position and (soft shadows) its normal.
 constexpr size_t kKeptVectorBytes = 3 * sizeof(cl_float);  // packed (vstore3), position and normal alike
-constexpr size_t kKeptVertexBytes = 2 * kKeptVectorBytes;
 // The marking pass dices the camera's view this many times coarser (in
 // micropolygon edge) than the frame: its vertices mark the pages around
 // them, and need to be close only next to a page.
@@ -37,13 +36,15 @@ cl_float mark_reach(const FrameParams& coarse) { return coarse.micropoly_edge; }
 ShadowMaps::ShadowMaps(DeviceSession& session)
     : session_(session),
       mark_(session.program(), "mark_shadow_pages"),
+      mark_kept_(session.program(), "mark_kept_shadow_pages"),
       mark_soft_(session.program(), "mark_soft_shadow_pages"),
       mark_soft_grid_(session.program(), "mark_soft_shadow_pages_grid"),
       clear_(session.program(), "clear_shadow_pages"),
       set_entries_(session.program(), "set_page_entries"),
       sample_(session.program(), "shadow_sample"),
       farthest_(session.program(), "shadow_page_farthest"),
-      occlusion_build_(session.program(), "shadow_occlusion_build") {}
+      occlusion_build_(session.program(), "shadow_occlusion_build"),
+      depth_(session) {}
 
 void ShadowMaps::upload_records(const ShadowLayout& layout) {
   DeviceQueue& q = session_.queue();
@@ -57,40 +58,97 @@ void ShadowMaps::upload_records(const ShadowLayout& layout) {
                          layout.levels.data());
 }
 
-bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, MicropolygonPass& pass, bool keep,
-                      std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries, ShadowStats& stats) {
+void ShadowMaps::clear_requests(const ShadowLayout& layout) {
+  const size_t n = layout.table_entries;
+  session_.reserve(requests_, requests_capacity_, n, "shadow page requests");
+  session_.queue().enqueueFillBuffer(requests_, cl_uchar(0), 0, n);
+}
+
+bool ShadowMaps::camera_view(const ShadowLayout& layout, const FrameSetup& frame, MicropolygonPass& pass, bool soft,
+                             const cl::Buffer& camera_order, ShadowStats& stats) {
   StageTimer& timer = pass.timer();
   StageTimer::Redirect to(timer, Stage::ShadowMark);
   const auto started = std::chrono::steady_clock::now();
   DeviceQueue& q = session_.queue();
-  const size_t n = layout.table_entries;
-  session_.reserve(requests_, requests_capacity_, n, "shadow page requests");
-  q.enqueueFillBuffer(requests_, cl_uchar(0), 0, n);
   FrameParams coarse = frame.params;
   coarse.micropoly_edge *= kMarkCoarsening;
   const cl_uint light_count = cl_uint(layout.shadows.size());
   GridBuffers& grids = pass.grids();
+  const SceneBuffers& buffers = pass.scene();
+  camera_order_ = camera_order;
+  depth_.begin(frame.params, camera_order(), timer);
   kept_vertices_ = 0;
   kept_overflow_ = false;
+  bool keep = true;
   ViewTarget target;
   // The soft marking's search compares with the displaced surface's tangent plane.
-  target.normals = keep;
-  target.take = [&, keep](const cl::Buffer& diceable, cl_uint count) mutable {
+  target.normals = soft;
+  target.take = [&](const cl::Buffer& diceable, cl_uint count) {
     const cl_uint vertices = grids.vertex_total;
     ++stats.batches;
+    depth_.rasterise(diceable, count, buffers, coarse, grids, timer);
     // The kept vertices stay within their share of the budget: past it the
-    // soft marking dices the view again instead (mark_soft).
+    // batch marks its pages now, before the depth is complete (all its
+    // vertices, seen or not), and the soft marking dices the view again.
     if (keep && size_t(kept_vertices_) + vertices > kept_limit_) keep = false, kept_overflow_ = true;
     if (keep) keep_room(size_t(kept_vertices_) + vertices);
     bind_args(mark_, diceable, count, grids.vertex_offsets, vertices, coarse, grids.p, grids.n, inputs_.shadows,
-              inputs_.levels, light_count, requests_, mark_reach(coarse), cl_uint(keep), kept_vertices_,
-              keep ? kept_p_ : grids.p, keep ? kept_n_ : grids.n);  // unwritten when not kept
+              inputs_.levels, light_count, requests_, mark_reach(coarse), cl_uint(!keep), cl_uint(keep),
+              cl_uint(soft), kept_vertices_, keep ? kept_p_ : grids.p, keep && soft ? kept_n_ : grids.n,
+              depth_.image(), OcclusionParams{});  // unwritten when not kept; no depth test yet
     cl::Event e;
     q.enqueueNDRangeKernel(mark_, cl::NullRange, round_up_range(vertices), cl::NDRange(64), nullptr, &e);
     timer.add(Stage::ShadowMark, e);
     if (keep) kept_vertices_ += vertices;
   };
-  if (pass.run(PassView{coarse, PassViews{}, PassOcclusion{}}, target).cancelled) return false;
+  const BoundSplitResult r = pass.run(
+      PassView{coarse, PassViews{}, depth_.occlusion(camera_order, session_.info().type == "cpu", timer)}, target);
+  stats.marking_occluded += r.occluded;
+  if (r.cancelled) return false;
+  // Complete: the markings and any pass over the view again test against all of it.
+  depth_.refresh(timer);
+  stats.mark_wall_ms += ms_since(started);
+  return true;
+}
+
+bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, MicropolygonPass& pass, bool first,
+                      std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries, ShadowStats& stats) {
+  StageTimer& timer = pass.timer();
+  StageTimer::Redirect to(timer, Stage::ShadowMark);
+  const auto started = std::chrono::steady_clock::now();
+  DeviceQueue& q = session_.queue();
+  FrameParams coarse = frame.params;
+  coarse.micropoly_edge *= kMarkCoarsening;
+  const cl_uint light_count = cl_uint(layout.shadows.size());
+  if (kept_vertices_ > 0) {
+    bind_args(mark_kept_, kept_p_, kept_vertices_, coarse, inputs_.shadows, inputs_.levels, light_count, requests_,
+              mark_reach(coarse), depth_.image(), depth_.params());
+    cl::Event e;
+    q.enqueueNDRangeKernel(mark_kept_, cl::NullRange, round_up_range(kept_vertices_), cl::NDRange(64), nullptr, &e);
+    timer.add(Stage::ShadowMark, e);
+  }
+  if (kept_overflow_ && !first) {
+    // The batches past the kept share marked their pages in the camera's
+    // view; at a coarser level bias they do so again, diced anew.
+    ++stats.marking_passes;
+    GridBuffers& grids = pass.grids();
+    ViewTarget target;
+    target.normals = false;
+    target.take = [&](const cl::Buffer& diceable, cl_uint count) {
+      ++stats.batches;
+      const cl_uint vertices = grids.vertex_total;
+      if (vertices == 0) return;
+      bind_args(mark_, diceable, count, grids.vertex_offsets, vertices, coarse, grids.p, grids.n, inputs_.shadows,
+                inputs_.levels, light_count, requests_, mark_reach(coarse), cl_uint(1), cl_uint(0), cl_uint(0),
+                cl_uint(0), grids.p, grids.n, depth_.image(), depth_.params());
+      cl::Event e;
+      q.enqueueNDRangeKernel(mark_, cl::NullRange, round_up_range(vertices), cl::NDRange(64), nullptr, &e);
+      timer.add(Stage::ShadowMark, e);
+    };
+    const BoundSplitResult r = pass.run(PassView{coarse, PassViews{}, depth_.complete(camera_order_)}, target);
+    stats.marking_occluded += r.occluded;
+    if (r.cancelled) return false;
+  }
   collect_requests(layout, keys, entries);
   stats.mark_wall_ms += ms_since(started);
   return true;
@@ -113,7 +171,8 @@ bool ShadowMaps::mark_soft(const ShadowLayout& layout, const FrameSetup& frame, 
   };
   if (kept_overflow_) {
     // More vertices than the budget keeps: the view is diced again, as the
-    // first marking diced it, and marked batch by batch.
+    // camera's view diced it (culled by its complete depth), and marked
+    // batch by batch.
     ++stats.marking_passes;
     GridBuffers& grids = pass.grids();
     ViewTarget target;
@@ -121,13 +180,16 @@ bool ShadowMaps::mark_soft(const ShadowLayout& layout, const FrameSetup& frame, 
       ++stats.batches;
       if (grids.vertex_total == 0) return;
       bind_args(mark_soft_grid_, diceable, count, grids.vertex_offsets, coarse, grids.p, grids.n, inputs_.shadows,
-                inputs_.levels, light_count, inputs_.pages, inputs_.pool, requests_, mark_reach(coarse));
+                inputs_.levels, light_count, inputs_.pages, inputs_.pool, requests_, mark_reach(coarse),
+                depth_.image(), depth_.params());
       launch(mark_soft_grid_, grids.vertex_total);
     };
-    if (pass.run(PassView{coarse, PassViews{}, PassOcclusion{}}, target).cancelled) return false;
+    const BoundSplitResult r = pass.run(PassView{coarse, PassViews{}, depth_.complete(camera_order_)}, target);
+    stats.marking_occluded += r.occluded;
+    if (r.cancelled) return false;
   } else if (kept_vertices_ > 0) {
     bind_args(mark_soft_, kept_p_, kept_n_, kept_vertices_, coarse, inputs_.shadows, inputs_.levels, light_count,
-              inputs_.pages, inputs_.pool, requests_, mark_reach(coarse));
+              inputs_.pages, inputs_.pool, requests_, mark_reach(coarse), depth_.image(), depth_.params());
     launch(mark_soft_, kept_vertices_);
   }
   collect_requests(layout, keys, entries);
@@ -136,13 +198,15 @@ bool ShadowMaps::mark_soft(const ShadowLayout& layout, const FrameSetup& frame, 
 }
 
 void ShadowMaps::keep_room(size_t vertices) {
+  const bool normals = kept_normals_;
   if (vertices <= kept_capacity_) return;
   const size_t grown = std::max(vertices, std::min(kept_capacity_ + kept_capacity_ / 2, kept_limit_));
   cl::Buffer p = session_.allocate(grown * kKeptVectorBytes, "shadow marking vertices");
-  cl::Buffer nrm = session_.allocate(grown * kKeptVectorBytes, "shadow marking normals");
+  cl::Buffer nrm = normals ? session_.allocate(grown * kKeptVectorBytes, "shadow marking normals") : cl::Buffer();
   if (kept_vertices_ > 0) {
     session_.queue().enqueueCopyBuffer(kept_p_, p, 0, 0, size_t(kept_vertices_) * kKeptVectorBytes);
-    session_.queue().enqueueCopyBuffer(kept_n_, nrm, 0, 0, size_t(kept_vertices_) * kKeptVectorBytes);
+    if (normals)
+      session_.queue().enqueueCopyBuffer(kept_n_, nrm, 0, 0, size_t(kept_vertices_) * kKeptVectorBytes);
   }
   kept_p_ = p;
   kept_n_ = nrm;
@@ -318,7 +382,7 @@ bool ShadowMaps::render_views(const std::vector<FrameParams>& views, const std::
 }
 
 bool ShadowMaps::render(const Scene& scene, const std::vector<Light>& lights, const FrameSetup& frame,
-                        MicropolygonPass& pass, ShadowStats& stats) {
+                        MicropolygonPass& pass, const cl::Buffer& camera_order, ShadowStats& stats) {
   const SceneBuffers& buffers = pass.scene();
   stats = ShadowStats{};
   const RenderSettings& settings = scene.settings;
@@ -339,17 +403,23 @@ bool ShadowMaps::render(const Scene& scene, const std::vector<Light>& lights, co
       soft = soft || (d.kind != MP_SHADOW_NONE && d.shape != MP_SHADOW_SHAPE_POINT);
 
   // The budget holds the page tables, the requests, the page masks (at most
-  // a third of the tables) and, with culling, their pyramids, the views and
-  // the lights' records first; then the soft marking's kept vertices take up
-  // to an eighth and the lights' patch orders (culling) up to a sixteenth;
-  // pages take the rest. Every part stays within its share, so the whole
-  // never exceeds the budget. A budget too short for culling's parts and
-  // sixteen pages renders the lights' views without culling.
+  // a third of the tables) and, with culling, their pyramids, the camera's
+  // coarse depth, the views and the lights' records first; then the
+  // marking's kept vertices take up to an eighth (where there is a depth to
+  // test them against, or soft shadows to mark from them) and the lights'
+  // patch orders (culling) up to a sixteenth; pages take the rest. Every
+  // part stays within its share, so the whole never exceeds the budget. A
+  // budget too short for the depth, or for culling's parts, and sixteen
+  // pages does without them.
   const size_t masks = size_t(layout.table_entries) * 4 / 3;
   size_t fixed = size_t(layout.table_entries) * (sizeof(cl_uint) + 1) + masks +
                  MP_MAX_PASS_VIEWS * sizeof(FrameParams) + layout.shadows.size() * sizeof(DeviceShadow) +
                  layout.levels.size() * sizeof(DeviceShadowLevel);
-  const size_t kept_share = soft ? stats.budget_bytes / 8 : 0;
+  const size_t depth_bytes = MarkingDepth::bytes_for(frame.params);
+  const bool depth_on =
+      camera_order() && fixed + depth_bytes + stats.budget_bytes / 8 + 16 * kPageCost <= stats.budget_bytes;
+  if (depth_on) fixed += depth_bytes;
+  const size_t kept_share = soft || depth_on ? stats.budget_bytes / 8 : 0;
   const bool culling = settings.occlusion_culling && fixed + kept_share + masks * sizeof(cl_uint) +
                                                             stats.budget_bytes / 16 + 16 * kPageCost <=
                                                         stats.budget_bytes;
@@ -359,9 +429,12 @@ bool ShadowMaps::render(const Scene& scene, const std::vector<Light>& lights, co
     throw Error("the shadow map memory budget of " + std::to_string(settings.shadow_memory_mib) + " MiB is too small for " +
                 std::to_string(layout.shadowed_lights) + " shadowed lights: it needs at least " +
                 std::to_string((fixed + kept_share + orders_share + 16 * kPageCost + 1048575) >> 20) + " MiB");
-  kept_limit_ = kept_share / kKeptVertexBytes;
+  const size_t kept_vertex_bytes = soft ? 2 * kKeptVectorBytes : kKeptVectorBytes;
+  kept_limit_ = kept_share / kept_vertex_bytes;
   orders_limit_ = orders_share;
-  if (kept_capacity_ > kept_limit_) kept_p_ = kept_n_ = cl::Buffer(), kept_capacity_ = 0;
+  // Kept buffers of another size or kind (frames before had or lacked soft shadows) go.
+  if (kept_capacity_ > kept_limit_ || kept_normals_ != soft) kept_p_ = kept_n_ = cl::Buffer(), kept_capacity_ = 0;
+  kept_normals_ = soft;
   for (LightOrder& o : orders_)
     if (o.bytes > orders_limit_) o = LightOrder{};
   const size_t capacity = (stats.budget_bytes - fixed - kept_share - orders_share) / kPageCost;
@@ -384,10 +457,17 @@ bool ShadowMaps::render(const Scene& scene, const std::vector<Light>& lights, co
   // budget too short for them coarsens every light.
   std::vector<ShadowPageKey> keys;
   std::vector<uint32_t> entries;
+  set_shadow_level_bias(layout, 0);
+  upload_records(layout);
+  clear_requests(layout);
+  if (!camera_view(layout, frame, pass, soft, depth_on ? camera_order : cl::Buffer(), stats)) return false;
   for (int bias = 0;; ++bias) {
-    set_shadow_level_bias(layout, bias);
-    upload_records(layout);
-    if (!mark(layout, frame, pass, soft, keys, entries, stats)) return false;
+    if (bias > 0) {
+      set_shadow_level_bias(layout, bias);
+      upload_records(layout);
+      clear_requests(layout);
+    }
+    if (!mark(layout, frame, pass, bias == 0, keys, entries, stats)) return false;
     stats.level_bias = bias;
     if (keys.size() <= capacity || bias >= kMaxShadowLevelBias) break;
   }
@@ -412,7 +492,8 @@ bool ShadowMaps::render(const Scene& scene, const std::vector<Light>& lights, co
   for (const LightOrder& o : orders_) orders += o.bytes;
   stats.peak_bytes = size_t(pool_pages_) * (kPageBytes + 1) + pages_capacity_ + requests_capacity_ +
                      masks_capacity_ + pyramid_capacity_ + views_capacity_ + records_capacity_ + levels_capacity_ +
-                     clear_capacity_ + writes_capacity_ + kept_capacity_ * kKeptVertexBytes + orders;
+                     clear_capacity_ + writes_capacity_ + kept_capacity_ * (kept_normals_ ? 2 : 1) * kKeptVectorBytes +
+                     depth_.held_bytes() + orders;
   return true;
 }
 

@@ -2,7 +2,9 @@
 // frame, before the camera's view:
 //  1. the lights' layout (shadow_layout.h) and records go to the device;
 //  2. a coarse pass over the camera's view (bound & split, dicing and
-//     displacement) marks the pages its vertices need, at the levels their
+//     displacement) writes the camera's coarse depth, culling what it hides
+//     near to far (marking_depth.h), and keeps its vertices; those the
+//     camera may see then mark the pages they need, at the levels their
 //     pixel footprints ask for (soft shadows: their blocker search's);
 //  3. the requests come back and get physical pages within the budget
 //     (shadow_page_pool.h); pages kept from earlier frames whose light and
@@ -30,6 +32,7 @@
 #include "pipeline/pass/micropolygon_pass.h"
 #include "pipeline/pass/micropolygon_stages.h"
 #include "pipeline/device_scene/scene_buffers.h"
+#include "pipeline/shadows/marking_depth.h"
 #include "pipeline/shadows/shadow_layout.h"
 #include "pipeline/shadows/shadow_page_pool.h"
 #include "pipeline/pass/stage_timer.h"
@@ -40,16 +43,26 @@ class ShadowMaps {
  public:
   explicit ShadowMaps(DeviceSession& session);
   // Makes the frame's shadow maps (none when no light casts shadows);
-  // returns false when the runner was cancelled.
+  // returns false when the runner was cancelled. `camera_order`: the
+  // patches near to far from the camera, where the camera's view may cull
+  // (none: the marking neither culls nor tests what the camera sees).
   bool render(const Scene& scene, const std::vector<Light>& lights, const FrameSetup& frame, MicropolygonPass& pass,
-              ShadowStats& stats);
+              const cl::Buffer& camera_order, ShadowStats& stats);
   const ShadowInputs& inputs() const { return inputs_; }
 
  private:
-  // Marks the pages the camera's receivers need (the first marking), its
-  // vertices kept for the soft marking where `keep`; returns them all,
-  // coarser maps first, with their page-table entries.
-  bool mark(const ShadowLayout& layout, const FrameSetup& frame, MicropolygonPass& pass, bool keep,
+  // The camera's coarse view: its depth (culling what it hides, where
+  // `camera_order` is given) and its vertices, kept within their share of
+  // the budget (with their normals where `soft`) for the markings; past
+  // that share, batches mark their pages at once.
+  bool camera_view(const ShadowLayout& layout, const FrameSetup& frame, MicropolygonPass& pass, bool soft,
+                   const cl::Buffer& camera_order, ShadowStats& stats);
+  // Marks the pages the camera's receivers need (the first marking) from
+  // the kept vertices the camera may see, and, unless `first` (the camera
+  // view marked them then), from the view diced again where they passed
+  // their share; returns them all, coarser maps first, with their page-table
+  // entries.
+  bool mark(const ShadowLayout& layout, const FrameSetup& frame, MicropolygonPass& pass, bool first,
             std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries, ShadowStats& stats);
   // The soft marking, over the first's kept vertices (or, where they passed
   // their share of the budget, over the view diced again); adds to its
@@ -58,6 +71,7 @@ class ShadowMaps {
                  std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries, ShadowStats& stats);
   void collect_requests(const ShadowLayout& layout, std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries);
   void keep_room(size_t vertices);
+  void clear_requests(const ShadowLayout& layout);
   // Zeroes the page tables (`entries` of them) and writes the given entries.
   void write_table(size_t entries, const std::vector<cl_uint2>& writes);
   // Gives the requested pages physical ones, writes the page tables and
@@ -77,19 +91,22 @@ class ShadowMaps {
   // would pass their share of the budget (the pass then culls at batch ends
   // only).
   const cl::Buffer& light_order(int light, const FrameParams& view, const SceneBuffers& buffers, uint64_t scene_key);
-  // Vertices the first marking may keep for the soft one within the budget.
+  // Vertices the camera's view may keep for the markings within the budget.
   size_t kept_limit_ = 0;
   bool kept_overflow_ = false;
+  cl::Buffer camera_order_;  // this frame's (camera_view)
   size_t orders_limit_ = 0;  // bytes the lights' patch orders may hold
 
   DeviceSession& session_;
-  cl::Kernel mark_, mark_soft_, mark_soft_grid_, clear_, set_entries_, sample_, farthest_, occlusion_build_;
+  cl::Kernel mark_, mark_kept_, mark_soft_, mark_soft_grid_, clear_, set_entries_, sample_, farthest_, occlusion_build_;
   std::vector<size_t> light_pages_;  // resident pages per light, this frame
   ShadowPagePool pool_;
   ShadowInputs inputs_;
   cl::Buffer requests_, views_, masks_, clear_list_, writes_;
-  cl::Buffer kept_p_, kept_n_;  // the first marking's vertices and normals, for the soft one
+  cl::Buffer kept_p_, kept_n_;  // the camera view's vertices and (soft shadows) normals, for the markings
   size_t kept_capacity_ = 0, writes_capacity_ = 0;
+  bool kept_normals_ = false;  // whether normals are kept too (kept_n_, as many as kept_p_)
+  MarkingDepth depth_;
   cl_uint kept_vertices_ = 0;
   size_t requests_capacity_ = 0, pages_capacity_ = 0, views_capacity_ = 0, masks_capacity_ = 0, clear_capacity_ = 0, records_capacity_ = 0,
          levels_capacity_ = 0;

@@ -1,0 +1,99 @@
+#include "pipeline/shadows/marking_depth.h"
+
+#include <algorithm>
+
+#include "cl/kernel_args.h"
+#include "stages/mp_occlusion.h"
+
+namespace mp {
+namespace {
+
+// One sample per 2 x 2 pixels: the coarse micropolygons are about eight
+// pixels wide, so each covers a dozen samples or more.
+constexpr int kCellShift = 1;
+
+OcclusionParams layout_for(const FrameParams& f) {
+  OcclusionParams o{};
+  o.cell_shift = kCellShift;
+  o.base_w = std::max((f.width + (1 << kCellShift) - 1) >> kCellShift, 1);
+  o.base_h = std::max((f.height + (1 << kCellShift) - 1) >> kCellShift, 1);
+  o.levels = 1;
+  while (o.levels < MP_OCCLUSION_MAX_LEVELS && std::max(o.base_w, o.base_h) > (1 << (o.levels - 1))) ++o.levels;
+  return o;
+}
+
+cl::NDRange range_2d(int w, int h) {
+  return cl::NDRange(static_cast<size_t>((w + 7) / 8 * 8), static_cast<size_t>((h + 7) / 8 * 8));
+}
+
+}  // namespace
+
+MarkingDepth::MarkingDepth(DeviceSession& session)
+    : session_(session),
+      raster_(session.program(), "marking_depth"),
+      reduce_(session.program(), "occlusion_reduce") {}
+
+size_t MarkingDepth::bytes_for(const FrameParams& f) {
+  return size_t(mp_occlusion_cells(layout_for(f))) * sizeof(cl_uint);
+}
+
+void MarkingDepth::begin(const FrameParams& f, bool on, StageTimer& timer) {
+  params_ = on ? layout_for(f) : OcclusionParams{};
+  const size_t cells = on ? size_t(mp_occlusion_cells(params_)) : 1;
+  if (cells > held_ || (!on && held_ > 1)) {
+    pyramid_ = cl::Buffer();
+    held_ = 0;
+    pyramid_ = session_.allocate(cells * sizeof(cl_uint), "shadow marking depth");
+    held_ = cells;
+  }
+  cl::Event e;
+  session_.queue().enqueueFillBuffer(pyramid_, ~cl_uint(0), 0, cells * sizeof(cl_uint), nullptr, &e);
+  timer.add(Stage::ShadowMark, e);
+}
+
+void MarkingDepth::rasterise(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
+                             const FrameParams& f, const GridBuffers& grids, StageTimer& timer) {
+  if (!on() || count == 0) return;
+  const cl_uint total = grids.micropolygon_offsets_host[count] - grids.micropolygon_offsets_host[0];
+  if (total == 0) return;
+  bind_args(raster_, diceable, count, grids.micropolygon_offsets, total, scene.patch_info, scene.materials, f, grids.p,
+            params_, pyramid_);
+  cl::Event e;
+  session_.queue().enqueueNDRangeKernel(raster_, cl::NullRange, round_up_range(total), cl::NDRange(64), nullptr, &e);
+  timer.add(Stage::ShadowMark, e);
+}
+
+void MarkingDepth::refresh(StageTimer& timer) {
+  for (int k = 1; k < params_.levels; ++k) {
+    bind_args(reduce_, pyramid_, params_, k);
+    cl::Event e;
+    session_.queue().enqueueNDRangeKernel(
+        reduce_, cl::NullRange, range_2d(mp_occlusion_side(params_.base_w, k), mp_occlusion_side(params_.base_h, k)),
+        cl::NDRange(8, 8), nullptr, &e);
+    timer.add(Stage::ShadowMark, e);
+  }
+}
+
+PassOcclusion MarkingDepth::occlusion(const cl::Buffer& order, bool waves, StageTimer& timer) {
+  PassOcclusion o;
+  if (!on()) return o;
+  o.pyramid = pyramid_;
+  o.params = params_;
+  o.root_order = order;
+  o.waves = waves;
+  o.refresh = [this, &timer] { refresh(timer); };
+  return o;
+}
+
+PassOcclusion MarkingDepth::complete(const cl::Buffer& order) const {
+  PassOcclusion o;
+  if (!on()) return o;
+  o.pyramid = pyramid_;
+  o.params = params_;
+  o.root_order = order;
+  o.waves = false;  // nothing the pass dices changes the image
+  o.refresh = [] {};
+  return o;
+}
+
+}  // namespace mp
