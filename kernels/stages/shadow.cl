@@ -21,8 +21,14 @@ MP_INLINE float mp_mark_margin(const MP_GLOBAL DeviceShadow* sh) {
   return sh->shape == MP_SHADOW_SHAPE_POINT ? 2.0f : MP_SHADOW_SEARCH_TEXELS + 2.0f;
 }
 
-inline void mp_mark_rect(__global uchar* requests, uint table, int side, int origin_x, int origin_y, float x0, float y0,
-                         float x1, float y1) {
+/* Per page-table entry, `requests` says whether a receiver asked for the
+ * page, and `caps` holds the farthest depth in the map's view (a positive
+ * float's bits) of the receivers that asked for it or may ask for it in the
+ * soft marking: whatever lies beyond shadows none of them, and the lights'
+ * views cull it (shadow_page_farthest). Where `request` is 0 the rectangle's
+ * caps grow but nothing is asked for. */
+inline void mp_mark_rect(__global uchar* requests, volatile __global uint* caps, uint table, int side, int origin_x,
+                         int origin_y, float x0, float y0, float x1, float y1, uint far_bits, int request) {
   float last = (float)(side * MP_PAGE_SIZE - 1);
   if (x1 < 0.0f || y1 < 0.0f || x0 > last || y0 > last) return;
   int px0 = (int)fmax(x0, 0.0f) >> 7, px1 = (int)fmin(x1, last) >> 7;
@@ -30,7 +36,9 @@ inline void mp_mark_rect(__global uchar* requests, uint table, int side, int ori
   for (int py = py0; py <= py1; ++py)
     for (int px = px0; px <= px1; ++px) {
       int sx = (px + origin_x) & (side - 1), sy = (py + origin_y) & (side - 1);
-      requests[table + (uint)(sy * side + sx)] = (uchar)1;
+      uint e = table + (uint)(sy * side + sx);
+      if (request) requests[e] = (uchar)1;
+      if (caps[e] < far_bits) atomic_max(caps + e, far_bits);
     }
 }
 
@@ -76,24 +84,32 @@ inline void mp_probe_levels(__global const DeviceShadow* sh, float3 lo, float3 h
 
 /* Marks the pages of levels [first, last] under the light-space box [lo,
  * hi], grown by the margin the light's filters need. */
-inline void mp_mark_levels(__global const DeviceShadow* sh, __global const DeviceShadowLevel* levels, float3 lo, float3 hi,
-                           int first, int last, __global uchar* requests) {
+inline void mp_mark_levels(__global const DeviceShadow* sh, __global const DeviceShadowLevel* levels, float3 lo,
+                           float3 hi, int first, int last, __global uchar* requests, volatile __global uint* caps,
+                           int request) {
   int count = mp_shadow_level_count(sh);
   first = clamp(first, 0, count - 1);
   last = clamp(last, 0, count - 1);
   float margin = mp_mark_margin(sh);
+  /* The receivers' farthest depth: the box's (a sun's depth runs down from
+   * z_top; a face's is the light-space coordinate along its axis). The box
+   * reaches a coarse micropolygon's edge around its vertex, so it holds the
+   * finer surface of the micropolygons around the vertex nearer to it than
+   * to their other corners. */
   if (sh->kind == MP_SHADOW_SUN) {
+    uint far_bits = as_uint(fmax(sh->z_top - lo.z, 1e-30f));
     for (int i = first; i <= last; ++i) {
       __global const DeviceShadowLevel* lv = levels + sh->level_records + (uint)i;
       float k = 1.0f / lv->texel;
-      mp_mark_rect(requests, lv->page_table, MP_MAP_PAGES, lv->origin_x, lv->origin_y,
+      mp_mark_rect(requests, caps, lv->page_table, MP_MAP_PAGES, lv->origin_x, lv->origin_y,
                    (lo.x + lv->offset[0]) * k - margin, (lo.y + lv->offset[1]) * k - margin,
-                   (hi.x + lv->offset[0]) * k + margin, (hi.y + lv->offset[1]) * k + margin);
+                   (hi.x + lv->offset[0]) * k + margin, (hi.y + lv->offset[1]) * k + margin, far_bits, request);
     }
     return;
   }
   float dn, df;
   mp_box_depths(lo, hi, &dn, &df);
+  float radius = mp_light_shape_radius(sh);
   for (int m = first; m <= last; ++m) {
     float texels = (float)mp_cube_mip_texels(m);
     /* The margin as scene units at the box's far side. */
@@ -102,8 +118,13 @@ inline void mp_mark_levels(__global const DeviceShadow* sh, __global const Devic
     for (int face = 0; face < 6; ++face) {
       float x0, y0, x1, y1;
       if (!mp_cube_face_box(face, lo - e, hi + e, texels, &x0, &y0, &x1, &y1)) continue;
-      mp_mark_rect(requests, sh->page_table + (uint)face * MP_CUBE_FACE_ENTRIES + mp_cube_mip_entries(m),
-                   MP_MAP_PAGES >> m, 0, 0, x0, y0, x1, y1);
+      /* The face's depth of the box's far side; a segment from a receiver
+       * to the light's shape reaches no deeper than the receiver or the
+       * shape's own extent. */
+      float far_depth = -fmin(mp_cube_face_view(face, lo).z, mp_cube_face_view(face, hi).z);
+      uint far_bits = as_uint(fmax(far_depth, fmax(radius, 1e-30f)));
+      mp_mark_rect(requests, caps, sh->page_table + (uint)face * MP_CUBE_FACE_ENTRIES + mp_cube_mip_entries(m),
+                   MP_MAP_PAGES >> m, 0, 0, x0, y0, x1, y1, far_bits, request);
     }
   }
 }
@@ -148,7 +169,7 @@ inline int mp_marking_box(__global const DeviceShadow* sh, float3 p, FrameParams
  * neighbours (`reach` pixels). */
 inline void mp_mark_vertex(float3 p, FrameParams f, __global const DeviceShadow* shadows,
                            __global const DeviceShadowLevel* levels, uint light_count, __global uchar* requests,
-                           float reach) {
+                           volatile __global uint* caps, float reach, uint soft) {
   for (uint l = 0; l < light_count; ++l) {
     __global const DeviceShadow* sh = shadows + l;
     if (sh->kind == MP_SHADOW_NONE) continue;
@@ -157,8 +178,14 @@ inline void mp_mark_vertex(float3 p, FrameParams f, __global const DeviceShadow*
     if (!mp_marking_box(sh, p, f, reach, &q, &lo, &hi, &s)) continue;
     int first, last;
     mp_base_levels(sh, lo, hi, s, &first, &last);
+    const int base_first = first;
     if (sh->shape != MP_SHADOW_SHAPE_POINT) mp_probe_levels(sh, lo, hi, first, last, &first, &last);
-    mp_mark_levels(sh, levels, lo, hi, first, last, requests);
+    mp_mark_levels(sh, levels, lo, hi, first, last, requests, caps, 1);
+    /* The soft marking (`soft`) may ask for any level from the base one on,
+     * for this receiver's box (mp_mark_soft_vertex): those caps grow now, so
+     * that no page rendered before it is rendered again for it. */
+    if (sh->shape != MP_SHADOW_SHAPE_POINT && soft)
+      mp_mark_levels(sh, levels, lo, hi, base_first, mp_shadow_level_count(sh) - 1, requests, caps, 0);
   }
 }
 
@@ -269,9 +296,9 @@ __kernel void mark_shadow_pages(__global const SubPatch* diceable, uint count, _
                                 uint vertex_total, FrameParams f, __global const float4* grid_p,
                                 __global const float4* grid_n, __global const DeviceShadow* shadows,
                                 __global const DeviceShadowLevel* levels, uint light_count,
-                                __global uchar* requests, float reach, uint mark, uint keep, uint keep_n,
-                                uint keep_base, __global float* kept_p, __global float* kept_n,
-                                __global const uint* depth, OcclusionParams o) {
+                                __global uchar* requests, volatile __global uint* caps, float reach, uint soft,
+                                uint mark, uint keep, uint keep_n, uint keep_base, __global float* kept_p,
+                                __global float* kept_n, __global const uint* depth, OcclusionParams o) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   float2 uv;
@@ -283,20 +310,21 @@ __kernel void mark_shadow_pages(__global const SubPatch* diceable, uint count, _
   }
   if (!valid || !mark) return;
   float3 p = grid_p[index].xyz;
-  if (mp_marking_seen(p, f, depth, o, reach)) mp_mark_vertex(p, f, shadows, levels, light_count, requests, reach);
+  if (mp_marking_seen(p, f, depth, o, reach))
+    mp_mark_vertex(p, f, shadows, levels, light_count, requests, caps, reach, soft);
 }
 
 /* The first marking from the kept vertices, once the coarse depth is
  * complete: only those the camera may see mark pages. */
 __kernel void mark_kept_shadow_pages(__global const float* kept_p, uint kept, FrameParams f,
                                      __global const DeviceShadow* shadows, __global const DeviceShadowLevel* levels,
-                                     uint light_count, __global uchar* requests, float reach,
-                                     __global const uint* depth, OcclusionParams o) {
+                                     uint light_count, __global uchar* requests, volatile __global uint* caps,
+                                     float reach, uint soft, __global const uint* depth, OcclusionParams o) {
   uint gid = get_global_id(0);
   if (gid >= kept) return;
   float3 p = vload3(gid, kept_p);
   if (isnan(p.x) || !mp_marking_seen(p, f, depth, o, reach)) return;
-  mp_mark_vertex(p, f, shadows, levels, light_count, requests, reach);
+  mp_mark_vertex(p, f, shadows, levels, light_count, requests, caps, reach, soft);
 }
 
 /* Second marking, for soft shadows, on the maps the first rendered (one
@@ -308,7 +336,7 @@ __kernel void mark_kept_shadow_pages(__global const float* kept_p, uint kept, Fr
 inline void mp_mark_soft_vertex(float3 p, float3 n, FrameParams f, __global const DeviceShadow* shadows,
                                 __global const DeviceShadowLevel* levels, uint light_count,
                                 __global const uint* pages, __global const uint* pool, __global uchar* requests,
-                                float reach) {
+                                volatile __global uint* caps, float reach) {
   MpShadowMaps maps = {shadows, levels, pages, pool};
   for (uint l = 0; l < light_count; ++l) {
     __global const DeviceShadow* sh = shadows + l;
@@ -333,7 +361,7 @@ inline void mp_mark_soft_vertex(float3 p, float3 n, FrameParams f, __global cons
     int finest = (int)floor(mp_filter_level(sh, q, radius * nearest));
     int first, last;
     mp_base_levels(sh, lo, hi, s, &first, &last);
-    mp_mark_levels(sh, levels, lo, hi, max(first, min(finest, second)), count_levels - 1, requests);
+    mp_mark_levels(sh, levels, lo, hi, max(first, min(finest, second)), count_levels - 1, requests, caps, 1);
   }
 }
 
@@ -341,13 +369,13 @@ __kernel void mark_soft_shadow_pages(__global const float* kept_p, __global cons
                                      FrameParams f, __global const DeviceShadow* shadows,
                                      __global const DeviceShadowLevel* levels, uint light_count,
                                      __global const uint* pages, __global const uint* pool,
-                                     __global uchar* requests, float reach, __global const uint* depth,
-                                     OcclusionParams o) {
+                                     __global uchar* requests, volatile __global uint* caps, float reach,
+                                     __global const uint* depth, OcclusionParams o) {
   uint gid = get_global_id(0);
   if (gid >= kept) return;
   float3 p = vload3(gid, kept_p);
   if (isnan(p.x) || !mp_marking_seen(p, f, depth, o, reach)) return;
-  mp_mark_soft_vertex(p, vload3(gid, kept_n), f, shadows, levels, light_count, pages, pool, requests, reach);
+  mp_mark_soft_vertex(p, vload3(gid, kept_n), f, shadows, levels, light_count, pages, pool, requests, caps, reach);
 }
 
 /* The same, straight from a batch's grids: where the first marking's
@@ -359,7 +387,7 @@ __kernel void mark_soft_shadow_pages_grid(__global const SubPatch* diceable, uin
                                           __global const DeviceShadow* shadows,
                                           __global const DeviceShadowLevel* levels, uint light_count,
                                           __global const uint* pages, __global const uint* pool,
-                                          __global uchar* requests, float reach,
+                                          __global uchar* requests, volatile __global uint* caps, float reach,
                                           __global const uint* depth, OcclusionParams o) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
@@ -367,8 +395,19 @@ __kernel void mark_soft_shadow_pages_grid(__global const SubPatch* diceable, uin
   ulong index;
   if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
   if (!mp_marking_seen(grid_p[index].xyz, f, depth, o, reach)) return;
-  mp_mark_soft_vertex(grid_p[index].xyz, grid_n[index].xyz, f, shadows, levels, light_count, pages, pool, requests,
+  mp_mark_soft_vertex(grid_p[index].xyz, grid_n[index].xyz, f, shadows, levels, light_count, pages, pool, requests, caps,
                       reach);
+}
+
+/* The requested page-table entries, each with its cap, in no particular
+ * order (the host sorts them): one work-item per entry. Past `capacity`
+ * only the count grows, and the host reads the whole tables instead. */
+__kernel void list_requests(__global const uchar* requests, __global const uint* caps, uint n,
+                            volatile __global uint* count, __global uint2* list, uint capacity) {
+  uint e = get_global_id(0);
+  if (e >= n || !requests[e]) return;
+  uint k = atomic_inc(count);
+  if (k < capacity) list[k] = (uint2)(e, caps[e]);
 }
 
 /* Writes the frame's page-table entries (index, value) into a table filled
@@ -392,10 +431,12 @@ __kernel void clear_shadow_pages(__global const uint* pages, uint texel_count, _
 /* The farthest depth of each 16 x 16-texel cell of the listed pages that
  * the shadow pass wrote to since the last look (dirty), and of each page,
  * into the occlusion pyramid's buffer (mp_page_occluded): one work-group of
- * 64 per page, a work-item per cell. */
+ * 64 per page, a work-item per cell. No deeper than the page's cap (caps,
+ * as the list: the farthest receiver that asked for it, requests): what
+ * lies beyond shadows none of them. */
 __kernel __attribute__((reqd_work_group_size(64, 1, 1))) void shadow_page_farthest(
-    __global const uint* pages, uint count, __global const uint* pool, __global uchar* dirty, __global uint* pyramid,
-    uint page_cells, uint page_farthest) {
+    __global const uint* pages, __global const uint* caps, uint count, __global const uint* pool,
+    __global uchar* dirty, __global uint* pyramid, uint page_cells, uint page_farthest) {
   __local uint part[64];
   uint g = get_group_id(0), l = get_local_id(0);
   if (g >= count) return;
@@ -405,6 +446,7 @@ __kernel __attribute__((reqd_work_group_size(64, 1, 1))) void shadow_page_farthe
   __global const uint* texels = pool + (ulong)page * MP_PAGE_TEXELS + (ulong)((l >> 3) * 16u * MP_PAGE_SIZE + (l & 7u) * 16u);
   for (uint y = 0; y < 16u; ++y)
     for (uint x = 0; x < 16u; ++x) m = max(m, texels[y * MP_PAGE_SIZE + x]);
+  m = min(m, caps[g]);
   pyramid[page_cells + page * 64u + l] = m;
   part[l] = m;
   barrier(CLK_LOCAL_MEM_FENCE);

@@ -42,6 +42,27 @@ TEST(ShadowPagePool, KeepsResidentPagesAndRendersOnlyNewOnes) {
   EXPECT_EQ(pool.resident(), 4u);  // pages 0 and 2 stay cached until space is needed
 }
 
+TEST(ShadowPagePool, RendersAgainWhatWasRenderedForNearerReceivers) {
+  // A page holds what lies in front of the receivers it was rendered for:
+  // asked for with a farther receiver, it is rendered again, in its place;
+  // asked for with a nearer one, or after being rendered uncapped, it is kept.
+  ShadowPagePool pool(8);
+  std::vector<ShadowPagePool::Grant> g;
+  pool.grant({key(1, 0), key(1, 1)}, {10u, 10u}, g);
+  const uint32_t first = g[0].physical;
+  pool.grant({key(1, 0), key(1, 1)}, {20u, 5u}, g);
+  EXPECT_TRUE(g[0].render);
+  EXPECT_EQ(g[0].physical, first);
+  EXPECT_FALSE(g[1].render);
+  pool.grant({key(1, 0)}, {20u}, g);
+  EXPECT_FALSE(g[0].render);
+  pool.uncap(key(1, 1));
+  pool.grant({key(1, 1)}, {1000u}, g);
+  EXPECT_FALSE(g[0].render);
+  pool.grant({key(1, 0)}, g);  // no caps: everything
+  EXPECT_TRUE(g[0].render);
+}
+
 TEST(ShadowPagePool, EvictsLeastRecentlyUsedAndNeverExceedsCapacity) {
   ShadowPagePool pool(3);
   std::vector<ShadowPagePool::Grant> g;
@@ -625,14 +646,45 @@ TEST_F(ShadowRenderTest, OnlyWhatTheCameraSeesAsksForPages) {
   EXPECT_EQ(culled.rgba, all.rgba);
 }
 
+TEST_F(ShadowRenderTest, NothingBeyondTheFarthestReceiverIsRendered) {
+  // The camera sees a tile that fills its frame; beside it, outside the
+  // frame and below the tile (farther from the lamp above than any
+  // receiver), lie 48 layers that the lamp sees in the same pages as the
+  // tile. They can shadow no receiver, so the lights' views leave them out:
+  // the same image and about the shadow micropolygons of the tile alone.
+  Light lamp;
+  lamp.type = Light::Type::Point;
+  lamp.intensity = 60.0f;
+  lamp.position = glm::vec3(0.0f, 0.0f, 6.0f);
+  lamp.radius = 0.2f;
+  Scene tile = floor_scene(lamp);
+  tile.meshes.front() = polygon({{-4.5f, -3.5f, 1.0f}, {4.5f, -3.5f, 1.0f}, {4.5f, 3.5f, 1.0f}, {-4.5f, 3.5f, 1.0f}});
+  Scene s = tile;
+  for (int k = 0; k < 48; ++k) {
+    const float z = -0.05f * float(k);
+    s.meshes.push_back(polygon({{4.6f, -3.0f, z}, {9.0f, -3.0f, z}, {9.0f, 3.0f, z}, {4.6f, 3.0f, z}}));
+  }
+  const RenderResult alone = Renderer().render(tile);
+  const RenderResult beside = Renderer().render(s);
+  s.settings.occlusion_culling = false;
+  const RenderResult all = Renderer().render(s);
+  const size_t a = alone.stats.shadows.micropolygons, b = beside.stats.shadows.micropolygons;
+  ASSERT_GT(a, 0u);
+  EXPECT_EQ(beside.rgba, alone.rgba);
+  EXPECT_EQ(all.rgba, alone.rgba);
+  EXPECT_EQ(beside.stats.shadows.pages_requested, alone.stats.shadows.pages_requested);
+  EXPECT_LT(double(b), 1.1 * double(a)) << b << " shadow micropolygons with the layers beside, " << a << " without";
+  EXPECT_GT(double(all.stats.shadows.micropolygons), 2.0 * double(a)) << "the layers lie outside the tile's pages";
+}
+
 TEST_F(ShadowRenderTest, MarkingVerticesKeepToTheirShareOfTheBudget) {
   // Enough layers that the soft marking's vertices pass an eighth of a
-  // 6 MiB budget: the marking dices the view again rather than keep them,
+  // 7 MiB budget: the marking dices the view again rather than keep them,
   // and the pages (and so the image) are those of an ample budget.
   Scene s = layer_stack(160);
   s.settings.occlusion_culling = false;
   const RenderResult ample = Renderer().render(s);
-  s.settings.shadow_memory_mib = 6.0f;
+  s.settings.shadow_memory_mib = 7.0f;
   const RenderResult tight = Renderer().render(s);
   const ShadowStats& t = tight.stats.shadows;
   EXPECT_EQ(ample.stats.shadows.marking_passes, 0u);

@@ -14,10 +14,6 @@ namespace {
 // few tens, and the test reads up to 4 x 4 cells of the level that fits.
 constexpr int kCellShift = 2;
 
-cl::NDRange range_2d(int w, int h) {
-  return cl::NDRange(static_cast<size_t>((w + 7) / 8 * 8), static_cast<size_t>((h + 7) / 8 * 8));
-}
-
 }  // namespace
 
 OcclusionCulling::OcclusionCulling(DeviceSession& session)
@@ -26,13 +22,18 @@ OcclusionCulling::OcclusionCulling(DeviceSession& session)
       reduce_(session.program(), "occlusion_reduce"),
       covered_(session.allocate(sizeof(cl_uint), "covered pixel count")) {}
 
-void OcclusionCulling::size_for(const FrameParams& f) {
+OcclusionParams occlusion_layout(const FrameParams& f, int cell_shift) {
   OcclusionParams o{};
-  o.cell_shift = kCellShift;
-  o.base_w = (f.width + (1 << kCellShift) - 1) >> kCellShift;
-  o.base_h = (f.height + (1 << kCellShift) - 1) >> kCellShift;
+  o.cell_shift = cell_shift;
+  o.base_w = std::max((f.width + (1 << cell_shift) - 1) >> cell_shift, 1);
+  o.base_h = std::max((f.height + (1 << cell_shift) - 1) >> cell_shift, 1);
   o.levels = 1;
   while (o.levels < MP_OCCLUSION_MAX_LEVELS && std::max(o.base_w, o.base_h) > (1 << (o.levels - 1))) ++o.levels;
+  return o;
+}
+
+void OcclusionCulling::size_for(const FrameParams& f) {
+  const OcclusionParams o = occlusion_layout(f, kCellShift);
   params_ = o;
   size_t cells = 0;
   for (int k = 0; k < o.levels; ++k)

@@ -52,6 +52,10 @@ class OcclusionCulling {
   OcclusionParams params_{};
 };
 
+// The layout of a max-depth pyramid over frame f whose level-0 cells are
+// 2^cell_shift pixels wide, halving up to one cell.
+OcclusionParams occlusion_layout(const FrameParams& f, int cell_shift);
+
 // Patch indices ordered by the distance from the eye to their camera-space
 // boxes (lo and hi per patch), those whose box lies outside the view last:
 // the order bound & split takes its roots in when culling.

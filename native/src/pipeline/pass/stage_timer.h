@@ -68,14 +68,19 @@ class StageTimer {
   std::array<double, static_cast<size_t>(Stage::Count)> ms_{};
 };
 
-// Rounds a 1D launch up to a multiple of the work-group size used for it.
 // Milliseconds of wall time since t0.
 inline double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// Rounds a 1D launch up to a multiple of the work-group size used for it.
 inline cl::NDRange round_up_range(size_t n, size_t group = 64) {
   return cl::NDRange(((n + group - 1) / group) * group);
+}
+
+// A 2-D range of 8 x 8 work-groups covering w x h.
+inline cl::NDRange range_2d(int w, int h) {
+  return cl::NDRange(static_cast<size_t>((w + 7) / 8 * 8), static_cast<size_t>((h + 7) / 8 * 8));
 }
 
 }  // namespace mp

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "cl/kernel_args.h"
+#include "pipeline/pass/occlusion_culling.h"
 #include "stages/mp_occlusion.h"
 
 namespace mp {
@@ -12,19 +13,7 @@ namespace {
 // pixels wide, so each covers a dozen samples or more.
 constexpr int kCellShift = 1;
 
-OcclusionParams layout_for(const FrameParams& f) {
-  OcclusionParams o{};
-  o.cell_shift = kCellShift;
-  o.base_w = std::max((f.width + (1 << kCellShift) - 1) >> kCellShift, 1);
-  o.base_h = std::max((f.height + (1 << kCellShift) - 1) >> kCellShift, 1);
-  o.levels = 1;
-  while (o.levels < MP_OCCLUSION_MAX_LEVELS && std::max(o.base_w, o.base_h) > (1 << (o.levels - 1))) ++o.levels;
-  return o;
-}
-
-cl::NDRange range_2d(int w, int h) {
-  return cl::NDRange(static_cast<size_t>((w + 7) / 8 * 8), static_cast<size_t>((h + 7) / 8 * 8));
-}
+OcclusionParams layout_for(const FrameParams& f) { return occlusion_layout(f, kCellShift); }
 
 }  // namespace
 

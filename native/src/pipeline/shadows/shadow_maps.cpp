@@ -31,6 +31,17 @@ constexpr float kMarkCoarsening = 8.0f;
 // Each marking vertex's box reaches its neighbours: one coarse micropolygon edge.
 cl_float mark_reach(const FrameParams& coarse) { return coarse.micropoly_edge; }
 
+// Requested pages the device lists for the host (collect_requests); more
+// are read as whole tables. A page-table entry's share is half a byte.
+cl_uint list_capacity(cl_uint table_entries) { return std::max<cl_uint>(4096, table_entries / 16); }
+
+// The markings' coarse view of the camera's.
+FrameParams marking_view(const FrameSetup& frame) {
+  FrameParams coarse = frame.params;
+  coarse.micropoly_edge *= kMarkCoarsening;
+  return coarse;
+}
+
 }  // namespace
 
 ShadowMaps::ShadowMaps(DeviceSession& session)
@@ -41,9 +52,11 @@ ShadowMaps::ShadowMaps(DeviceSession& session)
       mark_soft_grid_(session.program(), "mark_soft_shadow_pages_grid"),
       clear_(session.program(), "clear_shadow_pages"),
       set_entries_(session.program(), "set_page_entries"),
+      list_requests_(session.program(), "list_requests"),
       sample_(session.program(), "shadow_sample"),
       farthest_(session.program(), "shadow_page_farthest"),
       occlusion_build_(session.program(), "shadow_occlusion_build"),
+      list_count_(session.allocate(sizeof(cl_uint), "shadow request count")),
       depth_(session) {}
 
 void ShadowMaps::upload_records(const ShadowLayout& layout) {
@@ -62,6 +75,8 @@ void ShadowMaps::clear_requests(const ShadowLayout& layout) {
   const size_t n = layout.table_entries;
   session_.reserve(requests_, requests_capacity_, n, "shadow page requests");
   session_.queue().enqueueFillBuffer(requests_, cl_uchar(0), 0, n);
+  session_.reserve(caps_, caps_held_, n * sizeof(cl_uint), "shadow page caps");
+  session_.queue().enqueueFillBuffer(caps_, cl_uint(0), 0, n * sizeof(cl_uint));
 }
 
 bool ShadowMaps::camera_view(const ShadowLayout& layout, const FrameSetup& frame, MicropolygonPass& pass, bool soft,
@@ -69,9 +84,7 @@ bool ShadowMaps::camera_view(const ShadowLayout& layout, const FrameSetup& frame
   StageTimer& timer = pass.timer();
   StageTimer::Redirect to(timer, Stage::ShadowMark);
   const auto started = std::chrono::steady_clock::now();
-  DeviceQueue& q = session_.queue();
-  FrameParams coarse = frame.params;
-  coarse.micropoly_edge *= kMarkCoarsening;
+  const FrameParams coarse = marking_view(frame);
   const cl_uint light_count = cl_uint(layout.shadows.size());
   GridBuffers& grids = pass.grids();
   const SceneBuffers& buffers = pass.scene();
@@ -93,12 +106,11 @@ bool ShadowMaps::camera_view(const ShadowLayout& layout, const FrameSetup& frame
     if (keep && size_t(kept_vertices_) + vertices > kept_limit_) keep = false, kept_overflow_ = true;
     if (keep) keep_room(size_t(kept_vertices_) + vertices);
     bind_args(mark_, diceable, count, grids.vertex_offsets, vertices, coarse, grids.p, grids.n, inputs_.shadows,
-              inputs_.levels, light_count, requests_, mark_reach(coarse), cl_uint(!keep), cl_uint(keep),
+              inputs_.levels, light_count, request_args(), mark_reach(coarse), cl_uint(soft), cl_uint(!keep),
+              cl_uint(keep),
               cl_uint(soft), kept_vertices_, keep ? kept_p_ : grids.p, keep && soft ? kept_n_ : grids.n,
               depth_.image(), OcclusionParams{});  // unwritten when not kept; no depth test yet
-    cl::Event e;
-    q.enqueueNDRangeKernel(mark_, cl::NullRange, round_up_range(vertices), cl::NDRange(64), nullptr, &e);
-    timer.add(Stage::ShadowMark, e);
+    launch(mark_, vertices, timer);
     if (keep) kept_vertices_ += vertices;
   };
   const BoundSplitResult r = pass.run(
@@ -116,39 +128,24 @@ bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, Micro
   StageTimer& timer = pass.timer();
   StageTimer::Redirect to(timer, Stage::ShadowMark);
   const auto started = std::chrono::steady_clock::now();
-  DeviceQueue& q = session_.queue();
-  FrameParams coarse = frame.params;
-  coarse.micropoly_edge *= kMarkCoarsening;
+  const FrameParams coarse = marking_view(frame);
   const cl_uint light_count = cl_uint(layout.shadows.size());
   if (kept_vertices_ > 0) {
-    bind_args(mark_kept_, kept_p_, kept_vertices_, coarse, inputs_.shadows, inputs_.levels, light_count, requests_,
-              mark_reach(coarse), depth_.image(), depth_.params());
-    cl::Event e;
-    q.enqueueNDRangeKernel(mark_kept_, cl::NullRange, round_up_range(kept_vertices_), cl::NDRange(64), nullptr, &e);
-    timer.add(Stage::ShadowMark, e);
+    bind_args(mark_kept_, kept_p_, kept_vertices_, coarse, inputs_.shadows, inputs_.levels, light_count,
+              request_args(), mark_reach(coarse), cl_uint(kept_normals_), depth_.image(), depth_.params());
+    launch(mark_kept_, kept_vertices_, timer);
   }
-  if (kept_overflow_ && !first) {
-    // The batches past the kept share marked their pages in the camera's
-    // view; at a coarser level bias they do so again, diced anew.
-    ++stats.marking_passes;
-    GridBuffers& grids = pass.grids();
-    ViewTarget target;
-    target.normals = false;
-    target.take = [&](const cl::Buffer& diceable, cl_uint count) {
-      ++stats.batches;
-      const cl_uint vertices = grids.vertex_total;
-      if (vertices == 0) return;
-      bind_args(mark_, diceable, count, grids.vertex_offsets, vertices, coarse, grids.p, grids.n, inputs_.shadows,
-                inputs_.levels, light_count, requests_, mark_reach(coarse), cl_uint(1), cl_uint(0), cl_uint(0),
-                cl_uint(0), grids.p, grids.n, depth_.image(), depth_.params());
-      cl::Event e;
-      q.enqueueNDRangeKernel(mark_, cl::NullRange, round_up_range(vertices), cl::NDRange(64), nullptr, &e);
-      timer.add(Stage::ShadowMark, e);
-    };
-    const BoundSplitResult r = pass.run(PassView{coarse, PassViews{}, depth_.complete(camera_order_)}, target);
-    stats.marking_occluded += r.occluded;
-    if (r.cancelled) return false;
-  }
+  // The batches past the kept share marked their pages in the camera's
+  // view; at a coarser level bias they do so again, diced anew.
+  GridBuffers& grids = pass.grids();
+  if (kept_overflow_ && !first &&
+      !mark_again(pass, coarse, false, mark_, stats, [&](const cl::Buffer& diceable, cl_uint count) {
+        bind_args(mark_, diceable, count, grids.vertex_offsets, grids.vertex_total, coarse, grids.p, grids.n,
+                  inputs_.shadows, inputs_.levels, light_count, request_args(), mark_reach(coarse),
+                  cl_uint(kept_normals_), cl_uint(1), cl_uint(0), cl_uint(0), cl_uint(0), grids.p, grids.n,
+                  depth_.image(), depth_.params());
+      }))
+    return false;
   collect_requests(layout, keys, entries);
   stats.mark_wall_ms += ms_since(started);
   return true;
@@ -159,42 +156,51 @@ bool ShadowMaps::mark_soft(const ShadowLayout& layout, const FrameSetup& frame, 
   StageTimer& timer = pass.timer();
   StageTimer::Redirect to(timer, Stage::ShadowMark);
   const auto started = std::chrono::steady_clock::now();
-  DeviceQueue& q = session_.queue();
-  FrameParams coarse = frame.params;
-  coarse.micropoly_edge *= kMarkCoarsening;
+  const FrameParams coarse = marking_view(frame);
   // The soft marking adds to the first's requests.
   const cl_uint light_count = cl_uint(layout.shadows.size());
-  auto launch = [&](cl::Kernel& k, cl_uint vertices) {
-    cl::Event e;
-    q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(vertices), cl::NDRange(64), nullptr, &e);
-    timer.add(Stage::ShadowMark, e);
-  };
+  GridBuffers& grids = pass.grids();
   if (kept_overflow_) {
     // More vertices than the budget keeps: the view is diced again, as the
     // camera's view diced it (culled by its complete depth), and marked
     // batch by batch.
-    ++stats.marking_passes;
-    GridBuffers& grids = pass.grids();
-    ViewTarget target;
-    target.take = [&](const cl::Buffer& diceable, cl_uint count) {
-      ++stats.batches;
-      if (grids.vertex_total == 0) return;
-      bind_args(mark_soft_grid_, diceable, count, grids.vertex_offsets, coarse, grids.p, grids.n, inputs_.shadows,
-                inputs_.levels, light_count, inputs_.pages, inputs_.pool, requests_, mark_reach(coarse),
-                depth_.image(), depth_.params());
-      launch(mark_soft_grid_, grids.vertex_total);
-    };
-    const BoundSplitResult r = pass.run(PassView{coarse, PassViews{}, depth_.complete(camera_order_)}, target);
-    stats.marking_occluded += r.occluded;
-    if (r.cancelled) return false;
+    if (!mark_again(pass, coarse, true, mark_soft_grid_, stats, [&](const cl::Buffer& diceable, cl_uint count) {
+          bind_args(mark_soft_grid_, diceable, count, grids.vertex_offsets, coarse, grids.p, grids.n,
+                    inputs_.shadows, inputs_.levels, light_count, inputs_.pages, inputs_.pool, request_args(),
+                    mark_reach(coarse), depth_.image(), depth_.params());
+        }))
+      return false;
   } else if (kept_vertices_ > 0) {
     bind_args(mark_soft_, kept_p_, kept_n_, kept_vertices_, coarse, inputs_.shadows, inputs_.levels, light_count,
-              inputs_.pages, inputs_.pool, requests_, mark_reach(coarse), depth_.image(), depth_.params());
-    launch(mark_soft_, kept_vertices_);
+              inputs_.pages, inputs_.pool, request_args(), mark_reach(coarse), depth_.image(), depth_.params());
+    launch(mark_soft_, kept_vertices_, timer);
   }
   collect_requests(layout, keys, entries);
   stats.mark_wall_ms += ms_since(started);
   return true;
+}
+
+void ShadowMaps::launch(cl::Kernel& kernel, cl_uint items, StageTimer& timer) {
+  cl::Event e;
+  session_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, round_up_range(items), cl::NDRange(64), nullptr, &e);
+  timer.add(Stage::ShadowMark, e);
+}
+
+bool ShadowMaps::mark_again(MicropolygonPass& pass, const FrameParams& coarse, bool normals, cl::Kernel& kernel,
+                            ShadowStats& stats, const std::function<void(const cl::Buffer&, cl_uint)>& bind) {
+  ++stats.marking_passes;
+  GridBuffers& grids = pass.grids();
+  ViewTarget target;
+  target.normals = normals;
+  target.take = [&](const cl::Buffer& diceable, cl_uint count) {
+    ++stats.batches;
+    if (grids.vertex_total == 0) return;
+    bind(diceable, count);
+    launch(kernel, grids.vertex_total, pass.timer());
+  };
+  const BoundSplitResult r = pass.run(PassView{coarse, PassViews{}, depth_.complete(camera_order_)}, target);
+  stats.marking_occluded += r.occluded;
+  return !r.cancelled;
 }
 
 void ShadowMaps::keep_room(size_t vertices) {
@@ -215,29 +221,69 @@ void ShadowMaps::keep_room(size_t vertices) {
 
 void ShadowMaps::collect_requests(const ShadowLayout& layout, std::vector<ShadowPageKey>& keys,
                                   std::vector<uint32_t>& entries) {
-  const size_t n = layout.table_entries;
-  std::vector<uint8_t> requested(n);
-  session_.queue().enqueueReadBuffer(requests_, CL_TRUE, 0, n, requested.data());
-  // Coarser maps first: a budget too short for everything keeps them.
+  const cl_uint n = cl_uint(layout.table_entries);
+  DeviceQueue& q = session_.queue();
+  // The requested entries and their caps, listed on the device: a few
+  // hundred pairs to read rather than every table (a sun's 393,216 entries).
+  const cl_uint capacity = list_capacity(n);
+  session_.reserve(list_, list_held_, size_t(capacity) * sizeof(cl_uint2), "shadow request list");
+  cl_uint count = 0;
+  q.enqueueFillBuffer(list_count_, cl_uint(0), 0, sizeof count);
+  bind_args(list_requests_, requests_, caps_, n, list_count_, list_, capacity);
+  q.enqueueNDRangeKernel(list_requests_, cl::NullRange, round_up_range(n, 256), cl::NDRange(256));
+  q.enqueueReadBuffer(list_count_, CL_TRUE, 0, sizeof count, &count);
+  std::vector<cl_uint2> listed(count);
+  if (count <= capacity) {
+    if (count) q.enqueueReadBuffer(list_, CL_TRUE, 0, size_t(count) * sizeof(cl_uint2), listed.data());
+  } else {
+    // More than the list holds: the whole tables.
+    std::vector<uint8_t> requested(n);
+    std::vector<uint32_t> caps(n);
+    q.enqueueReadBuffer(requests_, CL_TRUE, 0, n, requested.data());
+    q.enqueueReadBuffer(caps_, CL_TRUE, 0, size_t(n) * sizeof(cl_uint), caps.data());
+    listed.clear();
+    for (cl_uint e = 0; e < n; ++e)
+      if (requested[e]) listed.push_back({{e, caps[e]}});
+  }
+  // Coarser maps first (a budget too short for everything keeps them), in
+  // the layout's order among equals, each map's pages in raster order.
   std::vector<size_t> order(layout.maps.size());
   std::iota(order.begin(), order.end(), size_t(0));
   std::stable_sort(order.begin(), order.end(),
                    [&](size_t a, size_t b) { return layout.maps[a].coarseness > layout.maps[b].coarseness; });
+  std::vector<size_t> rank(layout.maps.size());
+  for (size_t r = 0; r < order.size(); ++r) rank[order[r]] = r;
+  // Maps by their first table entry, to find each entry's.
+  std::vector<std::pair<uint32_t, size_t>> starts(layout.maps.size());
+  for (size_t i = 0; i < layout.maps.size(); ++i) starts[i] = {layout.maps[i].table, i};
+  std::sort(starts.begin(), starts.end());
+  struct Listed {
+    size_t rank, map;
+    cl_uint2 entry;
+  };
+  std::vector<Listed> sorted;
+  sorted.reserve(listed.size());
+  for (const cl_uint2& l : listed) {
+    auto it = std::upper_bound(starts.begin(), starts.end(), std::make_pair(l.s[0], ~size_t(0)));
+    const size_t map = std::prev(it)->second;
+    sorted.push_back({rank[map], map, l});
+  }
+  std::sort(sorted.begin(), sorted.end(), [](const Listed& a, const Listed& b) {
+    return a.rank != b.rank ? a.rank < b.rank : a.entry.s[0] < b.entry.s[0];
+  });
   keys.clear();
   entries.clear();
-  for (size_t i : order) {
-    const ShadowMapInfo& m = layout.maps[i];
-    for (int sy = 0; sy < m.side; ++sy)
-      for (int sx = 0; sx < m.side; ++sx) {
-        const uint32_t e = m.table + uint32_t(sy * m.side + sx);
-        if (!requested[e]) continue;
-        ShadowPageKey k;
-        k.light = layout.light_keys[size_t(m.light)];
-        k.map = m.map_id;
-        layout.page_position(m, sx, sy, &k.x, &k.y);
-        keys.push_back(k);
-        entries.push_back(e);
-      }
+  request_caps_.clear();
+  for (const Listed& l : sorted) {
+    const ShadowMapInfo& m = layout.maps[l.map];
+    const uint32_t e = l.entry.s[0], at = e - m.table;
+    ShadowPageKey k;
+    k.light = layout.light_keys[size_t(m.light)];
+    k.map = m.map_id;
+    layout.page_position(m, int(at % uint32_t(m.side)), int(at / uint32_t(m.side)), &k.x, &k.y);
+    keys.push_back(k);
+    entries.push_back(e);
+    request_caps_.push_back(l.entry.s[1]);
   }
 }
 
@@ -363,7 +409,8 @@ bool ShadowMaps::render_views(const std::vector<FrameParams>& views, const std::
         if (looked_at > 0 && (written - looked_at) * 8 < written) return;
         looked_at = std::max<size_t>(written, 1);
         cl::Event e1, e2;
-        bind_args(farthest_, clear_list_, fresh_pages, inputs_.pool, dirty_, pyramid_, page_cells, page_farthest);
+        bind_args(farthest_, clear_list_, caps_list_, fresh_pages, inputs_.pool, dirty_, pyramid_, page_cells,
+                  page_farthest);
         q.enqueueNDRangeKernel(farthest_, cl::NullRange, cl::NDRange(size_t(fresh_pages) * 64), cl::NDRange(64),
                                nullptr, &e1);
         bind_args(occlusion_build_, views_, inputs_.pages, pyramid_, page_farthest);
@@ -397,12 +444,13 @@ bool ShadowMaps::render(const Scene& scene, const std::vector<Light>& lights, co
   }
   stats.lights = layout.shadowed_lights;
 
-  bool soft = false;
-  if (settings.soft_shadow_pages)
-    for (const DeviceShadow& d : layout.shadows)
-      soft = soft || (d.kind != MP_SHADOW_NONE && d.shape != MP_SHADOW_SHAPE_POINT);
+  bool soft_lights = false;
+  for (const DeviceShadow& d : layout.shadows)
+    soft_lights = soft_lights || (d.kind != MP_SHADOW_NONE && d.shape != MP_SHADOW_SHAPE_POINT);
+  const bool soft = soft_lights && settings.soft_shadow_pages;
+  capped_ = settings.soft_shadow_pages || !soft_lights;
 
-  // The budget holds the page tables, the requests, the page masks (at most
+  // The budget holds the page tables, the requests, their caps and list, the page masks (at most
   // a third of the tables) and, with culling, their pyramids, the camera's
   // coarse depth, the views and the lights' records first; then the
   // marking's kept vertices take up to an eighth (where there is a depth to
@@ -412,7 +460,8 @@ bool ShadowMaps::render(const Scene& scene, const std::vector<Light>& lights, co
   // budget too short for the depth, or for culling's parts, and sixteen
   // pages does without them.
   const size_t masks = size_t(layout.table_entries) * 4 / 3;
-  size_t fixed = size_t(layout.table_entries) * (sizeof(cl_uint) + 1) + masks +
+  size_t fixed = size_t(layout.table_entries) * (2 * sizeof(cl_uint) + 1) +
+                 size_t(list_capacity(cl_uint(layout.table_entries))) * sizeof(cl_uint2) + masks +
                  MP_MAX_PASS_VIEWS * sizeof(FrameParams) + layout.shadows.size() * sizeof(DeviceShadow) +
                  layout.levels.size() * sizeof(DeviceShadowLevel);
   const size_t depth_bytes = MarkingDepth::bytes_for(frame.params);
@@ -490,9 +539,10 @@ bool ShadowMaps::render(const Scene& scene, const std::vector<Light>& lights, co
   }
   size_t orders = 0;
   for (const LightOrder& o : orders_) orders += o.bytes;
-  stats.peak_bytes = size_t(pool_pages_) * (kPageBytes + 1) + pages_capacity_ + requests_capacity_ +
+  stats.peak_bytes = size_t(pool_pages_) * (kPageBytes + 1) + pages_capacity_ + requests_capacity_ + caps_held_ +
+                     list_held_ +
                      masks_capacity_ + pyramid_capacity_ + views_capacity_ + records_capacity_ + levels_capacity_ +
-                     clear_capacity_ + writes_capacity_ + kept_capacity_ * (kept_normals_ ? 2 : 1) * kKeptVectorBytes +
+                     clear_capacity_ + caps_capacity_ + writes_capacity_ + kept_capacity_ * (kept_normals_ ? 2 : 1) * kKeptVectorBytes +
                      depth_.held_bytes() + orders;
   return true;
 }
@@ -507,12 +557,17 @@ bool ShadowMaps::allocate_and_render(const ShadowLayout& layout, const std::vect
     std::chrono::steady_clock::time_point from;
     ~AddWall() { to += ms_since(from); }
   } add_wall{stats.render_wall_ms, started};
+  // Pages render only what lies in front of the farthest receiver that
+  // asked for them (requests), where every reader of a page asked for it:
+  // not where pages are missing (readers fall back to coarser levels that
+  // others asked for) nor where soft shadows read levels that no marking
+  // asked for (RenderSettings::soft_shadow_pages off).
   std::vector<ShadowPagePool::Grant> grants;
-  pool_.grant(keys, grants);
+  pool_.grant(keys, capped_ ? request_caps_ : std::vector<uint32_t>{}, grants);
 
   // Page tables: the granted pages, marked for rendering where new.
   std::vector<uint32_t> table(layout.table_entries, 0u);
-  std::vector<uint32_t> fresh;
+  std::vector<uint32_t> fresh, fresh_caps;
   std::vector<cl_uint2> writes;
   writes.reserve(keys.size());
   stats.pages_missing = 0;
@@ -524,7 +579,12 @@ bool ShadowMaps::allocate_and_render(const ShadowLayout& layout, const std::vect
     }
     table[entries[i]] = g.physical | MP_PAGE_RESIDENT | (g.render ? MP_PAGE_RENDER : 0u);
     writes.push_back({{entries[i], table[entries[i]]}});
-    if (g.render) fresh.push_back(g.physical);
+    if (g.render) fresh.push_back(g.physical), fresh_caps.push_back(capped_ ? request_caps_[i] : ShadowPagePool::kUncapped);
+  }
+  if (stats.pages_missing > 0 && capped_) {
+    for (size_t i = 0; i < keys.size(); ++i)
+      if (grants[i].render) pool_.uncap(keys[i]);
+    std::fill(fresh_caps.begin(), fresh_caps.end(), ShadowPagePool::kUncapped);
   }
   stats.pages_rendered += fresh.size();
 
@@ -589,6 +649,8 @@ bool ShadowMaps::allocate_and_render(const ShadowLayout& layout, const std::vect
   StageTimer::Redirect to(timer, Stage::ShadowBoundSplit);
   session_.reserve(clear_list_, clear_capacity_, fresh.size() * sizeof(cl_uint), "shadow page list");
   q.enqueueWriteBuffer(clear_list_, CL_TRUE, 0, fresh.size() * sizeof(cl_uint), fresh.data());
+  session_.reserve(caps_list_, caps_capacity_, fresh.size() * sizeof(cl_uint), "shadow page caps");
+  q.enqueueWriteBuffer(caps_list_, CL_TRUE, 0, fresh.size() * sizeof(cl_uint), fresh_caps.data());
   const cl_uint texels = cl_uint(fresh.size() * MP_PAGE_TEXELS);
   bind_args(clear_, clear_list_, texels, inputs_.pool, dirty_);
   cl::Event e;

@@ -11,7 +11,8 @@
 //     geometry did not change are not rendered again;
 //  4. the lights' views go through bound & split, dicing and displacement
 //     as the camera's do, several views per pass, and their micropolygons
-//     are rasterised into the new pages (depth only);
+//     are rasterised into the new pages (depth only); with culling, nothing
+//     beyond a page's farthest receiver (its request) is diced;
 //  5. for soft shadows, a second marking runs the first search round on
 //     those maps, from the vertices the first marking kept (no second pass
 //     over the scene): where it finds occluders, the finer levels the penumbra
@@ -25,6 +26,7 @@
 #include <vector>
 
 #include "cl/device_session.h"
+#include "cl/kernel_args.h"
 #include "micropoly/renderer.h"
 #include "pipeline/pass/bound_split.h"
 #include "pipeline/frame/frame_params.h"
@@ -69,6 +71,13 @@ class ShadowMaps {
   // requests. Returns false when the runner was cancelled.
   bool mark_soft(const ShadowLayout& layout, const FrameSetup& frame, MicropolygonPass& pass,
                  std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries, ShadowStats& stats);
+  // Dices the markings' coarse view again (culled by the camera's complete
+  // coarse depth) and runs `kernel` on each batch's vertices, its arguments
+  // bound by `bind`; false when the runner was cancelled.
+  bool mark_again(MicropolygonPass& pass, const FrameParams& coarse, bool normals, cl::Kernel& kernel,
+                  ShadowStats& stats, const std::function<void(const cl::Buffer&, cl_uint)>& bind);
+  // A marking kernel over `items` vertices, timed as the marking.
+  void launch(cl::Kernel& kernel, cl_uint items, StageTimer& timer);
   void collect_requests(const ShadowLayout& layout, std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries);
   void keep_room(size_t vertices);
   void clear_requests(const ShadowLayout& layout);
@@ -98,14 +107,24 @@ class ShadowMaps {
   size_t orders_limit_ = 0;  // bytes the lights' patch orders may hold
 
   DeviceSession& session_;
-  cl::Kernel mark_, mark_kept_, mark_soft_, mark_soft_grid_, clear_, set_entries_, sample_, farthest_, occlusion_build_;
+  cl::Kernel mark_, mark_kept_, mark_soft_, mark_soft_grid_, clear_, set_entries_, list_requests_, sample_, farthest_,
+      occlusion_build_;
   std::vector<size_t> light_pages_;  // resident pages per light, this frame
   ShadowPagePool pool_;
   ShadowInputs inputs_;
-  cl::Buffer requests_, views_, masks_, clear_list_, writes_;
+  // Per page-table entry, whether it is asked for and its cap (the
+  // farthest receiver's depth, mp_mark_rect); the device's list of those
+  // asked for; the caps of the pages asked for, as collect_requests lists
+  // them, and of the fresh pages (caps_list_, as clear_list_).
+  cl::Buffer requests_, caps_, list_, views_, masks_, clear_list_, caps_list_, writes_;
+  size_t caps_held_ = 0, list_held_ = 0;
+  auto request_args() const { return arg_pack(requests_, caps_); }
+  std::vector<uint32_t> request_caps_;
+  bool capped_ = false;  // whether pages render only what lies in front of their caps
   cl::Buffer kept_p_, kept_n_;  // the camera view's vertices and (soft shadows) normals, for the markings
-  size_t kept_capacity_ = 0, writes_capacity_ = 0;
+  size_t kept_capacity_ = 0, writes_capacity_ = 0, caps_capacity_ = 0;
   bool kept_normals_ = false;  // whether normals are kept too (kept_n_, as many as kept_p_)
+  cl::Buffer list_count_;
   MarkingDepth depth_;
   cl_uint kept_vertices_ = 0;
   size_t requests_capacity_ = 0, pages_capacity_ = 0, views_capacity_ = 0, masks_capacity_ = 0, clear_capacity_ = 0, records_capacity_ = 0,

@@ -44,12 +44,20 @@ uint32_t ShadowPagePool::extent() const {
   return e;
 }
 
-size_t ShadowPagePool::grant(const std::vector<ShadowPageKey>& requests, std::vector<Grant>& grants) {
+void ShadowPagePool::uncap(const ShadowPageKey& key) {
+  auto it = pages_.find(key);
+  if (it != pages_.end()) it->second.cap = kUncapped;
+}
+
+size_t ShadowPagePool::grant(const std::vector<ShadowPageKey>& requests, const std::vector<uint32_t>& caps,
+                             std::vector<Grant>& grants) {
   ++frame_;
   grants.assign(requests.size(), Grant{});
+  auto cap_of = [&](size_t i) { return caps.empty() ? kUncapped : caps[i]; };
   size_t granted = 0;
   std::vector<size_t> fresh;
-  // Resident pages first: they cost nothing to keep.
+  // Resident pages first: they cost nothing to keep, unless they were
+  // rendered only to a nearer depth than asked for now.
   for (size_t i = 0; i < requests.size(); ++i) {
     auto it = pages_.find(requests[i]);
     if (it == pages_.end()) {
@@ -57,7 +65,9 @@ size_t ShadowPagePool::grant(const std::vector<ShadowPageKey>& requests, std::ve
       continue;
     }
     it->second.used = frame_;
-    grants[i] = Grant{it->second.physical, false};
+    const bool again = it->second.cap < cap_of(i);
+    if (again) it->second.cap = cap_of(i);
+    grants[i] = Grant{it->second.physical, again};
     ++granted;
   }
   // Pages of earlier frames that this one does not use, least recent first.
@@ -78,7 +88,7 @@ size_t ShadowPagePool::grant(const std::vector<ShadowPageKey>& requests, std::ve
     } else {
       break;
     }
-    pages_[requests[i]] = Entry{physical, frame_};
+    pages_[requests[i]] = Entry{physical, frame_, cap_of(i)};
     grants[i] = Grant{physical, true};
     ++granted;
   }

@@ -50,7 +50,17 @@ class ShadowPagePool {
   // Gives the requests pages, in order: resident ones keep theirs, new ones
   // take free pages or those least recently used by earlier frames. Grants
   // at most `capacity` pages (the first requests first); returns how many.
-  size_t grant(const std::vector<ShadowPageKey>& requests, std::vector<Grant>& grants);
+  // `caps` (one per request, empty: kUncapped for all): the farthest depth
+  // (a positive float's bits) the page must hold what lies in front of; a
+  // resident page rendered for a nearer cap is rendered again.
+  size_t grant(const std::vector<ShadowPageKey>& requests, const std::vector<uint32_t>& caps,
+               std::vector<Grant>& grants);
+  size_t grant(const std::vector<ShadowPageKey>& requests, std::vector<Grant>& grants) {
+    return grant(requests, {}, grants);
+  }
+  // Marks a resident page as rendered with everything, whatever its cap.
+  void uncap(const ShadowPageKey& key);
+  static constexpr uint32_t kUncapped = 0xffffffffu;
   size_t resident() const { return pages_.size(); }
   // One more than the highest physical page in use (the pool buffer's size).
   uint32_t extent() const;
@@ -59,6 +69,7 @@ class ShadowPagePool {
   struct Entry {
     uint32_t physical;
     uint64_t used;  // the frame that last requested it
+    uint32_t cap;   // the depth it was rendered to (kUncapped: all of it)
   };
   uint32_t take_free();
   size_t capacity_;
