@@ -503,6 +503,32 @@ TEST_F(ShadowRenderTest, PagesAreKeptBetweenFramesWhileLightsAndGeometryStay) {
   EXPECT_EQ(turned.rgba, fresh.render(s).rgba);
 }
 
+TEST_F(ShadowRenderTest, KeptPagesAreRenderedAgainWhereTheirReceiversNowLieFarther) {
+  // The first frame sees only a tile high above the floor, so its pages
+  // hold only what lies in front of the tile, and an occluder below it is
+  // left out. The camera then pans (the same pixel size, so the same
+  // levels) to the floor beside the tile, where that occluder's shadow falls
+  // in some of the same pages: those are rendered again, and the frame is
+  // what a renderer that never saw the first makes.
+  Light sun;
+  sun.type = Light::Type::Distant;
+  sun.direction = glm::normalize(glm::vec3(0.3f, 0.0f, -1.0f));
+  Scene s = floor_scene(sun);
+  s.meshes.push_back(polygon({{-0.6f, -0.6f, 2.0f}, {0.6f, -0.6f, 2.0f}, {0.6f, 0.6f, 2.0f}, {-0.6f, 0.6f, 2.0f}}));
+  s.meshes.push_back(occluder(0.9f, -0.2f, 1.2f, 0.2f, 1.0f));
+  auto window = [&](float x0) {
+    s.camera.screen_left = x0, s.camera.screen_right = x0 + 0.8f;
+    s.camera.screen_bottom = -0.3f, s.camera.screen_top = 0.3f;
+  };
+  window(-0.2f);  // the tile's top up to its right edge, and nothing else
+  const RenderResult tile = renderer_->render(s);
+  ASSERT_GT(tile.stats.shadows.pages_rendered, 0u);
+  window(0.8f);
+  const RenderResult panned = renderer_->render(s);
+  EXPECT_GT(panned.stats.shadows.pages_rendered, 0u);
+  EXPECT_EQ(panned.rgba, Renderer().render(s).rgba);
+}
+
 TEST_F(ShadowRenderTest, BoundSplitStrategiesMakeTheSameShadows) {
   Light spot;
   spot.type = Light::Type::Spot;
