@@ -13,6 +13,7 @@
 #include "geometry/mp_grid.h"
 #include "geometry/mp_bound.h"
 #include "shadow/mp_shadow.h"
+#include "stages/mp_occlusion.h"
 
 /* Texels of margin around a receiver's box when marking: soft shadows'
  * filters read up to MP_SHADOW_SEARCH_TEXELS from a receiver, hard shadows'
@@ -283,6 +284,38 @@ inline int mp_marking_seen(float3 p, FrameParams f, __global const uint* depth, 
     for (int x = max(cx - 1, 0); x <= min(cx + 1, o.base_w - 1); ++x)
       if (depth[y * o.base_w + x] >= near_bits) return 1;
   return 0;
+}
+
+/* The camera's roots, seen ones first (marking_depth.h): at each position
+ * i of the camera's near-to-far order, 0 where that patch's box lies inside
+ * the frame but behind the marking's complete coarse depth everywhere, else
+ * 1 (boxes outside the frame count as seen: their first test culls them,
+ * wherever they come). Only an order: the camera culls against its own
+ * samples, never against this depth. */
+__kernel void marking_roots_seen(__global const uint* order, uint n, __global const float4* patch_bounds,
+                                 FrameParams f, __global const uint* depth, OcclusionParams o, __global uint* seen) {
+  uint i = get_global_id(0);
+  if (i > n) return;
+  if (i == n) { /* one past the end: 0, so that the scan leaves the total there */
+    seen[n] = 0u;
+    return;
+  }
+  uint p = order[i];
+  float3 lo = patch_bounds[2 * (ulong)p].xyz, hi = patch_bounds[2 * (ulong)p + 1].xyz;
+  MpBound b = mp_bound_boxes(&lo, &hi, 1, f);
+  seen[i] = mp_bound_culled(b, &lo, &hi, 1, f, 0, 1) || !mp_occluded(depth, o, f, b.xmin, b.ymin, b.xmax, b.ymax, b.dmin)
+                ? 1u
+                : 0u;
+}
+
+/* The order again, the seen roots first and then the rest, each in the
+ * order they had: `at` is the exclusive prefix sum of marking_roots_seen's
+ * flags (n + 1 of them, the total last). */
+__kernel void marking_roots_partition(__global const uint* order, uint n, __global const uint* at,
+                                      __global uint* out) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  out[at[i + 1u] > at[i] ? at[i] : at[n] + (i - at[i])] = order[i];
 }
 
 /* The first marking from a coarse camera batch's grids (one work-item per

@@ -16,7 +16,7 @@ constexpr cl_uint kSampleChunk = 256;
 
 bool render_camera_bucket(MicropolygonPass& pass, const CameraStages& stages, const Scene& scene,
                           const FrameSetup& frame, const Bucket& bucket, const ShadowInputs& shadows,
-                          uint64_t scene_key, RenderStats& st) {
+                          const CameraRoots& roots, uint64_t scene_key, RenderStats& st) {
   DeviceSession& s = pass.session();
   FrameProgress& progress = pass.progress();
   StageTimer& timer = pass.timer();
@@ -40,6 +40,7 @@ bool render_camera_bucket(MicropolygonPass& pass, const CameraStages& stages, co
     view.occlusion.pyramid = occ.pyramid();
     view.occlusion.params = occ.params();
     view.occlusion.root_order = occ.root_order(buffers.host_patch_bounds, scene_key, fb);
+    if (roots.seen > 0) view.occlusion.root_order = roots.order, view.occlusion.first_wave = roots.seen;
     view.occlusion.waves = s.info().type == "cpu";
     sample.mark_occlusion_cells(occ.dirty(), occ.params());
     view.occlusion.refresh = [&] {

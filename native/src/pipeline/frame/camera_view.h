@@ -26,10 +26,18 @@ struct CameraStages {
   OcclusionCulling& occlusion;
 };
 
+// The camera's roots with those an earlier look may see first (the shadow
+// marking's coarse depth, MarkingDepth::seen_first): taken as a wave of
+// their own when culling. None (seen 0): near to far only.
+struct CameraRoots {
+  cl::Buffer order;
+  cl_uint seen = 0;
+};
+
 // Renders bucket `bucket` of `frame` (shading reads `shadows`) and resolves
 // it; false when the caller cancelled. `scene_key` keys the patches' order.
 bool render_camera_bucket(MicropolygonPass& pass, const CameraStages& stages, const Scene& scene,
                           const FrameSetup& frame, const Bucket& bucket, const ShadowInputs& shadows,
-                          uint64_t scene_key, RenderStats& stats);
+                          const CameraRoots& roots, uint64_t scene_key, RenderStats& stats);
 
 }  // namespace mp

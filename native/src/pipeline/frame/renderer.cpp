@@ -240,7 +240,8 @@ void Renderer::Impl::render_frame(const Scene& scene, RenderResult& out, const P
   const CameraStages camera{d.shade, d.programs, d.sample, d.resolve, d.occlusion};
   for (size_t b = 0; b < buckets.size() && going; ++b) {
     asks.set_share(float(b) / float(buckets.size()), 1.0f / float(buckets.size()));
-    going = render_camera_bucket(pass, camera, scene, frame, buckets[b], d.shadow_maps.inputs(), d.scene_key, st);
+    going = render_camera_bucket(pass, camera, scene, frame, buckets[b], d.shadow_maps.inputs(),
+                                 d.shadow_maps.camera_roots(), d.scene_key, st);
   }
   if (!going) {
     s.queue().finish();

@@ -89,6 +89,10 @@ struct PassOcclusion {
   cl::Buffer root_order;     // patch indices near to far
   std::function<void()> refresh;
   bool waves = true;  // take the roots in waves (bound_split_bounded.cpp)
+  // Roots at the start of root_order that an earlier look found may be
+  // seen (MarkingDepth::seen_first): the bounded method takes them as a wave
+  // of their own, sampled before any later root is taken (0: no such wave).
+  cl_uint first_wave = 0;
   bool on() const { return params.levels > 0; }
 };
 

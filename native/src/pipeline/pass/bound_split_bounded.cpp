@@ -43,7 +43,11 @@ constexpr size_t kMaxWorkers = size_t(1) << 20;
 // rest are taken at once. A partly filled batch costs about a millisecond
 // of launches and host round trips on a GPU, more than rasterising a few
 // hidden layers there, so waves are for CPU devices (PassOcclusion::waves);
-// on a GPU the pyramid is rebuilt at the batches' natural ends only.
+// on a GPU the pyramid is rebuilt at the batches' natural ends only. Where
+// an earlier look (the shadow marking's coarse depth) put the roots it may
+// see first (PassOcclusion::first_wave), those are one wave on any device,
+// sampled before the rest are taken: the rest are then tested against what
+// hides them, at the cost of one partly filled batch.
 constexpr size_t kWorthwhile = 64;
 constexpr cl_uint kMinWave = 64;
 
@@ -93,7 +97,9 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
               occ.params, ws.stacks, ws.sizes, stack_depth, ws.ring, ring_capacity, ws.diceable, dice_capacity,
               ws.counters, kStepsPerLaunch);
     const cl_uint root_count = ctx.root_count();
+    const cl_uint first_wave = occ.on() && occ.first_wave < root_count ? occ.first_wave : 0;
     cl_uint root_limit = occ.on() && occ.waves ? std::min<cl_uint>(root_count, 1) : root_count;
+    if (first_wave > 0) root_limit = std::min(root_limit, first_wave);
     size_t diced = 0, wave_roots = root_limit, diced_before_wave = 0, occluded_before_wave = 0;
     auto whole_groups = [&](size_t n) { return std::min(workers, std::max<size_t>(64, (n + 63) / 64 * 64)); };
     // More workers than a few dice batches' worth would mostly hold work they
@@ -126,7 +132,10 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
       const bool done = wave_done && root_limit >= root_count;
       // A wave ends in a flush once it has kMinWave sub-patches to dice (or
       // it is the last); smaller ones are carried into the next wave.
-      if (dice_count == dice_capacity || (wave_done && dice_count > 0 && (done || dice_count >= kMinWave))) {
+      // The seen roots' wave (first_wave) is sampled whole before any other.
+      const bool seen_done = wave_done && root_limit == first_wave;
+      if (dice_count == dice_capacity ||
+          (wave_done && dice_count > 0 && (done || seen_done || dice_count >= kMinWave))) {
         ctx.sink(ws.diceable, dice_count);
         diced += dice_count;
         dice_count = 0;
@@ -148,7 +157,8 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
         size_t roots = wave_roots + (wave_roots + 3) / 4;
         if (diced + result.occluded >= kMinWave)  // a rate measured on enough sub-patches; at most 4x the last
           roots = std::max(roots, std::min(4 * wave_roots, static_cast<size_t>(double(kMinWave) / per_root)));
-        if (!worthwhile) roots = root_count;
+        if (!worthwhile || !occ.waves) roots = root_count;
+        if (root_limit < first_wave) roots = std::min<size_t>(roots, first_wave - root_limit);
         wave_roots = std::min<size_t>(roots, root_count - root_limit);
         root_limit += static_cast<cl_uint>(wave_roots);
         diced_before_wave = diced;

@@ -34,11 +34,15 @@ void PrefixSum::scan_level(const cl::Buffer& data, cl_uint n, size_t level, Stag
   }
 }
 
-cl_uint PrefixSum::exclusive_scan(const cl::Buffer& data, cl_uint n, StageTimer& timer) {
-  if (n == 0) return 0;
+void PrefixSum::exclusive_scan_on_device(const cl::Buffer& data, cl_uint n, StageTimer& timer) {
   // The caller's array holds n + 1 entries with data[n] == 0, so after the
   // exclusive scan data[n] is the total.
   scan_level(data, n + 1, 0, timer);
+}
+
+cl_uint PrefixSum::exclusive_scan(const cl::Buffer& data, cl_uint n, StageTimer& timer) {
+  if (n == 0) return 0;
+  exclusive_scan_on_device(data, n, timer);
   cl_uint total = 0;
   session_.queue().enqueueReadBuffer(data, CL_TRUE, n * sizeof(cl_uint), sizeof total, &total);
   return total;

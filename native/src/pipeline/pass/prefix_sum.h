@@ -14,6 +14,8 @@ class PrefixSum {
   PrefixSum(DeviceSession& session, MemoryTally& tally);
   // Scans data[0, n) in place; returns the total of the n inputs.
   cl_uint exclusive_scan(const cl::Buffer& data, cl_uint n, StageTimer& timer);
+  // The same without reading the total back: it stays in data[n].
+  void exclusive_scan_on_device(const cl::Buffer& data, cl_uint n, StageTimer& timer);
 
  private:
   void scan_level(const cl::Buffer& data, cl_uint n, size_t level, StageTimer& timer);

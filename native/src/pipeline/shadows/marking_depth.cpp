@@ -20,7 +20,10 @@ OcclusionParams layout_for(const FrameParams& f) { return occlusion_layout(f, kC
 MarkingDepth::MarkingDepth(DeviceSession& session)
     : session_(session),
       raster_(session.program(), "marking_depth"),
-      reduce_(session.program(), "occlusion_reduce") {}
+      reduce_(session.program(), "occlusion_reduce"),
+      seen_(session.program(), "marking_roots_seen"),
+      partition_(session.program(), "marking_roots_partition"),
+      scan_(session, scan_tally_) {}
 
 size_t MarkingDepth::bytes_for(const FrameParams& f) {
   return size_t(mp_occlusion_cells(layout_for(f))) * sizeof(cl_uint);
@@ -72,6 +75,34 @@ PassOcclusion MarkingDepth::occlusion(const cl::Buffer& order, bool waves, Stage
   o.waves = waves;
   o.refresh = [this, &timer] { refresh(timer); };
   return o;
+}
+
+void MarkingDepth::seen_first(const cl::Buffer& order, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+                              StageTimer& timer) {
+  roots_ = 0, seen_total_ = kUnread;
+  if (!on() || count == 0) return;
+  roots_ = count;
+  DeviceQueue& q = session_.queue();
+  const size_t bytes = size_t(count) * sizeof(cl_uint);
+  session_.reserve(flags_, flags_held_, bytes + sizeof(cl_uint), "camera roots seen");  // and the scan's total
+  session_.reserve(seen_order_, seen_held_, bytes, "camera roots, seen first");
+  bind_args(seen_, order, count, scene.patch_bounds, f, pyramid_, params_, flags_);
+  cl::Event e;
+  q.enqueueNDRangeKernel(seen_, cl::NullRange, round_up_range(size_t(count) + 1), cl::NDRange(64), nullptr, &e);
+  timer.add(Stage::ShadowMark, e);
+  scan_.exclusive_scan_on_device(flags_, count, timer);
+  bind_args(partition_, order, count, flags_, seen_order_);
+  cl::Event e2;
+  q.enqueueNDRangeKernel(partition_, cl::NullRange, round_up_range(count), cl::NDRange(64), nullptr, &e2);
+  timer.add(Stage::ShadowMark, e2);
+}
+
+cl_uint MarkingDepth::seen_count() {
+  if (roots_ == 0) return 0;
+  if (seen_total_ == kUnread)
+    session_.queue().enqueueReadBuffer(flags_, CL_TRUE, size_t(roots_) * sizeof(cl_uint), sizeof(cl_uint),
+                                       &seen_total_);
+  return seen_total_;
 }
 
 PassOcclusion MarkingDepth::complete(const cl::Buffer& order) const {

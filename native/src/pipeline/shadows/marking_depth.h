@@ -14,6 +14,7 @@
 #include "pipeline/frame/frame_params.h"
 #include "pipeline/pass/bound_split.h"
 #include "pipeline/pass/micropolygon_stages.h"
+#include "pipeline/pass/prefix_sum.h"
 #include "pipeline/pass/stage_timer.h"
 
 namespace mp {
@@ -37,6 +38,17 @@ class MarkingDepth {
   PassOcclusion occlusion(const cl::Buffer& order, bool waves, StageTimer& timer);
   // Culling against the complete image (another pass over the same view).
   PassOcclusion complete(const cl::Buffer& order) const;
+  // The camera's roots, `order` (near to far, `count` of them) with those
+  // the complete image may show first, each part in its order, into
+  // seen_order(); seen_count() says how many may be seen (read when first
+  // asked, so the queue runs on meanwhile). The camera takes those as a
+  // wave of their own (PassOcclusion::first_wave) and culls the rest against
+  // its own samples: the image only orders, it never culls the camera's view.
+  void seen_first(const cl::Buffer& order, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+                  StageTimer& timer);
+  const cl::Buffer& seen_order() const { return seen_order_; }
+  cl_uint seen_count();
+  cl_uint roots() const { return roots_; }  // roots seen_first ordered (0: none this frame)
   // The image (level 0 first) and its layout, as the marking kernels take
   // them; a one-cell buffer and zero levels while off.
   const cl::Buffer& image() const { return pyramid_; }
@@ -45,7 +57,13 @@ class MarkingDepth {
 
  private:
   DeviceSession& session_;
-  cl::Kernel raster_, reduce_;
+  cl::Kernel raster_, reduce_, seen_, partition_;
+  MemoryTally scan_tally_;
+  PrefixSum scan_;
+  cl::Buffer flags_, seen_order_;
+  size_t flags_held_ = 0, seen_held_ = 0;
+  static constexpr cl_uint kUnread = 0xffffffffu;
+  cl_uint roots_ = 0, seen_total_ = kUnread;
   cl::Buffer pyramid_;
   size_t held_ = 0;  // cells the buffer holds
   OcclusionParams params_{};

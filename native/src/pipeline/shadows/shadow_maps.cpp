@@ -79,6 +79,14 @@ void ShadowMaps::clear_requests(const ShadowLayout& layout) {
   session_.queue().enqueueFillBuffer(caps_, cl_uint(0), 0, n * sizeof(cl_uint));
 }
 
+CameraRoots ShadowMaps::camera_roots() {
+  // A wave of its own costs a partly filled batch (about a millisecond on a
+  // GPU): worth it only where an eighth of the roots or more lie hidden.
+  const cl_uint roots = depth_.roots(), seen = depth_.seen_count();
+  if (roots == 0 || size_t(roots - seen) * 8 < roots) return CameraRoots{};
+  return CameraRoots{depth_.seen_order(), seen};
+}
+
 bool ShadowMaps::camera_view(const ShadowLayout& layout, const FrameSetup& frame, MicropolygonPass& pass, bool soft,
                              const cl::Buffer& camera_order, ShadowStats& stats) {
   StageTimer& timer = pass.timer();
@@ -117,8 +125,10 @@ bool ShadowMaps::camera_view(const ShadowLayout& layout, const FrameSetup& frame
       PassView{coarse, PassViews{}, depth_.occlusion(camera_order, session_.info().type == "cpu", timer)}, target);
   stats.marking_occluded += r.occluded;
   if (r.cancelled) return false;
-  // Complete: the markings and any pass over the view again test against all of it.
+  // Complete: the markings and any pass over the view again test against
+  // all of it, and the camera's view takes first the roots it may see.
   depth_.refresh(timer);
+  depth_.seen_first(camera_order, buffers.patch_count, buffers, frame.params, timer);
   stats.mark_wall_ms += ms_since(started);
   return true;
 }
@@ -432,6 +442,7 @@ bool ShadowMaps::render(const Scene& scene, const std::vector<Light>& lights, co
                         MicropolygonPass& pass, const cl::Buffer& camera_order, ShadowStats& stats) {
   const SceneBuffers& buffers = pass.scene();
   stats = ShadowStats{};
+  depth_.seen_first(cl::Buffer(), 0, buffers, frame.params, pass.timer());  // none until the marking orders them
   const RenderSettings& settings = scene.settings;
   stats.budget_bytes = size_t(double(settings.shadow_memory_mib) * 1048576.0);
   inputs_.enabled = false;

@@ -29,6 +29,7 @@
 #include "cl/kernel_args.h"
 #include "micropoly/renderer.h"
 #include "pipeline/pass/bound_split.h"
+#include "pipeline/frame/camera_view.h"
 #include "pipeline/frame/frame_params.h"
 #include "pipeline/materials/material_programs.h"
 #include "pipeline/pass/micropolygon_pass.h"
@@ -51,6 +52,9 @@ class ShadowMaps {
   bool render(const Scene& scene, const std::vector<Light>& lights, const FrameSetup& frame, MicropolygonPass& pass,
               const cl::Buffer& camera_order, ShadowStats& stats);
   const ShadowInputs& inputs() const { return inputs_; }
+  // This frame's camera roots, those the marking's coarse depth may see
+  // first (none where it had no depth).
+  CameraRoots camera_roots();
 
  private:
   // The camera's coarse view: its depth (culling what it hides, where
