@@ -42,6 +42,23 @@ FrameParams marking_view(const FrameSetup& frame) {
   return coarse;
 }
 
+// What every marking step shares: its launches count as the marking, its
+// wall time joins the marking's, and it works in the coarse view.
+struct MarkingStep {
+  MarkingStep(MicropolygonPass& pass, const FrameSetup& frame, const ShadowLayout& layout, ShadowStats& stats)
+      : timer(pass.timer()), to(timer, Stage::ShadowMark), coarse(marking_view(frame)),
+        light_count(cl_uint(layout.shadows.size())), stats_(stats) {}
+  ~MarkingStep() { stats_.mark_wall_ms += ms_since(started_); }
+  StageTimer& timer;
+  StageTimer::Redirect to;
+  const FrameParams coarse;
+  const cl_uint light_count;
+
+ private:
+  ShadowStats& stats_;
+  const std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
+};
+
 }  // namespace
 
 ShadowMaps::ShadowMaps(DeviceSession& session)
@@ -89,11 +106,10 @@ CameraRoots ShadowMaps::camera_roots() {
 
 bool ShadowMaps::camera_view(const ShadowLayout& layout, const FrameSetup& frame, MicropolygonPass& pass, bool soft,
                              const cl::Buffer& camera_order, ShadowStats& stats) {
-  StageTimer& timer = pass.timer();
-  StageTimer::Redirect to(timer, Stage::ShadowMark);
-  const auto started = std::chrono::steady_clock::now();
-  const FrameParams coarse = marking_view(frame);
-  const cl_uint light_count = cl_uint(layout.shadows.size());
+  MarkingStep step(pass, frame, layout, stats);
+  StageTimer& timer = step.timer;
+  const FrameParams& coarse = step.coarse;
+  const cl_uint light_count = step.light_count;
   GridBuffers& grids = pass.grids();
   const SceneBuffers& buffers = pass.scene();
   camera_order_ = camera_order;
@@ -129,17 +145,15 @@ bool ShadowMaps::camera_view(const ShadowLayout& layout, const FrameSetup& frame
   // all of it, and the camera's view takes first the roots it may see.
   depth_.refresh(timer);
   depth_.seen_first(camera_order, buffers.patch_count, buffers, frame.params, timer);
-  stats.mark_wall_ms += ms_since(started);
   return true;
 }
 
 bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, MicropolygonPass& pass, bool first,
                       std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries, ShadowStats& stats) {
-  StageTimer& timer = pass.timer();
-  StageTimer::Redirect to(timer, Stage::ShadowMark);
-  const auto started = std::chrono::steady_clock::now();
-  const FrameParams coarse = marking_view(frame);
-  const cl_uint light_count = cl_uint(layout.shadows.size());
+  MarkingStep step(pass, frame, layout, stats);
+  StageTimer& timer = step.timer;
+  const FrameParams& coarse = step.coarse;
+  const cl_uint light_count = step.light_count;
   if (kept_vertices_ > 0) {
     bind_args(mark_kept_, kept_p_, kept_vertices_, coarse, inputs_.shadows, inputs_.levels, light_count,
               request_args(), mark_reach(coarse), cl_uint(kept_normals_), depth_.image(), depth_.params());
@@ -157,18 +171,16 @@ bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, Micro
       }))
     return false;
   collect_requests(layout, keys, entries);
-  stats.mark_wall_ms += ms_since(started);
   return true;
 }
 
 bool ShadowMaps::mark_soft(const ShadowLayout& layout, const FrameSetup& frame, MicropolygonPass& pass,
                            std::vector<ShadowPageKey>& keys, std::vector<uint32_t>& entries, ShadowStats& stats) {
-  StageTimer& timer = pass.timer();
-  StageTimer::Redirect to(timer, Stage::ShadowMark);
-  const auto started = std::chrono::steady_clock::now();
-  const FrameParams coarse = marking_view(frame);
   // The soft marking adds to the first's requests.
-  const cl_uint light_count = cl_uint(layout.shadows.size());
+  MarkingStep step(pass, frame, layout, stats);
+  StageTimer& timer = step.timer;
+  const FrameParams& coarse = step.coarse;
+  const cl_uint light_count = step.light_count;
   GridBuffers& grids = pass.grids();
   if (kept_overflow_) {
     // More vertices than the budget keeps: the view is diced again, as the
@@ -186,7 +198,6 @@ bool ShadowMaps::mark_soft(const ShadowLayout& layout, const FrameSetup& frame, 
     launch(mark_soft_, kept_vertices_, timer);
   }
   collect_requests(layout, keys, entries);
-  stats.mark_wall_ms += ms_since(started);
   return true;
 }
 
