@@ -67,11 +67,8 @@ void MarkingDepth::refresh(StageTimer& timer) {
 }
 
 PassOcclusion MarkingDepth::occlusion(const cl::Buffer& order, bool waves, StageTimer& timer) {
-  PassOcclusion o;
+  PassOcclusion o = complete(order);
   if (!on()) return o;
-  o.pyramid = pyramid_;
-  o.params = params_;
-  o.root_order = order;
   o.waves = waves;
   o.refresh = [this, &timer] { refresh(timer); };
   return o;
