@@ -16,6 +16,7 @@
 #include "geometry/mp_grid.h"
 #include "materials/mp_node_lib.h"
 #include "textures/mp_tex_image.h"
+#include "core/mp_scene_data.h"
 
 /* @MATERIAL_PROGRAM_SOURCE@ */
 
@@ -122,17 +123,13 @@ inline int mp_program_vertex(uint gid, uint count, __global const uint* vertex_o
   return (int)materials[*material].program[0] == program;
 }
 
-#define MP_PROGRAM_INPUT_ARGS                                                                             \
-  __global const uint *patch_edges, __global const float4 *patch_uvs, uint uv_layers,                     \
-      __global const DeviceImage *images, uint image_count, __global const float4 *texels,                \
-      __global const float *params
-#define MP_PROGRAM_INPUTS {patch_edges, patch_uvs, uv_layers, images, image_count, texels, params}
+/* What node programs read of the scene (mp_node_lib.h), from MP_SCENE_PARAMS. */
+#define MP_PROGRAM_INPUTS {patch_edges, patch_uvs, uv_layers, images, image_count, texels, node_params}
 
 /* Moves each vertex by the program's displacement vector (object space). */
-__kernel void displace_grids(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
-                             __global const DeviceMaterial* materials, __global const DeviceObject* objects,
-                             FrameParams f, int program, __global float4* grid_p, __global const float4* grid_n,
-                             MP_PROGRAM_INPUT_ARGS, __global const uint* vertex_offsets) {
+__kernel void displace_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, uint count, FrameParams f,
+                             int program, __global float4* grid_p, __global const float4* grid_n,
+                             __global const uint* vertex_offsets) {
   uint gid = get_global_id(0), material, object, i, j;
   SubPatch sp;
   float2 uv;
@@ -153,17 +150,10 @@ __kernel void displace_grids(__global const SubPatch* diceable, uint count, __gl
 }
 
 /* Shades each vertex with the Principled inputs the program computes. */
-__kernel void shade_program_grids(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
-                                  __global const DeviceMaterial* materials, __global const DeviceObject* objects,
-                                  FrameParams f, int program, __global const float4* grid_p,
-                                  __global float4* grid_n, MP_PROGRAM_INPUT_ARGS,
-                                  __global const DeviceLight* lights, uint light_count, __global float4* grid_c,
-                                  __global const uint* vertex_offsets, uint use_shadows,
-                                  __global const DeviceShadow* shadows, __global const DeviceShadowLevel* shadow_levels,
-                                  __global const uint* shadow_pages, __global const uint* shadow_pool,
-                                  uint alpha_only, __global const float4* world_glossy,
-                                  __global const uint* refract_roots, __global const float4* refract_nodes,
-                                  __global const float4* refract_tris) {
+__kernel void shade_program_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, uint count, FrameParams f,
+                                  int program, __global const float4* grid_p, __global float4* grid_n,
+                                  __global float4* grid_c, __global const uint* vertex_offsets,
+                                  MP_SHADOW_INPUT_PARAMS, uint alpha_only) {
   uint gid = get_global_id(0), material, object, i, j;
   SubPatch sp;
   float2 uv;
@@ -233,7 +223,7 @@ __kernel void shade_program_grids(__global const SubPatch* diceable, uint count,
     }
   /* Shadows compare with the surface's tangent plane (for smooth-shaded
    * polygons, which shade.cl gave their interpolated normal, that normal's). */
-  MpShadowMaps maps = {shadows, shadow_levels, shadow_pages, shadow_pool};
+  MpShadowMaps maps = MP_SHADOW_INPUTS;
   MpShadowQuery shadow = {&maps, n, mp_pixel_footprint(-p.z, f)};
   /* Sharp lobes widened by the normal's spread across the micropolygon
    * (mp_normal_spread2): the grid's normals, final since shade.cl. */
@@ -290,13 +280,13 @@ float3 mp_world_radiance(float3 d, const MpProgramInputs* in, int camera_ray, fl
 
 /* The world over an equirectangular map (scene.h, World), at each texel's
  * centre, as the light surfaces receive; the world's node values from
- * params_at in the parameter buffer. */
-__kernel void bake_world(uint width, uint height, MP_PROGRAM_INPUT_ARGS, uint params_at, __global float4* out) {
+ * world_params_at in the parameter buffer. */
+__kernel void bake_world(MP_SCENE_PARAMS uint width, uint height, __global float4* out) {
   uint i = get_global_id(0);
   if (i >= width * height) return;
   float u = ((float)(i % width) + 0.5f) / (float)width, v = ((float)(i / width) + 0.5f) / (float)height;
   MpProgramInputs in = MP_PROGRAM_INPUTS;
-  in.params += params_at;
+  in.params += world_params_at;
   /* The light is baked once for every view: no image position (the node
    * compiler warns of these outputs in a world). */
   float3 zero = (float3)(0.0f);
@@ -306,13 +296,12 @@ __kernel void bake_world(uint width, uint height, MP_PROGRAM_INPUT_ARGS, uint pa
 /* The world behind each pixel of the frame (its crop): the mean of 2 x 2
  * stratified rays through the pixel, the raster mapping of FrameParams
  * inverted, turned into the world by rows r0..r2 (camera to world). */
-__kernel void world_pixels(FrameParams f, float4 r0, float4 r1, float4 r2, MP_PROGRAM_INPUT_ARGS,
-                           uint params_at, __global float* out) {
+__kernel void world_pixels(MP_SCENE_PARAMS FrameParams f, float4 r0, float4 r1, float4 r2, __global float* out) {
   uint i = get_global_id(0);
   if (i >= (uint)f.width * (uint)f.height) return;
   float px = (float)(i % (uint)f.width), py = (float)(i / (uint)f.width);
   MpProgramInputs in = MP_PROGRAM_INPUTS;
-  in.params += params_at;
+  in.params += world_params_at;
   float3 sum = (float3)(0.0f);
   for (int s = 0; s < 4; ++s) {
     /* The ray's point on the image plane at depth 1 (perspective: its

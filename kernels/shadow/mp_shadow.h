@@ -168,6 +168,15 @@ typedef struct {
   const MP_GLOBAL uint* pool;   /* physical pages, MP_PAGE_TEXELS float depths each */
 } MpShadowMaps;
 
+#ifdef __OPENCL_VERSION__
+/* The shadow maps as shading kernels take them, in the order the host's
+ * ShadowInputs::args() binds them: whether shadows are on, then the maps. */
+#define MP_SHADOW_INPUT_PARAMS                                                                                  \
+  uint use_shadows, __global const DeviceShadow *shadows, __global const DeviceShadowLevel *shadow_levels,     \
+      __global const uint *shadow_pages, __global const uint *shadow_pool
+#define MP_SHADOW_INPUTS {shadows, shadow_levels, shadow_pages, shadow_pool}
+#endif
+
 MP_INLINE MpShadowMap mp_sun_map(const MP_GLOBAL DeviceShadow* sh, const MP_GLOBAL DeviceShadowLevel* lv) {
   MpShadowMap m;
   m.table = lv->page_table;

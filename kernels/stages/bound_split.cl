@@ -15,6 +15,7 @@
 #include "geometry/mp_surface.h"
 #include "geometry/mp_grid.h"
 #include "geometry/mp_bound.h"
+#include "core/mp_scene_data.h"
 
 /* Root r of a pass over patch_count patches in one or more views: the whole
  * domain of patch r % patch_count in view r / patch_count, no edge rated yet.
@@ -47,17 +48,14 @@ inline FrameParams mp_subpatch_view(const SubPatch* sp, FrameParams f, __global 
 /* ---- breadth-first ------------------------------------------------------ */
 
 /* Initial queue: one whole-domain sub-patch per patch and view. */
-__kernel void bs_init_queue(__global SubPatch* queue, uint n, uint patch_count, uint view_count,
+__kernel void bs_init_queue(MP_SCENE_PARAMS __global SubPatch* queue, uint n, uint view_count,
                             __global const uint* order) {
   uint i = get_global_id(0);
   if (i >= n) return;
   queue[i] = mp_root_subpatch(i, patch_count, view_count, order);
 }
 
-__kernel void bs_breadth_classify(__global SubPatch* queue, uint n,
-                                  __global const float4* points, __global const uint* patch_info,
-                                  __global const uint* edges, __global const float4* curves,
-                                  __global const float4* patch_bounds, FrameParams f,
+__kernel void bs_breadth_classify(MP_SCENE_PARAMS __global SubPatch* queue, uint n, FrameParams f,
                                   __global const FrameParams* views, uint view_count,
                                   __global const uchar* page_masks, __global const uint* occlusion,
                                   OcclusionParams occ, volatile __global uint* occluded, __global uint* decision,
@@ -70,8 +68,8 @@ __kernel void bs_breadth_classify(__global SubPatch* queue, uint n,
     return;
   }
   SubPatch sp = queue[i];
-  uint d = mp_classify(points, patch_info, edges, curves, patch_bounds, &sp, mp_subpatch_view(&sp, f, views, view_count),
-                       page_masks, occlusion, occ);
+  uint d = mp_classify(points, patch_info, patch_edges, edge_curves, patch_bounds, &sp,
+                       mp_subpatch_view(&sp, f, views, view_count), page_masks, occlusion, occ);
   uint action = MP_DECISION_ACTION(d);
   if (d == MP_CULL_OCCLUDED) atomic_inc(occluded);
   queue[i] = sp; /* with the edge rates measured here */
@@ -119,10 +117,7 @@ __kernel void bs_breadth_scatter(__global const SubPatch* queue, uint n, __globa
 #define BS_ROOT_LIMIT 11 /* the roots taken so far (occlusion culling takes them in waves) */
 #define BS_COUNTERS 12
 
-__kernel void bs_bounded_step(__global const float4* points, __global const uint* patch_info,
-                              __global const uint* edges, __global const float4* curves,
-                              __global const float4* patch_bounds, uint patch_count,
-                              __global const uint* root_order, FrameParams f,
+__kernel void bs_bounded_step(MP_SCENE_PARAMS __global const uint* root_order, FrameParams f,
                               __global const FrameParams* views, uint view_count, __global const uchar* page_masks,
                               __global const uint* occlusion, OcclusionParams occ,
                               __global SubPatch* stacks, __global uint* stack_sizes, uint stack_depth,
@@ -150,7 +145,7 @@ __kernel void bs_bounded_step(__global const float4* points, __global const uint
       }
     }
     SubPatch sp = stack[--size];
-    uint d = mp_classify(points, patch_info, edges, curves, patch_bounds, &sp,
+    uint d = mp_classify(points, patch_info, patch_edges, edge_curves, patch_bounds, &sp,
                          mp_subpatch_view(&sp, f, views, view_count), page_masks, occlusion, occ);
     uint action = MP_DECISION_ACTION(d);
     if (d == MP_CULL_OCCLUDED) atomic_inc(&counters[BS_OCCLUDED]);

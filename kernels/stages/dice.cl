@@ -8,25 +8,23 @@
 #include "geometry/mp_patch_eval.h"
 #include "geometry/mp_surface.h"
 #include "geometry/mp_grid.h"
+#include "core/mp_scene_data.h"
 
-__kernel void dice_grids(__global const SubPatch* diceable, uint count,
-                         __global const float4* points, __global const uint* patch_info,
-                         __global const uint* edges, __global const float4* curves,
-                         __global const DeviceMaterial* materials, FrameParams f, __global float4* grid_p,
-                         __global float4* grid_n, __global const uint* vertex_offsets) {
+__kernel void dice_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, uint count, FrameParams f,
+                         __global float4* grid_p, __global float4* grid_n, __global const uint* vertex_offsets) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   float2 uv;
   ulong index;
   if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
   float3 p, dpdu, dpdv;
-  mp_surface_point(points, patch_info, edges, curves, sp.patch, uv.x, uv.y, &p, &dpdu, &dpdv);
+  mp_surface_point(points, patch_info, patch_edges, edge_curves, sp.patch, uv.x, uv.y, &p, &dpdu, &dpdv);
   uint flags = patch_info[4 * (ulong)sp.patch + 2];
   /* Displaced materials move shared edge vertices along the edge's own normal
    * (watertight); others shade with the patch's normal, which keeps polygon
    * faces flat. */
   float3 n = materials[patch_info[4 * (ulong)sp.patch + 1]].program[1] > 0.0f
-                 ? mp_surface_normal(points, patch_info, edges, curves, sp.patch, uv.x, uv.y, dpdu, dpdv)
+                 ? mp_surface_normal(points, patch_info, patch_edges, edge_curves, sp.patch, uv.x, uv.y, dpdu, dpdv)
                  : mp_patch_normal(points + (ulong)sp.patch * MP_PATCH_POINTS, patch_info[4 * (ulong)sp.patch], uv.x,
                                    uv.y, dpdu, dpdv);
   if (flags & MP_PATCH_FLIP_ORIENTATION) n = -n;
@@ -52,8 +50,7 @@ __kernel void grid_counts(__global const SubPatch* diceable, uint count, FramePa
  * surface normal they replace. Where the differences vanish (a collapsed
  * grid edge) the undisplaced normal stays. Runs after every material's
  * displacement (material_program.cl). */
-__kernel void displaced_normals(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
-                                __global const DeviceMaterial* materials, FrameParams f,
+__kernel void displaced_normals(MP_SCENE_PARAMS __global const SubPatch* diceable, uint count, FrameParams f,
                                 __global const float4* grid_p, __global float4* grid_n,
                                 __global const uint* vertex_offsets) {
   uint gid = get_global_id(0), i, j;
@@ -77,22 +74,21 @@ __kernel void displaced_normals(__global const SubPatch* diceable, uint count, _
 }
 
 /* Motion blur: the positions of the same grid vertices at one motion step,
- * from that step's control points and edge curves (the same patches, moved),
- * (points + point_offset, curves + curve_offset) into grid_p + out_offset.
+ * from that step's control points and edge curves (the same patches, moved,
+ * in motion_points and motion_curves) into grid_p + out_offset.
  * The same (u, v) and the same edge rates as the shutter centre's grid, so
  * shared edges stay shared at every step. */
-__kernel void dice_motion_positions(__global const SubPatch* diceable, uint count, __global const float4* points,
-                                    ulong point_offset, __global const uint* patch_info, __global const uint* edges,
-                                    __global const float4* curves, ulong curve_offset, FrameParams f,
-                                    __global float4* grid_p, ulong out_offset, __global const uint* vertex_offsets) {
+__kernel void dice_motion_positions(MP_SCENE_PARAMS __global const SubPatch* diceable, uint count, uint step,
+                                    FrameParams f, __global float4* grid_p, ulong out_offset,
+                                    __global const uint* vertex_offsets) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   float2 uv;
   ulong index;
   if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
   float3 p, dpdu, dpdv;
-  mp_surface_point(points + point_offset, patch_info, edges, curves + curve_offset, sp.patch, uv.x, uv.y, &p, &dpdu,
-                   &dpdv);
+  mp_surface_point(motion_points + (ulong)step * point_count, patch_info, patch_edges,
+                   motion_curves + (ulong)step * curve_count, sp.patch, uv.x, uv.y, &p, &dpdu, &dpdv);
   grid_p[out_offset + index] = (float4)(p, 1.0f);
 }
 

@@ -16,6 +16,7 @@
 #include "geometry/mp_grid.h"
 #include "stages/mp_occlusion.h"
 #include "stages/mp_sample.h"
+#include "core/mp_scene_data.h"
 
 #define MP_PASS_DEPTH 0u
 #define MP_PASS_ATTRIBUTES 1u
@@ -282,13 +283,13 @@ inline void mp_mark_occlusion_cells(__global uchar* dirty, OcclusionParams o, Fr
  * its code. */
 #define MP_SAMPLE_ARGS                                                                                                 \
   __global const SubPatch *diceable, uint first, uint count, __global const uint *offsets, uint base, uint total,    \
-      __global const uint *patch_info, FrameParams f, __global const float4 *grid_p, __global const float4 *grid_c,   \
+      FrameParams f, __global const float4 *grid_p, __global const float4 *grid_c,                                   \
       __global const float4 *grid_n, __global const ushort *sample_offsets, uint pass, volatile __global ulong *keys, \
       __global float *colors, __global uint *normals, volatile __global ulong *totals,                               \
       __global uchar *occlusion_dirty, OcclusionParams occ, __global const float4 *sample_table,                      \
       __global const float4 *grid_pm, ulong motion_stride
 #define MP_SAMPLE_PASS                                                                                                 \
-  diceable, first, count, offsets, base, total, patch_info, f, grid_p, grid_c, grid_n, sample_offsets, pass, keys,    \
+  diceable, first, count, offsets, base, total, f, grid_p, grid_c, grid_n, sample_offsets, pass, keys,                \
       colors, normals, totals, occlusion_dirty, occ, sample_table, grid_pm, motion_stride
 
 /* One work-item per micropolygon of grids [first, first + count): `offsets`
@@ -296,7 +297,7 @@ inline void mp_mark_occlusion_cells(__global uchar* dirty, OcclusionParams o, Fr
  * layout, GridLayoutStage), `base` is the first of these grids' and `total`
  * their number. A work-item finds its grid by binary search, so no
  * work-item idles on an unused grid slot. */
-inline void mp_sample(MP_SAMPLE_ARGS, __local ulong* area_sum, __local uint* count_sum, __local uint* test_sum,
+inline void mp_sample(__global const uint* patch_info, MP_SAMPLE_ARGS, __local ulong* area_sum, __local uint* count_sum, __local uint* test_sum,
                       const int blur) {
   uint stride = (uint)f.max_grid + 1u;
   uint gid = get_global_id(0);
@@ -347,15 +348,15 @@ inline void mp_sample(MP_SAMPLE_ARGS, __local ulong* area_sum, __local uint* cou
   mp_count_sampled(get_local_id(0), area2, tests, pass, totals, area_sum, count_sum, test_sum);
 }
 
-__kernel __attribute__((reqd_work_group_size(64, 1, 1))) void sample_micropolygons(MP_SAMPLE_ARGS) {
+__kernel __attribute__((reqd_work_group_size(64, 1, 1))) void sample_micropolygons(MP_SCENE_PARAMS MP_SAMPLE_ARGS) {
   __local ulong area_sum[64];
   __local uint count_sum[64], test_sum[64];
-  mp_sample(MP_SAMPLE_PASS, area_sum, count_sum, test_sum, 0);
+  mp_sample(patch_info, MP_SAMPLE_PASS, area_sum, count_sum, test_sum, 0);
 }
 
 /* Samples with times and lens positions (mp_blur.h). */
-__kernel __attribute__((reqd_work_group_size(64, 1, 1))) void sample_micropolygons_blur(MP_SAMPLE_ARGS) {
+__kernel __attribute__((reqd_work_group_size(64, 1, 1))) void sample_micropolygons_blur(MP_SCENE_PARAMS MP_SAMPLE_ARGS) {
   __local ulong area_sum[64];
   __local uint count_sum[64], test_sum[64];
-  mp_sample(MP_SAMPLE_PASS, area_sum, count_sum, test_sum, 1);
+  mp_sample(patch_info, MP_SAMPLE_PASS, area_sum, count_sum, test_sum, 1);
 }

@@ -22,6 +22,7 @@
 #include "stages/mp_raster.h"
 #include "geometry/mp_grid.h"
 #include "stages/mp_sample.h"
+#include "core/mp_scene_data.h"
 
 /* A projected vertex: fixed-point raster x and y, 1/depth's bits, and 1
  * where the vertex cannot be rasterised (behind the eye, past the guard
@@ -289,7 +290,7 @@ inline uint mp_sample_tile_fast(const MpTriangle* tris, long xmin, long xmax, lo
  * tile's samples under that bound. totals: micropolygons, twice their area
  * (fixed-point units) and samples tested, each micropolygon counted in the
  * tile that holds its bound's first pixel. */
-__kernel void sample_tiles(__global const SubPatch* diceable, __global const uint* patch_info, FrameParams f,
+__kernel void sample_tiles(MP_SCENE_PARAMS __global const SubPatch* diceable, FrameParams f,
                            __global const int4* projected, __global const float4* grid_c,
                            __global const float4* grid_n, __global const ushort* sample_offsets,
                            __global const ushort* sample_soa, __global const uint* tile_ids, __global const uint* starts,

@@ -6,16 +6,11 @@
 #include "closures/mp_shading.h"
 #include "closures/mp_shade_closures.h"
 #include "geometry/mp_grid.h"
+#include "core/mp_scene_data.h"
 
-__kernel void shade_grids(__global const SubPatch* diceable, uint count, __global const uint* patch_info,
-                          FrameParams f, __global const float4* grid_p, __global float4* grid_n,
-                          __global const DeviceMaterial* materials, __global const DeviceLight* lights,
-                          uint light_count, __global float4* grid_c, __global const uint* vertex_offsets,
-                          __global const float4* patch_normals, uint use_shadows,
-                          __global const DeviceShadow* shadows, __global const DeviceShadowLevel* shadow_levels,
-                          __global const uint* shadow_pages, __global const uint* shadow_pool,
-                          __global const float4* world_glossy, __global const uint* refract_roots,
-                          __global const float4* refract_nodes, __global const float4* refract_tris) {
+__kernel void shade_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, uint count, FrameParams f,
+                          __global const float4* grid_p, __global float4* grid_n, __global float4* grid_c,
+                          __global const uint* vertex_offsets, MP_SHADOW_INPUT_PARAMS) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   float2 uv;
@@ -24,7 +19,7 @@ __kernel void shade_grids(__global const SubPatch* diceable, uint count, __globa
   DeviceMaterial m = materials[patch_info[4 * (ulong)sp.patch + 1]];
   float3 p = grid_p[index].xyz, n = grid_n[index].xyz;
   /* Shadows compare with the surface's own tangent plane (mp_shadow.h). */
-  MpShadowMaps maps = {shadows, shadow_levels, shadow_pages, shadow_pool};
+  MpShadowMaps maps = MP_SHADOW_INPUTS;
   MpShadowQuery shadow = {&maps, n, mp_pixel_footprint(-p.z, f)};
   /* Smooth-shaded polygons: their interpolated normal replaces the surface's
    * for shading, node programs and the Normal pass (w = 1: already faced).

@@ -14,6 +14,7 @@
 #include "geometry/mp_bound.h"
 #include "shadow/mp_shadow.h"
 #include "stages/mp_occlusion.h"
+#include "core/mp_scene_data.h"
 
 /* Texels of margin around a receiver's box when marking: soft shadows'
  * filters read up to MP_SHADOW_SEARCH_TEXELS from a receiver, hard shadows'
@@ -169,9 +170,9 @@ inline int mp_marking_box(__global const DeviceShadow* sh, float3 p, FrameParams
  * round's levels for soft ones, under a box around it reaching its
  * neighbours (`reach` pixels). */
 inline void mp_mark_vertex(float3 p, FrameParams f, __global const DeviceShadow* shadows,
-                           __global const DeviceShadowLevel* levels, uint light_count, __global uchar* requests,
+                           __global const DeviceShadowLevel* levels, uint shadow_count, __global uchar* requests,
                            volatile __global uint* caps, float reach, uint soft) {
-  for (uint l = 0; l < light_count; ++l) {
+  for (uint l = 0; l < shadow_count; ++l) {
     __global const DeviceShadow* sh = shadows + l;
     if (sh->kind == MP_SHADOW_NONE) continue;
     float3 q, lo, hi;
@@ -203,9 +204,8 @@ inline void mp_mark_vertex(float3 p, FrameParams f, __global const DeviceShadow*
  * opacity below one hide nothing here: what shows through their holes needs
  * its pages. */
 __kernel __attribute__((reqd_work_group_size(64, 1, 1)))
-void marking_depth(__global const SubPatch* diceable, uint count, __global const uint* offsets, uint total,
-                   __global const uint* patch_info, __global const DeviceMaterial* materials, FrameParams f,
-                   __global const float4* grid_p, OcclusionParams o, volatile __global uint* depth) {
+void marking_depth(MP_SCENE_PARAMS __global const SubPatch* diceable, uint count, __global const uint* offsets,
+                   uint total, FrameParams f, __global const float4* grid_p, OcclusionParams o, volatile __global uint* depth) {
   uint gid = get_global_id(0);
   if (gid >= total || count == 0u) return;
   uint first = offsets[0];
@@ -292,8 +292,7 @@ inline int mp_marking_seen(float3 p, FrameParams f, __global const uint* depth, 
  * 1 (boxes outside the frame count as seen: their first test culls them,
  * wherever they come). Only an order: the camera culls against its own
  * samples, never against this depth. */
-__kernel void marking_roots_seen(__global const uint* order, uint n, __global const float4* patch_bounds,
-                                 FrameParams f, __global const uint* depth, OcclusionParams o, __global uint* seen) {
+__kernel void marking_roots_seen(MP_SCENE_PARAMS __global const uint* order, uint n, FrameParams f, __global const uint* depth, OcclusionParams o, __global uint* seen) {
   uint i = get_global_id(0);
   if (i > n) return;
   if (i == n) { /* one past the end: 0, so that the scan leaves the total there */
@@ -328,7 +327,7 @@ __kernel void marking_roots_partition(__global const uint* order, uint n, __glob
 __kernel void mark_shadow_pages(__global const SubPatch* diceable, uint count, __global const uint* vertex_offsets,
                                 uint vertex_total, FrameParams f, __global const float4* grid_p,
                                 __global const float4* grid_n, __global const DeviceShadow* shadows,
-                                __global const DeviceShadowLevel* levels, uint light_count,
+                                __global const DeviceShadowLevel* levels, uint shadow_count,
                                 __global uchar* requests, volatile __global uint* caps, float reach, uint soft,
                                 uint mark, uint keep, uint keep_n, uint keep_base, __global float* kept_p,
                                 __global float* kept_n, __global const uint* depth, OcclusionParams o) {
@@ -344,20 +343,20 @@ __kernel void mark_shadow_pages(__global const SubPatch* diceable, uint count, _
   if (!valid || !mark) return;
   float3 p = grid_p[index].xyz;
   if (mp_marking_seen(p, f, depth, o, reach))
-    mp_mark_vertex(p, f, shadows, levels, light_count, requests, caps, reach, soft);
+    mp_mark_vertex(p, f, shadows, levels, shadow_count, requests, caps, reach, soft);
 }
 
 /* The first marking from the kept vertices, once the coarse depth is
  * complete: only those the camera may see mark pages. */
 __kernel void mark_kept_shadow_pages(__global const float* kept_p, uint kept, FrameParams f,
                                      __global const DeviceShadow* shadows, __global const DeviceShadowLevel* levels,
-                                     uint light_count, __global uchar* requests, volatile __global uint* caps,
+                                     uint shadow_count, __global uchar* requests, volatile __global uint* caps,
                                      float reach, uint soft, __global const uint* depth, OcclusionParams o) {
   uint gid = get_global_id(0);
   if (gid >= kept) return;
   float3 p = vload3(gid, kept_p);
   if (isnan(p.x) || !mp_marking_seen(p, f, depth, o, reach)) return;
-  mp_mark_vertex(p, f, shadows, levels, light_count, requests, caps, reach, soft);
+  mp_mark_vertex(p, f, shadows, levels, shadow_count, requests, caps, reach, soft);
 }
 
 /* Second marking, for soft shadows, on the maps the first rendered (one
@@ -367,11 +366,11 @@ __kernel void mark_kept_shadow_pages(__global const float* kept_p, uint kept, Fr
  * finest level) to the coarsest; receivers that see no occluder read
  * nothing more. */
 inline void mp_mark_soft_vertex(float3 p, float3 n, FrameParams f, __global const DeviceShadow* shadows,
-                                __global const DeviceShadowLevel* levels, uint light_count,
+                                __global const DeviceShadowLevel* levels, uint shadow_count,
                                 __global const uint* pages, __global const uint* pool, __global uchar* requests,
                                 volatile __global uint* caps, float reach) {
   MpShadowMaps maps = {shadows, levels, pages, pool};
-  for (uint l = 0; l < light_count; ++l) {
+  for (uint l = 0; l < shadow_count; ++l) {
     __global const DeviceShadow* sh = shadows + l;
     if (sh->kind == MP_SHADOW_NONE || sh->shape == MP_SHADOW_SHAPE_POINT) continue;
     float3 q, lo, hi;
@@ -400,7 +399,7 @@ inline void mp_mark_soft_vertex(float3 p, float3 n, FrameParams f, __global cons
 
 __kernel void mark_soft_shadow_pages(__global const float* kept_p, __global const float* kept_n, uint kept,
                                      FrameParams f, __global const DeviceShadow* shadows,
-                                     __global const DeviceShadowLevel* levels, uint light_count,
+                                     __global const DeviceShadowLevel* levels, uint shadow_count,
                                      __global const uint* pages, __global const uint* pool,
                                      __global uchar* requests, volatile __global uint* caps, float reach,
                                      __global const uint* depth, OcclusionParams o) {
@@ -408,7 +407,7 @@ __kernel void mark_soft_shadow_pages(__global const float* kept_p, __global cons
   if (gid >= kept) return;
   float3 p = vload3(gid, kept_p);
   if (isnan(p.x) || !mp_marking_seen(p, f, depth, o, reach)) return;
-  mp_mark_soft_vertex(p, vload3(gid, kept_n), f, shadows, levels, light_count, pages, pool, requests, caps, reach);
+  mp_mark_soft_vertex(p, vload3(gid, kept_n), f, shadows, levels, shadow_count, pages, pool, requests, caps, reach);
 }
 
 /* The same, straight from a batch's grids: where the first marking's
@@ -418,7 +417,7 @@ __kernel void mark_soft_shadow_pages_grid(__global const SubPatch* diceable, uin
                                           __global const uint* vertex_offsets, FrameParams f,
                                           __global const float4* grid_p, __global const float4* grid_n,
                                           __global const DeviceShadow* shadows,
-                                          __global const DeviceShadowLevel* levels, uint light_count,
+                                          __global const DeviceShadowLevel* levels, uint shadow_count,
                                           __global const uint* pages, __global const uint* pool,
                                           __global uchar* requests, volatile __global uint* caps, float reach,
                                           __global const uint* depth, OcclusionParams o) {
@@ -428,7 +427,7 @@ __kernel void mark_soft_shadow_pages_grid(__global const SubPatch* diceable, uin
   ulong index;
   if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
   if (!mp_marking_seen(grid_p[index].xyz, f, depth, o, reach)) return;
-  mp_mark_soft_vertex(grid_p[index].xyz, grid_n[index].xyz, f, shadows, levels, light_count, pages, pool, requests, caps,
+  mp_mark_soft_vertex(grid_p[index].xyz, grid_n[index].xyz, f, shadows, levels, shadow_count, pages, pool, requests, caps,
                       reach);
 }
 
@@ -548,8 +547,8 @@ inline int mp_shadow_vertex(float4 p, FrameParams v, MpFixed2* r, float* inv_d) 
  * as their bits do). Opacity below one keeps a matching fraction of texels,
  * as the camera's samples do. */
 __kernel __attribute__((reqd_work_group_size(64, 1, 1)))
-void shadow_sample(__global const SubPatch* diceable, uint first, uint count, __global const uint* offsets, uint base,
-                   uint total, __global const uint* patch_info, __global const DeviceMaterial* materials, FrameParams f,
+void shadow_sample(MP_SCENE_PARAMS __global const SubPatch* diceable, uint first, uint count,
+                   __global const uint* offsets, uint base, uint total, FrameParams f,
                    __global const FrameParams* views, __global const float4* grid_p, __global const float4* grid_c,
                    __global const uint* page_table, volatile __global uint* pool, __global uchar* dirty) {
   uint gid = get_global_id(0);

@@ -36,6 +36,10 @@ class DeviceSession {
   double program_build_ms() const { return build_ms_; }
   bool program_cache_hit() const { return cache_hit_; }
   size_t max_alloc_bytes() const { return max_alloc_; }
+  // A number no earlier call returned: names one upload of scene data, so a
+  // kernel knows whether the buffers it holds are still the scene's
+  // (scene_kernel.h).
+  uint64_t next_data_version() { return ++data_versions_; }
   // Whether the program holds the tile sampler (sample_tiles.cl). PoCL
   // built on LLVM 14 or older (e.g. PyPI's pocl-binary-distribution 3.0)
   // aborts the process compiling its 16-wide vector code, so on such a
@@ -89,6 +93,7 @@ class DeviceSession {
   bool cache_hit_ = false;
   bool tile_sampler_ = true;
   size_t max_alloc_ = 0;
+  uint64_t data_versions_ = 0;
 };
 
 }  // namespace mp

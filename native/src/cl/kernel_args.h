@@ -41,10 +41,16 @@ void bind_arg(cl::Kernel& kernel, cl_uint& index, const T& value) {
 
 }  // namespace detail
 
+// The same from argument `first` on: a kernel whose first arguments stay
+// bound (the scene's data, scene_kernel.h).
+template <typename... Args>
+void bind_args_from(cl::Kernel& kernel, cl_uint first, const Args&... args) {
+  (detail::bind_arg(kernel, first, args), ...);
+}
+
 template <typename... Args>
 void bind_args(cl::Kernel& kernel, const Args&... args) {
-  cl_uint index = 0;
-  (detail::bind_arg(kernel, index, args), ...);
+  bind_args_from(kernel, 0, args...);
 }
 
 }  // namespace mp

@@ -370,6 +370,7 @@ void upload_lights(DeviceSession& session, const std::vector<Light>& lights, con
   upload_or_drain(session, [&] {
     buffers.lights = upload(session, records);
     buffers.light_count = static_cast<cl_uint>(records.size());
+    buffers.version = session.next_data_version();
     session.queue().finish();  // `records` lives only for the call
   });
 }
@@ -377,6 +378,7 @@ void upload_lights(DeviceSession& session, const std::vector<Light>& lights, con
 void upload_world_glossy(DeviceSession& session, const std::vector<glm::vec4>& maps, SceneBuffers& buffers) {
   upload_or_drain(session, [&] {
     buffers.world_glossy = upload(session, maps);
+    buffers.version = session.next_data_version();
     session.queue().finish();  // `maps` is the caller's; the write must end while it lives
   });
 }
@@ -399,7 +401,7 @@ SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data
     b.patch_bounds = upload(session, b.host_patch_bounds);
     b.images = upload(session, data.images);
     b.texels = upload(session, data.texels);
-    b.params = upload(session, data.params);
+    b.node_params = upload(session, data.params);
     b.world_params_at = static_cast<cl_uint>(data.world_params_at);
     b.world_glossy = upload(session, no_world_glossy);
     b.motion_points = upload(session, data.motion_points);
@@ -414,6 +416,7 @@ SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data
     b.image_count = static_cast<cl_uint>(data.images.size());
     b.patch_count = static_cast<cl_uint>(data.patches.size());
     b.light_count = static_cast<cl_uint>(data.lights.size());
+    b.version = session.next_data_version();
     session.queue().finish();
   });
   return b;

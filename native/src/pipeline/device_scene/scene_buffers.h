@@ -6,6 +6,7 @@
 #include "cl/cl.h"
 #include "micropoly/scene.h"
 #include "core/mp_types.h"
+#include "core/mp_scene_data.h"
 #include "pipeline/device_scene/patch_cache.h"
 #include "pipeline/materials/refraction_proxy.h"
 #include "subdiv/patch_buffer.h"
@@ -42,32 +43,21 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache = nullptr
 // two records, so it comes last (shadow records follow the lights' order).
 std::vector<DeviceLight> device_lights(const std::vector<Light>& lights, const glm::mat4& world_to_camera);
 
+// The scene's device data: one member per entry of kernels/core/mp_scene_data.h
+// (a cl::Buffer per BUFFER, a cl_uint per VALUE), which the kernels declare
+// by the same names (MP_SCENE_PARAMS) and SceneKernel binds in its order.
+#define MP_HOST_SCENE_BUFFER(type, name) cl::Buffer name;
+#define MP_HOST_SCENE_VALUE(type, name) cl_##type name = 0;
 struct SceneBuffers {
-  cl::Buffer points;      // float4 x MP_PATCH_POINTS per patch
-  cl::Buffer patch_info;  // uint4 per patch
-  cl::Buffer patch_edges;  // MP_EDGE_REFS uints per patch (kernels/geometry/mp_patch.h)
-  cl::Buffer edge_curves;  // MP_CURVE_FLOAT4S float4 per shared edge curve
-  cl::Buffer materials;
-  cl::Buffer objects;
-  cl::Buffer lights;
-  cl::Buffer patch_uvs;   // 2 float4 per patch and UV layer (kernels/geometry/mp_patch.h)
-  cl::Buffer patch_normals;  // 4 float4 per patch: smooth shading normals at its corners
-  cl::Buffer patch_bounds;   // 2 float4 per patch: camera-space box of its net, displacement included
-  std::vector<glm::vec4> host_patch_bounds;  // the same on the host (occlusion culling's root order)
-  cl::Buffer images;      // DeviceImage per image
-  cl::Buffer texels;      // float4
-  cl::Buffer params;      // float: HostSceneData::params
-  cl_uint world_params_at = 0;
-  cl::Buffer world_glossy;  // float4: the world's glossy maps (kernels/closures/mp_world.h), or one zero texel
-  cl::Buffer motion_points, motion_curves;  // HostSceneData's (one float4 when there is no motion)
-  cl::Buffer refract_roots, refract_nodes, refract_tris;  // RefractionProxies (kernels/geometry/mp_refract_trace.h)
-  cl_uint motion_steps = 0;
-  cl_uint point_count = 0, curve_count = 0;  // float4s of one step
-  cl_uint patch_count = 0;
-  cl_uint light_count = 0;
-  cl_uint uv_layers = 0;
-  cl_uint image_count = 0;
+  MP_SCENE_DATA(MP_HOST_SCENE_BUFFER, MP_HOST_SCENE_VALUE)
+  std::vector<glm::vec4> host_patch_bounds;  // patch_bounds on the host (occlusion culling's root order)
+  // Which upload these buffers are (DeviceSession::next_data_version); every
+  // replacement of a buffer takes a new one, so kernels bound to the old
+  // buffers bind again (scene_kernel.h).
+  uint64_t version = 0;
 };
+#undef MP_HOST_SCENE_BUFFER
+#undef MP_HOST_SCENE_VALUE
 SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data);
 // Replaces the world's glossy maps (world_lighting.h, world_glossy_maps).
 void upload_world_glossy(DeviceSession& session, const std::vector<glm::vec4>& maps,

@@ -59,23 +59,13 @@ MaterialPrograms::Built* MaterialPrograms::build(const MaterialProgram& mp, cons
   stats.program_build_ms += b.build_ms;
   auto built = std::make_unique<Built>();
   built->program = b.program;
-  built->displace = cl::Kernel(built->program, "displace_grids");
-  built->shade = cl::Kernel(built->program, "shade_program_grids");
-  built->bake_world = cl::Kernel(built->program, "bake_world");
-  built->world_pixels = cl::Kernel(built->program, "world_pixels");
+  built->displace = SceneKernel(built->program, "displace_grids");
+  built->shade = SceneKernel(built->program, "shade_program_grids");
+  built->bake_world = SceneKernel(built->program, "bake_world");
+  built->world_pixels = SceneKernel(built->program, "world_pixels");
   built->used = generation_;
   return built_.emplace(mp.source, std::move(built)).first->second.get();
 }
-
-namespace {
-
-// MP_PROGRAM_INPUT_ARGS (material_program.cl), in its order.
-auto program_inputs(const SceneBuffers& buffers) {
-  return arg_pack(buffers.patch_edges, buffers.patch_uvs, buffers.uv_layers, buffers.images, buffers.image_count,
-                  buffers.texels, buffers.params);
-}
-
-}  // namespace
 
 WorldMap MaterialPrograms::bake_world(const Scene& scene, const SceneBuffers& buffers) {
   WorldMap map;
@@ -84,8 +74,7 @@ WorldMap MaterialPrograms::bake_world(const Scene& scene, const SceneBuffers& bu
   map.height = map.width / 2;
   const size_t texels = size_t(map.width) * size_t(map.height);
   cl::Buffer out = session_.allocate(texels * sizeof(cl_float4), "world map");
-  cl::Kernel& k = world_->bake_world;
-  bind_args(k, cl_uint(map.width), cl_uint(map.height), program_inputs(buffers), buffers.world_params_at, out);
+  cl::Kernel& k = world_->bake_world.bind(buffers, cl_uint(map.width), cl_uint(map.height), out);
   DeviceQueue& q = session_.queue();
   q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(cl_uint(texels)), cl::NDRange(64));
   std::vector<cl_float4> host(texels);
@@ -102,26 +91,14 @@ std::vector<float> MaterialPrograms::world_background(const Scene& scene, const 
   cl::Buffer out = session_.allocate(pixels * 3 * sizeof(float), "world background");
   // Camera to world: the inverse of the view's rotation, by rows.
   const glm::mat3 to_world = glm::inverse(glm::mat3(scene.camera.world_to_camera));
-  cl::Kernel& k = world_->world_pixels;
   auto row = [&](int r) { return cl_float4{{to_world[0][r], to_world[1][r], to_world[2][r], 0.0f}}; };
-  bind_args(k, f, row(0), row(1), row(2), program_inputs(buffers), buffers.world_params_at, out);
+  cl::Kernel& k = world_->world_pixels.bind(buffers, f, row(0), row(1), row(2), out);
   DeviceQueue& q = session_.queue();
   q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(cl_uint(pixels)), cl::NDRange(64));
   std::vector<float> host(pixels * 3);
   q.enqueueReadBuffer(out, CL_TRUE, 0, host.size() * sizeof(float), host.data());
   return host;
 }
-
-namespace {
-
-// The arguments displace_grids and shade_program_grids share (material_program.cl).
-auto grid_args(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
-               cl_int program, const GridBuffers& grids) {
-  return arg_pack(diceable, count, scene.patch_info, scene.materials, scene.objects, f, program, grids.p, grids.n,
-                  program_inputs(scene));
-}
-
-}  // namespace
 
 void MaterialPrograms::launch(cl::Kernel& kernel, cl_uint count, GridBuffers& grids, Stage stage, StageTimer& timer) {
   cl::Event e;
@@ -135,14 +112,12 @@ void MaterialPrograms::displace(const cl::Buffer& diceable, cl_uint count, const
   if (!displaces_) return;
   for (Active& a : active_) {
     if (!a.displaces) continue;
-    cl::Kernel& k = a.built->displace;
-    bind_args(k, grid_args(diceable, count, scene, f, a.index, grids), grids.vertex_offsets);
-    launch(k, count, grids, Stage::Dice, timer);
+    launch(a.built->displace.bind(scene, diceable, count, f, a.index, grids.p, grids.n, grids.vertex_offsets), count,
+           grids, Stage::Dice, timer);
   }
   if (!normals) return;
-  cl::Kernel& k = normals_;
-  bind_args(k, diceable, count, scene.patch_info, scene.materials, f, grids.p, grids.n, grids.vertex_offsets);
-  launch(k, count, grids, Stage::Dice, timer);
+  launch(normals_.bind(scene, diceable, count, f, grids.p, grids.n, grids.vertex_offsets), count, grids, Stage::Dice,
+         timer);
 }
 
 void MaterialPrograms::shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
@@ -161,10 +136,8 @@ void MaterialPrograms::run_shade(const cl::Buffer& diceable, cl_uint count, cons
                                  bool alpha_only, StageTimer& timer) {
   for (Active& a : active_) {
     if (!(alpha_only ? a.alpha : a.shades)) continue;
-    cl::Kernel& k = a.built->shade;
-    bind_args(k, grid_args(diceable, count, scene, f, a.index, grids), scene.lights, scene.light_count, grids.c,
-              grids.vertex_offsets, shadows.args(), cl_uint(alpha_only ? 1 : 0), scene.world_glossy,
-              scene.refract_roots, scene.refract_nodes, scene.refract_tris);
+    cl::Kernel& k = a.built->shade.bind(scene, diceable, count, f, a.index, grids.p, grids.n, grids.c,
+                                        grids.vertex_offsets, shadows.args(), cl_uint(alpha_only ? 1 : 0));
     launch(k, count, grids, Stage::Shade, timer);
   }
 }

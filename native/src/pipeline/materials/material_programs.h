@@ -48,7 +48,7 @@ class MaterialPrograms {
  private:
   struct Built {
     cl::Program program;
-    cl::Kernel displace, shade, bake_world, world_pixels;
+    SceneKernel displace, shade, bake_world, world_pixels;
     unsigned long long used = 0;  // the last prepare() that used it
   };
   // Programs kept beyond those the current scene uses: node values are
@@ -75,7 +75,7 @@ class MaterialPrograms {
   std::vector<Active> active_;
   Built* world_ = nullptr;  // the scene's world program, if any
   bool displaces_ = false;
-  cl::Kernel normals_;  // displaced_normals, from the main program
+  SceneKernel normals_;  // displaced_normals, from the main program
 };
 
 }  // namespace mp

@@ -10,6 +10,7 @@
 #include "cl/device_session.h"
 #include "micropoly/renderer.h"
 #include "pipeline/device_scene/scene_buffers.h"
+#include "pipeline/device_scene/scene_kernel.h"
 #include "pipeline/pass/stage_timer.h"
 
 namespace mp {
@@ -114,6 +115,7 @@ struct BoundSplitContext {
 // reallocated whenever its size changes, so what is held is exactly what the
 // current budget asks for.
 struct BoundedWorkspace {
+  SceneKernel step;  // bs_bounded_step, made on first use and kept with its scene data bound
   cl::Buffer stacks, sizes, ring, diceable, counters;
   size_t stacks_bytes = 0, sizes_bytes = 0, ring_bytes = 0, diceable_bytes = 0, counters_bytes = 0;
 };

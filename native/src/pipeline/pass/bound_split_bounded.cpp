@@ -90,10 +90,8 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
     queue.enqueueFillBuffer(ws.sizes, zero, 0, workers * sizeof(cl_uint));
 
     const PassOcclusion& occ = ctx.occlusion;
-    cl::Kernel step(s.program(), "bs_bounded_step");
-    bind_args(step, ctx.scene.points, ctx.scene.patch_info, ctx.scene.patch_edges, ctx.scene.edge_curves,
-              ctx.scene.patch_bounds, ctx.scene.patch_count, occ.on() ? occ.root_order : cl::Buffer(), ctx.frame,
-              ctx.views.views, ctx.views.count, ctx.views.page_masks, occ.on() ? occ.pyramid : cl::Buffer(),
+    if (!ws.step.kernel()()) ws.step = SceneKernel(s.program(), "bs_bounded_step");
+    cl::Kernel& step = ws.step.bind(ctx.scene, occ.on() ? occ.root_order : cl::Buffer(), ctx.frame, ctx.views.views, ctx.views.count, ctx.views.page_masks, occ.on() ? occ.pyramid : cl::Buffer(),
               occ.params, ws.stacks, ws.sizes, stack_depth, ws.ring, ring_capacity, ws.diceable, dice_capacity,
               ws.counters, kStepsPerLaunch);
     const cl_uint root_count = ctx.root_count();

@@ -20,8 +20,10 @@ BoundSplitResult bound_split_breadth(BoundSplitContext& ctx, cl_uint dice_capaci
     TalliedBuffer queue_in(tally), queue_out(tally), decision(tally), dice_flag(tally), split_flag(tally);
     TalliedBuffer diceable(tally), batch(tally);
     PrefixSum scan(s, tally);
-    cl::Kernel init(s.program(), "bs_init_queue"), classify(s.program(), "bs_breadth_classify"),
-        scatter(s.program(), "bs_breadth_scatter");
+    // Made per pass: the breadth-first method is the reference, not the
+    // renderer's default, so it keeps no kernels between passes.
+    cl::Kernel scatter(s.program(), "bs_breadth_scatter");
+    SceneKernel init(s.program(), "bs_init_queue"), classify(s.program(), "bs_breadth_classify");
 
     // Occlusion culling tests each level's sub-patches against what the
     // levels before it sampled (the roots, all taken at once, against none).
@@ -32,22 +34,20 @@ BoundSplitResult bound_split_breadth(BoundSplitContext& ctx, cl_uint dice_capaci
     cl_uint n = ctx.root_count();
     const size_t rec = sizeof(SubPatch);
     queue_in.reserve(s, n * rec);
-    bind_args(init, queue_in.get(), n, ctx.scene.patch_count, ctx.views.count,
-              occ.on() ? occ.root_order : cl::Buffer());
+    cl::Kernel& k0 = init.bind(ctx.scene, queue_in.get(), n, ctx.views.count, occ.on() ? occ.root_order : cl::Buffer());
     cl::Event e0;
-    queue.enqueueNDRangeKernel(init, cl::NullRange, round_up_range(n), cl::NDRange(64), nullptr, &e0);
+    queue.enqueueNDRangeKernel(k0, cl::NullRange, round_up_range(n), cl::NDRange(64), nullptr, &e0);
     ctx.timer.add(Stage::BoundSplit, e0);
 
     for (int depth = 0; n > 0; ++depth) {
       decision.reserve(s, n * sizeof(cl_uint));
       dice_flag.reserve(s, (n + 1) * sizeof(cl_uint));
       split_flag.reserve(s, (n + 1) * sizeof(cl_uint));
-      bind_args(classify, queue_in.get(), n, ctx.scene.points, ctx.scene.patch_info, ctx.scene.patch_edges,
-                ctx.scene.edge_curves, ctx.scene.patch_bounds, ctx.frame, ctx.views.views, ctx.views.count,
-                ctx.views.page_masks, occ.on() ? occ.pyramid : cl::Buffer(), occ.params, occluded.get(), decision.get(),
-                dice_flag.get(), split_flag.get());
+      cl::Kernel& k = classify.bind(ctx.scene, queue_in.get(), n, ctx.frame, ctx.views.views, ctx.views.count,
+                                    ctx.views.page_masks, occ.on() ? occ.pyramid : cl::Buffer(), occ.params,
+                                    occluded.get(), decision.get(), dice_flag.get(), split_flag.get());
       cl::Event e1;
-      queue.enqueueNDRangeKernel(classify, cl::NullRange, round_up_range(n + 1), cl::NDRange(64), nullptr, &e1);
+      queue.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(n + 1), cl::NDRange(64), nullptr, &e1);
       ctx.timer.add(Stage::BoundSplit, e1);
       ++result.launches;
 

@@ -105,12 +105,10 @@ void DiceStage::run_motion(const cl::Buffer& diceable, cl_uint count, const Scen
   q.enqueueCopyBuffer(grids.p, grids.rest_p, 0, 0, size_t(count) * grids.vertices_per_slot * sizeof(cl_float4));
   for (cl_uint k = 0; k < scene.motion_steps; ++k) {
     // Step k's control points and curves follow the steps before it.
-    bind_args(motion_kernel_, diceable, count, scene.motion_points, cl_ulong(size_t(k) * scene.point_count),
-              scene.patch_info, scene.patch_edges, scene.motion_curves, cl_ulong(size_t(k) * scene.curve_count), f,
-              grids.motion_p, cl_ulong(size_t(k) * grids.slot_space()), grids.vertex_offsets);
+    cl::Kernel& kernel = motion_kernel_.bind(scene, diceable, count, k, f, grids.motion_p,
+                                             cl_ulong(size_t(k) * grids.slot_space()), grids.vertex_offsets);
     cl::Event e;
-    q.enqueueNDRangeKernel(motion_kernel_, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64), nullptr,
-                           &e);
+    q.enqueueNDRangeKernel(kernel, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64), nullptr, &e);
     timer.add(Stage::Dice, e);
   }
 }
@@ -127,10 +125,9 @@ void DiceStage::displaced(const cl::Buffer& diceable, cl_uint count, const Frame
 
 void DiceStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
                     GridBuffers& grids, StageTimer& timer) {
-  bind_args(kernel_, diceable, count, scene.points, scene.patch_info, scene.patch_edges, scene.edge_curves,
-            scene.materials, f, grids.p, grids.n, grids.vertex_offsets);
+  cl::Kernel& kernel = kernel_.bind(scene, diceable, count, f, grids.p, grids.n, grids.vertex_offsets);
   cl::Event e;
-  session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64),
+  session_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64),
                                         nullptr, &e);
   timer.add(Stage::Dice, e);
 }
@@ -139,11 +136,10 @@ ShadeStage::ShadeStage(DeviceSession& session) : session_(session), kernel_(sess
 
 void ShadeStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
                      GridBuffers& grids, const ShadowInputs& shadows, StageTimer& timer) {
-  bind_args(kernel_, diceable, count, scene.patch_info, f, grids.p, grids.n, scene.materials, scene.lights,
-            scene.light_count, grids.c, grids.vertex_offsets, scene.patch_normals, shadows.args(), scene.world_glossy,
-            scene.refract_roots, scene.refract_nodes, scene.refract_tris);
+  cl::Kernel& kernel =
+      kernel_.bind(scene, diceable, count, f, grids.p, grids.n, grids.c, grids.vertex_offsets, shadows.args());
   cl::Event e;
-  session_.queue().enqueueNDRangeKernel(kernel_, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64),
+  session_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64),
                                         nullptr, &e);
   timer.add(Stage::Shade, e);
 }
@@ -155,7 +151,7 @@ SampleStage::SampleStage(DeviceSession& session)
       clear_(session.program(), "clear_samples"),
       project_(session.tile_sampler() ? cl::Kernel(session.program(), "project_grids") : cl::Kernel()),
       bound_runs_(session.tile_sampler() ? cl::Kernel(session.program(), "bound_runs") : cl::Kernel()),
-      tile_kernel_(session.tile_sampler() ? cl::Kernel(session.program(), "sample_tiles") : cl::Kernel()) {
+      tile_kernel_(session.tile_sampler() ? SceneKernel(session.program(), "sample_tiles") : SceneKernel()) {
   totals_ = session.allocate(3 * sizeof(cl_ulong), "sample totals");
 }
 
@@ -289,13 +285,14 @@ void SampleStage::run(const cl::Buffer& diceable, cl_uint first, cl_uint count, 
     run_tiles(diceable, first, count, scene, f, grids, timer, keep_going);
     return;
   }
-  cl::Kernel& k = mp_blur_on(f) ? blur_kernel_ : kernel_;
+  SceneKernel& sampler = mp_blur_on(f) ? blur_kernel_ : kernel_;
   // Pass 0 finds each sample's nearest key; pass 1 lets its owner write.
   for (cl_uint pass = 0; pass < 2; ++pass) {
     // Motion positions: any valid buffer when there are none.
-    bind_args(k, diceable, first, count, grids.micropolygon_offsets, base, total, scene.patch_info, f, grids.p,
-              grids.c, grids.n, offsets_, pass, keys_, colors_, normals_, totals_, occlusion_dirty_, occlusion_, blur_,
-              grids.motion_p() ? grids.motion_p : grids.p, cl_ulong(grids.slot_space()));
+    cl::Kernel& k = sampler.bind(scene, diceable, first, count, grids.micropolygon_offsets, base, total, f, grids.p,
+                                 grids.c, grids.n, offsets_, pass, keys_, colors_, normals_, totals_,
+                                 occlusion_dirty_, occlusion_, blur_, grids.motion_p() ? grids.motion_p : grids.p,
+                                 cl_ulong(grids.slot_space()));
     cl::Event e;
     session_.queue().enqueueNDRangeKernel(k, cl::NullRange, round_up_range(total), cl::NDRange(64), nullptr, &e);
     timer.add(Stage::Sample, e);

@@ -12,6 +12,7 @@
 #include "pipeline/frame/buckets.h"
 #include "pipeline/frame/frame_params.h"
 #include "pipeline/device_scene/scene_buffers.h"
+#include "pipeline/device_scene/scene_kernel.h"
 #include "pipeline/pass/stage_timer.h"
 
 namespace mp {
@@ -81,7 +82,7 @@ class GridLayoutStage {
 struct ShadowInputs {
   bool enabled = false;
   cl::Buffer shadows, levels, pages, pool;
-  // As the kernels take them (MP_SHADOW_INPUT_ARGS order): whether
+  // As the kernels take them (MP_SHADOW_INPUT_PARAMS, mp_shadow.h): whether
   // enabled, then the four buffers.
   auto args() const { return arg_pack(cl_uint(enabled ? 1 : 0), shadows, levels, pages, pool); }
 };
@@ -101,7 +102,8 @@ class DiceStage {
 
  private:
   DeviceSession& session_;
-  cl::Kernel kernel_, motion_kernel_, displaced_kernel_;
+  SceneKernel kernel_, motion_kernel_;
+  cl::Kernel displaced_kernel_;
 };
 
 class ShadeStage {
@@ -112,7 +114,7 @@ class ShadeStage {
 
  private:
   DeviceSession& session_;
-  cl::Kernel kernel_;
+  SceneKernel kernel_;
 };
 
 class SampleStage {
@@ -148,9 +150,10 @@ class SampleStage {
   // into per-tile lists on the host, then samples each tile.
   void run_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
                  const FrameParams& f, GridBuffers& grids, StageTimer& timer, const std::function<bool()>& keep_going);
-  cl::Kernel kernel_, blur_kernel_;  // pinhole samples; samples with times and lens positions
+  SceneKernel kernel_, blur_kernel_;  // pinhole samples; samples with times and lens positions
   cl::Kernel clear_;
-  cl::Kernel project_, bound_runs_, tile_kernel_;
+  cl::Kernel project_, bound_runs_;
+  SceneKernel tile_kernel_;
   bool tiles_ = false;
   cl::Buffer projected_, rects_, tile_ids_, tile_starts_, tile_entries_;
   size_t projected_bytes_ = 0, rect_bytes_ = 0, tile_bytes_ = 0, start_bytes_ = 0, entry_bytes_ = 0;

@@ -88,16 +88,15 @@ void SampleStage::run_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint c
   q.enqueueWriteBuffer(tile_starts_, CL_FALSE, 0, (active + 1) * sizeof(cl_uint), tile_starts_host_.data());
   q.enqueueWriteBuffer(tile_entries_, CL_FALSE, 0, entries * sizeof(cl_uint), tile_entries_host_.data());
 
-  cl::Kernel& k = tile_kernel_;
   // All tiles in one launch, or (when the caller may cancel) in parts, with
   // a question between them. A fixed work-group size: PoCL compiles a
   // kernel once per size it meets.
   const cl_uint part = keep_going ? kTileChunk : active;
   for (cl_uint first_tile = 0; first_tile < active; first_tile += part) {
     if (first_tile > 0 && !keep_going()) break;
-    bind_args(k, diceable, scene.patch_info, f, projected_, grids.c, grids.n, offsets_, offsets_soa_, tile_ids_,
-              tile_starts_, tile_entries_, runs_per_grid, first_tile, active, tiles_x, keys_, colors_, normals_,
-              totals_, occlusion_dirty_, occlusion_);
+    cl::Kernel& k = tile_kernel_.bind(scene, diceable, f, projected_, grids.c, grids.n, offsets_, offsets_soa_,
+                                      tile_ids_, tile_starts_, tile_entries_, runs_per_grid, first_tile, active,
+                                      tiles_x, keys_, colors_, normals_, totals_, occlusion_dirty_, occlusion_);
     cl::Event t;
     q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(std::min(part, active - first_tile), kTileGroup),
                            cl::NDRange(kTileGroup), nullptr, &t);

@@ -20,8 +20,8 @@ OcclusionParams layout_for(const FrameParams& f) { return occlusion_layout(f, kC
 MarkingDepth::MarkingDepth(DeviceSession& session)
     : session_(session),
       raster_(session.program(), "marking_depth"),
-      reduce_(session.program(), "occlusion_reduce"),
       seen_(session.program(), "marking_roots_seen"),
+      reduce_(session.program(), "occlusion_reduce"),
       partition_(session.program(), "marking_roots_partition"),
       scan_(session, scan_tally_) {}
 
@@ -48,10 +48,9 @@ void MarkingDepth::rasterise(const cl::Buffer& diceable, cl_uint count, const Sc
   if (!on() || count == 0) return;
   const cl_uint total = grids.micropolygon_offsets_host[count] - grids.micropolygon_offsets_host[0];
   if (total == 0) return;
-  bind_args(raster_, diceable, count, grids.micropolygon_offsets, total, scene.patch_info, scene.materials, f, grids.p,
-            params_, pyramid_);
+  cl::Kernel& k = raster_.bind(scene, diceable, count, grids.micropolygon_offsets, total, f, grids.p, params_, pyramid_);
   cl::Event e;
-  session_.queue().enqueueNDRangeKernel(raster_, cl::NullRange, round_up_range(total), cl::NDRange(64), nullptr, &e);
+  session_.queue().enqueueNDRangeKernel(k, cl::NullRange, round_up_range(total), cl::NDRange(64), nullptr, &e);
   timer.add(Stage::ShadowMark, e);
 }
 
@@ -83,9 +82,9 @@ void MarkingDepth::seen_first(const cl::Buffer& order, cl_uint count, const Scen
   const size_t bytes = size_t(count) * sizeof(cl_uint);
   session_.reserve(flags_, flags_held_, bytes + sizeof(cl_uint), "camera roots seen");  // and the scan's total
   session_.reserve(seen_order_, seen_held_, bytes, "camera roots, seen first");
-  bind_args(seen_, order, count, scene.patch_bounds, f, pyramid_, params_, flags_);
+  cl::Kernel& seen = seen_.bind(scene, order, count, f, pyramid_, params_, flags_);
   cl::Event e;
-  q.enqueueNDRangeKernel(seen_, cl::NullRange, round_up_range(size_t(count) + 1), cl::NDRange(64), nullptr, &e);
+  q.enqueueNDRangeKernel(seen, cl::NullRange, round_up_range(size_t(count) + 1), cl::NDRange(64), nullptr, &e);
   timer.add(Stage::ShadowMark, e);
   scan_.exclusive_scan_on_device(flags_, count, timer);
   bind_args(partition_, order, count, flags_, seen_order_);

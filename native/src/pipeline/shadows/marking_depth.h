@@ -57,7 +57,8 @@ class MarkingDepth {
 
  private:
   DeviceSession& session_;
-  cl::Kernel raster_, reduce_, seen_, partition_;
+  SceneKernel raster_, seen_;
+  cl::Kernel reduce_, partition_;
   MemoryTally scan_tally_;
   PrefixSum scan_;
   cl::Buffer flags_, seen_order_;

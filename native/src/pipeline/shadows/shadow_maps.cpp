@@ -47,12 +47,12 @@ FrameParams marking_view(const FrameSetup& frame) {
 struct MarkingStep {
   MarkingStep(MicropolygonPass& pass, const FrameSetup& frame, const ShadowLayout& layout, ShadowStats& stats)
       : timer(pass.timer()), to(timer, Stage::ShadowMark), coarse(marking_view(frame)),
-        light_count(cl_uint(layout.shadows.size())), stats_(stats) {}
+        shadow_count(cl_uint(layout.shadows.size())), stats_(stats) {}
   ~MarkingStep() { stats_.mark_wall_ms += ms_since(started_); }
   StageTimer& timer;
   StageTimer::Redirect to;
   const FrameParams coarse;
-  const cl_uint light_count;
+  const cl_uint shadow_count;  // shadow records, one per light
 
  private:
   ShadowStats& stats_;
@@ -70,9 +70,9 @@ ShadowMaps::ShadowMaps(DeviceSession& session)
       clear_(session.program(), "clear_shadow_pages"),
       set_entries_(session.program(), "set_page_entries"),
       list_requests_(session.program(), "list_requests"),
-      sample_(session.program(), "shadow_sample"),
       farthest_(session.program(), "shadow_page_farthest"),
       occlusion_build_(session.program(), "shadow_occlusion_build"),
+      sample_(session.program(), "shadow_sample"),
       list_count_(session.allocate(sizeof(cl_uint), "shadow request count")),
       depth_(session) {}
 
@@ -109,7 +109,7 @@ bool ShadowMaps::camera_view(const ShadowLayout& layout, const FrameSetup& frame
   MarkingStep step(pass, frame, layout, stats);
   StageTimer& timer = step.timer;
   const FrameParams& coarse = step.coarse;
-  const cl_uint light_count = step.light_count;
+  const cl_uint shadow_count = step.shadow_count;
   GridBuffers& grids = pass.grids();
   const SceneBuffers& buffers = pass.scene();
   camera_order_ = camera_order;
@@ -130,7 +130,7 @@ bool ShadowMaps::camera_view(const ShadowLayout& layout, const FrameSetup& frame
     if (keep && size_t(kept_vertices_) + vertices > kept_limit_) keep = false, kept_overflow_ = true;
     if (keep) keep_room(size_t(kept_vertices_) + vertices);
     bind_args(mark_, diceable, count, grids.vertex_offsets, vertices, coarse, grids.p, grids.n, inputs_.shadows,
-              inputs_.levels, light_count, request_args(), mark_reach(coarse), cl_uint(soft), cl_uint(!keep),
+              inputs_.levels, shadow_count, request_args(), mark_reach(coarse), cl_uint(soft), cl_uint(!keep),
               cl_uint(keep),
               cl_uint(soft), kept_vertices_, keep ? kept_p_ : grids.p, keep && soft ? kept_n_ : grids.n,
               depth_.image(), OcclusionParams{});  // unwritten when not kept; no depth test yet
@@ -153,9 +153,9 @@ bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, Micro
   MarkingStep step(pass, frame, layout, stats);
   StageTimer& timer = step.timer;
   const FrameParams& coarse = step.coarse;
-  const cl_uint light_count = step.light_count;
+  const cl_uint shadow_count = step.shadow_count;
   if (kept_vertices_ > 0) {
-    bind_args(mark_kept_, kept_p_, kept_vertices_, coarse, inputs_.shadows, inputs_.levels, light_count,
+    bind_args(mark_kept_, kept_p_, kept_vertices_, coarse, inputs_.shadows, inputs_.levels, shadow_count,
               request_args(), mark_reach(coarse), cl_uint(kept_normals_), depth_.image(), depth_.params());
     launch(mark_kept_, kept_vertices_, timer);
   }
@@ -165,7 +165,7 @@ bool ShadowMaps::mark(const ShadowLayout& layout, const FrameSetup& frame, Micro
   if (kept_overflow_ && !first &&
       !mark_again(pass, coarse, false, mark_, stats, [&](const cl::Buffer& diceable, cl_uint count) {
         bind_args(mark_, diceable, count, grids.vertex_offsets, grids.vertex_total, coarse, grids.p, grids.n,
-                  inputs_.shadows, inputs_.levels, light_count, request_args(), mark_reach(coarse),
+                  inputs_.shadows, inputs_.levels, shadow_count, request_args(), mark_reach(coarse),
                   cl_uint(kept_normals_), cl_uint(1), cl_uint(0), cl_uint(0), cl_uint(0), grids.p, grids.n,
                   depth_.image(), depth_.params());
       }))
@@ -180,7 +180,7 @@ bool ShadowMaps::mark_soft(const ShadowLayout& layout, const FrameSetup& frame, 
   MarkingStep step(pass, frame, layout, stats);
   StageTimer& timer = step.timer;
   const FrameParams& coarse = step.coarse;
-  const cl_uint light_count = step.light_count;
+  const cl_uint shadow_count = step.shadow_count;
   GridBuffers& grids = pass.grids();
   if (kept_overflow_) {
     // More vertices than the budget keeps: the view is diced again, as the
@@ -188,12 +188,12 @@ bool ShadowMaps::mark_soft(const ShadowLayout& layout, const FrameSetup& frame, 
     // batch by batch.
     if (!mark_again(pass, coarse, true, mark_soft_grid_, stats, [&](const cl::Buffer& diceable, cl_uint count) {
           bind_args(mark_soft_grid_, diceable, count, grids.vertex_offsets, coarse, grids.p, grids.n,
-                    inputs_.shadows, inputs_.levels, light_count, inputs_.pages, inputs_.pool, request_args(),
+                    inputs_.shadows, inputs_.levels, shadow_count, inputs_.pages, inputs_.pool, request_args(),
                     mark_reach(coarse), depth_.image(), depth_.params());
         }))
       return false;
   } else if (kept_vertices_ > 0) {
-    bind_args(mark_soft_, kept_p_, kept_n_, kept_vertices_, coarse, inputs_.shadows, inputs_.levels, light_count,
+    bind_args(mark_soft_, kept_p_, kept_n_, kept_vertices_, coarse, inputs_.shadows, inputs_.levels, shadow_count,
               inputs_.pages, inputs_.pool, request_args(), mark_reach(coarse), depth_.image(), depth_.params());
     launch(mark_soft_, kept_vertices_, timer);
   }
@@ -384,10 +384,10 @@ bool ShadowMaps::render_views(const std::vector<FrameParams>& views, const std::
     const cl_uint total = grids.micropolygon_offsets_host[count] - base;
     written += total;
     if (total == 0) return;
-    bind_args(sample_, diceable, cl_uint(0), count, grids.micropolygon_offsets, base, total, buffers.patch_info,
-              buffers.materials, f, views_, grids.p, grids.c, inputs_.pages, inputs_.pool, dirty_);
+    cl::Kernel& k = sample_.bind(buffers, diceable, cl_uint(0), count, grids.micropolygon_offsets, base, total, f,
+                                 views_, grids.p, grids.c, inputs_.pages, inputs_.pool, dirty_);
     cl::Event e;
-    q.enqueueNDRangeKernel(sample_, cl::NullRange, round_up_range(total), cl::NDRange(64), nullptr, &e);
+    q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(total), cl::NDRange(64), nullptr, &e);
     timer.add(Stage::Sample, e);
   };
   for (size_t first = 0; first < views.size();) {

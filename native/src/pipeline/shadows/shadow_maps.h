@@ -111,8 +111,9 @@ class ShadowMaps {
   size_t orders_limit_ = 0;  // bytes the lights' patch orders may hold
 
   DeviceSession& session_;
-  cl::Kernel mark_, mark_kept_, mark_soft_, mark_soft_grid_, clear_, set_entries_, list_requests_, sample_, farthest_,
+  cl::Kernel mark_, mark_kept_, mark_soft_, mark_soft_grid_, clear_, set_entries_, list_requests_, farthest_,
       occlusion_build_;
+  SceneKernel sample_;
   std::vector<size_t> light_pages_;  // resident pages per light, this frame
   ShadowPagePool pool_;
   ShadowInputs inputs_;
