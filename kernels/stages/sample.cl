@@ -297,7 +297,8 @@ inline void mp_mark_occlusion_cells(__global uchar* dirty, OcclusionParams o, Fr
  * layout, GridLayoutStage), `base` is the first of these grids' and `total`
  * their number. A work-item finds its grid by binary search, so no
  * work-item idles on an unused grid slot. */
-inline void mp_sample(__global const uint* patch_info, MP_SAMPLE_ARGS, __local ulong* area_sum, __local uint* count_sum, __local uint* test_sum,
+inline void mp_sample(__global const uint* patch_info, MP_SAMPLE_ARGS, __local ulong* area_sum,
+                      __local uint* count_sum, __local uint* test_sum,
                       const int blur) {
   uint stride = (uint)f.max_grid + 1u;
   uint gid = get_global_id(0);
@@ -355,7 +356,8 @@ __kernel __attribute__((reqd_work_group_size(64, 1, 1))) void sample_micropolygo
 }
 
 /* Samples with times and lens positions (mp_blur.h). */
-__kernel __attribute__((reqd_work_group_size(64, 1, 1))) void sample_micropolygons_blur(MP_SCENE_PARAMS MP_SAMPLE_ARGS) {
+__kernel __attribute__((reqd_work_group_size(64, 1, 1)))
+void sample_micropolygons_blur(MP_SCENE_PARAMS MP_SAMPLE_ARGS) {
   __local ulong area_sum[64];
   __local uint count_sum[64], test_sum[64];
   mp_sample(patch_info, MP_SAMPLE_PASS, area_sum, count_sum, test_sum, 1);

@@ -205,7 +205,8 @@ inline void mp_mark_vertex(float3 p, FrameParams f, __global const DeviceShadow*
  * its pages. */
 __kernel __attribute__((reqd_work_group_size(64, 1, 1)))
 void marking_depth(MP_SCENE_PARAMS __global const SubPatch* diceable, uint count, __global const uint* offsets,
-                   uint total, FrameParams f, __global const float4* grid_p, OcclusionParams o, volatile __global uint* depth) {
+                   uint total, FrameParams f, __global const float4* grid_p, OcclusionParams o,
+                   volatile __global uint* depth) {
   uint gid = get_global_id(0);
   if (gid >= total || count == 0u) return;
   uint first = offsets[0];
@@ -292,7 +293,8 @@ inline int mp_marking_seen(float3 p, FrameParams f, __global const uint* depth, 
  * 1 (boxes outside the frame count as seen: their first test culls them,
  * wherever they come). Only an order: the camera culls against its own
  * samples, never against this depth. */
-__kernel void marking_roots_seen(MP_SCENE_PARAMS __global const uint* order, uint n, FrameParams f, __global const uint* depth, OcclusionParams o, __global uint* seen) {
+__kernel void marking_roots_seen(MP_SCENE_PARAMS __global const uint* order, uint n, FrameParams f,
+                                 __global const uint* depth, OcclusionParams o, __global uint* seen) {
   uint i = get_global_id(0);
   if (i > n) return;
   if (i == n) { /* one past the end: 0, so that the scan leaves the total there */
@@ -427,8 +429,8 @@ __kernel void mark_soft_shadow_pages_grid(__global const SubPatch* diceable, uin
   ulong index;
   if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
   if (!mp_marking_seen(grid_p[index].xyz, f, depth, o, reach)) return;
-  mp_mark_soft_vertex(grid_p[index].xyz, grid_n[index].xyz, f, shadows, levels, shadow_count, pages, pool, requests, caps,
-                      reach);
+  mp_mark_soft_vertex(grid_p[index].xyz, grid_n[index].xyz, f, shadows, levels, shadow_count, pages, pool, requests,
+                      caps, reach);
 }
 
 /* The requested page-table entries, each with its cap, in no particular

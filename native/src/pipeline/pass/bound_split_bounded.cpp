@@ -91,9 +91,10 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
 
     const PassOcclusion& occ = ctx.occlusion;
     if (!ws.step.kernel()()) ws.step = SceneKernel(s.program(), "bs_bounded_step");
-    cl::Kernel& step = ws.step.bind(ctx.scene, occ.on() ? occ.root_order : cl::Buffer(), ctx.frame, ctx.views.views, ctx.views.count, ctx.views.page_masks, occ.on() ? occ.pyramid : cl::Buffer(),
-              occ.params, ws.stacks, ws.sizes, stack_depth, ws.ring, ring_capacity, ws.diceable, dice_capacity,
-              ws.counters, kStepsPerLaunch);
+    cl::Kernel& step =
+        ws.step.bind(ctx.scene, occ.on() ? occ.root_order : cl::Buffer(), ctx.frame, ctx.views.views, ctx.views.count,
+                     ctx.views.page_masks, occ.on() ? occ.pyramid : cl::Buffer(), occ.params, ws.stacks, ws.sizes,
+                     stack_depth, ws.ring, ring_capacity, ws.diceable, dice_capacity, ws.counters, kStepsPerLaunch);
     const cl_uint root_count = ctx.root_count();
     const cl_uint first_wave = occ.on() && occ.first_wave < root_count ? occ.first_wave : 0;
     cl_uint root_limit = occ.on() && occ.waves ? std::min<cl_uint>(root_count, 1) : root_count;

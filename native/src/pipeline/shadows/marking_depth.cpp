@@ -48,7 +48,8 @@ void MarkingDepth::rasterise(const cl::Buffer& diceable, cl_uint count, const Sc
   if (!on() || count == 0) return;
   const cl_uint total = grids.micropolygon_offsets_host[count] - grids.micropolygon_offsets_host[0];
   if (total == 0) return;
-  cl::Kernel& k = raster_.bind(scene, diceable, count, grids.micropolygon_offsets, total, f, grids.p, params_, pyramid_);
+  cl::Kernel& k =
+      raster_.bind(scene, diceable, count, grids.micropolygon_offsets, total, f, grids.p, params_, pyramid_);
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(k, cl::NullRange, round_up_range(total), cl::NDRange(64), nullptr, &e);
   timer.add(Stage::ShadowMark, e);
