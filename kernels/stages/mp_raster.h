@@ -26,6 +26,11 @@ typedef struct {
  * held-out share (Holdout, grid normals' w after shading) is the same mean. */
 MP_INLINE float mp_quad_opacity(float a, float b, float c, float d) { return 0.25f * (a + b + c + d); }
 
+/* The surface whose micropolygons share stochastic-opacity thresholds (the
+ * camera's, mp_sample.h, and the shadow maps'): a patch, so neighbouring
+ * grids of one patch agree. */
+MP_INLINE uint mp_opacity_surface(uint patch) { return mp_hash32(patch ^ 0x6f706163u); }
+
 MP_INLINE long mp_to_fixed(float r) { return (long)floor(r * (float)MP_SUBPIXEL_ONE + 0.5f); }
 
 /* Sample positions repeat over tiles of MP_SAMPLE_TILE x MP_SAMPLE_TILE

@@ -16,9 +16,18 @@
 typedef struct {
   MpFixed2 p;
   float inv_d;    /* 1/depth (perspective) or depth (orthographic) */
-  float3 c_over_d;
+  float4 c_over_d; /* colour and opacity */
   float3 n_over_d;
 } MpRasterVertex;
+
+/* What a micropolygon's samples keep of it: its mean opacity (1: opaque,
+ * no sample tests its opacity), its held-out share (Holdout) and the
+ * surface its stochastic opacity draws thresholds for (mp_opacity_keeps). */
+typedef struct {
+  float opacity;
+  float holdout;
+  uint surface;
+} MpCover;
 
 /* Raster position of camera-space point p; *ok = 0 where it lies behind the
  * eye or beyond the guard band. */
@@ -39,7 +48,7 @@ inline MpRasterVertex mp_raster_attributes(MpFixed2 q, float inv_d, float4 c, fl
   v.p = q;
   v.inv_d = inv_d;
   float w = f.ortho ? 1.0f : inv_d;
-  v.c_over_d = c.xyz * w;
+  v.c_over_d = c * w;
   v.n_over_d = n.xyz * w;
   return v;
 }
@@ -122,14 +131,31 @@ inline int mp_triangle_depth(const MpTriangle* t, float la, float lb, float lc, 
   return *d >= f.clip_near && *d <= f.clip_far;
 }
 
-/* Stochastic opacity: whether micropolygon mp_id keeps sample s of pixel
- * (px, py). The hash follows whole-image pixels (the crop origin added), so
- * a crop, a bucket or a tile draws the same coverage as the whole frame. */
-inline int mp_opacity_keeps(uint mp_id, int px, int py, int s, float opacity, FrameParams f) {
+/* Stochastic opacity, as hashed alpha testing (Wyman & McGuire 2017): sample
+ * s of pixel (px, py) keeps a surface where the surface's opacity at the
+ * sample exceeds a threshold drawn for that surface, pixel and sample. The
+ * thresholds do not depend on the micropolygon, so neighbouring
+ * micropolygons of a surface agree on each sample: a hard alpha cut keeps
+ * a crisp edge through the opacity interpolated across the micropolygon,
+ * with no isolated specks, and a surface of uniform opacity a covers a of
+ * a pixel's samples. A pixel's thresholds follow the golden-ratio sequence
+ * from a random start, so they spread over [0, 1) almost evenly. Surfaces
+ * draw their own thresholds, so one seen through another keeps its share.
+ * The hash follows whole-image pixels (the crop origin added), so a crop,
+ * a bucket or a tile draws the same coverage as the whole frame. */
+inline int mp_opacity_keeps(uint surface, int px, int py, int s, float opacity, FrameParams f) {
   if (opacity >= 1.0f) return 1;
-  uint h = mp_hash_combine(mp_hash_combine(mp_hash_combine(mp_id, (uint)(px + f.crop_x0)), (uint)(py + f.crop_y0)),
-                           (uint)s);
-  return mp_hash_unit(h) < opacity;
+  uint h = mp_hash_combine(mp_hash_combine(surface, (uint)(px + f.crop_x0)), (uint)(py + f.crop_y0));
+  float t = mp_hash_unit(h) + (float)s * 0.61803398875f;
+  return t - floor(t) < opacity;
+}
+
+/* The opacity at a covered sample of depth d (perspective-correct, as the
+ * colour), or 1 where the whole micropolygon is opaque. */
+inline float mp_sample_opacity(const MpTriangle* t, float la, float lb, float lc, float d, float mean, FrameParams f) {
+  if (mean >= 1.0f) return 1.0f;
+  float w = f.ortho ? 1.0f : d;
+  return (la * t->a.c_over_d.w + lb * t->b.c_over_d.w + lc * t->c.c_over_d.w) * w;
 }
 
 /* Holdout (mp_closures.h): a sample's held-out share h travels in the 8
@@ -154,7 +180,7 @@ inline float3 mp_sample_color(float3 col, float h) {
 inline void mp_triangle_attributes(const MpTriangle* t, float la, float lb, float lc, float d, FrameParams f,
                                    float3* col, float3* nrm) {
   float w = f.ortho ? 1.0f : d;
-  *col = (la * t->a.c_over_d + lb * t->b.c_over_d + lc * t->c.c_over_d) * w;
+  *col = (la * t->a.c_over_d.xyz + lb * t->b.c_over_d.xyz + lc * t->c.c_over_d.xyz) * w;
   *nrm = (la * t->a.n_over_d + lb * t->b.n_over_d + lc * t->c.n_over_d) * w;
 }
 

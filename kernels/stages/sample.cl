@@ -24,13 +24,13 @@
 /* Sample s of pixel (px, py), covered by triangle t at barycentrics (la,
  * lb, lc): within the clip range and the stochastic opacity, the depth pass
  * keeps the nearest key and the attribute pass lets its owner write.
- * cover: the micropolygon's opacity and its held-out share (Holdout). */
+ * cover: what its samples keep of the micropolygon (MpCover). */
 inline void mp_sample_write(const MpTriangle* t, float la, float lb, float lc, int px, int py, int s, int spp,
-                            uint mp_id, float2 cover, FrameParams f, uint pass, volatile __global ulong* keys,
+                            uint mp_id, MpCover cover, FrameParams f, uint pass, volatile __global ulong* keys,
                             __global float* colors, __global uint* normals) {
   float d;
   if (!mp_triangle_depth(t, la, lb, lc, f, &d)) return;
-  if (!mp_opacity_keeps(mp_id, px, py, s, cover.x, f)) return;
+  if (!mp_opacity_keeps(cover.surface, px, py, s, mp_sample_opacity(t, la, lb, lc, d, cover.opacity, f), f)) return;
   ulong pixel = (ulong)py * (ulong)f.width + (ulong)px, index = pixel * (ulong)spp + (ulong)s;
   ulong key = mp_sample_key(d, mp_id);
   if (pass == MP_PASS_DEPTH) {
@@ -38,14 +38,14 @@ inline void mp_sample_write(const MpTriangle* t, float la, float lb, float lc, i
   } else if (keys[index] == key) {
     float3 col, nrm;
     mp_triangle_attributes(t, la, lb, lc, d, f, &col, &nrm);
-    mp_store_color(colors, pixel, s, spp, mp_sample_color(col, cover.y), f);
+    mp_store_color(colors, pixel, s, spp, mp_sample_color(col, cover.holdout), f);
     if (f.normal_pass) normals[index] = mp_encode_normal(normalize(nrm));
   }
 }
 
 /* Rasterises the quad v[0..3]'s triangles that `keep` selects
  * (mp_setup_quad). */
-inline void mp_raster_quad(const MpRasterVertex* v, uint keep, uint mp_id, float2 cover, FrameParams f,
+inline void mp_raster_quad(const MpRasterVertex* v, uint keep, uint mp_id, MpCover cover, FrameParams f,
                            __global const ushort* offsets, uint pass, volatile __global ulong* keys,
                            __global float* colors, __global uint* normals, uint* tests) {
   MpTriangle tris[2];
@@ -111,7 +111,7 @@ inline float3 mp_blur_position(int i, float t, int steps, const float4* p, float
  * lens position, a cheap box rejection, then the fixed-point edge tests. */
 inline void mp_blur_sample(int px, int py, int s, int spp, MpFixed2 sq, float4 e, int steps, const float4* p,
                            float4 ps[4][MP_BLUR_LOCAL_STEPS], __global const float4* pm, const ulong* idx, ulong stride,
-                           float8* still, const float4* c, const float4* n, uint keep, uint mp_id, float2 cover,
+                           float8* still, const float4* c, const float4* n, uint keep, uint mp_id, MpCover cover,
                            FrameParams f, uint pass, volatile __global ulong* keys, __global float* colors,
                            __global uint* normals) {
   float3 q[4];
@@ -144,7 +144,7 @@ inline void mp_blur_sample(int px, int py, int s, int spp, MpFixed2 sq, float4 e
     return;
   for (int i = 0; i < 4; ++i) {
     float w = f.ortho ? 1.0f : v[i].inv_d;
-    v[i].c_over_d = c[i].xyz * w;
+    v[i].c_over_d = c[i] * w;
     v[i].n_over_d = n[i].xyz * w;
   }
   MpTriangle tris[2];
@@ -183,7 +183,7 @@ inline int mp_blur_path_box(int i, float t0, float t1, float2 bx, float2 by, int
  * centre's culling (`keep`); attributes are the centre's (shading once per
  * grid vertex). Motion positions: pm[idx[i] + k * stride] for step k. */
 inline void mp_raster_quad_blur(const float4* p, __global const float4* pm, const ulong* idx, ulong stride,
-                                const float4* c, const float4* n, uint keep, uint mp_id, float2 cover, FrameParams f,
+                                const float4* c, const float4* n, uint keep, uint mp_id, MpCover cover, FrameParams f,
                                 __global const ushort* offsets, __global const float4* table, uint pass,
                                 volatile __global ulong* keys, __global float* colors, __global uint* normals,
                                 uint* tests) {
@@ -334,8 +334,8 @@ inline void mp_sample(__global const uint* patch_info, MP_SAMPLE_ARGS, __local u
   uint tests = 0u;
   if (keep) {
     uint mp_id = mp_micropolygon_id(mp_grid_id(&sp), m);
-    float2 cover = (float2)(mp_quad_opacity(vc[0].w, vc[1].w, vc[2].w, vc[3].w),
-                            mp_quad_opacity(vn[0].w, vn[1].w, vn[2].w, vn[3].w));
+    MpCover cover = {mp_quad_opacity(vc[0].w, vc[1].w, vc[2].w, vc[3].w),
+                     mp_quad_opacity(vn[0].w, vn[1].w, vn[2].w, vn[3].w), mp_opacity_surface(sp.patch)};
     if (pass == MP_PASS_DEPTH && occlusion_dirty) mp_mark_occlusion_cells(occlusion_dirty, occ, f, v[0].p, v[1].p, v[2].p, v[3].p);
     if (blur) {
       ulong idx[4];

@@ -99,9 +99,9 @@ inline MpFixed2 mp_projected_position(int4 v) {
 
 /* The same samples one at a time in 64-bit arithmetic (mp_edge_triangle_covers),
  * for micropolygons too large for the int32 path, not opaque or held out
- * (cover: opacity, held-out share). */
+ * (cover: MpCover). */
 inline uint mp_sample_tile_slow(const MpTriangle* tris, long xmin, long xmax, long ymin, long ymax, int px0, int px1,
-                                int py0, int py1, uint mp_id, float2 cover, FrameParams f,
+                                int py0, int py1, uint mp_id, MpCover cover, FrameParams f,
                                 __global const ushort* sample_offsets, __global ulong* keys, __global float* colors,
                                 __global uint* normals, int* written) {
   int spp = f.spp_x * f.spp_y;
@@ -116,13 +116,15 @@ inline uint mp_sample_tile_slow(const MpTriangle* tris, long xmin, long xmax, lo
         float la, lb, lc, d;
         int t = mp_quad_covers(tris, sq, &la, &lb, &lc);
         if (t < 0 || !mp_triangle_depth(&tris[t], la, lb, lc, f, &d)) continue;
-        if (!mp_opacity_keeps(mp_id, px, py, s, cover.x, f)) continue;
+        if (!mp_opacity_keeps(cover.surface, px, py, s, mp_sample_opacity(&tris[t], la, lb, lc, d, cover.opacity, f),
+                              f))
+          continue;
         ulong key = mp_sample_key(d, mp_id), index = pixel * (ulong)spp + (ulong)s;
         if (key >= keys[index]) continue;
         keys[index] = key;
         float3 col, nrm;
         mp_triangle_attributes(&tris[t], la, lb, lc, d, f, &col, &nrm);
-        mp_store_color(colors, pixel, s, spp, mp_sample_color(col, cover.y), f);
+        mp_store_color(colors, pixel, s, spp, mp_sample_color(col, cover.holdout), f);
         if (f.normal_pass) normals[index] = mp_encode_normal(normalize(nrm));
         *written = 1;
       }
@@ -341,14 +343,15 @@ __kernel void sample_tiles(MP_SCENE_PARAMS __global const SubPatch* diceable, Fr
       MpTriangle tris[2];
       mp_setup_quad(v, keep, tris);
       uint mp_id = mp_micropolygon_id(grid_id, m);
-      float2 cover = (float2)(mp_quad_opacity(grid_c[base + q[0]].w, grid_c[base + q[1]].w, grid_c[base + q[2]].w,
-                                              grid_c[base + q[3]].w),
-                              mp_quad_opacity(grid_n[base + q[0]].w, grid_n[base + q[1]].w, grid_n[base + q[2]].w,
-                                              grid_n[base + q[3]].w));
+      MpCover cover = {mp_quad_opacity(grid_c[base + q[0]].w, grid_c[base + q[1]].w, grid_c[base + q[2]].w,
+                                       grid_c[base + q[3]].w),
+                       mp_quad_opacity(grid_n[base + q[0]].w, grid_n[base + q[1]].w, grid_n[base + q[2]].w,
+                                       grid_n[base + q[3]].w),
+                       mp_opacity_surface(sp.patch)};
       int px0 = (int)max(xmin >> MP_SUBPIXEL_BITS, (long)tx0), px1 = (int)min(xmax >> MP_SUBPIXEL_BITS, (long)tx1);
       int py0 = (int)max(ymin >> MP_SUBPIXEL_BITS, (long)ty0), py1 = (int)min(ymax >> MP_SUBPIXEL_BITS, (long)ty1);
       int written = 0;
-      if (xmax - xmin <= MP_FAST_SPAN && ymax - ymin <= MP_FAST_SPAN && cover.x >= 1.0f && !(cover.y > 0.0f))
+      if (xmax - xmin <= MP_FAST_SPAN && ymax - ymin <= MP_FAST_SPAN && cover.opacity >= 1.0f && !(cover.holdout > 0.0f))
         tests += mp_sample_tile_fast(tris, xmin, xmax, ymin, ymax, px0, px1, py0, py1, mp_id, f, sample_soa, keys,
                                      colors, normals, &written);
       else

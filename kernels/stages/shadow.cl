@@ -584,15 +584,15 @@ void shadow_sample(MP_SCENE_PARAMS __global const SubPatch* diceable, uint first
   /* Opacity: the material's, or per vertex where its node program computes
    * one (material_program.cl, run for alpha only in shadow passes). */
   __global const DeviceMaterial* mat = materials + patch_info[4 * (ulong)sp.patch + 1];
-  float opacity = mat->program[3] > 0.0f ? mp_quad_opacity(grid_c[grid_base + q[0]].w, grid_c[grid_base + q[1]].w,
-                                                            grid_c[grid_base + q[2]].w, grid_c[grid_base + q[3]].w)
-                                         : mat->opacity[3];
-  uint mp_id = 0u;
-  if (opacity < 1.0f) {
-    mp_id = mp_hash32(sp.patch);
-    for (int k = 0; k < 8; ++k) mp_id = mp_hash_combine(mp_id, as_uint(sp.corner[k]));
-    mp_id = mp_hash_combine(mp_id, m);
-  }
+  float o[4];
+  for (int k = 0; k < 4; ++k) o[k] = mat->program[3] > 0.0f ? grid_c[grid_base + q[k]].w : mat->opacity[3];
+  float opacity = mp_quad_opacity(o[0], o[1], o[2], o[3]);
+  /* Per texel, the opacity interpolated in the triangle that covers it and
+   * a threshold drawn for the patch and texel (as mp_opacity_keeps draws
+   * the camera's): a hard alpha cut casts a crisp-edged shadow. */
+  float to[2][3] = {{o[0], tris[0].swapped ? o[2] : o[1], tris[0].swapped ? o[1] : o[2]},
+                    {o[0], tris[1].swapped ? o[3] : o[2], tris[1].swapped ? o[2] : o[3]}};
+  uint surface = opacity < 1.0f ? mp_opacity_surface(sp.patch) : 0u;
   int side = v.page_side;
   /* Most micropolygons lie within one page: one table lookup for all. */
   int one_page = (px0 >> 7) == (px1 >> 7) && (py0 >> 7) == (py1 >> 7);
@@ -625,7 +625,10 @@ void shadow_sample(MP_SCENE_PARAMS __global const SubPatch* diceable, uint first
       float d = v.ortho ? iw : 1.0f / iw;
       if (!(d >= v.clip_near && d <= v.clip_far)) continue;
       uint texel = (uint)((py & 127) * MP_PAGE_SIZE + (px & 127));
-      if (opacity < 1.0f && mp_hash_unit(mp_hash_combine(mp_id, (uint)(py * v.width + px))) >= opacity) continue;
+      if (opacity < 1.0f &&
+          mp_hash_unit(mp_hash_combine(surface, (uint)(py * v.width + px))) >=
+              la * to[t][0] + lb * to[t][1] + lc * to[t][2])
+        continue;
       atomic_min(&pool[(ulong)MP_PAGE_PHYSICAL(e) * MP_PAGE_TEXELS + texel], as_uint(d));
     }
 }
