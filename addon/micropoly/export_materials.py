@@ -6,7 +6,12 @@ the constant material: Principled BSDF (its Alpha as opacity) and Diffuse
 BSDF give their constant inputs, an Emission shader gives emission; other
 shader trees are material programs (node_compiler), whose closures replace
 the constant material's shading; a material without a Surface link uses its
-viewport color, metallic and roughness."""
+viewport color, metallic and roughness.
+
+Materials Cycles builds itself follow Cycles (docs/blender-conventions.md,
+"Missing materials"): a material whose nodes are off is a Diffuse BSDF of
+its viewport colour, and an object or face without a material gets Cycles'
+default surface."""
 
 from . import export_images, node_compiler
 
@@ -27,12 +32,34 @@ def _surface_node(material):
     return node_compiler.linked_from(out.inputs["Surface"])[0] if out is not None else None
 
 
-def material_parameters(material):
-    """dict of add_material keyword arguments for a Blender material."""
+def _diffuse(params, color):
+    """A Diffuse BSDF (Lambert: roughness 0 in Cycles) of `color`."""
+    params.update(color=list(color)[:3], specular=0.0, roughness=1.0)
+    return params
+
+
+def default_surface_parameters():
+    """Cycles' default surface, for objects and faces without a material:
+    a Diffuse BSDF of 0.8 grey before Blender 5.0, a Principled BSDF with
+    its default inputs from 5.0 on (ShaderManager::add_default)."""
     params = dict(model="principled", color=[0.8, 0.8, 0.8], metallic=0.0, roughness=0.5, specular=0.5,
                   emission=[0.0, 0.0, 0.0])
-    if material is None:
+    if node_compiler.blender_version() >= 500:
+        params.update(layered=True)
         return params
+    return _diffuse(params, (0.8, 0.8, 0.8))
+
+
+def material_parameters(material):
+    """dict of add_material keyword arguments for a Blender material."""
+    if material is None:
+        return default_surface_parameters()
+    params = dict(model="principled", color=[0.8, 0.8, 0.8], metallic=0.0, roughness=0.5, specular=0.5,
+                  emission=[0.0, 0.0, 0.0])
+    if not getattr(material, "use_nodes", True) or material.node_tree is None:
+        # Cycles' sync: without nodes, a Diffuse BSDF of the viewport colour
+        # (its metallic and roughness are for the viewport only).
+        return _diffuse(params, material.diffuse_color)
     node = _surface_node(material)
     if node is None:
         params.update(color=list(material.diffuse_color)[:3], metallic=float(material.metallic),
@@ -49,7 +76,7 @@ def material_parameters(material):
                       retro_diffuse=node_compiler.blender_version() < 400,
                       multiscatter=getattr(node, "distribution", "GGX") == "MULTI_GGX")
     elif node.type == "BSDF_DIFFUSE":
-        params.update(color=list(_input(node, "Color"))[:3], specular=0.0, roughness=1.0)
+        _diffuse(params, _input(node, "Color"))
     elif node.type == "EMISSION":
         strength = float(_input(node, "Strength", default=1.0))
         params.update(color=[0.0, 0.0, 0.0], specular=0.0,

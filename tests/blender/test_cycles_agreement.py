@@ -43,7 +43,7 @@ def light(scene, kind, location=(2.0, -4.0, 3.0), target=(0.0, 0.0, 0.0), energy
     return ru.add_aimed_light(scene, kind, location, target, energy, **props)
 
 
-def compare(name, scene, checks):
+def compare(name, scene, checks, min_psnr=30.0):
     ru.setup_cycles(scene, samples=CYCLES_SAMPLES)
     cycles = ru.render_passes(scene, "CYCLES", W, H, cycles_data=True)
     micro = ru.render_passes(scene, "MICROPOLY", W, H, samples=16)
@@ -64,8 +64,8 @@ def compare(name, scene, checks):
         failures.append(f"silhouette IoU {metrics['iou']:.4f} < 0.98")
     if metrics["covered"] < 500:
         failures.append(f"only {metrics['covered']} covered pixels: the scene is not in view")
-    if "psnr" in checks and metrics["psnr"] < 30.0:
-        failures.append(f"PSNR {metrics['psnr']:.2f} dB < 30")
+    if "psnr" in checks and metrics["psnr"] < min_psnr:
+        failures.append(f"PSNR {metrics['psnr']:.2f} dB < {min_psnr:g}")
     if "passes" in checks:
         if metrics["depth_rel"] > 0.01:
             failures.append(f"Depth differs by {metrics['depth_rel']:.4f} (median relative)")
@@ -156,7 +156,33 @@ def case_instances():
     return compare("collection instances and linked duplicates, sun light", scene, set())
 
 
-CASES = [case_instances, case_subdivided_suzanne, case_polygon_mesh, case_smooth_polygon_mesh, case_orthographic, case_shifted_camera, case_disk_light]
+def case_missing_materials():
+    """Materials Cycles makes itself: an object without a material (Cycles'
+    default surface), one whose material has its nodes off (a Diffuse BSDF
+    of the viewport colour; the viewport's metallic and roughness, set here
+    to stand out, are not rendered), and a face whose slot is empty."""
+    scene = ru.reset_scene()
+    ru.add_camera(scene, (0.0, -7.0, 3.0), (0.0, 0.0, 0.0))
+    ru.add_sun(scene, (0.7, 0.0, 0.6), energy=3.0)
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, location=(-1.2, 0.0, 0.0))
+    bpy.ops.object.shade_smooth()
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, location=(1.2, 0.0, 0.0))
+    bpy.ops.object.shade_smooth()
+    old = bpy.data.materials.new("no nodes")
+    old.use_nodes = False
+    old.diffuse_color = (0.8, 0.35, 0.1, 1.0)
+    old.metallic, old.roughness = 0.7, 0.2
+    bpy.context.object.data.materials.append(old)
+    bpy.ops.mesh.primitive_cube_add(size=1.2, location=(0.0, 1.8, -0.2))
+    cube = bpy.context.object
+    cube.data.materials.append(ru.diffuse_material("blue", (0.1, 0.2, 0.8)))
+    cube.data.materials.append(None)
+    for i, polygon in enumerate(cube.data.polygons):
+        polygon.material_index = i % 2
+    return compare("no material, nodes off, an empty slot; sun light", scene, {"psnr"}, min_psnr=38.0)
+
+
+CASES = [case_missing_materials, case_instances, case_subdivided_suzanne, case_polygon_mesh, case_smooth_polygon_mesh, case_orthographic, case_shifted_camera, case_disk_light]
 
 
 def main():
