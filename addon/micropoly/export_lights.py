@@ -37,19 +37,25 @@ def _ray_visibility(world):
     return get("camera"), get("diffuse"), get("glossy")
 
 
+# A uniform world's map (equirectangular, texels): the world lighting needs
+# no more for a constant (its glossy maps stop at 8 texels wide).
+UNIFORM_WORLD_MAP = (16, 32)
+
+
 def export_world(native_scene, world, materials=None, warnings=None, film_transparent=False):
-    """The world: a uniform color as ambient light; a Background whose color
+    """The world: a uniform color as a constant map; a Background whose color
     or strength comes from nodes (an HDRI, a gradient), or a tree of
     Backgrounds mixed or added, as a world program baked into an
-    environment map, whose light the scene shadows
-    (native world_lighting.h). Returns the background color (for a uniform
+    environment map. Both light the scene through the same occluded world
+    lighting (native world_lighting.h: probe suns the scene shadows), so no
+    world adds unshadowed light. Returns the background color (for a uniform
     world; a baked world's background comes with the render result)."""
     if world is None:
         return np.zeros(3, dtype=np.float32)
     color = np.array(list(world.color)[:3], dtype=np.float32)
     if world.use_nodes and world.node_tree is not None:
         output, shader = _world_shader(world)
-        # A Background of plain values is a uniform ambient light; one fed
+        # A Background of plain values is a uniform world (a constant map); one fed
         # by nodes, or a tree of shaders (a Mix Shader of two Backgrounds by
         # Light Path), is compiled and baked.
         compiled = shader is not None and shader.type in ("BACKGROUND", "EMISSION", "MIX_SHADER", "ADD_SHADER",
@@ -72,7 +78,12 @@ def export_world(native_scene, world, materials=None, warnings=None, film_transp
             warnings.append(f"world '{world.name}': a {shader.bl_label} node at its output is not supported; "
                             "its viewport color lights the scene")
     if np.any(color > 0):
-        native_scene.add_light("ambient", color=color.tolist(), intensity=1.0)
+        _, diffuse, glossy = _ray_visibility(world)
+        radiance = np.empty(UNIFORM_WORLD_MAP + (4,), dtype=np.float32)
+        radiance[..., :3] = color
+        radiance[..., 3] = 1.0
+        # The camera sees the returned colour; the map only lights.
+        native_scene.set_world(radiance=radiance, camera=False, diffuse=float(diffuse), glossy=float(glossy))
     return color
 
 

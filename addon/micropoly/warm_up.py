@@ -7,8 +7,8 @@ first launch, and a material's node tree is a program of its own (Blender's
 default material is one). When the add-on is enabled, a background thread
 loads the OpenCL drivers, builds the program and renders a small built-in
 scene that launches the kernels a render of an ordinary scene launches (a
-subdivision surface and a polygon floor under a sun, point, spot, area and
-ambient light, all with soft shadows), with the material programs of the
+subdivision surface and a polygon floor under a sun, point, spot and area
+light and a uniform world, all with soft shadows), with the material programs of the
 open file's materials (those that read no image; at most MAX_PROGRAMS), and
 again when a file is opened. It renders on the renderer final renders keep
 (final_renderers.FinalRenderers), so the first F12 finds its programs built and its
@@ -93,7 +93,8 @@ def scene(native, materials=None, uv_layers=0):
     s.add_light("spot", intensity=40.0, position=[2.0, -2.0, 3.0], direction=[-0.5, 0.5, -0.7], radius=0.2)
     s.add_light("area", intensity=5.0, position=[0.0, 2.0, 3.0], direction=[0.0, -0.5, -0.87], size_u=1.0,
                 size_v=1.0)
-    s.add_light("ambient", color=[0.05, 0.05, 0.05])
+    # Blender's default world: a uniform grey, lit through the world's probe suns.
+    s.set_world(radiance=np.full((16, 32, 4), 0.05, dtype=np.float32), camera=False)
     return s
 
 

@@ -5,7 +5,8 @@ Subdivision Surface on a floor, lit only by an HDRI that ships with Blender
 opaque film; a mutation check: the HDRI turned 90 degrees by a Mapping node
 still agrees, and an unturned render compared with Cycles' turned one does
 not. An occlusion check: the floor under a ball is darker than the open
-floor by the ratio Cycles gives, and not without the world's shadows. A
+floor by the ratio Cycles gives, and not without the world's shadows; the same in Blender's default grey world
+under a sun, whose uniform light is shadowed like an HDRI's. A
 world split by Light Path's Is Camera Ray lights the objects with the HDRI
 while the camera sees a plain backdrop, as in Cycles; Texture Coordinate's
 Window and Camera colour the background as Cycles' camera rays see them.
@@ -149,6 +150,42 @@ def check_occlusion():
     assert abs(unshadowed / cy - 1.0) > 0.10, "the check should fail without the world's shadows"
 
 
+def default_world_scene(directions=None):
+    """The ball on the floor in Blender's default world (a Background of
+    plain grey 0.0508) under a sun whose shadow falls beside the ball."""
+    scene = occlusion_scene(directions)
+    world = scene.world
+    for node in list(world.node_tree.nodes):
+        if node.type not in ("BACKGROUND", "OUTPUT_WORLD"):
+            world.node_tree.nodes.remove(node)
+    background = world.node_tree.nodes["Background"]
+    background.inputs["Color"].default_value = (0.0508, 0.0508, 0.0508, 1.0)
+    background.inputs["Strength"].default_value = 1.0
+    sun = ru.add_sun(scene, (math.radians(40.0), 0.0, math.radians(60.0)), energy=2.0)
+    ru.set_cast_shadow(sun.data, True)
+    return scene
+
+
+def check_default_world():
+    """A uniform world is shadowed like any other: the floor under the ball
+    darkens as in Cycles (within 0.02 of its ratio), and the frame agrees
+    over covered pixels; with the world's shadows off it would not."""
+    cy_scene = default_world_scene()
+    under, open_floor = floor_regions(cy_scene, (0.0, 0.0, 0.6), 0.6)
+    ru.setup_cycles(cy_scene, samples=256, shadows=True)
+    cy = ru.render_passes(cy_scene, "CYCLES", W, H, samples=16)["rgba"]
+    mp = ru.render_passes(default_world_scene(), "MICROPOLY", W, H, samples=16)["rgba"]
+    open_sky = ru.render_passes(default_world_scene(directions=0), "MICROPOLY", W, H, samples=16)["rgba"]
+    ru.save_side_by_side(OUTPUT, "world_default_grey", cy, mp)
+    ratios = [occlusion_ratio(img, under, open_floor) for img in (cy, mp, open_sky)]
+    db = covered_psnr(mp, cy)
+    print(f"default grey world and a sun: floor under the ball / open floor: Cycles {ratios[0]:.3f}, "
+          f"Micropoly {ratios[1]:.3f}, without the world's shadows {ratios[2]:.3f}; {db:.1f} dB over covered pixels")
+    assert abs(ratios[1] - ratios[0]) <= 0.02, f"darkening {ratios[1]:.3f} against Cycles' {ratios[0]:.3f}"
+    assert abs(ratios[2] - ratios[0]) > 0.02, "the check should fail without the world's shadows"
+    assert db >= 30.0, f"default world: {db:.1f} dB < 30"
+
+
 def split_world(scene, backdrop):
     """The HDRI world, with a Light Path's Is Camera Ray mixing in a plain
     `backdrop` colour for what the camera sees (an artist's usual split:
@@ -273,6 +310,7 @@ def main():
         assert glossy >= MIN_GLOSSY_DB, f"{hdri}: glossy {glossy:.1f} dB < {MIN_GLOSSY_DB}"
         assert background >= 35.0, f"{hdri}: background {background:.1f} dB"
     check_occlusion()
+    check_default_world()
     check_camera_ray_split()
     check_view_coordinates()
     check_rib()
