@@ -18,6 +18,10 @@
 #include "textures/mp_tex_image.h"
 #include "core/mp_scene_data.h"
 
+/* Half-thickness of a texture space with no extent along an axis: Blender
+ * raises a zero size to 1e-5 (the margin covers its float rounding). */
+#define MP_FLAT_TEXSPACE 1.5e-5f
+
 /* @MATERIAL_PROGRAM_SOURCE@ */
 
 inline float mp_row3(__global const float* m, int r, float3 v, float w) {
@@ -74,8 +78,14 @@ inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, f
   float3 loc = (float3)(o->texspace_location[0], o->texspace_location[1], o->texspace_location[2]);
   float3 size = (float3)(o->texspace_size[0], o->texspace_size[1], o->texspace_size[2]);
   float3 rel = g.P - loc;
-  g.generated = (float3)(size.x != 0.0f ? rel.x / (2.0f * size.x) : 0.0f, size.y != 0.0f ? rel.y / (2.0f * size.y) : 0.0f,
-                         size.z != 0.0f ? rel.z / (2.0f * size.z) : 0.0f) + (float3)(0.5f, 0.5f, 0.5f);
+  /* Along an axis the mesh does not extend (a plane, a card: Blender keeps
+   * its texture space 1e-5 thick there), the coordinate is the centre, as
+   * Cycles reads it from the mesh's own flat coordinates. Positions brought
+   * back from camera space carry round-off thousands of times that
+   * thickness, which would scatter a texture's cells across the surface. */
+  g.generated = (float3)(size.x > MP_FLAT_TEXSPACE ? rel.x / (2.0f * size.x) : 0.0f,
+                         size.y > MP_FLAT_TEXSPACE ? rel.y / (2.0f * size.y) : 0.0f,
+                         size.z > MP_FLAT_TEXSPACE ? rel.z / (2.0f * size.z) : 0.0f) + (float3)(0.5f, 0.5f, 0.5f);
   for (uint k = 0; k < MP_MAX_UV_LAYERS; ++k) {
     float2 t = k < in->uv_layers ? mp_patch_uv(in->uvs, in->uv_layers, in->edges, patch, k, uv.x, uv.y) : (float2)(0.0f);
     g.uv[k] = (float3)(t.x, t.y, 0.0f);
