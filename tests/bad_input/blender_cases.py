@@ -106,6 +106,19 @@ def case_nan_material_value():
     check("a NaN material value is reported or renders finite pixels", ok, error or "rendered")
 
 
+def case_nan_world_colour():
+    scene = scene_with_camera()
+    mesh_object(scene, "Lit", QUAD, [(0, 1, 2, 3)])
+    world = scene.world
+    world.use_nodes = True
+    background = next(n for n in world.node_tree.nodes if n.type == "BACKGROUND")
+    background.inputs["Color"].default_value = (math.nan, 0.5, 0.5, 1.0)
+    background.inputs["Strength"].default_value = 1.0
+    error, rgba = f12(scene)
+    ok = (error is not None and "world" in error) or (rgba is not None and np.isfinite(rgba).all())
+    check("a NaN world colour is reported or renders finite pixels", ok, error or "rendered")
+
+
 def case_zero_scale_object():
     scene = scene_with_camera()
     obj = mesh_object(scene, "Flattened", QUAD, [(0, 1, 2, 3)])
@@ -197,8 +210,8 @@ def main():
                 os._exit(3)
 
     threading.Thread(target=watchdog, daemon=True).start()
-    for case in (case_infinite_vertex, case_nan_uv, case_nan_material_value, case_zero_scale_object,
-                 case_zero_scale_camera, case_missing_image, case_loose_geometry, case_degenerate_subdivided,
+    for case in (case_infinite_vertex, case_nan_uv, case_nan_material_value, case_nan_world_colour,
+                 case_zero_scale_object, case_zero_scale_camera, case_missing_image, case_loose_geometry, case_degenerate_subdivided,
                  case_nonmanifold_subdivided, case_huge_displacement):
         current.update(name=case.__name__, started=time.perf_counter())
         case()
