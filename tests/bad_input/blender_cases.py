@@ -211,8 +211,8 @@ def main():
 
     threading.Thread(target=watchdog, daemon=True).start()
     for case in (case_infinite_vertex, case_nan_uv, case_nan_material_value, case_nan_world_colour,
-                 case_zero_scale_object, case_zero_scale_camera, case_missing_image, case_loose_geometry, case_degenerate_subdivided,
-                 case_nonmanifold_subdivided, case_huge_displacement):
+                 case_zero_scale_object, case_zero_scale_camera, case_missing_image, case_loose_geometry,
+                 case_degenerate_subdivided, case_nonmanifold_subdivided, case_huge_displacement):
         current.update(name=case.__name__, started=time.perf_counter())
         case()
     done.set()
