@@ -580,22 +580,7 @@ void shadow_sample(MP_SCENE_PARAMS __global const SubPatch* diceable, uint first
   int px1 = (int)min((xmax - centre) >> MP_SUBPIXEL_BITS, (long)v.width - 1);
   int py0 = (int)max((ymin - centre + MP_SUBPIXEL_ONE - 1) >> MP_SUBPIXEL_BITS, (long)0);
   int py1 = (int)min((ymax - centre) >> MP_SUBPIXEL_BITS, (long)v.height - 1);
-  /* Smaller than a texel both ways, a micropolygon may cover no texel
-   * centre: it then writes its nearest depth into the texel that holds its
-   * centre, so geometry finer than a level's texels (a leaf seen by a
-   * coarse level, which soft shadows' blocker search reads) keeps its
-   * shadow instead of falling between the samples. Slivers (a surface at a
-   * grazing angle to the light) still sample texel centres only: written
-   * where they do not lie, they would shadow their own surface. */
-  if (px0 > px1 || py0 > py1) {
-    if (xmax - xmin >= MP_SUBPIXEL_ONE || ymax - ymin >= MP_SUBPIXEL_ONE) return;
-  }
-  const int tiny = px0 > px1 || py0 > py1;
-  if (tiny) {
-    px0 = px1 = (int)(((xmin + xmax) >> 1) >> MP_SUBPIXEL_BITS);
-    py0 = py1 = (int)(((ymin + ymax) >> 1) >> MP_SUBPIXEL_BITS);
-    if (px0 < 0 || py0 < 0 || px0 >= v.width || py0 >= v.height) return;
-  }
+  if (px0 > px1 || py0 > py1) return;
   /* Opacity: the material's, or per vertex where its node program computes
    * one (material_program.cl, run for alpha only in shadow passes). */
   __global const DeviceMaterial* mat = materials + patch_info[4 * (ulong)sp.patch + 1];
@@ -630,21 +615,14 @@ void shadow_sample(MP_SCENE_PARAMS __global const SubPatch* diceable, uint first
       MpFixed2 s;
       s.x = (long)px * MP_SUBPIXEL_ONE + centre;
       s.y = (long)py * MP_SUBPIXEL_ONE + centre;
-      float la, lb, lc, d;
+      float la, lb, lc;
       int t = 0;
-      if (tiny) {
-        /* Its nearest corner; its mean opacity (the corners' weights). */
-        la = lb = lc = 1.0f / 3.0f;
-        to[0][0] = to[0][1] = to[0][2] = opacity;
-        d = v.ortho ? fmin(fmin(w[0], w[1]), fmin(w[2], w[3])) : 1.0f / fmax(fmax(w[0], w[1]), fmax(w[2], w[3]));
-      } else {
-        if (!mp_edge_triangle_covers(&tris[0], s, &la, &lb, &lc)) {
-          t = 1;
-          if (!mp_edge_triangle_covers(&tris[1], s, &la, &lb, &lc)) continue;
-        }
-        float iw = la * tw[t][0] + lb * tw[t][1] + lc * tw[t][2];
-        d = v.ortho ? iw : 1.0f / iw;
+      if (!mp_edge_triangle_covers(&tris[0], s, &la, &lb, &lc)) {
+        t = 1;
+        if (!mp_edge_triangle_covers(&tris[1], s, &la, &lb, &lc)) continue;
       }
+      float iw = la * tw[t][0] + lb * tw[t][1] + lc * tw[t][2];
+      float d = v.ortho ? iw : 1.0f / iw;
       if (!(d >= v.clip_near && d <= v.clip_far)) continue;
       uint texel = (uint)((py & 127) * MP_PAGE_SIZE + (px & 127));
       if (opacity < 1.0f &&
