@@ -33,6 +33,10 @@ class FakeScene:
     def set_camera(self, matrix, **kw):
         assert matrix.shape == (4, 4)
 
+    def set_world(self, radiance=None, **kw):
+        assert radiance.ndim == 3 and radiance.shape[2] == 4  # (height, width, RGBA), as the native Scene takes
+        self.world = radiance
+
     @property
     def material_count(self):
         return len(self.materials)
