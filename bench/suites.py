@@ -6,8 +6,9 @@ ratios between its cases it prints.
 The scenes are RIB files that the scene generators write with --rib-only
 into bench/out (blender_bench.py --shadows: shadow_suzannes;
 occlusion_bench.py: shells_N, shells_out_N, layers_point, layers_sun,
-field_2000; world_bench.py: world_*; blur_bench.py: blur_*); the standard
-suite writes its own (scenes.py) from tests/scenes/teapot.rib."""
+field_2000; world_bench.py: world_*; blur_bench.py: blur_*; texture_bench.py:
+texture_*); the standard suite writes its own (scenes.py) from
+tests/scenes/teapot.rib."""
 
 import os
 from collections import namedtuple
@@ -97,6 +98,12 @@ SUITES = {
     "blur": Suite("the six Suzannes still, with motion blur and with depth of field",
                   [Case(s, f"blur_{s}.rib", []) for s in ("static", "motion", "dof")],
                   repeat=20, ratios=[("motion", "static"), ("dof", "static")]),
+    "textures": Suite("image textures filtered (MIP-mapped, anisotropic) and unfiltered: a checkerboard floor to "
+                      "the horizon and a busy image on a small distant card, 1920x1080, 16 spp",
+                      [Case(f"{scene}/{mode}", f"texture_{scene}.rib", ["--texture-filter-width", width])
+                       for scene in ("floor", "card") for mode, width in (("filtered", "1"), ("unfiltered", "0"))],
+                      repeat=10, stages=("upload",) + CORE_STAGES,
+                      ratios=[("floor/filtered", "floor/unfiltered"), ("card/filtered", "card/unfiltered")]),
     "culling": Suite("hidden layers in every view, shadows on: nested shells (lamp inside, lamp outside), "
                      "1,000 stacked layers (point lamp, sun), the rock field",
                      _culling_cases(), repeat=3, stages=SHADOW_STAGES + CORE_STAGES,

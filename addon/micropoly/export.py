@@ -148,6 +148,15 @@ class ViewCamera:
         s.crop_x0, s.crop_x1, s.crop_y0, s.crop_y1 = self.crop or (0.0, 1.0, 0.0, 1.0)
 
 
+def pixel_filter_support(filter_type, width):
+    """The native filter's full support for Blender's Filter Width, as Cycles
+    reads that width: its Blackman-Harris reaches `width` on each side of
+    the pixel centre (Cycles doubles the width; docs/blender-conventions.md
+    section 4), where the native filter's width is the whole support, as
+    RenderMan's are."""
+    return 2.0 * width if filter_type == "BLACKMAN_HARRIS" else width
+
+
 def export_settings(native_scene, scene, width, height):
     settings = native_scene.settings
     mp = scene.micropoly
@@ -161,7 +170,7 @@ def export_settings(native_scene, scene, width, height):
     settings.shading_rate = mp.shading_rate
     settings.max_grid_size = mp.max_grid_size
     settings.filter = getattr(_native.PixelFilter, mp.filter_type)
-    settings.filter_width = mp.filter_width
+    settings.filter_width = pixel_filter_support(mp.filter_type, mp.filter_width)
     settings.bound_split = getattr(_native.BoundSplitMethod, mp.bound_split_method)
     settings.bound_split_memory_mib = mp.bound_split_memory
     settings.occlusion_culling = mp.use_occlusion_culling
@@ -173,6 +182,7 @@ def export_settings(native_scene, scene, width, height):
     settings.shadow_shading_rate = mp.shadow_shading_rate
     settings.world_probes = mp.world_shadow_directions
     settings.dof_dice_factor = mp.dof_dice_factor
+    settings.texture_filter_width = mp.texture_filter_width
     settings.sample_memory_mib = mp.sample_memory
 
 

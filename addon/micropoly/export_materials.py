@@ -152,7 +152,8 @@ class MaterialTable:
                     self.programs[compiled.source] = program
                 params.update(program=program, program_params=compiled.params, program_displaces=compiled.displaces,
                               program_shades=compiled.shades, displacement_bound=compiled.displacement_bound,
-                              displacement_bound_world=compiled.displacement_world, program_alpha=compiled.alpha)
+                              displacement_bound_world=compiled.displacement_world, program_alpha=compiled.alpha,
+                              program_alpha_cut=compiled.alpha_cut)
             self.native.add_material(name=key, **params)
             self.index[key] = self.native.material_count - 1
         return self.index[key]

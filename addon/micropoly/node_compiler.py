@@ -32,7 +32,7 @@ def _socket_kind(socket):
 
 class CompiledMaterial:
     def __init__(self, source, displaces, shades, displacement_bound, displacement_world=False, alpha=False,
-                 params=()):
+                 params=(), alpha_cut=False):
         self.source = source
         # The node values the program reads (MP_PARAM in its source): trees
         # that differ only in values share one source, so one program.
@@ -40,6 +40,9 @@ class CompiledMaterial:
         self.displaces = displaces
         self.shades = shades
         self.alpha = alpha  # the program computes the surface's alpha (which shadow views read too)
+        # ... and that alpha is a hard cut written as its edge's distance
+        # (mp_alpha_cut): samples keep the surface where it exceeds one half.
+        self.alpha_cut = alpha_cut
         self.displacement_bound = displacement_bound
         self.displacement_world = displacement_world  # the bound is in world units
 
@@ -94,6 +97,8 @@ class NodeCompiler:
         self.fn = None
         self.helpers = []          # extra functions (Bump heights), emitted before the main two
         self.uses_neighbours = False
+        self.neighbours_of_neighbours = False  # a filtered image inside a Bump's height
+        self.heights = 0           # height functions (Bump) being compiled, innermost last
         self.uses_thin_film = False
         self.uses_subsurface_walk = False
         self.displacement_world = False
@@ -101,6 +106,8 @@ class NodeCompiler:
         self.groups = []           # the Group nodes whose trees are being compiled, outermost first
         self.world = False         # compiling a world (baked into a map) rather than a material
         self.transparent = False   # the surface has Transparent closures (its alpha can be below 1)
+        self.alpha_cuts = 0        # Principled Alphas that are hard cuts (Math Greater / Less Than)
+        self.alpha_fractional = False  # transparency other than such cuts
         self.closures = 0          # closures the surface adds at most (MP_MAX_CLOSURES per vertex)
         self.params = []           # node values the program reads (MP_PARAM); not compiled in
 
@@ -255,7 +262,31 @@ class NodeCompiler:
 
     def uv(self, name=""):
         """The UV layer of that name ("": the mesh's active render UV map)."""
-        return f"g->uv[{self.resources.uv_layer(name)}]"
+        return self.uv_at(name)("g")
+
+    def uv_at(self, name=""):
+        """The same, for any globals: a function of their name."""
+        layer = self.resources.uv_layer(name)
+        return lambda g: f"{g}->uv[{layer}]"
+
+    def with_footprint(self, node, key, default):
+        """Input `key` of `node` as a float3 (`default(g)`, an expression of
+        globals g, where it is not linked) and its change over one
+        micropolygon along each axis of the grid: (value, d/dx, d/dy), the
+        footprint an image lookup filters over (mp_tex_image_area)."""
+        self.uses_neighbours = True
+        if self.heights:
+            self.neighbours_of_neighbours = True
+        socket = node.inputs[key]
+        if socket.is_linked:
+            value = self.input(node, key, VEC)[0]
+            fn = self.height_function(node, key, VEC)
+            at = lambda g: f"{fn}({g})"
+        else:
+            value, at = default("g"), default
+        dx = self.fn.temp(VEC, f"MP_FOOTPRINT(g, {at('g->dx')}, {value})")[0]
+        dy = self.fn.temp(VEC, f"MP_FOOTPRINT(g, {at('g->dy')}, {value})")[0]
+        return value, dx, dy
 
     def by_id(self, node, identifier, kind):
         for i, s in enumerate(node.inputs):
@@ -275,14 +306,20 @@ class NodeCompiler:
             return {}
         return emit(self, node)
 
-    def height_function(self, node, key):
-        """A helper function evaluating input `key` of `node` for any globals."""
+    def height_function(self, node, key, kind=FLOAT):
+        """A helper function evaluating input `key` of `node` for any
+        globals: a Bump's height (FLOAT), or an image's coordinates (VEC)."""
         outer = self.fn
-        name = f"mp_height_{len(self.helpers)}"
+        name = f"mp_height_{len(self.helpers)}" if kind == FLOAT else f"mp_coordinates_{len(self.helpers)}"
         self.helpers.append(None)  # reserve the slot: nested heights get later ones
         slot = len(self.helpers) - 1
-        text = self._function(f"float {name}(const MpNodeGlobals* g)",
-                              lambda: f"  return {self.input(node, key, FLOAT)[0]};\n")
+        ctype = "float" if kind == FLOAT else "float3"
+        self.heights += kind == FLOAT
+        try:
+            text = self._function(f"{ctype} {name}(const MpNodeGlobals* g)",
+                                  lambda: f"  return {self.input(node, key, kind)[0]};\n")
+        finally:
+            self.heights -= kind == FLOAT
         self.helpers[slot] = text
         self.fn = outer
         return name
@@ -339,9 +376,11 @@ class NodeCompiler:
             return None
 
         self.displacement_bounds = []  # one per Displacement / Vector Displacement node reached (None: unknown)
+        self.heights += bump_only  # evaluated at the neighbours too (bump_line)
         disp_src = self._function("float3 mp_node_displacement(const MpNodeGlobals* g)",
                                   lambda: "  return " + self.input(out, "Displacement", VEC)[0] + ";\n"
                                   if displaces or bump_only else "  return (float3)(0.0f);\n")
+        self.heights -= bump_only
         bound = self._displacement_bound(displaces)
 
         def surface_body():
@@ -358,6 +397,8 @@ class NodeCompiler:
         includes = "".join(f'#include "textures/{h}"\n' for h in sorted(self.headers))
         if self.uses_neighbours:
             includes = "#define MP_NODE_USES_NEIGHBOURS 1\n" + includes
+        if self.neighbours_of_neighbours:
+            includes = "#define MP_NODE_NEIGHBOURS_OF_NEIGHBOURS 1\n" + includes
         if self.uses_thin_film:
             # Ahead of the kernel headers (program_cache.cpp hoists it).
             includes = "#define MP_NODE_USES_THIN_FILM 1\n" + includes
@@ -365,7 +406,8 @@ class NodeCompiler:
             includes = "#define MP_NODE_USES_SUBSURFACE_WALK 1\n" + includes
         source = includes + "".join(self.helpers) + disp_src + surf_src
         return CompiledMaterial(source, displaces, shades, bound, displaces and self.displacement_world,
-                                alpha=self.transparent, params=self.params)
+                                alpha=self.transparent, params=self.params,
+                                alpha_cut=self.transparent and self.alpha_cuts > 0 and not self.alpha_fractional)
 
     # ---- shader trees -> closures ------------------------------------------------
     @staticmethod
@@ -460,6 +502,27 @@ class NodeCompiler:
             return "(float3)(0.0f)"
         return f"mp_rotate_tangent({self._tangent(node)}, {self._slot_normal(slot)}, {self._f(node, 'Rotation')})"
 
+    # A Math node's comparisons, as the side of its edge: a > b is a - b > 0.
+    _CUTS = {"GREATER_THAN": "({0}) - ({1})", "LESS_THAN": "({1}) - ({0})"}
+
+    def _alpha_cut(self, socket):
+        """An Alpha linked straight from a Math Greater Than or Less Than (a
+        hard cut, as leaves and fences are made) as the cut's side written
+        with its edge's distance (mp_alpha_cut: linear across a micropolygon,
+        one half on the edge), so the sampler can place the edge within
+        the micropolygon; None for any other alpha."""
+        node, _ = linked_from(socket)
+        if node is None or node.type != "MATH" or node.mute or node.operation not in self._CUTS:
+            return None
+        self.uses_neighbours = True
+        self.alpha_cuts += 1
+        a, b = (self.height_function(node, k) for k in (0, 1))
+        side = self._CUTS[node.operation]
+        here = self.fn.temp(FLOAT, side.format(f"{a}(g)", f"{b}(g)"))[0]
+        dx = self.fn.temp(FLOAT, f"MP_STEP_CHANGE(g, {side.format(f'{a}(g->dx)', f'{b}(g->dx)')}, {here})")[0]
+        dy = self.fn.temp(FLOAT, f"MP_STEP_CHANGE(g, {side.format(f'{a}(g->dy)', f'{b}(g->dy)')}, {here})")[0]
+        return self.fn.temp(FLOAT, f"mp_alpha_cut({here}, {dx}, {dy})")[0]
+
     def _f(self, node, *names, default="0.0f"):
         for name in names:
             if name in node.inputs:
@@ -500,6 +563,7 @@ class NodeCompiler:
             return self.emit_principled(node, weight)
         if t == "BSDF_TRANSPARENT":
             self.transparent = True
+            self.alpha_fractional = True
             add(f"  mp_add_transparent(s, {weight} * {self._c(node, 'Color')});")
             return
         if t == "HOLDOUT":
@@ -602,10 +666,13 @@ class NodeCompiler:
         alpha = node.inputs.get("Alpha")
         if alpha is not None and (alpha.is_linked or float(alpha.default_value) < 1.0):
             self.transparent = True
+        cut = self._alpha_cut(alpha) if alpha is not None and alpha.is_linked else None
+        if cut is None and self.transparent:
+            self.alpha_fractional = True
         self._note_thin_film(node)
         fields = {
             "base_color": c(node, "Base Color"), "metallic": f(node, "Metallic"), "roughness": f(node, "Roughness"),
-            "ior": f(node, "IOR", default="1.45f"), "alpha": f(node, "Alpha", default="1.0f"),
+            "ior": f(node, "IOR", default="1.45f"), "alpha": cut or f(node, "Alpha", default="1.0f"),
             "specular": f(node, "Specular IOR Level", "Specular", default="0.5f"),
             "specular_tint": c(node, "Specular Tint", default="(float3)(1.0f)") if v4
             else f"(float3)({f(node, 'Specular Tint')})",

@@ -25,18 +25,30 @@ WORLD_SUN_SPREAD = 2.5 * 2.0 * math.pi / 512
 def emit_image(c, node):
     c.headers.add("mp_tex_image.h")
     index, value_range = c.resources.image(node.image, lambda what: c.warn(node, what))
-    vec = c.input(node, "Vector", VEC)[0] if node.inputs["Vector"].is_linked else c.uv()
     interp = IMAGE_INTERPOLATION.get(node.interpolation, 0)
     ext = IMAGE_EXTENSION.get(node.extension, 0)
     images = f"g->images, g->image_count, g->texels, {index}"
+    if interp == IMAGE_INTERPOLATION["Closest"]:
+        # Closest reads the texel under the point at any distance, as in Cycles.
+        vec = c.input(node, "Vector", VEC)[0] if node.inputs["Vector"].is_linked else c.uv()
+        dx = dy = "(float3)(0.0f)"
+    else:
+        # Filtered over the micropolygon's footprint (mp_tex_image_area).
+        vec, dx, dy = c.with_footprint(node, "Vector", c.uv_at())
     if node.projection == "BOX":
         # Blended by the object-space normal, as Cycles does.
         blend = c.param(float(node.projection_blend))
-        rgba = c.fn.temp("float4", f"mp_tex_image_box({images}, {vec}, g->N, {blend}, {interp}, {ext})")[0]
+        rgba = c.fn.temp("float4", f"mp_tex_image_box_area({images}, {vec}, {dx}, {dy}, g->N, {blend}, {interp}, "
+                                   f"{ext})")[0]
     else:
         if node.projection in ("SPHERE", "TUBE"):
-            vec = c.fn.temp("float2", f"mp_image_{node.projection.lower()}_uv({vec})")[0]
-        rgba = c.fn.temp("float4", f"mp_tex_image({images}, ({vec}).x, ({vec}).y, {interp}, {ext})")[0]
+            proj = f"mp_image_{node.projection.lower()}_uv"
+            # The seam's jump of a whole turn is no footprint.
+            dx = f"mp_image_wrapped_change({proj}({vec} + {dx}) - {proj}({vec}))"
+            dy = f"mp_image_wrapped_change({proj}({vec} + {dy}) - {proj}({vec}))"
+            vec = c.fn.temp("float2", f"{proj}({vec})")[0]
+        rgba = c.fn.temp("float4", f"mp_tex_image_area({images}, ({vec}).x, ({vec}).y, ({dx}).xy, ({dy}).xy, "
+                                   f"{interp}, {ext})")[0]
     # Cycles hands out colour premultiplied by alpha unless the Alpha
     # output is used (or alpha is channel-packed, ignored, or data).
     image = node.image

@@ -27,6 +27,10 @@ class MicropolySceneSettings(bpy.types.PropertyGroup):
     viewport_shading_rate: FloatProperty(name="Viewport Shading Rate", description="Area of a micropolygon "
                                          "in pixels in the Rendered viewport; coarser than final renders keeps "
                                          "the view responsive", default=2.0, min=0.05, max=64.0)
+    texture_filter_width: FloatProperty(name="Texture Filter Width", description="Image textures are "
+                                        "averaged over this many times each micropolygon's area in the image "
+                                        "(MIP-mapped, anisotropic); 0 reads them unfiltered, which aliases "
+                                        "where they are minified", default=1.0, min=0.0, max=16.0)
     max_grid_size: IntProperty(name="Split Limit", description="Largest grid, in micropolygons per side, "
                                "that a sub-patch is diced into before it is split instead",
                                default=16, min=2, max=32)
@@ -37,7 +41,8 @@ class MicropolySceneSettings(bpy.types.PropertyGroup):
                                         "what is already rendered before dicing them (the image is the same; "
                                         "off for comparison)", default=True)
     filter_type: EnumProperty(name="Pixel Filter", items=FILTERS, default="BLACKMAN_HARRIS")
-    filter_width: FloatProperty(name="Filter Width", description="Pixel filter width in pixels",
+    filter_width: FloatProperty(name="Filter Width", description="Pixel filter width in pixels, as Cycles "
+                                "reads it (Blackman-Harris reaches this far on each side of a pixel's centre)",
                                 default=1.5, min=0.5, max=8.0, subtype="PIXEL")
     use_shadows: BoolProperty(name="Shadows", description="Lights cast shadows (each light's Cast Shadow "
                               "and each object's Shadow ray visibility still apply)", default=True)

@@ -60,6 +60,7 @@ class MICROPOLY_PT_dicing(MicropolyPanel, bpy.types.Panel):
         col.prop(settings, "viewport_shading_rate", text="Viewport")
         layout.prop(settings, "max_grid_size")
         layout.prop(settings, "dof_dice_factor")
+        layout.prop(settings, "texture_filter_width")
 
 
 class MICROPOLY_PT_motion_blur(MicropolyPanel, bpy.types.Panel):

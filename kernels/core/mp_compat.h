@@ -73,6 +73,7 @@ using std::ceil;
 using std::floor;
 using std::sqrt;
 using std::fabs;
+using std::log2;
 using std::isfinite;
 #endif
 

@@ -117,6 +117,9 @@ typedef struct {
    * bottom-left corner: (ndc_ax x / d + ndc_bx, ndc_ay y / d + ndc_by), d
    * replaced by 1 for orthographic views. Shadow views keep the camera's. */
   float ndc_ax, ndc_bx, ndc_ay, ndc_by;
+  /* Image lookups filter over this many micropolygon footprints
+   * (RenderSettings::texture_filter_width; mp_tex_image.h). */
+  float texture_filter;
 } FrameParams;
 
 /* The camera view's occlusion pyramid (mp_occlusion.h): level 0 has a cell

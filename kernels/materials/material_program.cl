@@ -96,21 +96,51 @@ inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, f
   g.params = in->params;
   g.dx = 0;
   g.dy = 0;
+  g.footprint = f->texture_filter;
   return g;
 }
 
-/* Globals a fraction t of the way from g to those of a neighbouring vertex:
- * positions and coordinates move, the normal stays, as when Cycles offsets
- * a shading point by a fraction of its differential for bump evaluation. */
-inline MpNodeGlobals mp_node_globals_toward(const MpNodeGlobals* g, const MpNodeGlobals* to, float t) {
+/* Globals moved fractions tx and ty of the way from g towards the next grid
+ * vertices x and y: positions and coordinates move, the normal stays, as
+ * when Cycles offsets a shading point by a fraction of its differentials
+ * for bump evaluation. */
+inline MpNodeGlobals mp_node_globals_step(const MpNodeGlobals* g, const MpNodeGlobals* x, const MpNodeGlobals* y,
+                                          float tx, float ty) {
   MpNodeGlobals r = *g;
-  r.P = g->P + t * (to->P - g->P);
-  r.generated = g->generated + t * (to->generated - g->generated);
-  r.camera = g->camera + t * (to->camera - g->camera);
-  r.window = g->window + t * (to->window - g->window);
-  for (uint k = 0; k < MP_MAX_UV_LAYERS; ++k) r.uv[k] = g->uv[k] + t * (to->uv[k] - g->uv[k]);
+  r.P = g->P + tx * (x->P - g->P) + ty * (y->P - g->P);
+  r.generated = g->generated + tx * (x->generated - g->generated) + ty * (y->generated - g->generated);
+  r.camera = g->camera + tx * (x->camera - g->camera) + ty * (y->camera - g->camera);
+  r.window = g->window + tx * (x->window - g->window) + ty * (y->window - g->window);
+  for (uint k = 0; k < MP_MAX_UV_LAYERS; ++k) r.uv[k] = g->uv[k] + tx * (x->uv[k] - g->uv[k]) + ty * (y->uv[k] - g->uv[k]);
+  r.dx = 0;
+  r.dy = 0;
   return r;
 }
+
+/* The differences nodes take (g.dx and g.dy, MP_NEIGHBOUR_STEP of the way
+ * to the next grid vertices nx and ny); with MP_NODE_NEIGHBOURS_OF_NEIGHBOURS
+ * (a Bump's height reads a filtered image), those points get theirs too, so
+ * the image is filtered alike at every point the height is differenced
+ * over. The caller's storage `at` holds the five points. */
+#define MP_WITH_NEIGHBOURS(g, nx, ny, at)                                                            \
+  do {                                                                                             \
+    (at)[0] = mp_node_globals_step(&(g), &(nx), &(ny), MP_NEIGHBOUR_STEP, 0.0f);                   \
+    (at)[1] = mp_node_globals_step(&(g), &(nx), &(ny), 0.0f, MP_NEIGHBOUR_STEP);                   \
+    MP_NEIGHBOURS_OF_NEIGHBOURS(g, nx, ny, at)                                                     \
+    (g).dx = &(at)[0];                                                                             \
+    (g).dy = &(at)[1];                                                                             \
+  } while (0)
+#ifdef MP_NODE_NEIGHBOURS_OF_NEIGHBOURS
+#define MP_NEIGHBOUR_POINTS 5
+#define MP_NEIGHBOURS_OF_NEIGHBOURS(g, nx, ny, at)                                                 \
+  (at)[2] = mp_node_globals_step(&(g), &(nx), &(ny), 2.0f * MP_NEIGHBOUR_STEP, 0.0f);              \
+  (at)[3] = mp_node_globals_step(&(g), &(nx), &(ny), MP_NEIGHBOUR_STEP, MP_NEIGHBOUR_STEP);        \
+  (at)[4] = mp_node_globals_step(&(g), &(nx), &(ny), 0.0f, 2.0f * MP_NEIGHBOUR_STEP);              \
+  (at)[0].dx = &(at)[2], (at)[0].dy = &(at)[3], (at)[1].dx = &(at)[3], (at)[1].dy = &(at)[4];
+#else
+#define MP_NEIGHBOUR_POINTS 2
+#define MP_NEIGHBOURS_OF_NEIGHBOURS(g, nx, ny, at)
+#endif
 
 /* Object -> camera for a normal: the transpose of camera -> object's linear part. */
 inline float3 mp_object_normal_to_camera(__global const DeviceObject* o, float3 n) {
@@ -154,6 +184,10 @@ __kernel void displace_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, 
   in.params += materials[material].params[0];
   MpNodeGlobals g = mp_node_globals(o, p, grid_n[index].xyz, &in, sp.patch, uv, &f);
   g.camera_ray = 0; /* Cycles displaces with no ray */
+  /* No neighbours (g.dx null): an image the displacement reads is read at
+   * level 0, however small the micropolygons, because a footprint differs
+   * between the grids on either side of a shared edge, and a displacement
+   * that depended on it would open cracks there (docs/pipeline.md). */
   float3 d = mp_node_displacement(&g);
   if (!(isfinite(d.x) && isfinite(d.y) && isfinite(d.z))) return;
   grid_p[index] = (float4)(p + mp_object_dir_to_camera(o, d), 1.0f);
@@ -197,18 +231,18 @@ __kernel void shade_program_grids(MP_SCENE_PARAMS __global const SubPatch* dicea
   if (!faced && g.backfacing && mp_grid_beside_contour(grid_p, grid_n, index - here, &shape, i, j, f.ortho))
     faced = 1, g.backfacing = 0;
 #ifdef MP_NODE_USES_NEIGHBOURS
-  /* Bump nodes go a tenth of the way: a small step keeps the difference
-   * first-order even where a micropolygon spans much of a texture's feature
-   * (grazing views). */
+  /* Bump nodes go MP_NEIGHBOUR_STEP of the way: a small step keeps the
+   * difference first-order even where a micropolygon spans much of a
+   * texture's feature (grazing views); image lookups scale it back to a
+   * whole micropolygon's footprint. */
   uint stride = (uint)f.max_grid + 1u;
   float2 uvx = uv, uvy = uv;
   mp_slot_uv(&sp, &shape, sx % stride, sx / stride, &uvx);
   mp_slot_uv(&sp, &shape, sy % stride, sy / stride, &uvy);
   MpNodeGlobals nx = mp_node_globals(o, grid_p[gx].xyz, grid_n[gx].xyz, &in, sp.patch, uvx, &f);
   MpNodeGlobals ny = mp_node_globals(o, grid_p[gy].xyz, grid_n[gy].xyz, &in, sp.patch, uvy, &f);
-  MpNodeGlobals g_dx = mp_node_globals_toward(&g, &nx, 0.1f), g_dy = mp_node_globals_toward(&g, &ny, 0.1f);
-  g.dx = &g_dx;
-  g.dy = &g_dy;
+  MpNodeGlobals near[MP_NEIGHBOUR_POINTS];
+  MP_WITH_NEIGHBOURS(g, nx, ny, near);
 #endif
   MpSurface s;
   mp_surface_init(&s, g.N);
@@ -275,6 +309,7 @@ float3 mp_world_radiance(float3 d, const MpProgramInputs* in, int camera_ray, fl
   g.params = in->params;
   g.dx = 0;
   g.dy = 0;
+  g.footprint = 0.0f;
   g.I = -d;
   g.ray_length = 1e30f;
   g.shadow_ray = 0;

@@ -47,11 +47,40 @@ typedef struct MpNodeGlobals {
    * numbers a program reads rather than compiles in, so that a tree whose
    * values change keeps its program and only these are uploaded again. */
   MP_GLOBAL const float* params;
-  /* The same a small step towards the next grid vertex along u and along v
-   * (the finite differences of Bump nodes), or null. */
+  /* The same MP_NEIGHBOUR_STEP of the way to the next grid vertex along u
+   * and along v (the finite differences of Bump nodes and the footprints
+   * of image lookups), or null. */
   const struct MpNodeGlobals* dx;
   const struct MpNodeGlobals* dy;
+  float footprint; /* image lookups' filter width in micropolygons (FrameParams.texture_filter) */
 } MpNodeGlobals;
+
+/* The fraction of a micropolygon that globals' dx and dy step. */
+#define MP_NEIGHBOUR_STEP 0.1f
+
+/* The change of a node value v (computed as `at_dx` at g->dx) over one whole
+ * micropolygon, times the filter width: an image lookup's footprint; zero
+ * without neighbours. */
+#define MP_FOOTPRINT(g, at_dx, v) ((g)->dx ? ((at_dx) - (v)) * ((g)->footprint / MP_NEIGHBOUR_STEP) : (v) * 0.0f)
+
+/* The change of a node value v (computed as `at_dx` at g->dx) over one whole
+ * micropolygon; zero without neighbours. */
+#define MP_STEP_CHANGE(g, at_dx, v) ((g)->dx ? ((at_dx) - (v)) * (1.0f / MP_NEIGHBOUR_STEP) : 0.0f)
+
+/* A hard alpha cut (a Math Greater Than into Alpha: opaque where s > 0) as
+ * the side of its edge written with the edge's distance: 0.5 + s over
+ * twice the most s changes across a micropolygon (dx, dy: its change along
+ * each grid axis), clamped to [0, 1]. Within a micropolygon the edge
+ * crosses, the corners' values stay unclamped, so the opacity interpolated
+ * across it passes one half where s passes zero; the sampler keeps such
+ * surfaces where that opacity exceeds one half (materials whose alpha is
+ * a cut, DeviceMaterial.program[3] = 2), so the edge falls where the cut
+ * falls, not halfway between two corners. */
+MP_INLINE float mp_alpha_cut(float s, float dx, float dy) {
+  float w = 1.41421356f * sqrt(dx * dx + dy * dy);
+  if (!(w > 0.0f) || !isfinite(w)) return s > 0.0f ? 1.0f : 0.0f;
+  return clamp(0.5f + s / (2.0f * w), 0.0f, 1.0f);
+}
 
 /* Node value k of the material, and three (four) from k as a vector or
  * colour; a table of n from k. Programs name them only in these forms, with

@@ -26,6 +26,27 @@ typedef struct {
  * held-out share (Holdout, grid normals' w after shading) is the same mean. */
 MP_INLINE float mp_quad_opacity(float a, float b, float c, float d) { return 0.25f * (a + b + c + d); }
 
+/* Whether a micropolygon's corners are each fully opaque or fully clear,
+ * some clear: a hard alpha cut (Math Greater Than and the like) crosses it.
+ * Its samples and texels then keep it where the opacity interpolated across
+ * it exceeds one half, so the cut's edge is crisp on the line halfway
+ * between its opaque and clear corners, as a binary alpha's edge is in
+ * Cycles; thresholds drawn per sample would dither it across the whole
+ * micropolygon, noise along every cut edge at 16 samples per pixel. */
+MP_INLINE int mp_quad_cut(float a, float b, float c, float d) {
+  int binary = (a == 0.0f || a == 1.0f) && (b == 0.0f || b == 1.0f) && (c == 0.0f || c == 1.0f) &&
+               (d == 0.0f || d == 1.0f);
+  return binary && a + b + c + d < 4.0f;
+}
+
+/* Whether a patch's material writes its alpha as a hard cut's edge distance
+ * (mp_alpha_cut; DeviceMaterial.program[3] = 2): kept above one half too,
+ * so the edge falls where the cut does within the micropolygon. */
+MP_INLINE int mp_material_cut(const MP_GLOBAL DeviceMaterial* materials, const MP_GLOBAL uint* patch_info,
+                              uint patch) {
+  return materials[patch_info[4 * (ulong)patch + 1]].program[3] > 1.5f;
+}
+
 /* The surface whose micropolygons share stochastic-opacity thresholds (the
  * camera's, mp_sample.h, and the shadow maps'): a patch, so neighbouring
  * grids of one patch agree. */

@@ -21,12 +21,14 @@ typedef struct {
 } MpRasterVertex;
 
 /* What a micropolygon's samples keep of it: its mean opacity (1: opaque,
- * no sample tests its opacity), its held-out share (Holdout) and the
- * surface its stochastic opacity draws thresholds for (mp_opacity_keeps). */
+ * no sample tests its opacity), its held-out share (Holdout), the surface
+ * its stochastic opacity draws thresholds for (mp_opacity_keeps) and
+ * whether a hard alpha cut crosses it (mp_quad_cut: a fixed threshold). */
 typedef struct {
   float opacity;
   float holdout;
   uint surface;
+  int cut;
 } MpCover;
 
 /* Raster position of camera-space point p; *ok = 0 where it lies behind the
@@ -143,8 +145,9 @@ inline int mp_triangle_depth(const MpTriangle* t, float la, float lb, float lc, 
  * draw their own thresholds, so one seen through another keeps its share.
  * The hash follows whole-image pixels (the crop origin added), so a crop,
  * a bucket or a tile draws the same coverage as the whole frame. */
-inline int mp_opacity_keeps(uint surface, int px, int py, int s, float opacity, FrameParams f) {
+inline int mp_opacity_keeps(uint surface, int cut, int px, int py, int s, float opacity, FrameParams f) {
   if (opacity >= 1.0f) return 1;
+  if (cut) return opacity > 0.5f;
   uint h = mp_hash_combine(mp_hash_combine(surface, (uint)(px + f.crop_x0)), (uint)(py + f.crop_y0));
   float t = mp_hash_unit(h) + (float)s * 0.61803398875f;
   return t - floor(t) < opacity;

@@ -30,7 +30,7 @@ inline void mp_sample_write(const MpTriangle* t, float la, float lb, float lc, i
                             __global float* colors, __global uint* normals) {
   float d;
   if (!mp_triangle_depth(t, la, lb, lc, f, &d)) return;
-  if (!mp_opacity_keeps(cover.surface, px, py, s, mp_sample_opacity(t, la, lb, lc, d, cover.opacity, f), f)) return;
+  if (!mp_opacity_keeps(cover.surface, cover.cut, px, py, s, mp_sample_opacity(t, la, lb, lc, d, cover.opacity, f), f)) return;
   ulong pixel = (ulong)py * (ulong)f.width + (ulong)px, index = pixel * (ulong)spp + (ulong)s;
   ulong key = mp_sample_key(d, mp_id);
   if (pass == MP_PASS_DEPTH) {
@@ -297,7 +297,7 @@ inline void mp_mark_occlusion_cells(__global uchar* dirty, OcclusionParams o, Fr
  * layout, GridLayoutStage), `base` is the first of these grids' and `total`
  * their number. A work-item finds its grid by binary search, so no
  * work-item idles on an unused grid slot. */
-inline void mp_sample(__global const uint* patch_info, MP_SAMPLE_ARGS, __local ulong* area_sum,
+inline void mp_sample(__global const uint* patch_info, __global const DeviceMaterial* materials, MP_SAMPLE_ARGS, __local ulong* area_sum,
                       __local uint* count_sum, __local uint* test_sum,
                       const int blur) {
   uint stride = (uint)f.max_grid + 1u;
@@ -335,7 +335,8 @@ inline void mp_sample(__global const uint* patch_info, MP_SAMPLE_ARGS, __local u
   if (keep) {
     uint mp_id = mp_micropolygon_id(mp_grid_id(&sp), m);
     MpCover cover = {mp_quad_opacity(vc[0].w, vc[1].w, vc[2].w, vc[3].w),
-                     mp_quad_opacity(vn[0].w, vn[1].w, vn[2].w, vn[3].w), mp_opacity_surface(sp.patch)};
+                     mp_quad_opacity(vn[0].w, vn[1].w, vn[2].w, vn[3].w), mp_opacity_surface(sp.patch),
+                     mp_material_cut(materials, patch_info, sp.patch) || mp_quad_cut(vc[0].w, vc[1].w, vc[2].w, vc[3].w)};
     if (pass == MP_PASS_DEPTH && occlusion_dirty) mp_mark_occlusion_cells(occlusion_dirty, occ, f, v[0].p, v[1].p, v[2].p, v[3].p);
     if (blur) {
       ulong idx[4];
@@ -352,7 +353,7 @@ inline void mp_sample(__global const uint* patch_info, MP_SAMPLE_ARGS, __local u
 __kernel __attribute__((reqd_work_group_size(64, 1, 1))) void sample_micropolygons(MP_SCENE_PARAMS MP_SAMPLE_ARGS) {
   __local ulong area_sum[64];
   __local uint count_sum[64], test_sum[64];
-  mp_sample(patch_info, MP_SAMPLE_PASS, area_sum, count_sum, test_sum, 0);
+  mp_sample(patch_info, materials, MP_SAMPLE_PASS, area_sum, count_sum, test_sum, 0);
 }
 
 /* Samples with times and lens positions (mp_blur.h). */
@@ -360,5 +361,5 @@ __kernel __attribute__((reqd_work_group_size(64, 1, 1)))
 void sample_micropolygons_blur(MP_SCENE_PARAMS MP_SAMPLE_ARGS) {
   __local ulong area_sum[64];
   __local uint count_sum[64], test_sum[64];
-  mp_sample(patch_info, MP_SAMPLE_PASS, area_sum, count_sum, test_sum, 1);
+  mp_sample(patch_info, materials, MP_SAMPLE_PASS, area_sum, count_sum, test_sum, 1);
 }

@@ -116,7 +116,7 @@ inline uint mp_sample_tile_slow(const MpTriangle* tris, long xmin, long xmax, lo
         float la, lb, lc, d;
         int t = mp_quad_covers(tris, sq, &la, &lb, &lc);
         if (t < 0 || !mp_triangle_depth(&tris[t], la, lb, lc, f, &d)) continue;
-        if (!mp_opacity_keeps(cover.surface, px, py, s, mp_sample_opacity(&tris[t], la, lb, lc, d, cover.opacity, f),
+        if (!mp_opacity_keeps(cover.surface, cover.cut, px, py, s, mp_sample_opacity(&tris[t], la, lb, lc, d, cover.opacity, f),
                               f))
           continue;
         ulong key = mp_sample_key(d, mp_id), index = pixel * (ulong)spp + (ulong)s;
@@ -347,7 +347,10 @@ __kernel void sample_tiles(MP_SCENE_PARAMS __global const SubPatch* diceable, Fr
                                        grid_c[base + q[3]].w),
                        mp_quad_opacity(grid_n[base + q[0]].w, grid_n[base + q[1]].w, grid_n[base + q[2]].w,
                                        grid_n[base + q[3]].w),
-                       mp_opacity_surface(sp.patch)};
+                       mp_opacity_surface(sp.patch),
+                       mp_material_cut(materials, patch_info, sp.patch) ||
+                           mp_quad_cut(grid_c[base + q[0]].w, grid_c[base + q[1]].w, grid_c[base + q[2]].w,
+                                       grid_c[base + q[3]].w)};
       int px0 = (int)max(xmin >> MP_SUBPIXEL_BITS, (long)tx0), px1 = (int)min(xmax >> MP_SUBPIXEL_BITS, (long)tx1);
       int py0 = (int)max(ymin >> MP_SUBPIXEL_BITS, (long)ty0), py1 = (int)min(ymax >> MP_SUBPIXEL_BITS, (long)ty1);
       int written = 0;

@@ -588,11 +588,13 @@ void shadow_sample(MP_SCENE_PARAMS __global const SubPatch* diceable, uint first
   for (int k = 0; k < 4; ++k) o[k] = mat->program[3] > 0.0f ? grid_c[grid_base + q[k]].w : mat->opacity[3];
   float opacity = mp_quad_opacity(o[0], o[1], o[2], o[3]);
   /* Per texel, the opacity interpolated in the triangle that covers it and
-   * a threshold drawn for the patch and texel (as mp_opacity_keeps draws
-   * the camera's): a hard alpha cut casts a crisp-edged shadow. */
+   * a threshold drawn for the patch and texel, or one half where a hard
+   * alpha cut crosses the micropolygon (as mp_opacity_keeps keeps the
+   * camera's samples): a hard alpha cut casts a crisp-edged shadow. */
   float to[2][3] = {{o[0], tris[0].swapped ? o[2] : o[1], tris[0].swapped ? o[1] : o[2]},
                     {o[0], tris[1].swapped ? o[3] : o[2], tris[1].swapped ? o[2] : o[3]}};
   uint surface = opacity < 1.0f ? mp_opacity_surface(sp.patch) : 0u;
+  int cut = mat->program[3] > 1.5f || mp_quad_cut(o[0], o[1], o[2], o[3]);
   int side = v.page_side;
   /* Most micropolygons lie within one page: one table lookup for all. */
   int one_page = (px0 >> 7) == (px1 >> 7) && (py0 >> 7) == (py1 >> 7);
@@ -625,9 +627,8 @@ void shadow_sample(MP_SCENE_PARAMS __global const SubPatch* diceable, uint first
       float d = v.ortho ? iw : 1.0f / iw;
       if (!(d >= v.clip_near && d <= v.clip_far)) continue;
       uint texel = (uint)((py & 127) * MP_PAGE_SIZE + (px & 127));
-      if (opacity < 1.0f &&
-          mp_hash_unit(mp_hash_combine(surface, (uint)(py * v.width + px))) >=
-              la * to[t][0] + lb * to[t][1] + lc * to[t][2])
+      if (opacity < 1.0f && (cut ? 0.5f : mp_hash_unit(mp_hash_combine(surface, (uint)(py * v.width + px)))) >=
+                                la * to[t][0] + lb * to[t][1] + lc * to[t][2])
         continue;
       atomic_min(&pool[(ulong)MP_PAGE_PHYSICAL(e) * MP_PAGE_TEXELS + texel], as_uint(d));
     }

@@ -5,7 +5,7 @@ camera's own Depth of Field settings):
     a floor, lit by a sun, through a round aperture, a 6-blade aperture
     (turned 10 degrees) and a round one focused by a focus object: Combined
     PSNR over the whole frame (transparent film, so silhouettes count)
-    >= 30 dB. Mutation checks: the same scene rendered by Micropoly with
+    >= 36 dB. Mutation checks: the same scene rendered by Micropoly with
     Depth of Field off, and with half the aperture, must miss it;
   - the blur extent: a card far behind the focus with a straight vertical
     edge; the width of its alpha ramp (5% to 95%, averaged over rows) is
@@ -25,7 +25,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import render_utils as ru  # noqa: E402
 
 W, H = 240, 180
-THRESHOLD_DB = 30.0
+THRESHOLD_DB = 36.0
 MICROPOLY_SPP = 64
 CYCLES_SAMPLES = 512
 OUTPUT = os.environ.get("MICROPOLY_TEST_OUTPUT")

@@ -173,6 +173,7 @@ void compare_material(Diff& d, const std::string& p, const Material& a, const Ma
     d.eq(p + ".program_displaces", a.program_displaces, b.program_displaces);
     d.eq(p + ".program_shades", a.program_shades, b.program_shades);
     d.eq(p + ".program_alpha", a.program_alpha, b.program_alpha);
+    d.eq(p + ".program_alpha_cut", a.program_alpha_cut, b.program_alpha_cut);
     d.eq(p + ".displacement_bound", a.displacement_bound, b.displacement_bound);
     d.eq(p + ".displacement_bound_world", a.displacement_bound_world, b.displacement_bound_world);
   }

@@ -135,6 +135,7 @@ class Decoder {
     if (flag()) {
       m.program = index(programs);
       m.program_displaces = flag(), m.program_shades = flag(), m.program_alpha = flag();
+      m.program_alpha_cut = m.program_alpha && flag();
       m.displacement_bound = real(0, 1), m.displacement_bound_world = flag();
     }
     return m;

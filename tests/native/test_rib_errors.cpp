@@ -230,7 +230,7 @@ TEST(RibErrors, ShadowOptionsAndProgramAlpha) {
   expect_error("Option \"micropoly\" \"float shadowshadingrate\" [-1]\n", 1, "shadowshadingrate");
   expect_error("WorldBegin\nAttribute \"micropoly\" \"integer material\" [1] \"string program\" [\"x\"]\n"
                "  \"integer programalpha\" [3]\n",
-               3, "\"programalpha\" expects one integer in [0, 1]");
+               3, "\"programalpha\" expects one integer in [0, 2]");
 }
 
 TEST(RibErrors, PrincipledFlags) {

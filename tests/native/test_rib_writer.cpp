@@ -133,6 +133,7 @@ void expect_same_material(const Material& a, const Material& b) {
     EXPECT_EQ(a.program_displaces, b.program_displaces);
     EXPECT_EQ(a.program_shades, b.program_shades);
     EXPECT_EQ(a.program_alpha, b.program_alpha);
+    EXPECT_EQ(a.program_alpha_cut, b.program_alpha_cut);
     EXPECT_EQ(a.displacement_bound, b.displacement_bound);
     EXPECT_EQ(a.displacement_bound_world, b.displacement_bound_world);
   }
@@ -643,6 +644,12 @@ TEST(RibWriter, ShadowExtensionsOnlyWhereNotDefault) {
   text = to_rib(s);
   EXPECT_NE(text.find("Attribute \"visibility\" \"int camera\" [1] \"int transmission\" [0]"), std::string::npos);
   expect_same_scene(s, round_trip(s));
+  // A hard cut's alpha (Material::program_alpha_cut) travels as programalpha 2.
+  s.materials[0].program_alpha_cut = true;
+  text = to_rib(s);
+  EXPECT_NE(text.find("\"integer programalpha\" [2]"), std::string::npos) << text;
+  EXPECT_TRUE(round_trip(s).materials[0].program_alpha_cut);
+  expect_same_scene(s, round_trip(s));
 }
 
 TEST(RibWriter, FloatsReadBackExactly) {
@@ -811,6 +818,34 @@ TEST(RibWriterExtensions, PngTexturesAreSrgbAndBottomRowFirst) {
   ASSERT_EQ(im.pixels.size(), 2u);
   EXPECT_EQ(im.pixels[0], glm::vec4(0.0f, 0.0f, std::round(linear_to_srgb(0.2f) * 255.0f) / 255.0f, 1.0f));
   EXPECT_EQ(im.pixels[1], glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
+}
+
+TEST(RibWriterExtensions, MakeTextureNamesItsPictureForLaterImages) {
+  // RenderMan's texture file is what every image gets at render time (its
+  // MIP levels): an image option naming the texture reads the picture.
+  RenderResult png;
+  png.width = 3, png.height = 2;
+  png.rgba.assign(3 * 2 * 4, 0.5f);
+  const std::string dir = ::testing::TempDir();
+  write_image(dir + "/make_texture_source.png", png);
+  const RibResult r = read_rib_string(
+      "MakeTexture \"make_texture_source.png\" \"made.tex\" \"periodic\" \"clamp\" \"gaussian\" 2 2\n"
+      "Option \"micropoly\" \"string imagefile\" \"made.tex\"\n",
+      dir + "/texture.rib", dir);
+  ASSERT_EQ(r.scene.images.size(), 1u);
+  EXPECT_EQ(r.scene.images[0].width, 3);
+  EXPECT_EQ(r.scene.images[0].height, 2);
+  EXPECT_EQ(r.scene.images[0].name, "made.tex");
+  // One warning says wrap modes and filters belong to each lookup (the
+  // other: the scene has no world block).
+  EXPECT_EQ(std::count_if(r.warnings.begin(), r.warnings.end(),
+                          [](const std::string& w) { return w.find("come from each lookup") != std::string::npos; }),
+            1);
+  // A wrap mode RenderMan does not have is an error.
+  EXPECT_THROW(read_rib_string("MakeTexture \"make_texture_source.png\" \"m.tex\" \"repeat\" \"clamp\" "
+                               "\"box\" 1 1\n",
+                               dir + "/texture.rib", dir),
+               RibError);
 }
 
 TEST(RibWriterExtensions, ShadowOptionsAndProgramAlpha) {

@@ -64,11 +64,11 @@ def test_binary_junk_is_an_error_not_a_crash(tmp_path):
 
 def test_unsupported_request_warns_once(tmp_path):
     rib = tmp_path / "warn.rib"
-    rib.write_text('Format 32 32 1\nWorldBegin\nMakeTexture "a" "b"\nMakeTexture "c" "d"\n'
+    rib.write_text('Format 32 32 1\nWorldBegin\nMakeShadow "a" "b"\nMakeShadow "c" "d"\n'
                    'Polygon "P" [-1 -1 5 1 -1 5 1 1 5]\nWorldEnd\n')
     r = run(str(rib), "-o", str(tmp_path / "w.png"))
     assert r.returncode == 0, r.stderr
-    assert r.stderr.count("MakeTexture") == 1
+    assert r.stderr.count("MakeShadow") == 1
 
 
 def test_usage_errors_and_device_listing(tmp_path):

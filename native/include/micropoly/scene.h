@@ -118,6 +118,10 @@ struct Material {
   // The program computes the alpha (opacity), which the shadow views then
   // evaluate too, so that a texture's cut-outs cast cut-out shadows.
   bool program_alpha = false;
+  // ... a hard cut whose per-point value is its edge's distance (a Math
+  // Greater or Less Than into Alpha: mp_alpha_cut in mp_node_lib.h):
+  // samples and shadow texels keep the surface where it exceeds one half.
+  bool program_alpha_cut = false;
   // The program's node values (the numbers it reads rather than compiles
   // in: node_compiler.py), so that materials whose trees differ only in
   // values share one program, and editing a value rebuilds nothing.
@@ -289,6 +293,10 @@ struct RenderSettings {
   // fraction of its circle of confusion's diameter where that is longer
   // (RenderMan's focus factor): blurred surfaces are diced coarser. 0: off.
   float dof_dice_factor = 0.5f;
+  // Image textures are filtered over this many times each micropolygon's
+  // footprint in the texture (kernels/textures/mp_tex_image.h; RenderMan's
+  // filter width); 0 reads the point each vertex lands on, unfiltered.
+  float texture_filter_width = 1.0f;
   Sampler sampler = Sampler::Auto;
   // Device memory the frame's samples may take (24 bytes each, 20 without
   // the Normal pass): a frame that needs more is rendered in buckets that

@@ -20,6 +20,7 @@ const char* kUsage =
     "                        [--bound-split-memory MIB] [--shadows on|off] [--shadow-memory MIB]\n"
     "                        [--fresh-shadows] [--occlusion-culling on|off] [--stats FILE.json]\n"
     "                        [--sampler auto|tiles|micropolygons] [--sample-memory MIB]\n"
+    "                        [--texture-filter-width W]\n"
     "                        [--repeat N] [--allow-path DIR]... [--allow-any-path]\n"
     "       micropoly-render --list-devices\n"
     "A scene may read archives and textures only inside its own folder and the\n"
@@ -31,6 +32,7 @@ struct Options {
   std::string scene, output, device, stats, bound_split, shadows, occlusion, sampler;
   int spp = 0, repeat = 1;
   float shading_rate = 0, memory_mib = 0, shadow_memory_mib = 0, sample_memory_mib = 0;
+  float texture_filter_width = -1;  // below 0: the scene's
   bool list_devices = false;
   bool fresh_shadows = false;  // every --repeat frame renders its shadow maps anew
   mp::RibReadOptions rib;      // --allow-path, --allow-any-path
@@ -82,6 +84,8 @@ Options parse(int argc, char** argv) {
       if (o.sampler != "auto" && o.sampler != "tiles" && o.sampler != "micropolygons")
         usage_error("--sampler is auto, tiles or micropolygons");
     } else if (a == "--sample-memory") o.sample_memory_mib = static_cast<float>(parse_number(a, value(), 1, 1 << 24));
+    else if (a == "--texture-filter-width")
+      o.texture_filter_width = static_cast<float>(parse_number(a, value(), 0, 16));
     else if (a == "--stats") o.stats = value();
     else if (a == "--repeat") o.repeat = static_cast<int>(parse_number(a, value(), 1, 10000));
     else if (a == "--list-devices") o.list_devices = true;
@@ -132,6 +136,7 @@ int main(int argc, char** argv) {
                                : o.sampler == "micropolygons" ? mp::Sampler::Micropolygons
                                                               : mp::Sampler::Auto;
     if (o.sample_memory_mib > 0) scene.settings.sample_memory_mib = o.sample_memory_mib;
+    if (o.texture_filter_width >= 0) scene.settings.texture_filter_width = o.texture_filter_width;
     // Only EXR files hold the Depth and Normal passes.
     auto dot = output.find_last_of('.');
     std::string ext = dot == std::string::npos ? "" : output.substr(dot + 1);

@@ -198,6 +198,7 @@ PYBIND11_MODULE(_native, m) {
       .def_readwrite("occlusion_culling", &RenderSettings::occlusion_culling)
       .def_readwrite("holdout_covers", &RenderSettings::holdout_covers)
       .def_readwrite("world_probes", &RenderSettings::world_probes)
+      .def_readwrite("texture_filter_width", &RenderSettings::texture_filter_width)
       .def_readwrite("dof_dice_factor", &RenderSettings::dof_dice_factor)
       .def_readwrite("sampler", &RenderSettings::sampler)
       .def_readwrite("sample_memory_mib", &RenderSettings::sample_memory_mib);
@@ -276,13 +277,15 @@ PYBIND11_MODULE(_native, m) {
              std::vector<float> opacity, float ka, float kd, float ks, float roughness, std::vector<float> specular_color,
              std::vector<float> emission, float metallic, float specular, int program, bool program_displaces,
              bool program_shades, float displacement_bound, bool displacement_bound_world, bool program_alpha,
-             bool layered, bool retro_diffuse, bool multiscatter, std::vector<float> program_params) {
+             bool layered, bool retro_diffuse, bool multiscatter, std::vector<float> program_params,
+             bool program_alpha_cut) {
             Material mat;
             mat.program_params = std::move(program_params);
             mat.layered = layered;
             mat.retro_diffuse = retro_diffuse;
             mat.multiscatter = multiscatter;
             mat.program_alpha = program_alpha;
+            mat.program_alpha_cut = program_alpha && program_alpha_cut;
             mat.displacement_bound_world = displacement_bound_world;
             mat.program = program;
             mat.program_displaces = program_displaces;
@@ -311,7 +314,7 @@ PYBIND11_MODULE(_native, m) {
           py::arg("program") = -1, py::arg("program_displaces") = false, py::arg("program_shades") = false,
           py::arg("displacement_bound") = 0.0f, py::arg("displacement_bound_world") = false,
           py::arg("program_alpha") = false, py::arg("layered") = false, py::arg("retro_diffuse") = false, py::arg("multiscatter") = false,
-          py::arg("program_params") = std::vector<float>{},
+          py::arg("program_params") = std::vector<float>{}, py::arg("program_alpha_cut") = false,
           "Adds a material (constant, matte, plastic or principled; see scene.h); returns its index. "
           "program_params are its program's node values (Material::program_params).")
       .def(

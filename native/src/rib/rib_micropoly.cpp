@@ -86,6 +86,8 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   s.shadow_shading_rate = params.get_float_checked("shadowshadingrate", s.shadow_shading_rate, positive,
                                                    "a positive number");
   params.get_int("worldshadowdirections", 0, 64, &s.world_probes);
+  s.texture_filter_width = params.get_float_checked(
+      "texturefilterwidth", s.texture_filter_width, [](float v) { return v >= 0.0f && v <= 16.0f; }, "0 to 16");
   // Depth of field beyond RiDepthOfField: Cycles' aperture shape and the
   // coarser dicing of blurred surfaces.
   Camera& cam = result_.scene.camera;
@@ -104,8 +106,8 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   warn_unknown(params,
                {"boundsplit", "boundsplitmemory", "maxgridsize", "maxsplitdepth", "backfaceculling",
                 "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate", "occlusionculling", "holdoutcovers",
-                "worldshadowdirections", "apertureblades", "aperturerotation", "apertureratio", "focusfactor",
-                "shuttercurve", "sampler", "samplememory"},
+                "worldshadowdirections", "texturefilterwidth", "apertureblades", "aperturerotation", "apertureratio",
+                "focusfactor", "shuttercurve", "sampler", "samplememory"},
                [&](const std::string& name) {
                  warn_once("option-micropoly:" + name, line,
                            "Option \"micropoly\": parameter \"" + name + "\" is ignored");
@@ -122,6 +124,36 @@ void Parser::check_program(const std::string& source, const ParamList& params, c
   }
 }
 
+// MakeTexture "picture" "texture" swrap twrap filter swidth twidth: what
+// RenderMan's texture file would hold, every image here gets when the scene
+// is uploaded (its MIP levels, kernels/textures/mp_tex_image.h), so the
+// texture is its picture: a later image or map naming the texture reads the
+// picture. Wrap modes and filter widths belong to each lookup here (the
+// material program's Image Texture node), not to the file.
+void Parser::req_make_texture(ArgReader& args) {
+  const int line = args.request().line;
+  const std::string picture = args.string(), texture = args.string();
+  for (const std::string& wrap : {args.string(), args.string()})
+    if (wrap != "periodic" && wrap != "clamp" && wrap != "black")
+      args.fail("MakeTexture: a wrap mode is \"periodic\", \"clamp\" or \"black\", not \"" + wrap + "\"");
+  args.string();  // the filter function: the levels are box-filtered whatever it names
+  for (double width : args.numbers(2))
+    if (!(width > 0.0)) args.fail("MakeTexture: filter widths must be positive");
+  const ParamList params(args, decls_);
+  warn_unknown(params, {}, [&](const std::string& name) {
+    warn_once("maketexture:" + name, line, "MakeTexture: parameter \"" + name + "\" is ignored");
+  });
+  made_textures_[texture] = find_file(picture, true, line, "MakeTexture").open;
+  warn_once("maketexture", line,
+            "MakeTexture: \"" + texture + "\" reads \"" + picture +
+                "\" with MIP levels built at render time; wrap modes and filter widths come from each lookup");
+}
+
+std::string Parser::texture_file(const std::string& name, int line, const std::string& request) const {
+  const auto made = made_textures_.find(name);
+  return made != made_textures_.end() ? made->second : find_file(name, true, line, request).open;
+}
+
 void Parser::read_image_option(ArgReader& args, const ParamList& params) {
   const int line = args.request().line;
   warn_unknown(params, {"image", "imagefile", "imagesrgb"}, [&](const std::string& name) {
@@ -130,7 +162,7 @@ void Parser::read_image_option(ArgReader& args, const ParamList& params) {
   });
   const std::string file = params.get_string("imagefile", "");
   if (file.empty()) args.fail("\"imagefile\" must name a texture file");
-  const std::string path = find_file(file, true, line, "Option \"micropoly\" \"imagefile\"").open;
+  const std::string path = texture_file(file, line, "Option \"micropoly\" \"imagefile\"");
   Image image;
   try {
     image = read_texture_image(path, Limits::kMaxTexels - texels_);
@@ -172,7 +204,7 @@ void Parser::read_environment_light(ArgReader& args, const ParamList& params) {
   } else {
     // An equirectangular map in world space (Cycles' convention, Z up).
     // Its radiance is the texture's times "intensity".
-    const std::string path = find_file(map, true, line, what + " \"mapname\"").open;
+    const std::string path = texture_file(map, line, what + " \"mapname\"");
     Image image;
     try {
       image = read_texture_image(path, Limits::kMaxTexels - texels_);
@@ -241,8 +273,9 @@ void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
     params.get_int("programshades", 0, 1, &flag);
     use.shades = flag != 0;
     flag = 0;
-    params.get_int("programalpha", 0, 1, &flag);
+    params.get_int("programalpha", 0, 2, &flag);  // 2: a hard cut (Material::program_alpha_cut)
     use.alpha = flag != 0;
+    use.alpha_cut = flag == 2;
     use.params = params.get_float_list("programparams");
     use.displacement_bound = params.get_float("displacementbound", 0.0f);
     flag = 0;
@@ -266,6 +299,7 @@ void Parser::define_material(int index, const std::string& name, const MaterialP
   m.program_displaces = use.displaces;
   m.program_shades = use.shades;
   m.program_alpha = use.alpha;
+  m.program_alpha_cut = use.alpha_cut;
   m.program_params = use.params;
   m.displacement_bound = use.displacement_bound;
   m.displacement_bound_world = use.displacement_world;

@@ -105,6 +105,7 @@ const std::unordered_map<std::string, Parser::Handler>& Parser::handlers() {
       {"ObjectBegin", &Parser::req_object_begin},
       {"ObjectEnd", &Parser::req_object_end},
       {"ObjectInstance", &Parser::req_object_instance},
+      {"MakeTexture", &Parser::req_make_texture},
   };
   return table;
 }

@@ -248,7 +248,7 @@ class Parser {
   // The material program a micropoly material attribute names (Material::program).
   struct MaterialProgramUse {
     int program = -1;
-    bool displaces = false, shades = false, alpha = false;
+    bool displaces = false, shades = false, alpha = false, alpha_cut = false;
     float displacement_bound = 0.0f;
     bool displacement_world = false;
     std::vector<float> params;  // the program's node values
@@ -269,6 +269,11 @@ class Parser {
   void check_program(const std::string& source, const ParamList& params, const std::string& what) const;
   // One texture image named by Option "micropoly" "string imagefile".
   void read_image_option(ArgReader& args, const ParamList& params);
+  // MakeTexture: a texture name that later image options read as its picture.
+  void req_make_texture(ArgReader& args);
+  // The file a texture image or map named `name` reads: the picture a
+  // MakeTexture made it from, else the file itself (find_file).
+  std::string texture_file(const std::string& name, int line, const std::string& request) const;
   // LightSource "micropoly_environmentlight": the Scene's World (docs/rib.md).
   void read_environment_light(ArgReader& args, const ParamList& params);
 
@@ -280,6 +285,7 @@ class Parser {
   const Source* source_ = nullptr;
   std::set<std::string> warned_;
   size_t texels_ = 0;  // read so far, against Limits::kMaxTexels
+  std::map<std::string, std::string> made_textures_;  // MakeTexture: texture name -> its picture's path
   PathPolicy paths_;
   SearchPath archive_search_ = default_search_path();
   SearchPath texture_search_ = default_search_path();

@@ -62,7 +62,8 @@ std::vector<float> Parser::material_key(const Material& m) {
           m.emission.x, m.emission.y, m.emission.z,
           m.metallic, m.specular, static_cast<float>(m.program), m.displacement_bound,
           static_cast<float>(m.program_displaces), static_cast<float>(m.program_shades),
-          static_cast<float>(m.displacement_bound_world), static_cast<float>(m.program_alpha),
+          static_cast<float>(m.displacement_bound_world),
+          static_cast<float>(m.program_alpha) + static_cast<float>(m.program_alpha_cut),
           static_cast<float>(m.layered), static_cast<float>(m.retro_diffuse), static_cast<float>(m.multiscatter),
           static_cast<float>(m.program_params.size())};
   key.insert(key.end(), m.program_params.begin(), m.program_params.end());

@@ -252,6 +252,8 @@ void write_options(std::string& o, const RenderSettings& s, const Camera& c) {
   if (s.world_probes != def.world_probes)
     param(o, "integer worldshadowdirections", static_cast<long long>(s.world_probes));
   if (differs(s.dof_dice_factor, def.dof_dice_factor)) param(o, "float focusfactor", s.dof_dice_factor);
+  if (differs(s.texture_filter_width, def.texture_filter_width))
+    param(o, "float texturefilterwidth", s.texture_filter_width);
   if (s.sampler != def.sampler)
     param(o, "string sampler", s.sampler == Sampler::Tiles ? "tiles" : "micropolygons");
   if (differs(s.sample_memory_mib, def.sample_memory_mib)) param(o, "float samplememory", s.sample_memory_mib);
@@ -453,7 +455,7 @@ void write_material(std::string& o, const Material& m, int index, const char* in
     param_list(o, "programparams", m.program_params);
     param(o, "integer programdisplaces", static_cast<long long>(m.program_displaces ? 1 : 0));
     param(o, "integer programshades", static_cast<long long>(m.program_shades ? 1 : 0));
-    if (m.program_alpha) param(o, "integer programalpha", static_cast<long long>(1));
+    if (m.program_alpha) param(o, "integer programalpha", static_cast<long long>(m.program_alpha_cut ? 2 : 1));
     param(o, "float displacementbound", m.displacement_bound);
     if (m.displacement_bound_world) param(o, "integer displacementworld", static_cast<long long>(1));
   }

@@ -216,6 +216,8 @@ void validate_scene(const Scene& scene) {
     throw Error("shadow map memory budget must be a positive number of MiB");
   if (!(s.shadow_shading_rate > 0) || !std::isfinite(s.shadow_shading_rate))
     throw Error("shadow shading rate must be a positive number");
+  if (!(s.texture_filter_width >= 0.0f && s.texture_filter_width <= 16.0f))
+    throw Error("texture filter width must be 0 to 16");
 
   const Camera& c = scene.camera;
   if (!finite(c.world_to_camera)) throw Error("camera transform contains NaN or infinite values");

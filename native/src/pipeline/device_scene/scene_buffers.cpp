@@ -7,7 +7,10 @@
 #include "cl/device_session.h"
 #include "micropoly/error.h"
 
+#include "cl/kernel_args.h"
 #include "geometry/mp_patch.h"
+#include "pipeline/pass/stage_timer.h"
+#include "textures/mp_tex_image.h"
 
 namespace mp {
 namespace {
@@ -35,7 +38,8 @@ DeviceMaterial to_device(const Material& m) {
   d.program[0] = static_cast<float>(m.program);
   d.program[1] = m.program >= 0 && m.program_displaces ? 1.0f : 0.0f;
   d.program[2] = m.program >= 0 && m.program_shades ? 1.0f : 0.0f;
-  d.program[3] = m.program >= 0 && m.program_shades && m.program_alpha ? 1.0f : 0.0f;
+  // 2: the alpha is a hard cut (Material::program_alpha_cut; mp_quad_cut).
+  d.program[3] = m.program >= 0 && m.program_shades && m.program_alpha ? (m.program_alpha_cut ? 2.0f : 1.0f) : 0.0f;
   return d;
 }
 
@@ -288,6 +292,31 @@ void upload_or_drain(DeviceSession& session, F&& body) {
   }
 }
 
+// Every image's level 0 where its DeviceImage says, then its other MIP
+// levels, each reduced from the one above on the device.
+cl::Buffer upload_images(DeviceSession& session, const HostSceneData& data) {
+  cl::Buffer b = session.allocate(data.device_texels * sizeof(glm::vec4), "image texels");
+  size_t from = 0;
+  for (const DeviceImage& im : data.images) {
+    const size_t n = size_t(im.width) * im.height;
+    session.queue().enqueueWriteBuffer(b, CL_FALSE, size_t(im.offset) * sizeof(glm::vec4), n * sizeof(glm::vec4),
+                                       data.texels.data() + from);
+    from += n;
+  }
+  if (data.images.empty()) return b;
+  cl::Kernel reduce(session.program(), "reduce_image_level");
+  for (const DeviceImage& im : data.images) {
+    const uint32_t levels = mp_image_levels(im.width, im.height);
+    for (uint32_t l = 1; l < levels; ++l) {
+      const DeviceImage above = mp_image_level(im, l - 1), level = mp_image_level(im, l);
+      bind_args(reduce, b, above, level, cl_uint(l == 1 ? 1 : 0));
+      session.queue().enqueueNDRangeKernel(reduce, cl::NullRange, round_up_range(size_t(level.width) * level.height),
+                                           cl::NDRange(64));
+    }
+  }
+  return b;
+}
+
 }  // namespace
 
 std::vector<DeviceLight> device_lights(const std::vector<Light>& lights, const glm::mat4& world_to_camera) {
@@ -354,12 +383,15 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
   }
   out.refraction = build_refraction_proxies(out.patches, out.objects.size(), refracts);
   for (const Image& image : scene.images) {
-    // DeviceImage offsets are 32-bit texel indices (64 GiB of float texels).
-    if (out.texels.size() + image.pixels.size() > size_t(UINT32_MAX))
-      throw Error("image '" + image.name + "': the scene's images exceed 2^32 texels");
-    out.images.push_back(DeviceImage{uint32_t(out.texels.size()), uint32_t(image.width), uint32_t(image.height),
+    // DeviceImage offsets are 32-bit texel indices (64 GiB of float texels),
+    // counting each image's MIP levels (a third more than its pixels).
+    const size_t levels = size_t(mp_image_texel_count(uint32_t(image.width), uint32_t(image.height)));
+    if (out.device_texels + levels > size_t(UINT32_MAX))
+      throw Error("image '" + image.name + "': the scene's images and their MIP levels exceed 2^32 texels");
+    out.images.push_back(DeviceImage{uint32_t(out.device_texels), uint32_t(image.width), uint32_t(image.height),
                                      image.srgb ? 1u : 0u});
     out.texels.insert(out.texels.end(), image.pixels.begin(), image.pixels.end());
+    out.device_texels += levels;
   }
   return out;
 }
@@ -400,7 +432,7 @@ SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data
     b.host_patch_bounds = patch_bounds(data.patches);  // lives until the queue finishes below
     b.patch_bounds = upload(session, b.host_patch_bounds);
     b.images = upload(session, data.images);
-    b.texels = upload(session, data.texels);
+    b.texels = upload_images(session, data);
     b.node_params = upload(session, data.params);
     b.world_params_at = static_cast<cl_uint>(data.world_params_at);
     b.world_glossy = upload(session, no_world_glossy);

@@ -22,8 +22,12 @@ struct HostSceneData {
   std::vector<DeviceMaterial> materials;
   std::vector<DeviceLight> lights;
   std::vector<DeviceObject> objects;  // one per surface, in patch order (MP_PATCH_OBJECT)
+  // Images' offsets count every MIP level (mp_tex_image.h): the device's
+  // texel buffer holds device_texels, each image's level 0 at its offset
+  // and its other levels after it, built on the device at upload.
   std::vector<DeviceImage> images;
-  std::vector<glm::vec4> texels;      // every image's pixels, one after the other
+  std::vector<glm::vec4> texels;      // every image's pixels (level 0), one after the other
+  size_t device_texels = 0;
   // Every material's node values (DeviceMaterial.params gives where each
   // starts), then the world's from world_params_at.
   std::vector<float> params;

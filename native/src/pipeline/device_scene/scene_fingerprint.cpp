@@ -119,7 +119,7 @@ void hash_surfaces(Hasher& h, const Scene& scene, bool shadows_only) {
   for (const Material& m : scene.materials) {
     h.value(m.opacity);
     h.value(m.program), h.value(m.program_displaces), h.value(m.program_shades), h.value(m.displacement_bound);
-    h.value(m.displacement_bound_world), h.value(m.program_alpha);
+    h.value(m.displacement_bound_world), h.value(m.program_alpha), h.value(m.program_alpha_cut);
     if (!shadows_only || m.program_displaces || m.program_alpha)
       h.value(m.program_params.size()), h.values(m.program_params);
     if (shadows_only) continue;
