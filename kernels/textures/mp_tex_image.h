@@ -257,9 +257,6 @@ MP_INLINE float4 mp_tex_image(const MP_GLOBAL DeviceImage* images, uint image_co
  * McCormack et al., "Feline", 1999). Probes sum colour times alpha and
  * alpha, as the levels were built. */
 #define MP_IMAGE_MAX_ANISOTROPY 16
-#ifndef MP_IMAGE_LOD_BIAS
-#define MP_IMAGE_LOD_BIAS 0.0f
-#endif
 
 /* Level `level`'s lookup at (u, v), linear, colour times alpha in xyz. */
 MP_INLINE float4 mp_image_probe(const MP_GLOBAL float4* texels, DeviceImage im, uint level, float u, float v,
@@ -294,7 +291,7 @@ MP_INLINE float4 mp_tex_image_area(const MP_GLOBAL DeviceImage* images, uint ima
   probes = probes < 1 ? 1 : probes;
   float spacing = fmax(major / (float)probes, minor);
   uint levels = mp_image_levels(im.width, im.height);
-  float lod = fmin(fmax(log2(spacing) + MP_IMAGE_LOD_BIAS, 0.0f), (float)(levels - 1u));
+  float lod = fmin(fmax(log2(spacing), 0.0f), (float)(levels - 1u));
   uint l0 = (uint)lod;
   float t = l0 + 1u < levels ? lod - (float)l0 : 0.0f;
   float4 sum = MP_F4(0.0f, 0.0f, 0.0f, 0.0f);

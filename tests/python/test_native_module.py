@@ -83,6 +83,12 @@ def test_bad_input_raises_a_clear_error(renderer):
         scene.add_light("laser")
     with pytest.raises(_native.Error):
         _native.Renderer("no-such-device")
+    for width in (float("nan"), -1.0, 17.0):
+        scene = make_scene(32, 32, 1)
+        square(scene)
+        scene.settings.texture_filter_width = width
+        with pytest.raises(_native.Error, match="texture filter width"):
+            renderer.render(scene)
 
 
 def test_progress_callback_can_cancel(renderer):
