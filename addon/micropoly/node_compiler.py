@@ -308,7 +308,9 @@ class NodeCompiler:
 
     def height_function(self, node, key, kind=FLOAT):
         """A helper function evaluating input `key` of `node` for any
-        globals: a Bump's height (FLOAT), or an image's coordinates (VEC)."""
+        globals: a value differenced across the micropolygon (FLOAT: a
+        Bump's height, an alpha cut's sides), or an image's coordinates
+        (VEC)."""
         outer = self.fn
         name = f"mp_height_{len(self.helpers)}" if kind == FLOAT else f"mp_coordinates_{len(self.helpers)}"
         self.helpers.append(None)  # reserve the slot: nested heights get later ones

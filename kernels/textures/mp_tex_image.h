@@ -127,7 +127,7 @@ MP_INLINE float mp_srgb_to_linear_single(float c) {
 
 /* Gauss-Legendre points (2 per piece) along [a, a + size) of level 0, cut
  * at the texel centres, where the Linear lookup is linear between them:
- * positions relative to `origin` and weights, at most 8 of them (size < 3). */
+ * positions relative to `origin` and weights, at most 8 of them (size <= 3). */
 MP_INLINE int mp_image_level_points(float a, float size, float origin, float* at, float* weight) {
   int n = 0;
   float end = a + size;
@@ -144,7 +144,7 @@ MP_INLINE int mp_image_level_points(float a, float size, float origin, float* at
 /* Texel (x, y) of level 1 (`to`), from the image `im` (level 0) as its
  * Linear lookup shows it: the mean over its area of that lookup, decoded
  * after interpolation, by Gauss-Legendre points in each piece of the area
- * between texel centres (where the lookup is bilinear). The area is under
+ * between texel centres (where the lookup is bilinear). The area is at most
  * 3 texels wide, so its lookups read a window of 5 x 5 texels (the area
  * and one beyond each side, clamped at the image's border), each once. */
 MP_INLINE float4 mp_image_first_level_texel(const MP_GLOBAL float4* texels, DeviceImage im, DeviceImage to, uint x,
@@ -197,6 +197,11 @@ MP_INLINE float4 mp_image_reduce_texel(const MP_GLOBAL float4* texels, DeviceIma
   return mp_image_mean(premultiplied, plain, sx * sy);
 }
 
+/* Colour decoded from sRGB after filtering; alpha as it is. */
+MP_INLINE float4 mp_srgb_to_linear4(float4 c) {
+  return MP_F4(mp_srgb_to_linear(c.x), mp_srgb_to_linear(c.y), mp_srgb_to_linear(c.z), c.w);
+}
+
 /* Filtered texel values of one image at (u, v). */
 MP_INLINE float4 mp_tex_image_filtered(const MP_GLOBAL float4* texels, DeviceImage im, float u, float v,
                                        int interpolation, int extension) {
@@ -239,7 +244,7 @@ MP_INLINE float4 mp_tex_image(const MP_GLOBAL DeviceImage* images, uint image_co
   if (index < 0 || (uint)index >= image_count) return MP_F4(1.0f, 0.0f, 1.0f, 1.0f);
   DeviceImage im = images[index];
   float4 c = mp_tex_image_filtered(texels, im, u, v, interpolation, extension);
-  if (im.srgb) c = MP_F4(mp_srgb_to_linear(c.x), mp_srgb_to_linear(c.y), mp_srgb_to_linear(c.z), c.w);
+  if (im.srgb) c = mp_srgb_to_linear4(c);
   return c;
 }
 
@@ -263,7 +268,7 @@ MP_INLINE float4 mp_image_probe(const MP_GLOBAL float4* texels, DeviceImage im, 
                                 int interpolation, int extension) {
   DeviceImage l = mp_image_level(im, level);
   float4 c = mp_tex_image_filtered(texels, l, u, v, level == 0u ? interpolation : MP_IMAGE_LINEAR, extension);
-  if (l.srgb) c = MP_F4(mp_srgb_to_linear(c.x), mp_srgb_to_linear(c.y), mp_srgb_to_linear(c.z), c.w);
+  if (l.srgb) c = mp_srgb_to_linear4(c);
   return MP_F4(c.x * c.w, c.y * c.w, c.z * c.w, c.w);
 }
 
