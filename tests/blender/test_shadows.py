@@ -14,6 +14,8 @@ black world, no denoising):
   - a box standing on the floor under a sun: the shadow's edges lie within
     1.5 px of Cycles' (light leaking or peter-panning at the contact would
     move them);
+  - five thin leaves stacked under a wide sun over a large ground: each
+    leaf's shadow on the next >= 30 dB (with the mutation check);
   - Blender's controls: a light's Cast Shadow off and an object's Shadow ray
     visibility off remove the shadow; an object hidden from the camera
     still casts one; a material with alpha 0.5 lets half the light through
@@ -184,6 +186,27 @@ def case_displaced_grazing():
     return compare("displaced ridges, sun at 10 deg", scene, HARD_DB, cycles_samples=128)
 
 
+def case_thin_leaves():
+    """Five leaves, flattened ellipsoids 12 x 7 cm and 4 mm thick, stacked
+    3 cm apart over a 30 m ground under an 11.4 degree sun: each leaf's
+    soft shadow on the next. The ground makes the sun's view deep, so a
+    blocker search as wide as the scene reads texels as large as a leaf."""
+    scene = ru.reset_scene()
+    for k in range(5):
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, segments=32, ring_count=16,
+                                             location=(0.035 * k - 0.07, 0.0, 0.03 * k))
+        leaf = bpy.context.object
+        leaf.scale = (0.06, 0.035, 0.002)
+        leaf.rotation_euler = (0.1 * (k % 2), 0.05, 0.5 * k)
+        bpy.ops.object.shade_smooth()
+        leaf.data.materials.append(ru.diffuse_material(f"leaf{k}", (0.2, 0.6, 0.15)))
+    floor(scene, size=30.0, z=-0.6)
+    # Tilted 10 degrees about x, then 25 about y: about 27 degrees from overhead.
+    sun(scene, angle=math.radians(11.4)).rotation_euler = (math.radians(10.0), math.radians(-25.0), 0.0)
+    ru.add_camera(scene, (0.03, -0.32, 0.3), (0.0, 0.0, 0.05), lens=40.0)
+    return compare("thin leaves, sun 11.4 deg over a 30 m ground", scene, HARD_DB)
+
+
 def lit_interior(cycles_on, cycles_off, margin=2):
     """Pixels Cycles lights fully (shadowed value >= 0.9 of the unshadowed
     one), at least `margin` pixels from any that it does not."""
@@ -325,7 +348,7 @@ def case_controls():
 CASES = [
     lambda: case_sun(False), lambda: case_sun(True), lambda: case_spot(False), lambda: case_spot(True),
     lambda: case_point(False), lambda: case_point(True), lambda: case_area(False), lambda: case_area(True),
-    case_displaced_grazing, case_acne, case_contact, case_controls,
+    case_displaced_grazing, case_acne, case_contact, case_controls, case_thin_leaves,
 ]
 
 
