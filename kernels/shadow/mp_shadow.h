@@ -369,12 +369,6 @@ MP_INLINE int mp_shadow_blocker(const MpShadowMaps* in, const MpShadowMap* m, co
  * local light (the search kernel is the light's shape scaled by f / (1 - f)
  * for a fraction f of the way). */
 #define MP_SHADOW_SEARCH_SCALE 1.0f
-/* Where a round of the first search finds nothing, it looks again over a
- * region this much smaller, at a level as much finer, down to the
- * receiver's own level: an occluder smaller than the texels of the level a
- * wide search reads may cover none of their centres (a leaf under a sun
- * over a large ground), yet it shadows the receivers close below it. */
-#define MP_SHADOW_SEARCH_STEP 0.125f
 /* Texels across the search and filter kernels' radius. */
 #define MP_SHADOW_SEARCH_TEXELS 8.0f
 #define MP_SHADOW_FILTER_TEXELS 4.0f
@@ -475,7 +469,7 @@ MP_INLINE float mp_tap_dither(int i) {
  * at even steps of radius, so that the small regions where occluders near
  * the receiver can stand get taps too; *reach is the radius (0..1). */
 MP_INLINE float3 mp_search_tap(const MpLightShape* s, int k, int n, float2 turn, float* reach) {
-  float r = (float)k / (float)(n - 1);
+  float r = n > 1 ? (float)k / (float)(n - 1) : 0.0f;
   *reach = r;
   return (r * turn.x) * s->u + (r * turn.y) * s->v;
 }
@@ -564,12 +558,12 @@ MP_INLINE void mp_plane_for(const MpShadowMap* m, float3 q, float3 n, float qdep
 /* The blocker search runs in two rounds. The first looks for occluders
  * between the receiver and (local lights) halfway to the light, or (suns)
  * the top of the scene; it tells whether any stands near at all and how far
- * off they are on average; where it finds none, it is retried over ever
- * narrower regions at finer levels (MP_SHADOW_SEARCH_STEP), counting, as
- * the second round does, only occluders between the receiver and the light
- * (occluders beside a receiver, which the wide round's sparse taps miss,
- * found by the narrow ones would only darken its outer penumbra). The
- * second searches again over the region those
+ * off they are on average. It reads a level whose texels suit its
+ * region, and an occluder smaller than those texels (a leaf under a sun
+ * over a large ground) may cover none of their centres; so where it finds
+ * none, one tap looks straight at the light from the receiver at the
+ * receiver's own level, which sees any occluder whose shadow's core covers
+ * the receiver. The second round searches again over the region those
  * can shadow (twice their mean scale), where its taps lie denser, and
  * counts only occluders that stand between the receiver and the light: a
  * tap at the shape's offset O scaled by s that finds an occluder of scale
@@ -581,8 +575,8 @@ MP_INLINE float mp_first_search_scale(const MP_GLOBAL DeviceShadow* sh, float3 q
   return sh->kind == MP_SHADOW_SUN ? fmax(sh->z_top - q.z, 0.0f) : MP_SHADOW_SEARCH_SCALE;
 }
 
-/* One round of the search at kernel scale s: the first (0), its narrower
- * retries (2) or the second (1). The occluders found
+/* One round of the search at kernel scale s: the first (0), the look
+ * straight at the light (2) or the second (1). The occluders found
  * (*found, their ratios' *sum and the *nearest ratio); returns the level it
  * read, or the level count when no level had its pages. */
 MP_INLINE int mp_blocker_round(const MpShadowMaps* in, const MP_GLOBAL DeviceShadow* sh, const MpLightShape* shape,
@@ -595,7 +589,7 @@ MP_INLINE int mp_blocker_round(const MpShadowMaps* in, const MP_GLOBAL DeviceSha
     *found = *sum = 0.0f;
     *nearest = 3.0e38f;
     float2 turn = MP_F2(1.0f, 0.0f);
-    const int taps = round == 1 ? MP_SHADOW_TAPS : MP_SHADOW_PROBE_TAPS;
+    const int taps = round == 1 ? MP_SHADOW_TAPS : round ? 1 : MP_SHADOW_PROBE_TAPS;
     MpShadowMap m;
     for (int k = 0; k < taps && !missing; ++k, turn = mp_golden_step(turn)) {
       float reach;
@@ -651,19 +645,14 @@ MP_INLINE float mp_shadow_visibility_light(const MpShadowMaps* in, const MP_GLOB
   float2 shift;
   const float2 spin = mp_filter_spin(q, &shift);
   const float widest = mp_first_search_scale(sh, q);
-  float search_scale = widest, found, sum, nearest;
-  for (int last = count;;) {
-    int ls = mp_blocker_round(in, sh, &shape, q, n, bias, base, last < count ? 2 : 0, search_scale, &plane_key,
-                              &plane, &found, &sum, &nearest);
-    if (ls < count && found > 0.0f) break;
-    if (ls >= last || ls <= base) return 1.0f;
-    last = ls;
-    search_scale *= MP_SHADOW_SEARCH_STEP;
-  }
-  /* The second round spans what the occluders found can shadow, which may
-   * be wider than the narrowed first round that found them. */
+  float found, sum, nearest;
+  int ls = mp_blocker_round(in, sh, &shape, q, n, bias, base, 0, widest, &plane_key, &plane, &found, &sum, &nearest);
+  if (ls >= count) return 1.0f;
+  if (!(found > 0.0f) && (ls == base || mp_blocker_round(in, sh, &shape, q, n, bias, base, 2, 0.0f, &plane_key, &plane,
+                                                         &found, &sum, &nearest) >= count || !(found > 0.0f)))
+    return 1.0f;
   float first = sum / found;
-  search_scale = fmin(widest, 2.0f * first);
+  float search_scale = fmin(widest, 2.0f * first);
   mp_blocker_round(in, sh, &shape, q, n, bias, base, 1, search_scale, &plane_key, &plane, &found, &sum,
                    &nearest);
   if (found >= (float)MP_SHADOW_TAPS - 1e-3f) return 0.0f;
