@@ -507,6 +507,15 @@ class NodeCompiler:
     # A Math node's comparisons, as the side of its edge: a > b is a - b > 0.
     _CUTS = {"GREATER_THAN": "({0}) - ({1})", "LESS_THAN": "({1}) - ({0})"}
 
+    @staticmethod
+    def _clear_transparent(socket):
+        """Whether a shader socket is fed straight by an unmuted Transparent
+        BSDF of white, unlinked colour."""
+        node, _ = linked_from(socket)
+        if node is None or node.type != "BSDF_TRANSPARENT" or node.mute or node.inputs["Color"].is_linked:
+            return False
+        return all(abs(float(v) - 1.0) < 1e-6 for v in node.inputs["Color"].default_value[:3])
+
     def _alpha_cut(self, socket):
         """An Alpha linked straight from a Math Greater Than or Less Than (a
         hard cut, as leaves and fences are made) as the cut's side written
@@ -544,9 +553,18 @@ class NodeCompiler:
         t = node.type
         add = self.fn.lines.append
         if t == "MIX_SHADER":
-            fac = self.fn.temp(FLOAT, f"mp_nl_clamp01({self.input(node, 0, FLOAT)[0]})")[0]
-            self.shader_input(node, 1, self._weighted(weight, f"(1.0f - {fac})"))
-            self.shader_input(node, 2, self._weighted(weight, fac))
+            # A clear Transparent BSDF mixed in by a comparison is a hard
+            # alpha cut, as Principled Alpha fed by one is (older leaf and
+            # fence materials are made this way).
+            clear = [self._clear_transparent(node.inputs[k]) for k in (1, 2)]
+            cut = self._alpha_cut(node.inputs[0]) if node.inputs[0].is_linked and clear[0] != clear[1] else None
+            fac = cut or self.fn.temp(FLOAT, f"mp_nl_clamp01({self.input(node, 0, FLOAT)[0]})")[0]
+            for k, w in ((1, f"(1.0f - {fac})"), (2, fac)):
+                if cut is not None and clear[k - 1]:
+                    self.transparent = True
+                    self.fn.lines.append(f"  mp_add_transparent(s, {self._weighted(weight, w)});")
+                else:
+                    self.shader_input(node, k, self._weighted(weight, w))
             return
         if t == "ADD_SHADER":
             self.shader_input(node, 0, weight)
@@ -666,11 +684,11 @@ class NodeCompiler:
         p = f"pr{self.fn.counter}"
         self.fn.counter += 1
         alpha = node.inputs.get("Alpha")
-        if alpha is not None and (alpha.is_linked or float(alpha.default_value) < 1.0):
+        see_through = alpha is not None and (alpha.is_linked or float(alpha.default_value) < 1.0)
+        cut = self._alpha_cut(alpha) if see_through and alpha.is_linked else None
+        if see_through:
             self.transparent = True
-        cut = self._alpha_cut(alpha) if alpha is not None and alpha.is_linked else None
-        if cut is None and self.transparent:
-            self.alpha_fractional = True
+            self.alpha_fractional = self.alpha_fractional or cut is None
         self._note_thin_film(node)
         fields = {
             "base_color": c(node, "Base Color"), "metallic": f(node, "Metallic"), "roughness": f(node, "Roughness"),
