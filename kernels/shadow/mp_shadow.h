@@ -648,9 +648,13 @@ MP_INLINE float mp_shadow_visibility_light(const MpShadowMaps* in, const MP_GLOB
   float found, sum, nearest;
   int ls = mp_blocker_round(in, sh, &shape, q, n, bias, base, 0, widest, &plane_key, &plane, &found, &sum, &nearest);
   if (ls >= count) return 1.0f;
-  if (!(found > 0.0f) && (ls == base || mp_blocker_round(in, sh, &shape, q, n, bias, base, 2, 0.0f, &plane_key, &plane,
-                                                         &found, &sum, &nearest) >= count || !(found > 0.0f)))
-    return 1.0f;
+  if (!(found > 0.0f)) {
+    /* None in the wide round's texels: straight at the light, at the receiver's level. */
+    if (ls == base || mp_blocker_round(in, sh, &shape, q, n, bias, base, 2, 0.0f, &plane_key, &plane, &found, &sum,
+                                       &nearest) >= count)
+      return 1.0f;
+    if (!(found > 0.0f)) return 1.0f;
+  }
   float first = sum / found;
   float search_scale = fmin(widest, 2.0f * first);
   mp_blocker_round(in, sh, &shape, q, n, bias, base, 1, search_scale, &plane_key, &plane, &found, &sum,
