@@ -7,6 +7,11 @@ alpha. Prints one line per scene and variant and exits non-zero on a
 difference.
 
   python3 bench/identical_images.py --before OLD_CLI --after NEW_CLI [--device gpu] [--spp 4] scene.rib ...
+
+One build with two settings that must give the same image:
+
+  python3 bench/identical_images.py --before CLI --after CLI --before-args="--visibility-first off" \
+      --after-args="--visibility-first on" scene.rib ...
 """
 
 import argparse
@@ -53,24 +58,27 @@ def main():
     ap.add_argument("--spp", type=int, default=4)
     ap.add_argument("--min-db", type=float, default=60.0)
     ap.add_argument("--variants", default=",".join(VARIANTS))
+    ap.add_argument("--before-args", default="", help="more options for the first build's renders")
+    ap.add_argument("--after-args", default="", help="more options for the second build's renders")
     ap.add_argument("scenes", nargs="+")
     a = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="identical-")
     failed = 0
+    builds = (("before", a.before, a.before_args.split()), ("after", a.after, a.after_args.split()))
     for rib in a.scenes:
         for v in a.variants.split(","):
             files = []
-            for tag, cli in (("before", a.before), ("after", a.after)):
+            for tag, cli, more in builds:
                 out = os.path.join(tmp, f"{tag}.exr")
-                render(cli, rib, out, a.device, a.spp, VARIANTS[v])
+                render(cli, rib, out, a.device, a.spp, VARIANTS[v] + more)
                 files.append(open(out, "rb").read())
             if files[0] == files[1]:
                 verdict = "identical"
             else:
                 # Measured on 8-bit images: enough to tell 60 dB from less.
-                b, n = [render(cli, rib, os.path.join(tmp, f"{t}.png"), a.device, a.spp, VARIANTS[v]) or
+                b, n = [render(cli, rib, os.path.join(tmp, f"{t}.png"), a.device, a.spp, VARIANTS[v] + more) or
                         read_png(os.path.join(tmp, f"{t}.png"))
-                        for t, cli in (("before", a.before), ("after", a.after))]
+                        for t, cli, more in builds]
                 db = psnr(n[..., :3], b[..., :3])
                 alpha_same = bool((b[..., 3] == n[..., 3]).all())
                 verdict = f"differs: {db:.1f} dB, alpha {'identical' if alpha_same else 'DIFFERS'}"

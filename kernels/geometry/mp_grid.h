@@ -295,4 +295,23 @@ MP_INLINE int mp_grid_beside_contour(const MP_GLOBAL float4* grid_p, const MP_GL
   return 0;
 }
 
+/* Whether a patch's material is opaque whatever its shading: no alpha
+ * program and a full fixed opacity. Its grids' depth needs no shading, so
+ * the camera's samplers can resolve it first (visibility first,
+ * MP_SAMPLE_OPAQUE_DEPTH in stages/mp_raster.h). */
+MP_INLINE int mp_material_opaque(const MP_GLOBAL DeviceMaterial* materials, const MP_GLOBAL uint* patch_info,
+                                 uint patch) {
+  const MP_GLOBAL DeviceMaterial* m = materials + patch_info[4 * (ulong)patch + 1];
+  return !(m->program[3] > 0.0f) && m->opacity[3] >= 1.0f;
+}
+
+/* Whether shading skips the grid vertex at `index` of the grid buffers:
+ * visibility first found its grid, opaque, owning no sample (`visible`: a
+ * byte per grid slot, or none when the view shades every grid). */
+MP_INLINE int mp_grid_unseen(const MP_GLOBAL uchar* visible, ulong index, int max_grid,
+                             const MP_GLOBAL DeviceMaterial* materials, const MP_GLOBAL uint* patch_info, uint patch) {
+  ulong side = (ulong)max_grid + 1u;
+  return visible && !visible[index / (side * side)] && mp_material_opaque(materials, patch_info, patch);
+}
+
 #endif

@@ -197,7 +197,7 @@ __kernel void displace_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, 
 __kernel void shade_program_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, uint count, FrameParams f,
                                   int program, __global const float4* grid_p, __global float4* grid_n,
                                   __global float4* grid_c, __global const uint* vertex_offsets,
-                                  MP_SHADOW_INPUT_PARAMS, uint alpha_only) {
+                                  MP_SHADOW_INPUT_PARAMS, uint alpha_only, __global const uchar* visible) {
   uint gid = get_global_id(0), material, object, i, j;
   SubPatch sp;
   float2 uv;
@@ -205,6 +205,7 @@ __kernel void shade_program_grids(MP_SCENE_PARAMS __global const SubPatch* dicea
   if (!mp_program_vertex(gid, count, vertex_offsets, f, diceable, patch_info, materials, program, &sp, &material,
                          &object, &uv, &i, &j, &index))
     return;
+  if (mp_grid_unseen(visible, index, f.max_grid, materials, patch_info, sp.patch)) return;
   DeviceMaterial m = materials[material];
   if (!(m.program[2] > 0.0f)) return;
   /* A shadow view needs only the alpha, and only of programs that compute it. */

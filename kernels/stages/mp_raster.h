@@ -69,6 +69,20 @@ MP_INLINE long mp_to_fixed(float r) { return (long)floor(r * (float)MP_SUBPIXEL_
  * the grid touches. */
 #define MP_TILE_RUN 16
 
+/* The samplers' passes over a batch's grids (sample.cl; the tile sampler
+ * does depth and attributes in one pass, MP_SAMPLE_ATTRIBUTES). Visibility
+ * first (docs/pipeline.md, step 5): before shading, the nearest keys of the
+ * grids whose material is opaque whatever its shading (mp_material_opaque),
+ * then a mark on each such grid that owns a sample; shading skips the
+ * unmarked ones, and the passes after it, flagged MP_SAMPLE_AFTER_MARK,
+ * leave the opaque grids' depth as it is and skip the unmarked grids. */
+#define MP_SAMPLE_DEPTH 0u
+#define MP_SAMPLE_ATTRIBUTES 1u
+#define MP_SAMPLE_OPAQUE_DEPTH 2u
+#define MP_SAMPLE_MARK 3u
+#define MP_SAMPLE_KIND 3u
+#define MP_SAMPLE_AFTER_MARK 4u
+
 MP_INLINE uint mp_sample_offset_packed(int tx, int ty, int s, FrameParams f) {
   /* Blurred, slot s is a time or lens stratum (mp_blur.h); its position
    * stratum is shuffled per pixel so the two do not follow each other. */

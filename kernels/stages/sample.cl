@@ -18,23 +18,24 @@
 #include "stages/mp_sample.h"
 #include "core/mp_scene_data.h"
 
-#define MP_PASS_DEPTH 0u
-#define MP_PASS_ATTRIBUTES 1u
-
 /* Sample s of pixel (px, py), covered by triangle t at barycentrics (la,
- * lb, lc): within the clip range and the stochastic opacity, the depth pass
- * keeps the nearest key and the attribute pass lets its owner write.
- * cover: what its samples keep of the micropolygon (MpCover). */
+ * lb, lc): within the clip range and the stochastic opacity, the depth
+ * passes keep the nearest key, the mark pass marks the grid (*mark) where
+ * the micropolygon owns the sample, and the attribute pass lets its owner
+ * write. pass: its kind (MP_SAMPLE_KIND bits). cover: what its samples keep
+ * of the micropolygon (MpCover). */
 inline void mp_sample_write(const MpTriangle* t, float la, float lb, float lc, int px, int py, int s, int spp,
                             uint mp_id, MpCover cover, FrameParams f, uint pass, volatile __global ulong* keys,
-                            __global float* colors, __global uint* normals) {
+                            __global float* colors, __global uint* normals, __global uchar* mark) {
   float d;
   if (!mp_triangle_depth(t, la, lb, lc, f, &d)) return;
   if (!mp_opacity_keeps(cover.surface, cover.cut, px, py, s, mp_sample_opacity(t, la, lb, lc, d, cover.opacity, f), f)) return;
   ulong pixel = (ulong)py * (ulong)f.width + (ulong)px, index = pixel * (ulong)spp + (ulong)s;
   ulong key = mp_sample_key(d, mp_id);
-  if (pass == MP_PASS_DEPTH) {
+  if (pass == MP_SAMPLE_DEPTH || pass == MP_SAMPLE_OPAQUE_DEPTH) {
     if (key < keys[index]) atom_min(&keys[index], key);
+  } else if (pass == MP_SAMPLE_MARK) {
+    if (keys[index] == key) *mark = (uchar)1;
   } else if (keys[index] == key) {
     float3 col, nrm;
     mp_triangle_attributes(t, la, lb, lc, d, f, &col, &nrm);
@@ -47,7 +48,7 @@ inline void mp_sample_write(const MpTriangle* t, float la, float lb, float lc, i
  * (mp_setup_quad). */
 inline void mp_raster_quad(const MpRasterVertex* v, uint keep, uint mp_id, MpCover cover, FrameParams f,
                            __global const ushort* offsets, uint pass, volatile __global ulong* keys,
-                           __global float* colors, __global uint* normals, uint* tests) {
+                           __global float* colors, __global uint* normals, __global uchar* mark, uint* tests) {
   MpTriangle tris[2];
   mp_setup_quad(v, keep, tris);
   long xmin = min(min(v[0].p.x, v[1].p.x), min(v[2].p.x, v[3].p.x)), xmax = max(max(v[0].p.x, v[1].p.x), max(v[2].p.x, v[3].p.x));
@@ -64,7 +65,7 @@ inline void mp_raster_quad(const MpRasterVertex* v, uint keep, uint mp_id, MpCov
         float la, lb, lc;
         int k = mp_quad_covers(tris, q, &la, &lb, &lc);
         if (k >= 0)
-          mp_sample_write(&tris[k], la, lb, lc, px, py, s, spp, mp_id, cover, f, pass, keys, colors, normals);
+          mp_sample_write(&tris[k], la, lb, lc, px, py, s, spp, mp_id, cover, f, pass, keys, colors, normals, mark);
       }
 }
 
@@ -113,7 +114,7 @@ inline void mp_blur_sample(int px, int py, int s, int spp, MpFixed2 sq, float4 e
                            float4 ps[4][MP_BLUR_LOCAL_STEPS], __global const float4* pm, const ulong* idx, ulong stride,
                            float8* still, const float4* c, const float4* n, uint keep, uint mp_id, MpCover cover,
                            FrameParams f, uint pass, volatile __global ulong* keys, __global float* colors,
-                           __global uint* normals) {
+                           __global uint* normals, __global uchar* mark) {
   float3 q[4];
   MpRasterVertex v[4];
   for (int i = 0; i < 4; ++i) {
@@ -151,7 +152,8 @@ inline void mp_blur_sample(int px, int py, int s, int spp, MpFixed2 sq, float4 e
   mp_setup_quad(v, keep, tris);
   float la, lb, lc;
   int t = mp_quad_covers(tris, sq, &la, &lb, &lc);
-  if (t >= 0) mp_sample_write(&tris[t], la, lb, lc, px, py, s, spp, mp_id, cover, f, pass, keys, colors, normals);
+  if (t >= 0)
+    mp_sample_write(&tris[t], la, lb, lc, px, py, s, spp, mp_id, cover, f, pass, keys, colors, normals, mark);
 }
 
 /* Grows the raster box by vertex i over the times [t0, t1] (its positions
@@ -186,7 +188,7 @@ inline void mp_raster_quad_blur(const float4* p, __global const float4* pm, cons
                                 const float4* c, const float4* n, uint keep, uint mp_id, MpCover cover, FrameParams f,
                                 __global const ushort* offsets, __global const float4* table, uint pass,
                                 volatile __global ulong* keys, __global float* colors, __global uint* normals,
-                                uint* tests) {
+                                __global uchar* mark, uint* tests) {
   int spp = f.spp_x * f.spp_y;
   int steps = mp_motion_on(f) ? f.motion_steps : 0;
   float4 ps[4][MP_BLUR_LOCAL_STEPS];
@@ -236,7 +238,7 @@ inline void mp_raster_quad_blur(const float4* p, __global const float4* pm, cons
           if (sq.x < fx0 || sq.x > fx1 || sq.y < fy0 || sq.y > fy1) continue;
           ++*tests;
           mp_blur_sample(px, py, k, spp, sq, table[(ty * MP_SAMPLE_TILE + tx) * spp + k], steps, p, ps, pm, idx,
-                         stride, still, c, n, keep, mp_id, cover, f, pass, keys, colors, normals);
+                         stride, still, c, n, keep, mp_id, cover, f, pass, keys, colors, normals, mark);
         }
       }
   }
@@ -247,8 +249,8 @@ inline void mp_raster_quad_blur(const float4* p, __global const float4* pm, cons
  * the benchmarks report as micropolygons per pixel of surface; and the
  * samples tested against micropolygon edges (inside a micropolygon's
  * bound): the rasteriser's work per sample, which blur multiplies. Counted
- * in the depth pass. */
-inline void mp_count_sampled(uint l, long area2, uint tests, uint pass, volatile __global ulong* totals,
+ * in the pass that finds the micropolygon's depth (`counts`). */
+inline void mp_count_sampled(uint l, long area2, uint tests, int counts, volatile __global ulong* totals,
                              __local ulong* area_sum, __local uint* count_sum, __local uint* test_sum) {
   area_sum[l] = (ulong)area2;
   count_sum[l] = area2 > 0 ? 1u : 0u;
@@ -262,7 +264,7 @@ inline void mp_count_sampled(uint l, long area2, uint tests, uint pass, volatile
     }
     barrier(CLK_LOCAL_MEM_FENCE);
   }
-  if (pass == MP_PASS_DEPTH && l == 0u && count_sum[0] > 0u) {
+  if (counts && l == 0u && count_sum[0] > 0u) {
     atom_add(&totals[0], (ulong)count_sum[0]);
     atom_add(&totals[1], area_sum[0]);
     atom_add(&totals[2], (ulong)test_sum[0]);
@@ -287,10 +289,10 @@ inline void mp_mark_occlusion_cells(__global uchar* dirty, OcclusionParams o, Fr
       __global const float4 *grid_n, __global const ushort *sample_offsets, uint pass, volatile __global ulong *keys, \
       __global float *colors, __global uint *normals, volatile __global ulong *totals,                               \
       __global uchar *occlusion_dirty, OcclusionParams occ, __global const float4 *sample_table,                      \
-      __global const float4 *grid_pm, ulong motion_stride
+      __global const float4 *grid_pm, ulong motion_stride, __global uchar *visible
 #define MP_SAMPLE_PASS                                                                                                 \
   diceable, first, count, offsets, base, total, f, grid_p, grid_c, grid_n, sample_offsets, pass, keys,                \
-      colors, normals, totals, occlusion_dirty, occ, sample_table, grid_pm, motion_stride
+      colors, normals, totals, occlusion_dirty, occ, sample_table, grid_pm, motion_stride, visible
 
 /* One work-item per micropolygon of grids [first, first + count): `offsets`
  * holds each grid of the batch's first micropolygon (from the batch's
@@ -314,6 +316,18 @@ inline void mp_sample(__global const uint* patch_info, __global const DeviceMate
     g = mp_grid_shape(&sp, (uint)f.max_grid);
     live = mp_grid_micropolygon(&g, m, q);
   }
+  /* Visibility first (MP_SAMPLE_OPAQUE_DEPTH): which grids this pass takes,
+   * and whether it is the one that finds their depth (and counts them). */
+  uint kind = pass & MP_SAMPLE_KIND;
+  int after = (pass & MP_SAMPLE_AFTER_MARK) != 0u;
+  int opaque = live && mp_material_opaque(materials, patch_info, sp.patch);
+  if (kind == MP_SAMPLE_OPAQUE_DEPTH)
+    live = opaque;
+  else if (kind == MP_SAMPLE_MARK)
+    live = opaque && !visible[slot];
+  else if (after && opaque)
+    live = kind == MP_SAMPLE_ATTRIBUTES && visible[slot];
+  int finds_depth = kind == MP_SAMPLE_OPAQUE_DEPTH || (kind == MP_SAMPLE_DEPTH && !(after && opaque));
   MpRasterVertex v[4]; /* counter-clockwise in (u, v) */
   float4 vp[4], vc[4], vn[4];
   ulong grid_base = (ulong)slot * stride * stride;
@@ -337,17 +351,23 @@ inline void mp_sample(__global const uint* patch_info, __global const DeviceMate
     MpCover cover = {mp_quad_opacity(vc[0].w, vc[1].w, vc[2].w, vc[3].w),
                      mp_quad_opacity(vn[0].w, vn[1].w, vn[2].w, vn[3].w), mp_opacity_surface(sp.patch),
                      mp_material_cut(materials, patch_info, sp.patch) || mp_quad_cut(vc[0].w, vc[1].w, vc[2].w, vc[3].w)};
-    if (pass == MP_PASS_DEPTH && occlusion_dirty) mp_mark_occlusion_cells(occlusion_dirty, occ, f, v[0].p, v[1].p, v[2].p, v[3].p);
+    /* Before shading, the grid's colours are not yet its own: opaque. */
+    if (kind >= MP_SAMPLE_OPAQUE_DEPTH) cover.opacity = 1.0f, cover.holdout = 0.0f, cover.cut = 0;
+    if (finds_depth && occlusion_dirty)
+      mp_mark_occlusion_cells(occlusion_dirty, occ, f, v[0].p, v[1].p, v[2].p, v[3].p);
     if (blur) {
       ulong idx[4];
       for (int k = 0; k < 4; ++k) idx[k] = grid_base + q[k];
-      mp_raster_quad_blur(vp, grid_pm, idx, motion_stride, vc, vn, keep, mp_id, cover, f, sample_offsets, sample_table, pass,
-                          keys, colors, normals, &tests);
+      mp_raster_quad_blur(vp, grid_pm, idx, motion_stride, vc, vn, keep, mp_id, cover, f, sample_offsets, sample_table,
+                          kind, keys, colors, normals, visible + slot, &tests);
     } else {
-      mp_raster_quad(v, keep, mp_id, cover, f, sample_offsets, pass, keys, colors, normals, &tests);
+      mp_raster_quad(v, keep, mp_id, cover, f, sample_offsets, kind, keys, colors, normals, visible + slot, &tests);
     }
   }
-  mp_count_sampled(get_local_id(0), area2, tests, pass, totals, area_sum, count_sum, test_sum);
+  /* Uniform over the work-group: whether this pass counts at all. */
+  int counting = kind == MP_SAMPLE_DEPTH || kind == MP_SAMPLE_OPAQUE_DEPTH;
+  mp_count_sampled(get_local_id(0), finds_depth ? area2 : 0, finds_depth ? tests : 0u, counting, totals, area_sum,
+                   count_sum, test_sum);
 }
 
 __kernel __attribute__((reqd_work_group_size(64, 1, 1))) void sample_micropolygons(MP_SCENE_PARAMS MP_SAMPLE_ARGS) {
@@ -362,4 +382,14 @@ void sample_micropolygons_blur(MP_SCENE_PARAMS MP_SAMPLE_ARGS) {
   __local ulong area_sum[64];
   __local uint count_sum[64], test_sum[64];
   mp_sample(patch_info, materials, MP_SAMPLE_PASS, area_sum, count_sum, test_sum, 1);
+}
+
+/* Visibility first's count, after its mark pass: one work-item per grid of
+ * the batch, adding to totals[3] the opaque grids that own no sample, which
+ * shading skips. */
+__kernel void count_unshaded(MP_SCENE_PARAMS __global const SubPatch* diceable, uint count,
+                             __global const uchar* visible, volatile __global ulong* totals) {
+  uint k = get_global_id(0);
+  if (k >= count || visible[k] || !mp_material_opaque(materials, patch_info, diceable[k].patch)) return;
+  atom_add(&totals[3], 1ul);
 }

@@ -97,13 +97,26 @@ inline MpFixed2 mp_projected_position(int4 v) {
   return p;
 }
 
+/* What a tile pass does with a covered sample whose key is `key`, the
+ * sample's nearest so far `old` (kind: MP_SAMPLE_KIND of the pass; owned:
+ * the batch's opaque grids already hold their keys, MP_SAMPLE_AFTER_MARK):
+ * 1 to take it (the depth, and the attributes unless only depth is
+ * sought), 0 to leave it, and in the mark pass *marked where it owns it. */
+inline int mp_tile_takes(ulong key, ulong old, uint kind, int owned, int* marked) {
+  if (kind == MP_SAMPLE_MARK) {
+    if (key == old) *marked = 1;
+    return 0;
+  }
+  return owned ? key <= old : key < old;
+}
+
 /* The same samples one at a time in 64-bit arithmetic (mp_edge_triangle_covers),
  * for micropolygons too large for the int32 path, not opaque or held out
- * (cover: MpCover). */
+ * (cover: MpCover). kind, owned, marked: mp_tile_takes. */
 inline uint mp_sample_tile_slow(const MpTriangle* tris, long xmin, long xmax, long ymin, long ymax, int px0, int px1,
                                 int py0, int py1, uint mp_id, MpCover cover, FrameParams f,
                                 __global const ushort* sample_offsets, __global ulong* keys, __global float* colors,
-                                __global uint* normals, int* written) {
+                                __global uint* normals, uint kind, int owned, int* written, int* marked) {
   int spp = f.spp_x * f.spp_y;
   uint tests = 0u;
   for (int py = py0; py <= py1; ++py)
@@ -120,13 +133,17 @@ inline uint mp_sample_tile_slow(const MpTriangle* tris, long xmin, long xmax, lo
                               f))
           continue;
         ulong key = mp_sample_key(d, mp_id), index = pixel * (ulong)spp + (ulong)s;
-        if (key >= keys[index]) continue;
+        if (!mp_tile_takes(key, keys[index], kind, owned, marked)) {
+          if (*marked) return tests;
+          continue;
+        }
         keys[index] = key;
+        *written = 1;
+        if (kind == MP_SAMPLE_OPAQUE_DEPTH) continue;
         float3 col, nrm;
         mp_triangle_attributes(&tris[t], la, lb, lc, d, f, &col, &nrm);
         mp_store_color(colors, pixel, s, spp, mp_sample_color(col, cover.holdout), f);
         if (f.normal_pass) normals[index] = mp_encode_normal(normalize(nrm));
-        *written = 1;
       }
     }
   return tests;
@@ -173,10 +190,11 @@ inline int16 mp_inside16(const MpEdge16* g, int sx, int sy, int16 ox, int16 oy, 
  * stored as vectors, a partial chunk's (the lanes past the pixel's samples
  * belong to other pixels) and normals one by one. Opaque micropolygons
  * only, none held out (the stochastic opacity and holdout are per sample:
- * mp_sample_tile_slow). */
+ * mp_sample_tile_slow). kind, owned, marked: mp_tile_takes. */
 inline uint mp_sample_tile_fast(const MpTriangle* tris, long xmin, long xmax, long ymin, long ymax, int px0, int px1,
                                 int py0, int py1, uint mp_id, FrameParams f, __global const ushort* soa,
-                                __global ulong* keys, __global float* colors, __global uint* normals, int* written) {
+                                __global ulong* keys, __global float* colors, __global uint* normals, uint kind,
+                                int owned, int* written, int* marked) {
   int spp = f.spp_x * f.spp_y, chunks = (spp + MP_LANES - 1) / MP_LANES;
   const int16 lane = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
   uint tests = 0u;
@@ -236,11 +254,19 @@ inline uint mp_sample_tile_fast(const MpTriangle* tris, long xmin, long xmax, lo
           /* A whole chunk of this pixel's samples: keys compared 16 at once. */
           old = vload16(0, kp);
           ulong16 key = (convert_ulong16(as_uint16(d)) << (ulong16)32) | (ulong16)(ulong)mp_id;
-          long16 wins = convert_long16(covered) & (key < old);
+          if (kind == MP_SAMPLE_MARK) {
+            if (any(convert_long16(covered) & (key == old))) {
+              *marked = 1;
+              return tests;
+            }
+            continue;
+          }
+          long16 wins = convert_long16(covered) & (owned ? key <= old : key < old);
           if (!any(wins)) continue;
           vstore16(select(old, key, wins), 0, kp);
           covered = convert_int16(wins);
           *written = 1;
+          if (kind == MP_SAMPLE_OPAQUE_DEPTH) continue;
         }
         float16 w = f.ortho ? (float16)1.0f : d;
 #define MP_ATTRIBUTE16(field, comp)                                                                        \
@@ -273,10 +299,14 @@ inline uint mp_sample_tile_fast(const MpTriangle* tris, long xmin, long xmax, lo
           ulong index = pixel * (ulong)spp + (ulong)(first + l);
           if (!whole) {
             ulong key = mp_sample_key(dl[l], mp_id);
-            if (key >= keys[index]) continue;
+            if (!mp_tile_takes(key, keys[index], kind, owned, marked)) {
+              if (*marked) return tests;
+              continue;
+            }
             keys[index] = key;
-            mp_store_color(colors, pixel, first + l, spp, (float3)(cx[l], cy[l], cz[l]), f);
             *written = 1;
+            if (kind == MP_SAMPLE_OPAQUE_DEPTH) continue;
+            mp_store_color(colors, pixel, first + l, spp, (float3)(cx[l], cy[l], cz[l]), f);
           }
           if (f.normal_pass) normals[index] = mp_encode_normal(normalize((float3)(nx[l], ny[l], nz[l])));
         }
@@ -291,14 +321,20 @@ inline uint mp_sample_tile_fast(const MpTriangle* tris, long xmin, long xmax, lo
  * those grids whose raster bound meets the tile is tested against the
  * tile's samples under that bound. totals: micropolygons, twice their area
  * (fixed-point units) and samples tested, each micropolygon counted in the
- * tile that holds its bound's first pixel. */
+ * tile that holds its bound's first pixel, in the pass that finds its depth;
+ * totals[4]: those of them that a plain pass (MP_SAMPLE_ATTRIBUTES alone)
+ * found hidden, writing no sample of that tile.
+ * pass: MP_SAMPLE_ATTRIBUTES (depth and attributes), or visibility first's
+ * MP_SAMPLE_OPAQUE_DEPTH and MP_SAMPLE_MARK (marks in `visible`, a byte per
+ * grid slot), and MP_SAMPLE_AFTER_MARK on the pass after shading. */
 __kernel void sample_tiles(MP_SCENE_PARAMS __global const SubPatch* diceable, FrameParams f,
                            __global const int4* projected, __global const float4* grid_c,
                            __global const float4* grid_n, __global const ushort* sample_offsets,
                            __global const ushort* sample_soa, __global const uint* tile_ids, __global const uint* starts,
                            __global const uint* entries, uint runs_per_grid, uint first_tile, uint active,
                            uint tiles_x, __global ulong* keys, __global float* colors, __global uint* normals,
-                           volatile __global ulong* totals, __global uchar* occlusion_dirty, OcclusionParams occ) {
+                           volatile __global ulong* totals, __global uchar* occlusion_dirty, OcclusionParams occ,
+                           uint pass, __global uchar* visible) {
   uint a = first_tile + get_global_id(0);
   if (a >= active) return;
   uint tile = tile_ids[a];
@@ -308,11 +344,22 @@ __kernel void sample_tiles(MP_SCENE_PARAMS __global const SubPatch* diceable, Fr
   long fx0 = (long)tx0 << MP_SUBPIXEL_BITS, fx1 = ((long)(tx1 + 1) << MP_SUBPIXEL_BITS) - 1;
   long fy0 = (long)ty0 << MP_SUBPIXEL_BITS, fy1 = ((long)(ty1 + 1) << MP_SUBPIXEL_BITS) - 1;
   uint stride = (uint)f.max_grid + 1u;
-  ulong counted = 0u, area_sum = 0u, tests = 0u;
+  ulong counted = 0u, area_sum = 0u, tests = 0u, lost = 0u;
   int wx0 = tx1 + 1, wx1 = tx0 - 1, wy0 = ty1 + 1, wy1 = ty0 - 1; /* pixels written */
+  uint kind = pass & MP_SAMPLE_KIND;
+  int after = (pass & MP_SAMPLE_AFTER_MARK) != 0u;
   for (uint e = starts[a]; e < starts[a + 1u]; ++e) {
     uint slot = entries[e] / runs_per_grid, run = entries[e] % runs_per_grid;
     SubPatch sp = diceable[slot];
+    /* Which grids this pass takes (as sample.cl's mp_sample). */
+    int opaque = mp_material_opaque(materials, patch_info, sp.patch);
+    if (kind == MP_SAMPLE_OPAQUE_DEPTH ? !opaque
+        : kind == MP_SAMPLE_MARK       ? !opaque || visible[slot]
+                                       : after && opaque && !visible[slot])
+      continue;
+    int owned = after && opaque;
+    int finds_depth = kind == MP_SAMPLE_OPAQUE_DEPTH || (kind == MP_SAMPLE_ATTRIBUTES && !owned);
+    int marked = 0;
     MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
     uint flags = patch_info[4 * (ulong)sp.patch + 2];
     uint grid_id = mp_grid_id(&sp);
@@ -333,7 +380,8 @@ __kernel void sample_tiles(MP_SCENE_PARAMS __global const SubPatch* diceable, Fr
       /* Counted once: in the tile of the bound's first pixel in the frame. */
       long hx = clamp(xmin >> MP_SUBPIXEL_BITS, (long)0, (long)f.width - 1);
       long hy = clamp(ymin >> MP_SUBPIXEL_BITS, (long)0, (long)f.height - 1);
-      if (hx >= tx0 && hx <= tx1 && hy >= ty0 && hy <= ty1) {
+      int here = finds_depth && hx >= tx0 && hx <= tx1 && hy >= ty0 && hy <= ty1;
+      if (here) {
         counted += area2 > 0 ? 1u : 0u;
         area_sum += (ulong)area2;
       }
@@ -351,16 +399,27 @@ __kernel void sample_tiles(MP_SCENE_PARAMS __global const SubPatch* diceable, Fr
                        mp_material_cut(materials, patch_info, sp.patch) ||
                            mp_quad_cut(grid_c[base + q[0]].w, grid_c[base + q[1]].w, grid_c[base + q[2]].w,
                                        grid_c[base + q[3]].w)};
+      /* Before shading, the grid's colours are not yet its own: opaque. */
+      if (kind != MP_SAMPLE_ATTRIBUTES) cover.opacity = 1.0f, cover.holdout = 0.0f, cover.cut = 0;
       int px0 = (int)max(xmin >> MP_SUBPIXEL_BITS, (long)tx0), px1 = (int)min(xmax >> MP_SUBPIXEL_BITS, (long)tx1);
       int py0 = (int)max(ymin >> MP_SUBPIXEL_BITS, (long)ty0), py1 = (int)min(ymax >> MP_SUBPIXEL_BITS, (long)ty1);
       int written = 0;
+      uint t;
       if (xmax - xmin <= MP_FAST_SPAN && ymax - ymin <= MP_FAST_SPAN && cover.opacity >= 1.0f && !(cover.holdout > 0.0f))
-        tests += mp_sample_tile_fast(tris, xmin, xmax, ymin, ymax, px0, px1, py0, py1, mp_id, f, sample_soa, keys,
-                                     colors, normals, &written);
+        t = mp_sample_tile_fast(tris, xmin, xmax, ymin, ymax, px0, px1, py0, py1, mp_id, f, sample_soa, keys, colors,
+                                normals, kind, owned, &written, &marked);
       else
-        tests += mp_sample_tile_slow(tris, xmin, xmax, ymin, ymax, px0, px1, py0, py1, mp_id, cover, f,
-                                     sample_offsets, keys, colors, normals, &written);
+        t = mp_sample_tile_slow(tris, xmin, xmax, ymin, ymax, px0, px1, py0, py1, mp_id, cover, f, sample_offsets,
+                                keys, colors, normals, kind, owned, &written, &marked);
+      if (finds_depth) tests += t;
+      /* Hidden when sampled: what visibility first would have left unshaded
+       * (a lower bound, per micropolygon; VisibilityChoice reads it). */
+      lost += here && !written && pass == MP_SAMPLE_ATTRIBUTES;
       if (written) wx0 = min(wx0, px0), wx1 = max(wx1, px1), wy0 = min(wy0, py0), wy1 = max(wy1, py1);
+      if (marked) {
+        visible[slot] = (uchar)1;
+        break;
+      }
     }
   }
   if (occlusion_dirty && wx0 <= wx1) mp_mark_occlusion_rect(occlusion_dirty, occ, f, wx0, wy0, wx1, wy1);
@@ -368,6 +427,7 @@ __kernel void sample_tiles(MP_SCENE_PARAMS __global const SubPatch* diceable, Fr
     atom_add(&totals[0], counted);
     atom_add(&totals[1], area_sum);
     atom_add(&totals[2], tests);
+    atom_add(&totals[4], lost);
   }
 }
 

@@ -10,12 +10,14 @@
 
 __kernel void shade_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, uint count, FrameParams f,
                           __global const float4* grid_p, __global float4* grid_n, __global float4* grid_c,
-                          __global const uint* vertex_offsets, MP_SHADOW_INPUT_PARAMS) {
+                          __global const uint* vertex_offsets, MP_SHADOW_INPUT_PARAMS,
+                          __global const uchar* visible) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   float2 uv;
   ulong index;
   if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
+  if (mp_grid_unseen(visible, index, f.max_grid, materials, patch_info, sp.patch)) return;
   DeviceMaterial m = materials[patch_info[4 * (ulong)sp.patch + 1]];
   float3 p = grid_p[index].xyz, n = grid_n[index].xyz;
   /* Shadows compare with the surface's own tangent plane (mp_shadow.h). */

@@ -74,6 +74,7 @@ void expect_same_settings(const RenderSettings& a, const RenderSettings& b) {
   EXPECT_EQ(a.shadow_shading_rate, b.shadow_shading_rate);
   EXPECT_EQ(a.occlusion_culling, b.occlusion_culling);
   EXPECT_EQ(a.holdout_covers, b.holdout_covers);
+  EXPECT_EQ(a.visibility_first, b.visibility_first);
 }
 
 void expect_same_camera(const Camera& a, const Camera& b) {
@@ -308,6 +309,7 @@ Scene full_scene() {
   st.shadow_shading_rate = 2.7f;
   st.occlusion_culling = false;
   st.holdout_covers = true;
+  st.visibility_first = VisibilityFirst::Off;
 
   s.camera = look_at({1.3f, 2.1f, 7.7f}, {0.1f, 0.2f, 0.0f}, 47.3f);
   s.camera.screen_left = -1.4f, s.camera.screen_right = 1.3f;

@@ -69,6 +69,9 @@ struct RenderStats {
   // complexity (surface layers rasterised per covered pixel).
   size_t subpatches_occluded = 0;
   size_t covered_pixels = 0;
+  // Visibility first (RenderSettings::visibility_first): diced sub-patches
+  // whose opaque grids owned no sample before shading, left unshaded.
+  size_t subpatches_unshaded = 0;
   size_t bound_split_peak_bytes = 0;
   size_t batches = 0;
   size_t bound_split_launches = 0;

@@ -252,6 +252,13 @@ enum class BoundSplitMethod { Bounded, Breadth };
 // micropolygon with atomics (kernels/stages/sample.cl, made for GPUs). Both give
 // the same image; Auto picks by the device's type.
 enum class Sampler { Auto, Tiles, Micropolygons };
+// Visibility first (docs/pipeline.md, step 5): each batch of the camera's
+// view finds the depth of its opaque grids before shading and shades only
+// those that own a sample; the image is the same either way. It costs a
+// depth pass and a marking pass per batch and saves the shading of hidden
+// grids: Auto takes it where the view's roots overlap enough to hide much
+// (CameraView's rule), On and Off always and never.
+enum class VisibilityFirst { Auto, On, Off };
 
 struct RenderSettings {
   int width = 640, height = 480;
@@ -298,6 +305,7 @@ struct RenderSettings {
   // filter width); 0 reads the point each vertex lands on, unfiltered.
   float texture_filter_width = 1.0f;
   Sampler sampler = Sampler::Auto;
+  VisibilityFirst visibility_first = VisibilityFirst::Auto;
   // Device memory the frame's samples may take (24 bytes each, 20 without
   // the Normal pass): a frame that needs more is rendered in buckets that
   // fit, each with the pixel filter's reach of samples around it.

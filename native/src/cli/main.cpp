@@ -20,6 +20,7 @@ const char* kUsage =
     "                        [--bound-split-memory MIB] [--shadows on|off] [--shadow-memory MIB]\n"
     "                        [--fresh-shadows] [--occlusion-culling on|off] [--stats FILE.json]\n"
     "                        [--sampler auto|tiles|micropolygons] [--sample-memory MIB]\n"
+    "                        [--visibility-first auto|on|off]\n"
     "                        [--texture-filter-width W]\n"
     "                        [--repeat N] [--allow-path DIR]... [--allow-any-path]\n"
     "       micropoly-render --list-devices\n"
@@ -29,7 +30,7 @@ const char* kUsage =
     "both rules (docs/rib.md, \"Untrusted scene files\").\n";
 
 struct Options {
-  std::string scene, output, device, stats, bound_split, shadows, occlusion, sampler;
+  std::string scene, output, device, stats, bound_split, shadows, occlusion, sampler, visibility_first;
   int spp = 0, repeat = 1;
   float shading_rate = 0, memory_mib = 0, shadow_memory_mib = 0, sample_memory_mib = 0;
   float texture_filter_width = -1;  // below 0: the scene's
@@ -83,6 +84,10 @@ Options parse(int argc, char** argv) {
       o.sampler = value();
       if (o.sampler != "auto" && o.sampler != "tiles" && o.sampler != "micropolygons")
         usage_error("--sampler is auto, tiles or micropolygons");
+    } else if (a == "--visibility-first") {
+      o.visibility_first = value();
+      if (o.visibility_first != "auto" && o.visibility_first != "on" && o.visibility_first != "off")
+        usage_error("--visibility-first is auto, on or off");
     } else if (a == "--sample-memory") o.sample_memory_mib = static_cast<float>(parse_number(a, value(), 1, 1 << 24));
     else if (a == "--texture-filter-width")
       o.texture_filter_width = static_cast<float>(parse_number(a, value(), 0, 16));
@@ -135,6 +140,10 @@ int main(int argc, char** argv) {
       scene.settings.sampler = o.sampler == "tiles"           ? mp::Sampler::Tiles
                                : o.sampler == "micropolygons" ? mp::Sampler::Micropolygons
                                                               : mp::Sampler::Auto;
+    if (!o.visibility_first.empty())
+      scene.settings.visibility_first = o.visibility_first == "on"    ? mp::VisibilityFirst::On
+                                        : o.visibility_first == "off" ? mp::VisibilityFirst::Off
+                                                                      : mp::VisibilityFirst::Auto;
     if (o.sample_memory_mib > 0) scene.settings.sample_memory_mib = o.sample_memory_mib;
     if (o.texture_filter_width >= 0) scene.settings.texture_filter_width = o.texture_filter_width;
     // Only EXR files hold the Depth and Normal passes.

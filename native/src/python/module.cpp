@@ -79,6 +79,7 @@ py::dict stats_dict(const RenderStats& s) {
   d["sampled_area_px"] = s.sampled_area_px;
   d["subpatches_occluded"] = s.subpatches_occluded;
   d["covered_pixels"] = s.covered_pixels;
+  d["subpatches_unshaded"] = s.subpatches_unshaded;
   d["depth_complexity"] = s.covered_pixels ? s.sampled_area_px / double(s.covered_pixels) : 0.0;
   d["micropolygons_per_covered_pixel"] =
       s.covered_pixels ? double(s.micropolygons_sampled) / double(s.covered_pixels) : 0.0;
@@ -165,6 +166,10 @@ PYBIND11_MODULE(_native, m) {
       .value("AUTO", Sampler::Auto)
       .value("TILES", Sampler::Tiles)
       .value("MICROPOLYGONS", Sampler::Micropolygons);
+  py::enum_<VisibilityFirst>(m, "VisibilityFirst")
+      .value("AUTO", VisibilityFirst::Auto)
+      .value("ON", VisibilityFirst::On)
+      .value("OFF", VisibilityFirst::Off);
 
   py::class_<RenderSettings>(m, "RenderSettings")
       .def(py::init<>())
@@ -201,6 +206,7 @@ PYBIND11_MODULE(_native, m) {
       .def_readwrite("texture_filter_width", &RenderSettings::texture_filter_width)
       .def_readwrite("dof_dice_factor", &RenderSettings::dof_dice_factor)
       .def_readwrite("sampler", &RenderSettings::sampler)
+      .def_readwrite("visibility_first", &RenderSettings::visibility_first)
       .def_readwrite("sample_memory_mib", &RenderSettings::sample_memory_mib);
 
   py::class_<Scene>(m, "Scene")

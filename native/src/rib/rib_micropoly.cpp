@@ -35,6 +35,24 @@ void warn_unknown(const ParamList& params, std::initializer_list<const char*> kn
   }
 }
 
+// A string parameter that names one of `choices` (or is absent: `current`
+// stays); any other value is an error that lists them.
+template <typename T>
+T string_choice(ArgReader& args, const ParamList& params, const char* name,
+                std::initializer_list<std::pair<const char*, T>> choices, T current) {
+  const std::string value = params.get_string(name, "");
+  if (value.empty()) return current;
+  std::string names;
+  size_t k = 0;
+  for (const auto& [text, choice] : choices) {
+    if (value == text) return choice;
+    names += std::string(k == 0 ? "" : k + 1 == choices.size() ? " or " : ", ") + "\"" + text + "\"";
+    ++k;
+  }
+  args.fail("\"" + std::string(name) + "\" must be " + names + ", not \"" + value + "\"");
+  return current;
+}
+
 }  // namespace
 
 void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
@@ -70,15 +88,13 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   params.get_int("holdoutcovers", 0, 1, &flag);
   s.holdout_covers = flag != 0;
   auto positive = [](float v) { return v > 0.0f && std::isfinite(v); };
-  const std::string sampler = params.get_string("sampler", "");
-  if (sampler == "auto")
-    s.sampler = Sampler::Auto;
-  else if (sampler == "tiles")
-    s.sampler = Sampler::Tiles;
-  else if (sampler == "micropolygons")
-    s.sampler = Sampler::Micropolygons;
-  else if (!sampler.empty())
-    args.fail("\"sampler\" must be \"auto\", \"tiles\" or \"micropolygons\", not \"" + sampler + "\"");
+  s.sampler = string_choice(args, params, "sampler", {{"auto", Sampler::Auto}, {"tiles", Sampler::Tiles},
+                                                       {"micropolygons", Sampler::Micropolygons}},
+                            s.sampler);
+  s.visibility_first = string_choice(args, params, "visibilityfirst",
+                                     {{"auto", VisibilityFirst::Auto}, {"on", VisibilityFirst::On},
+                                      {"off", VisibilityFirst::Off}},
+                                     s.visibility_first);
   s.sample_memory_mib = params.get_float_checked("samplememory", s.sample_memory_mib, positive,
                                                  "a positive number of MiB");
   s.shadow_memory_mib = params.get_float_checked("shadowmemory", s.shadow_memory_mib, positive,
@@ -107,7 +123,7 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
                {"boundsplit", "boundsplitmemory", "maxgridsize", "maxsplitdepth", "backfaceculling",
                 "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate", "occlusionculling", "holdoutcovers",
                 "worldshadowdirections", "texturefilterwidth", "apertureblades", "aperturerotation", "apertureratio",
-                "focusfactor", "shuttercurve", "sampler", "samplememory"},
+                "focusfactor", "shuttercurve", "sampler", "samplememory", "visibilityfirst"},
                [&](const std::string& name) {
                  warn_once("option-micropoly:" + name, line,
                            "Option \"micropoly\": parameter \"" + name + "\" is ignored");

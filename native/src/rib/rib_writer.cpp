@@ -257,6 +257,8 @@ void write_options(std::string& o, const RenderSettings& s, const Camera& c) {
   if (s.sampler != def.sampler)
     param(o, "string sampler", s.sampler == Sampler::Tiles ? "tiles" : "micropolygons");
   if (differs(s.sample_memory_mib, def.sample_memory_mib)) param(o, "float samplememory", s.sample_memory_mib);
+  if (s.visibility_first != def.visibility_first)
+    param(o, "string visibilityfirst", s.visibility_first == VisibilityFirst::On ? "on" : "off");
   if (c.lens_radius > 0.0f) {
     param(o, "integer apertureblades", static_cast<long long>(c.aperture_blades));
     param(o, "float aperturerotation", c.aperture_rotation);

@@ -30,6 +30,7 @@ bool render_camera_bucket(MicropolygonPass& pass, const CameraStages& stages, co
     progress(0.0f);
   }
   PassView view{fb, PassViews{}, PassOcclusion{}};
+  bool culling = false;
   // A blurred occluder hides only part of what lies behind it: culling
   // against the shutter centre's pinhole depths would lose what the lens
   // and the other times see past it.
@@ -46,17 +47,22 @@ bool render_camera_bucket(MicropolygonPass& pass, const CameraStages& stages, co
     view.occlusion.refresh = [&] {
       if (!progress.cancelled()) occ.refresh(sample.keys(), fb, timer);
     };
+    culling = true;
   }
   activity.reset();
+  CameraVisibility visibility(scene.settings, s.info(), culling, stages.occlusion.root_overlap(), sample, timer);
 
   ViewTarget target;
   target.motion = mp_motion_on(fb);
   target.dice_activity = "dice";
   target.take = [&](const cl::Buffer& diceable, cl_uint count) {
     GridBuffers& grids = pass.grids();
-    std::optional<DeviceSession::Activity> step(std::in_place, s, "shade");
-    stages.shade.run(diceable, count, buffers, fb, grids, shadows, timer);
-    stages.programs.shade(diceable, count, buffers, fb, grids, shadows, timer);
+    std::optional<DeviceSession::Activity> step(std::in_place, s, "sample");
+    const cl::Buffer& visible = visibility.before_shading(diceable, count, buffers, fb, grids);
+    step.emplace(s, "shade");
+    stages.shade.run(diceable, count, buffers, fb, grids, shadows, visible, timer);
+    stages.programs.shade(diceable, count, buffers, fb, grids, shadows, visible, timer);
+    visibility.before_sampling();
     // The tile sampler takes a batch at once (its lists cover the batch)
     // and asks between parts of its tiles.
     step.emplace(s, "sample");
@@ -68,7 +74,7 @@ bool render_camera_bucket(MicropolygonPass& pass, const CameraStages& stages, co
         return progress.again();
       };
     for (cl_uint first = 0; first < count && !progress.cancelled(); first += chunk) {
-      sample.run(diceable, first, std::min(chunk, count - first), buffers, fb, grids, timer, ask);
+      sample.run(diceable, first, std::min(chunk, count - first), buffers, fb, grids, timer, visibility.took(), ask);
       if (progress.asked()) {
         s.queue().finish();
         progress.again();
@@ -76,6 +82,7 @@ bool render_camera_bucket(MicropolygonPass& pass, const CameraStages& stages, co
     }
     st.subpatches_diced += count;
     ++st.batches;
+    visibility.after_sampling(grids, count);
   };
   const BoundSplitResult bs = pass.run(view, target);
   st.subpatches_occluded += bs.occluded;

@@ -10,6 +10,7 @@
 #include "micropoly/renderer.h"
 #include "pipeline/frame/buckets.h"
 #include "pipeline/frame/frame_params.h"
+#include "pipeline/frame/visibility_choice.h"
 #include "pipeline/materials/material_programs.h"
 #include "pipeline/pass/micropolygon_pass.h"
 #include "pipeline/pass/micropolygon_stages.h"

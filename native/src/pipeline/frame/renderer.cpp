@@ -379,7 +379,7 @@ void Renderer::Impl::collect_stage_times(StageTimer& timer, RenderStats& st) {
   DeviceStages& d = *stages;
   timer.collect();
   st.micropolygons = d.layout.micropolygons();
-  d.sample.sampled_totals(st.micropolygons_sampled, st.sampled_area_px, st.sample_tests);
+  d.sample.sampled_totals(st.micropolygons_sampled, st.sampled_area_px, st.sample_tests, st.subpatches_unshaded);
   StageTimings& t = st.timings_ms;
   t.bound_split = timer.ms(Stage::BoundSplit);
   t.dice = timer.ms(Stage::Dice);

@@ -122,22 +122,22 @@ void MaterialPrograms::displace(const cl::Buffer& diceable, cl_uint count, const
 
 void MaterialPrograms::shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
                              const FrameParams& f, GridBuffers& grids, const ShadowInputs& shadows,
-                             StageTimer& timer) {
-  run_shade(diceable, count, scene, f, grids, shadows, false, timer);
+                             const cl::Buffer& visible, StageTimer& timer) {
+  run_shade(diceable, count, scene, f, grids, shadows, visible, false, timer);
 }
 
 void MaterialPrograms::alpha(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
                              const FrameParams& f, GridBuffers& grids, StageTimer& timer) {
-  run_shade(diceable, count, scene, f, grids, ShadowInputs{}, true, timer);
+  run_shade(diceable, count, scene, f, grids, ShadowInputs{}, cl::Buffer(), true, timer);
 }
 
 void MaterialPrograms::run_shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
                                  const FrameParams& f, GridBuffers& grids, const ShadowInputs& shadows,
-                                 bool alpha_only, StageTimer& timer) {
+                                 const cl::Buffer& visible, bool alpha_only, StageTimer& timer) {
   for (Active& a : active_) {
     if (!(alpha_only ? a.alpha : a.shades)) continue;
     cl::Kernel& k = a.built->shade.bind(scene, diceable, count, f, a.index, grids.p, grids.n, grids.c,
-                                        grids.vertex_offsets, shadows.args(), cl_uint(alpha_only ? 1 : 0));
+                                        grids.vertex_offsets, shadows.args(), cl_uint(alpha_only ? 1 : 0), visible);
     launch(k, count, grids, Stage::Shade, timer);
   }
 }

@@ -31,9 +31,11 @@ class MaterialPrograms {
   // vertices.
   void displace(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
                 GridBuffers& grids, StageTimer& timer, bool normals = true);
-  // Shades the vertices whose materials compute their Principled inputs.
+  // Shades the vertices whose materials compute their Principled inputs
+  // (with `visible`, not those of opaque grids it leaves unmarked:
+  // ShadeStage::run).
   void shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
-             GridBuffers& grids, const ShadowInputs& shadows, StageTimer& timer);
+             GridBuffers& grids, const ShadowInputs& shadows, const cl::Buffer& visible, StageTimer& timer);
   // The world program's radiance map (scene.h, World), baked on the device
   // with the scene's images; empty when the world has no program.
   WorldMap bake_world(const Scene& scene, const SceneBuffers& buffers);
@@ -67,7 +69,8 @@ class MaterialPrograms {
   Built* build(const MaterialProgram& mp, const char* owner, RenderStats& stats);
   void launch(cl::Kernel& kernel, cl_uint count, GridBuffers& grids, Stage stage, StageTimer& timer);
   void run_shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
-                 GridBuffers& grids, const ShadowInputs& shadows, bool alpha_only, StageTimer& timer);
+                 GridBuffers& grids, const ShadowInputs& shadows, const cl::Buffer& visible, bool alpha_only,
+                 StageTimer& timer);
 
   DeviceSession& session_;
   std::unordered_map<std::string, std::unique_ptr<Built>> built_;  // by source

@@ -46,6 +46,7 @@ GridBuffers::GridBuffers(DeviceSession& session, cl_uint cap, int max_grid)
   c = device_buffer(session, bytes, "grid color buffer");
   vertex_offsets = device_buffer(session, (capacity + 1) * sizeof(cl_uint), "grid vertex offsets");
   micropolygon_offsets = device_buffer(session, (capacity + 1) * sizeof(cl_uint), "grid micropolygon offsets");
+  visible = device_buffer(session, capacity, "grid visibility marks");
 }
 
 GridLayoutStage::GridLayoutStage(DeviceSession& session, cl_uint capacity)
@@ -135,9 +136,9 @@ void DiceStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffer
 ShadeStage::ShadeStage(DeviceSession& session) : session_(session), kernel_(session.program(), "shade_grids") {}
 
 void ShadeStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
-                     GridBuffers& grids, const ShadowInputs& shadows, StageTimer& timer) {
-  cl::Kernel& kernel =
-      kernel_.bind(scene, diceable, count, f, grids.p, grids.n, grids.c, grids.vertex_offsets, shadows.args());
+                     GridBuffers& grids, const ShadowInputs& shadows, const cl::Buffer& visible, StageTimer& timer) {
+  cl::Kernel& kernel = kernel_.bind(scene, diceable, count, f, grids.p, grids.n, grids.c, grids.vertex_offsets,
+                                    shadows.args(), visible);
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64),
                                         nullptr, &e);
@@ -148,20 +149,33 @@ SampleStage::SampleStage(DeviceSession& session)
     : session_(session),
       kernel_(session.program(), "sample_micropolygons"),
       blur_kernel_(session.program(), "sample_micropolygons_blur"),
+      count_unshaded_(session.program(), "count_unshaded"),
       clear_(session.program(), "clear_samples"),
       project_(session.tile_sampler() ? cl::Kernel(session.program(), "project_grids") : cl::Kernel()),
       bound_runs_(session.tile_sampler() ? cl::Kernel(session.program(), "bound_runs") : cl::Kernel()),
       tile_kernel_(session.tile_sampler() ? SceneKernel(session.program(), "sample_tiles") : SceneKernel()) {
-  totals_ = session.allocate(3 * sizeof(cl_ulong), "sample totals");
+  totals_ = session.allocate(5 * sizeof(cl_ulong), "sample totals");
 }
 
-void SampleStage::sampled_totals(size_t& micropolygons, double& area_px, size_t& tests) {
-  cl_ulong t[3] = {0, 0, 0};
+void SampleStage::sampled_totals(size_t& micropolygons, double& area_px, size_t& tests, size_t& unshaded) {
+  cl_ulong t[5] = {0, 0, 0, 0, 0};
   session_.queue().enqueueReadBuffer(totals_, CL_TRUE, 0, sizeof t, t);
   micropolygons = static_cast<size_t>(t[0]);
   tests = static_cast<size_t>(t[2]);
+  unshaded = static_cast<size_t>(t[3]);
   // The sampler sums twice the area in fixed-point units (mp_raster.h).
   area_px = static_cast<double>(t[1]) / (2.0 * MP_SUBPIXEL_ONE * MP_SUBPIXEL_ONE);
+}
+
+void SampleStage::read_hidden_counts() {
+  session_.queue().enqueueReadBuffer(totals_, CL_FALSE, 3 * sizeof(cl_ulong), sizeof hidden_host_, hidden_host_,
+                                     nullptr, &hidden_read_);
+}
+
+SampleStage::HiddenCounts SampleStage::hidden_counts() {
+  if (hidden_read_()) hidden_read_.wait();
+  hidden_read_ = cl::Event();
+  return {static_cast<size_t>(hidden_host_[0]), static_cast<size_t>(hidden_host_[1])};
 }
 
 float warp_shutter_time(float u, const std::vector<float>& curve) {
@@ -265,7 +279,7 @@ void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer, const std
     pattern_ = pattern;
   }
   cl_ulong zero = 0;
-  session_.queue().enqueueFillBuffer(totals_, zero, 0, 3 * sizeof zero);
+  session_.queue().enqueueFillBuffer(totals_, zero, 0, 5 * sizeof zero);
   bind_args(clear_, keys_, static_cast<cl_ulong>(samples));
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(clear_, cl::NullRange, round_up_range(samples, 256), cl::NDRange(256), nullptr,
@@ -273,30 +287,65 @@ void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer, const std
   timer.add(Stage::Sample, e);
 }
 
-void SampleStage::run(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
-                      const FrameParams& f, GridBuffers& grids, StageTimer& timer,
-                      const std::function<bool()>& keep_going) {
-  if (count == 0) return;
+void SampleStage::sample_micropolygons(const cl::Buffer& diceable, cl_uint first, cl_uint count,
+                                       const SceneBuffers& scene, const FrameParams& f, GridBuffers& grids,
+                                       StageTimer& timer, cl_uint pass) {
   // The run's micropolygons, numbered within the batch by its layout.
   const cl_uint base = grids.micropolygon_offsets_host[first];
   const cl_uint total = grids.micropolygon_offsets_host[first + count] - base;
   if (total == 0) return;
+  SceneKernel& sampler = mp_blur_on(f) ? blur_kernel_ : kernel_;
+  // Motion positions: any valid buffer when there are none.
+  cl::Kernel& k = sampler.bind(scene, diceable, first, count, grids.micropolygon_offsets, base, total, f, grids.p,
+                               grids.c, grids.n, offsets_, pass, keys_, colors_, normals_, totals_, occlusion_dirty_,
+                               occlusion_, blur_, grids.motion_p() ? grids.motion_p : grids.p,
+                               cl_ulong(grids.slot_space()), grids.visible);
+  cl::Event e;
+  session_.queue().enqueueNDRangeKernel(k, cl::NullRange, round_up_range(total), cl::NDRange(64), nullptr, &e);
+  timer.add(Stage::Sample, e);
+}
+
+size_t SampleStage::visibility(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
+                               const FrameParams& f, GridBuffers& grids, StageTimer& timer) {
+  binned_ = false;
+  if (count == 0) return timer.cursor();
+  const cl_uchar unmarked = 0;
+  session_.queue().enqueueFillBuffer(grids.visible, unmarked, 0, count);
+  size_t passes = timer.cursor();
   if (tiles_) {
-    run_tiles(diceable, first, count, scene, f, grids, timer, keep_going);
+    binned_ = bin_tiles(diceable, 0, count, f, grids, timer);
+    passes = timer.cursor();
+    if (binned_) {
+      sample_binned(diceable, scene, f, grids, timer, MP_SAMPLE_OPAQUE_DEPTH, {});
+      sample_binned(diceable, scene, f, grids, timer, MP_SAMPLE_MARK, {});
+    }
+  } else {
+    sample_micropolygons(diceable, 0, count, scene, f, grids, timer, MP_SAMPLE_OPAQUE_DEPTH);
+    sample_micropolygons(diceable, 0, count, scene, f, grids, timer, MP_SAMPLE_MARK);
+  }
+  cl::Kernel& k = count_unshaded_.bind(scene, diceable, count, grids.visible, totals_);
+  cl::Event e;
+  session_.queue().enqueueNDRangeKernel(k, cl::NullRange, round_up_range(count), cl::NDRange(64), nullptr, &e);
+  timer.add(Stage::Sample, e);
+  return passes;
+}
+
+void SampleStage::run(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
+                      const FrameParams& f, GridBuffers& grids, StageTimer& timer, bool after_visibility,
+                      const std::function<bool()>& keep_going) {
+  if (count == 0) return;
+  const cl_uint after = after_visibility ? MP_SAMPLE_AFTER_MARK : 0u;
+  if (tiles_) {
+    // The lists visibility() made for this batch serve again.
+    const bool binned = after_visibility && binned_;
+    binned_ = false;
+    if (binned || (!after_visibility && bin_tiles(diceable, first, count, f, grids, timer)))
+      sample_binned(diceable, scene, f, grids, timer, MP_SAMPLE_ATTRIBUTES | after, keep_going);
     return;
   }
-  SceneKernel& sampler = mp_blur_on(f) ? blur_kernel_ : kernel_;
-  // Pass 0 finds each sample's nearest key; pass 1 lets its owner write.
-  for (cl_uint pass = 0; pass < 2; ++pass) {
-    // Motion positions: any valid buffer when there are none.
-    cl::Kernel& k = sampler.bind(scene, diceable, first, count, grids.micropolygon_offsets, base, total, f, grids.p,
-                                 grids.c, grids.n, offsets_, pass, keys_, colors_, normals_, totals_,
-                                 occlusion_dirty_, occlusion_, blur_, grids.motion_p() ? grids.motion_p : grids.p,
-                                 cl_ulong(grids.slot_space()));
-    cl::Event e;
-    session_.queue().enqueueNDRangeKernel(k, cl::NullRange, round_up_range(total), cl::NDRange(64), nullptr, &e);
-    timer.add(Stage::Sample, e);
-  }
+  // The first pass finds each sample's nearest key; the second lets its owner write.
+  sample_micropolygons(diceable, first, count, scene, f, grids, timer, MP_SAMPLE_DEPTH | after);
+  sample_micropolygons(diceable, first, count, scene, f, grids, timer, MP_SAMPLE_ATTRIBUTES | after);
 }
 
 ResolveStage::ResolveStage(DeviceSession& session)

@@ -56,6 +56,9 @@ struct GridBuffers {
   // micropolygon offsets are kept on the host too, to size sample launches.
   cl::Buffer vertex_offsets, micropolygon_offsets;
   cl_uint vertex_total = 0;
+  // Visibility first (SampleStage::visibility): a byte per slot, set where
+  // the grid is opaque and owns a sample before shading.
+  cl::Buffer visible;
   std::vector<cl_uint> micropolygon_offsets_host;
 };
 
@@ -109,8 +112,10 @@ class DiceStage {
 class ShadeStage {
  public:
   explicit ShadeStage(DeviceSession& session);
+  // Shades the batch's grid vertices; with `visible` (visibility first's
+  // marks, grids.visible), not those of opaque grids left unmarked.
   void run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
-           GridBuffers& grids, const ShadowInputs& shadows, StageTimer& timer);
+           GridBuffers& grids, const ShadowInputs& shadows, const cl::Buffer& visible, StageTimer& timer);
 
  private:
   DeviceSession& session_;
@@ -127,11 +132,22 @@ class SampleStage {
   // micropolygon (sample.cl).
   void begin_frame(const FrameParams& f, StageTimer& timer, const std::vector<float>& shutter_curve = {});
   bool tiles() const { return tiles_; }
+  // Visibility first, before a batch's grids are shaded: the nearest keys
+  // of its grids whose material is opaque whatever its shading, then a mark
+  // (grids.visible) on each of those that owns a sample; the others cannot
+  // show in the image, and shading skips them. run() then samples the batch
+  // with `after_visibility`: those grids' keys stay, the unmarked are
+  // skipped. The image is the same either way, bit for bit. Returns the
+  // timer's cursor where its own passes start (the tile sampler's binning
+  // before it serves the batch's sampling too).
+  size_t visibility(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
+                  GridBuffers& grids, StageTimer& timer);
   // Samples the grids of diceable sub-patches [first, first + count).
   // `keep_going` (optional): asked between parts of the work (the tile
   // sampler's launches of kTileChunk tiles); false stops sampling the batch.
   void run(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
-           GridBuffers& grids, StageTimer& timer, const std::function<bool()>& keep_going = {});
+           GridBuffers& grids, StageTimer& timer, bool after_visibility = false,
+           const std::function<bool()>& keep_going = {});
   // From now until the next begin_frame, the depth pass marks the level-0
   // cells of the occlusion pyramid (mp_occlusion.h) it writes in `dirty`.
   void mark_occlusion_cells(const cl::Buffer& dirty, const OcclusionParams& params);
@@ -140,28 +156,55 @@ class SampleStage {
   const cl::Buffer& normals() const { return normals_; }
   const cl::Buffer& offsets() const { return offsets_; }
   // Micropolygons rasterised this frame and their total screen area in
-  // pixels (front faces only when back faces are culled), and the samples
-  // tested against their edges in the depth pass (blocking read).
-  void sampled_totals(size_t& micropolygons, double& area_px, size_t& tests);
+  // pixels (front faces only when back faces are culled), the samples
+  // tested against their edges in the depth pass, and the sub-patches
+  // visibility first left unshaded (blocking read).
+  void sampled_totals(size_t& micropolygons, double& area_px, size_t& tests, size_t& unshaded);
+  // So far this frame: the sub-patches visibility first left unshaded, and
+  // the micropolygons the tile sampler's plain passes found hidden when it
+  // sampled them (per tile of their first pixel: a lower bound of what
+  // visibility first would have left unshaded). read_hidden_counts()
+  // enqueues their read; hidden_counts() waits for it, so the queue keeps
+  // working in between.
+  struct HiddenCounts {
+    size_t unshaded = 0, lost = 0;
+  };
+  void read_hidden_counts();
+  HiddenCounts hidden_counts();
 
  private:
   DeviceSession& session_;
   // The tile sampler (sample_tiles.cpp): projects the grids, sorts them
   // into per-tile lists on the host, then samples each tile.
-  void run_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
-                 const FrameParams& f, GridBuffers& grids, StageTimer& timer, const std::function<bool()>& keep_going);
+  // Projects a batch's grids and sorts their runs into per-tile lists; false
+  // where no tile is touched.
+  bool bin_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint count, const FrameParams& f, GridBuffers& grids,
+                 StageTimer& timer);
+  // Samples the binned tiles in one pass (pass: MP_SAMPLE_* of mp_raster.h).
+  void sample_binned(const cl::Buffer& diceable, const SceneBuffers& scene, const FrameParams& f, GridBuffers& grids,
+                     StageTimer& timer, cl_uint pass, const std::function<bool()>& keep_going);
+  // One pass of the per-micropolygon sampler over [first, first + count).
+  void sample_micropolygons(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
+                            const FrameParams& f, GridBuffers& grids, StageTimer& timer, cl_uint pass);
   SceneKernel kernel_, blur_kernel_;  // pinhole samples; samples with times and lens positions
+  SceneKernel count_unshaded_;
   cl::Kernel clear_;
   cl::Kernel project_, bound_runs_;
   SceneKernel tile_kernel_;
   bool tiles_ = false;
   cl::Buffer projected_, rects_, tile_ids_, tile_starts_, tile_entries_;
+  // The lists bin_tiles made: their tiles, runs per grid, tiles per row;
+  // binned_ while they hold the batch that visibility() sampled.
+  cl_uint active_tiles_ = 0, runs_per_grid_ = 0, tiles_x_ = 0;
+  bool binned_ = false;
   size_t projected_bytes_ = 0, rect_bytes_ = 0, tile_bytes_ = 0, start_bytes_ = 0, entry_bytes_ = 0;
   std::vector<cl_int> rects_host_;
   std::vector<cl_uint> tile_counts_, tile_ids_host_, tile_starts_host_, tile_entries_host_;
   cl::Buffer occlusion_dirty_;
   OcclusionParams occlusion_{};
   cl::Buffer keys_, colors_, normals_, offsets_, blur_, totals_;
+  cl_ulong hidden_host_[2] = {0, 0};
+  cl::Event hidden_read_;
   // The sample offsets of `offsets_` for the tile sampler's 16-lane tests:
   // per tile pixel, chunks of 16 x offsets then 16 y offsets.
   cl::Buffer offsets_soa_;

@@ -31,9 +31,8 @@ constexpr cl_uint kTileChunk = 128;
 
 }  // namespace
 
-void SampleStage::run_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
-                            const FrameParams& f, GridBuffers& grids, StageTimer& timer,
-                            const std::function<bool()>& keep_going) {
+bool SampleStage::bin_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint count, const FrameParams& f,
+                            GridBuffers& grids, StageTimer& timer) {
   DeviceQueue& q = session_.queue();
   ensure(session_, projected_, projected_bytes_, grids.slot_space(), sizeof(cl_int4), "projected grid vertices");
   // Runs of micropolygons per grid (MP_TILE_RUN): enough for the largest grid.
@@ -73,37 +72,46 @@ void SampleStage::run_tiles(const cl::Buffer& diceable, cl_uint first, cl_uint c
     entries += n;
   }
   tile_starts_host_.push_back(entries);
-  const cl_uint active = cl_uint(tile_ids_host_.size());
-  if (active == 0) return;
+  active_tiles_ = cl_uint(tile_ids_host_.size());
+  runs_per_grid_ = runs_per_grid;
+  tiles_x_ = tiles_x;
+  if (active_tiles_ == 0) return false;
   tile_entries_host_.resize(entries);
   // Entry: the run's grid slot * runs_per_grid + its run.
   const cl_uint base = first * runs_per_grid;
   for (size_t k = 0; k < runs; ++k)
     for_each_tile(k, [&](cl_uint t) { tile_entries_host_[tile_counts_[t]++] = base + cl_uint(k); });
 
-  ensure(session_, tile_ids_, tile_bytes_, active, sizeof(cl_uint), "tile list");
-  ensure(session_, tile_starts_, start_bytes_, active + 1, sizeof(cl_uint), "tile list starts");
+  ensure(session_, tile_ids_, tile_bytes_, active_tiles_, sizeof(cl_uint), "tile list");
+  ensure(session_, tile_starts_, start_bytes_, active_tiles_ + 1, sizeof(cl_uint), "tile list starts");
   ensure(session_, tile_entries_, entry_bytes_, entries, sizeof(cl_uint), "tile grid lists");
-  q.enqueueWriteBuffer(tile_ids_, CL_FALSE, 0, active * sizeof(cl_uint), tile_ids_host_.data());
-  q.enqueueWriteBuffer(tile_starts_, CL_FALSE, 0, (active + 1) * sizeof(cl_uint), tile_starts_host_.data());
+  q.enqueueWriteBuffer(tile_ids_, CL_FALSE, 0, active_tiles_ * sizeof(cl_uint), tile_ids_host_.data());
+  q.enqueueWriteBuffer(tile_starts_, CL_FALSE, 0, (active_tiles_ + 1) * sizeof(cl_uint), tile_starts_host_.data());
   q.enqueueWriteBuffer(tile_entries_, CL_FALSE, 0, entries * sizeof(cl_uint), tile_entries_host_.data());
+  // The host lists must outlive their (asynchronous) uploads.
+  q.finish();
+  return true;
+}
 
+void SampleStage::sample_binned(const cl::Buffer& diceable, const SceneBuffers& scene, const FrameParams& f,
+                                GridBuffers& grids, StageTimer& timer, cl_uint pass,
+                                const std::function<bool()>& keep_going) {
   // All tiles in one launch, or (when the caller may cancel) in parts, with
   // a question between them. A fixed work-group size: PoCL compiles a
   // kernel once per size it meets.
+  const cl_uint active = active_tiles_;
   const cl_uint part = keep_going ? kTileChunk : active;
   for (cl_uint first_tile = 0; first_tile < active; first_tile += part) {
     if (first_tile > 0 && !keep_going()) break;
     cl::Kernel& k = tile_kernel_.bind(scene, diceable, f, projected_, grids.c, grids.n, offsets_, offsets_soa_,
-                                      tile_ids_, tile_starts_, tile_entries_, runs_per_grid, first_tile, active,
-                                      tiles_x, keys_, colors_, normals_, totals_, occlusion_dirty_, occlusion_);
+                                      tile_ids_, tile_starts_, tile_entries_, runs_per_grid_, first_tile, active,
+                                      tiles_x_, keys_, colors_, normals_, totals_, occlusion_dirty_, occlusion_, pass,
+                                      grids.visible);
     cl::Event t;
-    q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(std::min(part, active - first_tile), kTileGroup),
-                           cl::NDRange(kTileGroup), nullptr, &t);
+    const cl::NDRange range = round_up_range(std::min(part, active - first_tile), kTileGroup);
+    session_.queue().enqueueNDRangeKernel(k, cl::NullRange, range, cl::NDRange(kTileGroup), nullptr, &t);
     timer.add(Stage::Sample, t);
   }
-  // The host lists must outlive their (asynchronous) uploads.
-  q.finish();
 }
 
 }  // namespace mp

@@ -47,15 +47,28 @@ class StageTimer {
   // Sums the events recorded so far; call after they have completed.
   void collect() {
     for (auto& [stage, event] : pending_) {
-      cl_ulong start = event.getProfilingInfo<CL_PROFILING_COMMAND_START>();
-      cl_ulong end = event.getProfilingInfo<CL_PROFILING_COMMAND_END>();
-      ms_[static_cast<size_t>(stage)] += static_cast<double>(end - start) * 1e-6;
+      const double ms = event_ms(event);
+      ms_[static_cast<size_t>(stage)] += ms;
+      collected_.push_back(ms);
     }
     pending_.clear();
   }
   double ms(Stage stage) const { return ms_[static_cast<size_t>(stage)]; }
+  // A point in the events recorded so far, and the device time of those
+  // recorded between two such points (they must have completed).
+  size_t cursor() const { return collected_.size() + pending_.size(); }
+  double ms_between(size_t from, size_t to) const {
+    double ms = 0;
+    for (size_t i = from; i < to && i < cursor(); ++i)
+      ms += i < collected_.size() ? collected_[i] : event_ms(pending_[i - collected_.size()].second);
+    return ms;
+  }
 
  private:
+  static double event_ms(const cl::Event& e) {
+    return static_cast<double>(e.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
+                               e.getProfilingInfo<CL_PROFILING_COMMAND_START>()) * 1e-6;
+  }
   Stage redirected(Stage s) const {
     if (!redirect_) return s;
     if (*redirect_ != Stage::ShadowBoundSplit) return *redirect_;
@@ -64,6 +77,7 @@ class StageTimer {
                                                   : Stage::ShadowSample;
   }
   std::vector<std::pair<Stage, cl::Event>> pending_;
+  std::vector<double> collected_;  // each collected event's time, in order
   std::optional<Stage> redirect_;
   std::array<double, static_cast<size_t>(Stage::Count)> ms_{};
 };
