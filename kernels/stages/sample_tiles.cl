@@ -1,6 +1,7 @@
 /* Sample, shaped for CPUs: a sort-middle rasteriser (Laine & Karras 2011,
  * "High-performance software rasterization on GPUs"; RenderMan's buckets).
- * After shading, each grid's vertices are projected once (project_grids)
+ * Each grid's vertices are projected once (project_grids; before shading
+ * when visibility first takes the batch, its passes sharing the lists)
  * and each run of its micropolygons is bounded in screen tiles of
  * MP_RASTER_TILE pixels (bound_runs); the host sorts the runs into per-tile
  * lists; then one work-item per tile rasterises its runs' micropolygons into the
