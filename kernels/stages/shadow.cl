@@ -213,8 +213,7 @@ void marking_depth(MP_SCENE_PARAMS __global const SubPatch* diceable, uint count
   uint slot = mp_find_grid(offsets, count, first + gid);
   uint m = first + gid - offsets[slot];
   SubPatch sp = diceable[slot];
-  __global const DeviceMaterial* mat = materials + patch_info[4 * (ulong)sp.patch + 1];
-  if (mat->program[3] > 0.0f || mat->opacity[3] < 1.0f) return;
+  if (!mp_material_opaque(materials, patch_info, sp.patch)) return;
   MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
   uint q[4];
   if (!mp_grid_micropolygon(&g, m, q)) return;
