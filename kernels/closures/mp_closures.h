@@ -269,6 +269,19 @@ MP_INLINE void mp_add_toon(MpSurface* s, float3 w, int slot, float size, float s
                                clamp(size, 0.0f, 1.0f), clamp(smooth, 0.0f, 1.0f)));
 }
 
+/* Geometric specular antialiasing (Kaplanyan, Hill, Patney and Lefohn
+ * 2016; Tokuyoshi and Kaplanyan 2019): a highlight narrower than a
+ * micropolygon, shaded at its vertices and interpolated between them,
+ * would alias; the spread of the normal across the micropolygon (n to its
+ * neighbours one step along u and v) is added to a sharp lobe's alpha^2
+ * instead, as the pixel filter would have blurred it: variance
+ * 1/(2 pi) (|dn_u|^2 + |dn_v|^2), at most 0.18. */
+MP_INLINE float mp_normal_spread2(float3 n, float3 nu, float3 nv) {
+  float3 du = nu - n, dv = nv - n;
+  float variance = (0.5f / 3.14159265358979f) /* 1 / (2 pi) */ * (dot(du, du) + dot(dv, dv));
+  return isfinite(variance) ? fmin(2.0f * variance, 0.18f) : 0.0f;
+}
+
 /* The surface's coverage: 1 - the Transparent weight's average (Cycles'
  * alpha), in [0, 1]. */
 MP_INLINE float mp_surface_alpha(const MpSurface* s) {

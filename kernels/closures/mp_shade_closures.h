@@ -30,19 +30,6 @@ MP_INLINE float mp_lamp_factor(MP_GLOBAL const DeviceLight* lt, int type, float3
   return fmax(dot(n, *l), 0.0f) / d2;
 }
 
-/* Geometric specular antialiasing (Kaplanyan, Hill, Patney and Lefohn
- * 2016; Tokuyoshi and Kaplanyan 2019): a highlight narrower than a
- * micropolygon, shaded at its vertices and interpolated between them,
- * would alias; the spread of the normal across the micropolygon (n to its
- * neighbours one step along u and v) is added to a sharp lobe's alpha^2
- * instead, as the pixel filter would have blurred it: variance
- * 1/(2 pi) (|dn_u|^2 + |dn_v|^2), at most 0.18. */
-MP_INLINE float mp_normal_spread2(float3 n, float3 nu, float3 nv) {
-  float3 du = nu - n, dv = nv - n;
-  float variance = (0.5f / MP_PI) * (dot(du, du) + dot(dv, dv));
-  return isfinite(variance) ? fmin(2.0f * variance, 0.18f) : 0.0f;
-}
-
 /* Readies a surface (normals in camera space) for mp_shade_closures at
  * camera-space point p: widens its GGX lobes by a normal spread^2
  * (mp_normal_spread2), and reads each microfiber sheen's transform and

@@ -3,20 +3,21 @@
  * host), built into its own program so that identical trees share one build
  * and a changed tree rebuilds only itself. Its kernels run over a whole
  * batch of diced grids and touch only the vertices of the materials that use
- * this program (DeviceMaterial.program[0]). */
+ * this program (DeviceMaterial.program[0]). Lighting is not here: the
+ * closures a tree makes are recorded (mp_surface_record.h) and lit by the
+ * light program, built once for every tree. */
 /* Tells the headers they build a material program (mp_bsdf.h). */
 #define MP_MATERIAL_PROGRAM 1
 #include "core/mp_compat.h"
 #include "geometry/mp_patch.h"
 #include "core/mp_types.h"
-#include "closures/mp_shading.h"
-#include "closures/mp_shade_closures.h"
 #include "geometry/mp_patch_eval.h"
 #include "geometry/mp_surface.h"
 #include "geometry/mp_grid.h"
 #include "materials/mp_node_lib.h"
 #include "textures/mp_tex_image.h"
 #include "core/mp_scene_data.h"
+#include "materials/mp_surface_record.h"
 
 /* Half-thickness of a texture space with no extent along an axis: Blender
  * raises a zero size to 1e-5 (the margin covers its float rounding). */
@@ -162,10 +163,13 @@ inline int mp_program_vertex(uint gid, uint count, __global const uint* vertex_o
   *object = MP_PATCH_OBJECT(patch_info[4 * (ulong)sp->patch + 2]);
   return (int)materials[*material].program[0] == program;
 }
-
 /* What node programs read of the scene (mp_node_lib.h), from MP_SCENE_PARAMS. */
 #define MP_PROGRAM_INPUTS {patch_edges, patch_uvs, uv_layers, images, image_count, texels, node_params}
 
+/* A tree builds either as a material's program (displace and shade) or as
+ * the world's (its radiance baked and behind the frame): the host defines
+ * MP_WORLD_PROGRAM for the world's, and each builds only its own kernels. */
+#ifndef MP_WORLD_PROGRAM
 /* Moves each vertex by the program's displacement vector (object space). */
 __kernel void displace_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, uint count, FrameParams f,
                              int program, __global float4* grid_p, __global const float4* grid_n,
@@ -193,15 +197,22 @@ __kernel void displace_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, 
   grid_p[index] = (float4)(p + mp_object_dir_to_camera(o, d), 1.0f);
 }
 
-/* Shades each vertex with the Principled inputs the program computes. */
+/* Evaluates the node tree at each vertex: only its alpha for a shadow view
+ * (alpha_only), else its closures, recorded in this launch's range of the
+ * record pool (its global offset is the pool's first vertex) for the light
+ * program to light (light_program.cl). */
 __kernel void shade_program_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, uint count, FrameParams f,
                                   int program, __global const float4* grid_p, __global float4* grid_n,
-                                  __global float4* grid_c, __global const uint* vertex_offsets,
-                                  MP_SHADOW_INPUT_PARAMS, uint alpha_only, __global const uchar* visible) {
+                                  __global float4* grid_c, __global const uint* vertex_offsets, uint alpha_only,
+                                  __global const uchar* visible, __global float4* records, uint record_stride) {
   uint gid = get_global_id(0), material, object, i, j;
   SubPatch sp;
   float2 uv;
   ulong index;
+  /* Every record of the range says whether it holds a surface; the light
+   * program reads no other. */
+  const uint k = gid - (uint)get_global_offset(0);
+  if (!alpha_only) mp_record_skip(records, record_stride, k);
   if (!mp_program_vertex(gid, count, vertex_offsets, f, diceable, patch_info, materials, program, &sp, &material,
                          &object, &uv, &i, &j, &index))
     return;
@@ -266,25 +277,14 @@ __kernel void shade_program_grids(MP_SCENE_PARAMS __global const SubPatch* dicea
       float3 t = mp_object_dir_to_camera(o, s.c[k].tangent);
       s.c[k].tangent = all(isfinite(t)) ? t : (float3)(0.0f);
     }
-  /* Shadows compare with the surface's tangent plane (for smooth-shaded
-   * polygons, which shade.cl gave their interpolated normal, that normal's). */
-  MpShadowMaps maps = MP_SHADOW_INPUTS;
-  MpShadowQuery shadow = {&maps, n, mp_pixel_footprint(-p.z, f)};
-  /* Sharp lobes widened by the normal's spread across the micropolygon
-   * (mp_normal_spread2): the grid's normals, final since shade.cl. */
-  mp_surface_prepare(&s, mp_normal_spread2(n, grid_n[gx].xyz, grid_n[gy].xyz), p, f.ortho);
-  MpRefractScene refract = {refract_nodes, refract_tris, refract_roots[object]};
-  float3 c = mp_shade_closures(p, n, faced, f.ortho, &s, lights, light_count, world_glossy,
-                               use_shadows ? &shadow : 0, refract.root != MP_REFRACT_NONE ? &refract : 0);
-  /* Stochastic coverage multiplies by alpha, and by 1 - the held-out share
-   * of it: what the closures give is the kept samples' colour. */
-  float held = mp_surface_holdout_share(&s, alpha), kept = alpha * (1.0f - held);
-  c = kept > 1e-6f ? c / kept : (float3)(0.0f);
-  grid_c[index] = (float4)(c, alpha);
-  /* The faced flag (read above) has served: w now carries the held-out
-   * share to the sampler (mp_raster.h). */
-  grid_n[index].w = held;
+  /* The light program lights it (light_program.cl), with the normal's
+   * spread across the micropolygon (mp_normal_spread2): the grid's normals,
+   * final since shade.cl. */
+  mp_record_store(records, record_stride, k, &s, (uint)index, object, faced, alpha,
+                  mp_normal_spread2(n, grid_n[gx].xyz, grid_n[gy].xyz));
 }
+
+#else
 
 /* The world's radiance towards world direction d: the world program's
  * Surface emission (a Background node's colour times its strength). World
@@ -366,3 +366,4 @@ __kernel void world_pixels(MP_SCENE_PARAMS FrameParams f, float4 r0, float4 r1, 
   sum *= 0.25f;
   out[3 * i] = sum.x, out[3 * i + 1] = sum.y, out[3 * i + 2] = sum.z;
 }
+#endif

@@ -14,6 +14,9 @@
 #include "rib/rib_reader.h"
 #include "rib/rib_writer.h"
 #include "renderer_fixture.h"
+#include "core/mp_compat.h"
+#include "materials/mp_surface_record.h"
+#include "pipeline/materials/material_programs.h"
 #include "scene_fixtures.h"
 
 namespace mp::test {
@@ -276,6 +279,52 @@ TEST_F(MaterialProgramTest, MaterialsSharingAProgramReadTheirOwnNodeValues) {
   EXPECT_EQ(back.materials[0].program_params, s.materials[0].program_params);
   EXPECT_EQ(back.materials[1].program_params, s.materials[1].program_params);
   expect_colours(renderer_->render(back), {0.9f, 0.0f, 0.5f}, {0.6f, 0.4f, 0.2f}, "read back from RIB");
+}
+
+// Programs shade a range of the batch's vertices at a time through the
+// record pool (kernels/materials/mp_surface_record.h): two programs on two
+// halves of a frame whose batch holds many ranges, each program's vertices
+// lit by it alone, every pixel checked against the analytic colour, and the
+// pool within its budget.
+TEST_F(MaterialProgramTest, TwoProgramsOverManyRecordRangesLightOnlyTheirOwnVertices) {
+  Scene s = facing_plane(static_cast<int>(Material::Model::Constant));
+  s.settings.width = s.settings.height = 384;
+  set_samples_per_pixel(s.settings, 1);
+  s.meshes[0] = polygon({{-3, -3, 0}, {0, -3, 0}, {0, 3, 0}, {-3, 3, 0}});
+  s.meshes.push_back(polygon({{0, -3, 0}, {3, -3, 0}, {3, 3, 0}, {0, 3, 0}}));
+  s.meshes[1].material = 1;
+  s.materials.push_back(s.materials[0]);
+  s.materials[1].name = "right";
+  s.materials[1].program = 1;
+  s.material_programs.push_back(
+      {"red by x", std::string(kNoDisplacement) + "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {"
+                                                  " mp_add_emission(s, (float3)(g->generated.x, 0.0f, 0.0f)); }\n"});
+  s.material_programs.push_back(
+      {"green by y", std::string(kNoDisplacement) + "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {"
+                                                    " mp_add_emission(s, (float3)(0.0f, g->generated.y, 0.0f)); }\n"});
+  s.materials[0].program_shades = s.materials[1].program_shades = true;
+  RenderResult r = renderer_->render(s);
+  ASSERT_EQ(r.width, 384);
+  // Generated coordinates span each half's own box: x over [-3, 0] on the
+  // left, y over [-3, 3] on the right.
+  const float half = 5.0f * std::tan(glm::radians(22.5f));
+  int checked = 0;
+  for (int row = 2; row < 384; row += 7)
+    for (int c = 2; c < 384; c += 7) {
+      const float x = half * ((c + 0.5f) / 192.0f - 1.0f), y = -half * ((row + 0.5f) / 192.0f - 1.0f);
+      if (std::fabs(x) < 0.05f) continue;  // pixels the seam between the halves covers
+      const float* px = &r.rgba[4 * (size_t(row) * 384 + size_t(c))];
+      const glm::vec3 want = x < 0.0f ? glm::vec3((x + 3.0f) / 3.0f, 0.0f, 0.0f)
+                                      : glm::vec3(0.0f, (y + 3.0f) / 6.0f, 0.0f);
+      for (int k = 0; k < 3; ++k) ASSERT_NEAR(px[k], want[k], 4e-3f) << "row " << row << " column " << c;
+      ++checked;
+    }
+  EXPECT_GT(checked, 2500);
+  // More vertices than one range holds (32 MiB of 928-byte records on a
+  // CPU, 256 MiB on a GPU), yet the pool never beyond its budget.
+  EXPECT_GT(r.stats.micropolygons, size_t(MaterialPrograms::kRecordPoolMiB << 20) / MP_SURFACE_RECORD_BYTES);
+  EXPECT_GT(r.stats.surface_record_bytes, 0u);
+  EXPECT_LE(r.stats.surface_record_bytes, size_t(MaterialPrograms::kRecordPoolGpuMiB) << 20);
 }
 
 // A curve's samples travel as node values too (MP_PARAM_TABLE, read by the

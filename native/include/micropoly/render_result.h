@@ -73,6 +73,9 @@ struct RenderStats {
   // whose opaque grids owned no sample before shading, left unshaded.
   size_t subpatches_unshaded = 0;
   size_t bound_split_peak_bytes = 0;
+  // The pool material programs hand their closures to lighting in
+  // (mp_surface_record.h): bytes held, within 32 MiB on CPUs, 256 on GPUs.
+  size_t surface_record_bytes = 0;
   size_t batches = 0;
   size_t bound_split_launches = 0;
   // Buckets the frame was rendered in (RenderSettings::sample_memory_mib).

@@ -106,7 +106,24 @@ std::string assemble_program_source() {
   return source;
 }
 
-std::string assemble_material_program_source(const std::string& generated) {
+std::vector<std::string> material_program_switches(const std::string& generated) {
+  std::vector<std::string> switches;
+  for (size_t line = 0; line < generated.size();) {
+    size_t end = generated.find('\n', line);
+    if (end == std::string::npos) end = generated.size();
+    if (generated.compare(line, 21, "#define MP_NODE_USES_") == 0) switches.push_back(generated.substr(line, end - line));
+    line = end + 1;
+  }
+  return switches;
+}
+
+std::string assemble_light_program_source(bool thin_film) {
+  const std::map<std::string, std::string> files = embedded_files();
+  const std::string switches = thin_film ? "#define MP_NODE_USES_THIN_FILM 1\n" : "";
+  return expand_includes(switches + files.at("materials/light_program.cl"), files, 0);
+}
+
+std::string assemble_material_program_source(const std::string& generated, bool world) {
   std::map<std::string, std::string> files = embedded_files();
   const std::string marker = "/* @MATERIAL_PROGRAM_SOURCE@ */";
   std::string text = files.at("materials/material_program.cl");
@@ -116,12 +133,8 @@ std::string assemble_material_program_source(const std::string& generated) {
   // Switches the generated code sets for the kernel headers
   // ("#define MP_NODE_USES_..." lines) go ahead of them.
   std::string switches;
-  for (size_t line = 0; line < generated.size();) {
-    size_t end = generated.find('\n', line);
-    if (end == std::string::npos) end = generated.size();
-    if (generated.compare(line, 21, "#define MP_NODE_USES_") == 0) switches += generated.substr(line, end - line) + "\n";
-    line = end + 1;
-  }
+  for (const std::string& line : material_program_switches(generated)) switches += line + "\n";
+  if (world) switches += "#define MP_WORLD_PROGRAM 1\n";
   return expand_includes(switches + text, files, 0);
 }
 

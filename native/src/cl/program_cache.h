@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "cl/cl.h"
 
@@ -15,8 +16,17 @@ namespace mp {
 std::string assemble_program_source();
 
 // One material program (kernels/materials/material_program.cl) with the
-// add-on's generated node functions in place of its marker.
-std::string assemble_material_program_source(const std::string& generated);
+// add-on's generated node functions in place of its marker: a material's
+// kernels, or (`world`) the world's.
+std::string assemble_material_program_source(const std::string& generated, bool world = false);
+
+// The "#define MP_NODE_USES_..." lines of a material program's generated
+// code: switches it sets for the kernel headers.
+std::vector<std::string> material_program_switches(const std::string& generated);
+
+// The light program (kernels/materials/light_program.cl), with or without
+// thin film (the one switch lighting reads).
+std::string assemble_light_program_source(bool thin_film);
 
 // The first error of an OpenCL compiler log as one line ("line L:C: error:
 // ...", with a count of the others), for messages; the whole log is kept in

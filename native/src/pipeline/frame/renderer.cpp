@@ -373,6 +373,7 @@ void Renderer::Impl::read_back(const Scene& scene, const FrameSetup& frame, Rend
   else
     out.background.clear();
   out.stats.timings_ms.readback += ms_since(started);
+  out.stats.surface_record_bytes = d.programs.record_pool_bytes();
 }
 
 void Renderer::Impl::collect_stage_times(StageTimer& timer, RenderStats& st) {

@@ -3,6 +3,7 @@
 #include "cl/kernel_args.h"
 #include "cl/program_cache.h"
 #include "micropoly/error.h"
+#include "materials/mp_surface_record.h"
 
 #include <algorithm>
 
@@ -21,13 +22,14 @@ void MaterialPrograms::prepare(const Scene& scene, RenderStats& stats) {
   }
   for (size_t i = 0; i < scene.material_programs.size(); ++i) {
     if (!displaces[i] && !shades[i]) continue;
-    active_.push_back({build(scene.material_programs[i], "material '", stats), static_cast<cl_int>(i),
+    active_.push_back({build(scene.material_programs[i], false, "material '", stats), static_cast<cl_int>(i),
                        static_cast<bool>(displaces[i]), static_cast<bool>(shades[i]), static_cast<bool>(alpha[i])});
     displaces_ = displaces_ || displaces[i];
+    if (shades[i]) light(active_.back().built->thin_film, stats);
   }
   const int w = scene.world.program;
   world_ = w >= 0 && size_t(w) < scene.material_programs.size()
-               ? build(scene.material_programs[size_t(w)], "world '", stats)
+               ? build(scene.material_programs[size_t(w)], true, "world '", stats)
                : nullptr;
   evict_unused();
 }
@@ -43,15 +45,17 @@ void MaterialPrograms::evict_unused() {
   for (const std::string& source : evict) built_.erase(source);
 }
 
-MaterialPrograms::Built* MaterialPrograms::build(const MaterialProgram& mp, const char* owner, RenderStats& stats) {
-  auto it = built_.find(mp.source);
+MaterialPrograms::Built* MaterialPrograms::build(const MaterialProgram& mp, bool world, const char* owner,
+                                                 RenderStats& stats) {
+  const std::string key = (world ? "world\n" : "material\n") + mp.source;
+  auto it = built_.find(key);
   if (it != built_.end()) {
     it->second->used = generation_;
     return it->second.get();
   }
   BuiltProgram b;
   try {
-    b = build_program_cached(session_.context(), session_.device(), assemble_material_program_source(mp.source),
+    b = build_program_cached(session_.context(), session_.device(), assemble_material_program_source(mp.source, world),
                              "-cl-std=CL1.2");
   } catch (const Error& e) {
     throw Error(owner + mp.name + "': its node tree did not compile: " + e.what());
@@ -59,12 +63,31 @@ MaterialPrograms::Built* MaterialPrograms::build(const MaterialProgram& mp, cons
   stats.program_build_ms += b.build_ms;
   auto built = std::make_unique<Built>();
   built->program = b.program;
-  built->displace = SceneKernel(built->program, "displace_grids");
-  built->shade = SceneKernel(built->program, "shade_program_grids");
-  built->bake_world = SceneKernel(built->program, "bake_world");
-  built->world_pixels = SceneKernel(built->program, "world_pixels");
+  const std::vector<std::string> switches = material_program_switches(mp.source);
+  built->thin_film = std::any_of(switches.begin(), switches.end(), [](const std::string& line) {
+    return line.rfind("#define MP_NODE_USES_THIN_FILM", 0) == 0;
+  });
+  if (world) {
+    built->bake_world = SceneKernel(built->program, "bake_world");
+    built->world_pixels = SceneKernel(built->program, "world_pixels");
+  } else {
+    built->displace = SceneKernel(built->program, "displace_grids");
+    built->shade = SceneKernel(built->program, "shade_program_grids");
+  }
   built->used = generation_;
-  return built_.emplace(mp.source, std::move(built)).first->second.get();
+  return built_.emplace(key, std::move(built)).first->second.get();
+}
+
+MaterialPrograms::Light& MaterialPrograms::light(bool thin_film, RenderStats& stats) {
+  std::unique_ptr<Light>& l = light_[thin_film ? 1 : 0];
+  if (l) return *l;
+  BuiltProgram b = build_program_cached(session_.context(), session_.device(),
+                                        assemble_light_program_source(thin_film), "-cl-std=CL1.2");
+  stats.program_build_ms += b.build_ms;
+  l = std::make_unique<Light>();
+  l->program = b.program;
+  l->kernel = SceneKernel(l->program, "light_program_surfaces");
+  return *l;
 }
 
 WorldMap MaterialPrograms::bake_world(const Scene& scene, const SceneBuffers& buffers) {
@@ -134,11 +157,42 @@ void MaterialPrograms::alpha(const cl::Buffer& diceable, cl_uint count, const Sc
 void MaterialPrograms::run_shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
                                  const FrameParams& f, GridBuffers& grids, const ShadowInputs& shadows,
                                  const cl::Buffer& visible, bool alpha_only, StageTimer& timer) {
-  for (Active& a : active_) {
-    if (!(alpha_only ? a.alpha : a.shades)) continue;
-    cl::Kernel& k = a.built->shade.bind(scene, diceable, count, f, a.index, grids.p, grids.n, grids.c,
-                                        grids.vertex_offsets, shadows.args(), cl_uint(alpha_only ? 1 : 0), visible);
-    launch(k, count, grids, Stage::Shade, timer);
+  if (alpha_only) {
+    for (Active& a : active_) {
+      if (!a.alpha) continue;
+      launch(a.built->shade.bind(scene, diceable, count, f, a.index, grids.p, grids.n, grids.c, grids.vertex_offsets,
+                                 cl_uint(1), visible, cl::Buffer(), cl_uint(0)),
+             count, grids, Stage::Shade, timer);
+    }
+    return;
+  }
+  if (grids.vertex_total == 0 ||
+      std::none_of(active_.begin(), active_.end(), [](const Active& a) { return a.shades; }))
+    return;
+  // The batch's vertices a range at a time, as many as the record pool's
+  // budget holds: each program records its vertices' closures, then the
+  // light program lights them, before the next range reuses the pool.
+  const size_t budget = (session_.info().type == "cpu" ? kRecordPoolMiB : kRecordPoolGpuMiB) << 20;
+  const size_t vertices = (size_t(grids.vertex_total) + 63) / 64 * 64;
+  const size_t range = std::min(vertices, std::max<size_t>(64, budget / MP_SURFACE_RECORD_BYTES / 64 * 64));
+  session_.reserve(records_, records_bytes_, range * MP_SURFACE_RECORD_BYTES, "material surface records");
+  DeviceQueue& q = session_.queue();
+  const cl_uint stride = cl_uint(range);
+  for (size_t first = 0; first < vertices; first += range) {
+    const size_t size = std::min(range, vertices - first);
+    for (Active& a : active_) {
+      if (!a.shades) continue;
+      cl::Event recorded, lit;
+      q.enqueueNDRangeKernel(a.built->shade.bind(scene, diceable, count, f, a.index, grids.p, grids.n, grids.c,
+                                                 grids.vertex_offsets, cl_uint(0), visible, records_, stride),
+                             cl::NDRange(first), cl::NDRange(size), cl::NDRange(64), nullptr, &recorded);
+      timer.add(Stage::Shade, recorded);
+      q.enqueueNDRangeKernel(light_[a.built->thin_film ? 1 : 0]->kernel.bind(scene, f, grids.p, grids.n, grids.c,
+                                                                             shadows.args(), records_, stride,
+                                                                             cl_uint(size)),
+                             cl::NullRange, cl::NDRange(size), cl::NDRange(64), nullptr, &lit);
+      timer.add(Stage::Shade, lit);
+    }
   }
 }
 

@@ -46,13 +46,32 @@ class MaterialPrograms {
   // what a shadow view needs.
   void alpha(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
              GridBuffers& grids, StageTimer& timer);
+  // The budget of the record pool a shading launch hands the light program
+  // (mp_surface_record.h): on CPUs, and on other devices, which want more
+  // vertices a launch.
+  static constexpr size_t kRecordPoolMiB = 32, kRecordPoolGpuMiB = 256;
+  // Bytes the record pool holds (at most its budget).
+  size_t record_pool_bytes() const { return records_bytes_; }
 
  private:
   struct Built {
     cl::Program program;
     SceneKernel displace, shade, bake_world, world_pixels;
+    bool thin_film = false;       // lit by the light program with thin film
     unsigned long long used = 0;  // the last prepare() that used it
   };
+  // The light program (kernels/materials/light_program.cl) without and with
+  // thin film: built on first use, then kept for the session.
+  struct Light {
+    cl::Program program;
+    SceneKernel kernel;
+  };
+  Light& light(bool thin_film, RenderStats& stats);
+  std::unique_ptr<Light> light_[2];
+  // The record pool (mp_surface_record.h): a range of the batch's vertices
+  // at a time, within kRecordPoolMiB.
+  cl::Buffer records_;
+  size_t records_bytes_ = 0;
   // Programs kept beyond those the current scene uses: node values are
   // parameters (Material::program_params), but a tree whose structure
   // changes (a link made, a node added, a mode switched) builds a new
@@ -66,14 +85,16 @@ class MaterialPrograms {
     cl_int index;  // the scene's program index, as DeviceMaterial.program[0]
     bool displaces, shades, alpha;
   };
-  Built* build(const MaterialProgram& mp, const char* owner, RenderStats& stats);
+  // The program of a material's tree, or (`world`) of the world's: each
+  // holds only its own kernels (material_program.cl).
+  Built* build(const MaterialProgram& mp, bool world, const char* owner, RenderStats& stats);
   void launch(cl::Kernel& kernel, cl_uint count, GridBuffers& grids, Stage stage, StageTimer& timer);
   void run_shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
                  GridBuffers& grids, const ShadowInputs& shadows, const cl::Buffer& visible, bool alpha_only,
                  StageTimer& timer);
 
   DeviceSession& session_;
-  std::unordered_map<std::string, std::unique_ptr<Built>> built_;  // by source
+  std::unordered_map<std::string, std::unique_ptr<Built>> built_;  // by kind and source
   unsigned long long generation_ = 0;                               // prepare() calls
   std::vector<Active> active_;
   Built* world_ = nullptr;  // the scene's world program, if any
