@@ -104,6 +104,12 @@ SUITES = {
                        for scene in ("floor", "card") for mode, width in (("filtered", "1"), ("unfiltered", "0"))],
                       repeat=10, stages=("upload",) + CORE_STAGES,
                       ratios=[("floor/filtered", "floor/unfiltered"), ("card/filtered", "card/unfiltered")]),
+    "materials": Suite("node trees recorded by their programs and lit by the light program: the soak scene's "
+                       "trees at 1920x1080 (bench/program_build_bench.py --make-rib), and the image textures' "
+                       "emission trees",
+                       [Case("trees", "material_trees_1080.rib", []),
+                        Case("floor", "texture_floor.rib", []), Case("card", "texture_card.rib", [])],
+                       repeat=10, stages=("upload",) + SHADOW_STAGES + CORE_STAGES),
     "culling": Suite("hidden layers in every view, shadows on: nested shells (lamp inside, lamp outside), "
                      "1,000 stacked layers (point lamp, sun), the rock field",
                      _culling_cases(), repeat=3, stages=SHADOW_STAGES + CORE_STAGES,
