@@ -266,6 +266,14 @@ mp::DeviceSession& session() {
   return *s;
 }
 
+// One MaterialPrograms for the process, as a renderer keeps one: the light
+// program every tree shares is built once, and trees beyond a few spare are
+// released (MaterialPrograms::kSparePrograms), so memory stays flat.
+mp::MaterialPrograms& programs() {
+  static const std::unique_ptr<mp::MaterialPrograms> p = std::make_unique<mp::MaterialPrograms>(session());
+  return *p;
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
@@ -297,10 +305,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   material.program_shades = true;
   material.program_displaces = true;
   scene.materials.push_back(material);
-  mp::MaterialPrograms programs(session());
   mp::RenderStats stats;
   try {
-    programs.prepare(scene, stats);
+    programs().prepare(scene, stats);
     if (print) std::fprintf(stderr, "built\n");
   } catch (const mp::Error& e) {
     if (print) std::fprintf(stderr, "refused: %.300s\n", e.what());
