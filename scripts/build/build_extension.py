@@ -4,7 +4,9 @@
 
 Run by `cmake --build build --target extension`. Steps:
   1. the micropoly_native wheel from this project's CMake, by scikit-build-core
-     (pyproject.toml), in a build venv under the build folder;
+     (pyproject.toml), in a build venv under the build folder; given
+     --core-archive (the developer build's core library, as the CMake target
+     passes it), only the Python module's own sources are compiled;
   2. auditwheel repair: the wheel then carries every shared library it links
      (OpenCL ICD loader, OpenSubdiv, libpng, OpenEXR, ...) and gets a
      manylinux tag;
@@ -81,6 +83,9 @@ def main():
     parser.add_argument("--source", required=True)
     parser.add_argument("--build", required=True)
     parser.add_argument("--out", required=True)
+    parser.add_argument("--core-archive",
+                        help="the developer build's libmicropoly_core.a, linked into the wheel's module instead of "
+                             "compiling the same sources again (CMake's extension target passes it)")
     args = parser.parse_args()
     source, build, out = (os.path.abspath(p) for p in (args.source, args.build, args.out))
     addon = os.path.join(source, "addon", "micropoly")
@@ -99,8 +104,11 @@ def main():
     env = dict(os.environ)
     # An incremental CMake build folder of its own, beside the developer one.
     env["SKBUILD_BUILD_DIR"] = os.path.join(build, "wheel-build")
+    settings = []
+    if args.core_archive:
+        settings = [f"--config-settings=cmake.define.MICROPOLY_CORE_ARCHIVE={os.path.abspath(args.core_archive)}"]
     run([python, "-m", "pip", "wheel", "-q", "--disable-pip-version-check", "--no-build-isolation", "--no-deps",
-         "-w", raw, source], env=env)
+         "-w", raw] + settings + [source], env=env)
     built = glob.glob(os.path.join(raw, "micropoly_native-*.whl"))
     if len(built) != 1:
         raise SystemExit(f"expected one micropoly_native wheel, found {built}")

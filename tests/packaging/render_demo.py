@@ -4,7 +4,7 @@ addons/, as a legacy add-on) or installed from the extension zip the way
 Preferences > Get Extensions > Install from Disk does.
 
   python render_demo.py --out OUT.png --report R.json (--addon-dir DIR | --install-zip ZIP | --installed)
-                        [--viewport]
+                        [--viewport] [--once] [--percentage P]
 
 The demo scene is built (scripts/build/demo_scene.py --no-render, which enables
 the add-on and so starts its kernel warm-up, addon/micropoly/warm_up.py);
@@ -77,6 +77,8 @@ def main():
     source.add_argument("--installed", action="store_true")
     parser.add_argument("--viewport", action="store_true")
     parser.add_argument("--once", action="store_true", help="one F12 (under emulation, where each takes a minute)")
+    parser.add_argument("--percentage", type=int, default=100,
+                        help="the render's resolution percentage (the emulated F12 renders a small frame)")
     args = parser.parse_args()
 
     import bpy
@@ -100,6 +102,7 @@ def main():
     t0 = time.perf_counter()
     sys.argv = [DEMO, "--", os.path.abspath(args.out), "--no-render"]
     runpy.run_path(DEMO, run_name="__main__")
+    bpy.context.scene.render.resolution_percentage = args.percentage
     warm_up = sys.modules[f"{module}.warm_up"]
     warm_up.wait(600.0)
     report["warm_up"] = dict(warm_up.state(), waited_s=time.perf_counter() - t0)
