@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
-# Packs the built CLI and test binary with the shared libraries they need
+# Packs the built CLI, test binary and device_limits with the shared libraries they need
 # (everything but glibc) into .device/, for running on a machine that has a
 # GPU but no Debian packages. Usage: bench/make_device_bundle.sh [build-dir]
 set -euo pipefail
 build=${1:-build}
 out=.device
 rm -rf "$out" && mkdir -p "$out/lib"
-cp "$build/micropoly-render" "$build/micropoly_tests" "$out/"
-for bin in "$build/micropoly-render" "$build/micropoly_tests"; do
+cp "$build/micropoly-render" "$build/micropoly_tests" "$build/device_limits" "$out/"
+for bin in "$build/micropoly-render" "$build/micropoly_tests" "$build/device_limits"; do
   ldd "$bin" | awk '/=> \//{print $3}' | grep -vE '/(libc|libm|libpthread|libdl|librt)\.so' | xargs -r cp -L -t "$out/lib/"
 done
 cp -r tests/scenes "$out/scenes"

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mp {
@@ -78,6 +79,12 @@ struct RenderStats {
   size_t surface_record_bytes = 0;
   size_t batches = 0;
   size_t bound_split_launches = 0;
+  // Times the host waited for the device during the frame (a finish, a
+  // blocking read, write or map, an event), and how many in each phase
+  // ("shadows/bound_split", ...; most first): each is a round trip in which
+  // a GPU runs dry (native/src/cl/host_waits.h).
+  size_t host_waits = 0;
+  std::vector<std::pair<std::string, size_t>> host_waits_by_phase;
   // Buckets the frame was rendered in (RenderSettings::sample_memory_mib).
   size_t buckets = 1;
   double program_build_ms = 0;       // 0 when the binary cache was used... see program_cache_hit

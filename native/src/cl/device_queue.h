@@ -1,7 +1,9 @@
 // The command queue every pipeline stage enqueues through: a
 // cl::CommandQueue whose enqueue and finish calls first pass the session's
-// fault injector (device_faults.h). Callers hold it as DeviceQueue& (a
-// cl::CommandQueue& would bypass the check, as these hide, not override).
+// fault injector (device_faults.h), and whose calls that hold the host until
+// the device is done are counted (host_waits.h). Callers hold it as
+// DeviceQueue& (a cl::CommandQueue& would bypass both, as these hide, not
+// override).
 #pragma once
 
 #include <utility>
@@ -9,14 +11,16 @@
 
 #include "cl/cl.h"
 #include "cl/device_faults.h"
+#include "cl/host_waits.h"
 
 namespace mp {
 
 class DeviceQueue : public cl::CommandQueue {
  public:
   DeviceQueue() = default;
-  DeviceQueue(const cl::CommandQueue& queue, FaultInjector& faults, const std::vector<const char*>& activities)
-      : cl::CommandQueue(queue), faults_(&faults), activities_(&activities) {}
+  DeviceQueue(const cl::CommandQueue& queue, FaultInjector& faults, const std::vector<const char*>& activities,
+              HostWaits& waits)
+      : cl::CommandQueue(queue), faults_(&faults), activities_(&activities), waits_(&waits) {}
 
   template <typename... A>
   cl_int enqueueNDRangeKernel(A&&... a) const {
@@ -24,19 +28,22 @@ class DeviceQueue : public cl::CommandQueue {
     return cl::CommandQueue::enqueueNDRangeKernel(std::forward<A>(a)...);
   }
   template <typename... A>
-  cl_int enqueueReadBuffer(A&&... a) const {
+  cl_int enqueueReadBuffer(const cl::Buffer& buffer, cl_bool blocking, A&&... a) const {
     check(DeviceOp::Read, "clEnqueueReadBuffer");
-    return cl::CommandQueue::enqueueReadBuffer(std::forward<A>(a)...);
+    if (blocking) waited();
+    return cl::CommandQueue::enqueueReadBuffer(buffer, blocking, std::forward<A>(a)...);
   }
   template <typename... A>
-  void* enqueueMapBuffer(A&&... a) const {
+  void* enqueueMapBuffer(const cl::Buffer& buffer, cl_bool blocking, A&&... a) const {
     check(DeviceOp::Read, "clEnqueueMapBuffer");
-    return cl::CommandQueue::enqueueMapBuffer(std::forward<A>(a)...);
+    if (blocking) waited();
+    return cl::CommandQueue::enqueueMapBuffer(buffer, blocking, std::forward<A>(a)...);
   }
   template <typename... A>
-  cl_int enqueueWriteBuffer(A&&... a) const {
+  cl_int enqueueWriteBuffer(const cl::Buffer& buffer, cl_bool blocking, A&&... a) const {
     check(DeviceOp::Write, "clEnqueueWriteBuffer");
-    return cl::CommandQueue::enqueueWriteBuffer(std::forward<A>(a)...);
+    if (blocking) waited();
+    return cl::CommandQueue::enqueueWriteBuffer(buffer, blocking, std::forward<A>(a)...);
   }
   template <typename... A>
   cl_int enqueueFillBuffer(A&&... a) const {
@@ -50,7 +57,13 @@ class DeviceQueue : public cl::CommandQueue {
   }
   cl_int finish() const {
     check(DeviceOp::Finish, "clFinish");
+    waited();
     return cl::CommandQueue::finish();
+  }
+  // Waits for `event`, one of this queue's commands.
+  void wait(const cl::Event& event) const {
+    waited();
+    event.wait();
   }
   // Waits for the queue without the fault check and without throwing: for
   // cleaning up after a failure, when host memory that queued transfers
@@ -61,8 +74,12 @@ class DeviceQueue : public cl::CommandQueue {
   void check(DeviceOp op, const char* call) const {
     if (faults_ && faults_->armed()) faults_->hit(op, call, activities_->empty() ? "" : activities_->back());
   }
+  void waited() const {
+    if (waits_) waits_->note(*activities_);
+  }
   FaultInjector* faults_ = nullptr;
   const std::vector<const char*>* activities_ = nullptr;
+  HostWaits* waits_ = nullptr;
 };
 
 }  // namespace mp

@@ -86,6 +86,10 @@ py::dict stats_dict(const RenderStats& s) {
   d["bound_split_peak_bytes"] = s.bound_split_peak_bytes;
   d["bound_split_launches"] = s.bound_split_launches;
   d["batches"] = s.batches;
+  d["host_waits"] = s.host_waits;
+  py::dict waits;
+  for (const auto& [phase, count] : s.host_waits_by_phase) waits[py::str(phase)] = count;
+  d["host_waits_by_phase"] = waits;
   d["buckets"] = s.buckets;
   d["program_build_ms"] = s.program_build_ms;
   d["program_cache_hit"] = s.program_cache_hit;

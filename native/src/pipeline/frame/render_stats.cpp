@@ -56,6 +56,12 @@ std::string RenderStats::to_json() const {
   j += "  \"surface_record_bytes\": " + std::to_string(surface_record_bytes) + ",\n";
   j += "  \"bound_split_launches\": " + std::to_string(bound_split_launches) + ",\n";
   j += "  \"batches\": " + std::to_string(batches) + ",\n";
+  j += "  \"host_waits\": " + std::to_string(host_waits) + ",\n";
+  j += "  \"host_waits_by_phase\": {";
+  for (size_t i = 0; i < host_waits_by_phase.size(); ++i)
+    j += std::string(i ? ", " : "") + json_string(host_waits_by_phase[i].first) + ": " +
+         std::to_string(host_waits_by_phase[i].second);
+  j += "},\n";
   j += "  \"buckets\": " + std::to_string(buckets) + ",\n";
   j += "  \"program_build_ms\": " + num(program_build_ms) + ",\n";
   j += "  \"program_cache_hit\": " + std::string(program_cache_hit ? "true" : "false") + ",\n";

@@ -249,6 +249,8 @@ void Renderer::Impl::render_frame(const Scene& scene, RenderResult& out, const P
   }
   read_back(scene, frame, out);
   collect_stage_times(timer, st);
+  st.host_waits = s.host_waits().total();
+  st.host_waits_by_phase = s.host_waits().by_phase();
   st.timings_ms.total = ms_since(started);
   if (progress) progress(1.0f);
 }
@@ -257,6 +259,7 @@ RenderStats& Renderer::Impl::begin_stats(RenderResult& out) {
   out.stats = RenderStats{};
   RenderStats& st = out.stats;
   st.device = session->info().name;
+  session->host_waits().reset();
   if (first_render) {
     st.program_build_ms = session->program_build_ms();
     st.program_cache_hit = session->program_cache_hit();

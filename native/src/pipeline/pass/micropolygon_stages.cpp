@@ -173,7 +173,7 @@ void SampleStage::read_hidden_counts() {
 }
 
 SampleStage::HiddenCounts SampleStage::hidden_counts() {
-  if (hidden_read_()) hidden_read_.wait();
+  if (hidden_read_()) session_.queue().wait(hidden_read_);
   hidden_read_ = cl::Event();
   return {static_cast<size_t>(hidden_host_[0]), static_cast<size_t>(hidden_host_[1])};
 }
