@@ -75,8 +75,8 @@ def report(suite, cases, builds, times, stages, last):
     two = len(builds) == 2
     print(f"| case | build | frame ms | {' | '.join(stages)} | micropolygons | shadow micropolygons | "
           f"micropolygons per pixel of surface | bound & split MiB peak | shadows MiB peak / budget | marking passes | buckets | "
-          f"host waits |" + (" after / before |" if two else ""))
-    print("|---|---|---|" + "---|" * len(stages) + "---|---|---|---|---|---|---|---|" + ("---|" if two else ""))
+          f"host waits | kernel launches |" + (" after / before |" if two else ""))
+    print("|---|---|---|" + "---|" * len(stages) + "---|---|---|---|---|---|---|---|---|" + ("---|" if two else ""))
     frame = {}
     for case in cases:
         for build, _ in builds:
@@ -94,7 +94,7 @@ def report(suite, cases, builds, times, stages, last):
                   f" | {s['micropolygons']:,} | {sh['micropolygons']:,} | "
                   f"{s['micropolygons_sampled'] / max(s['sampled_area_px'], 1e-9):.2f} | {mib(s['bound_split_peak_bytes']):.1f} | "
                   f"{mib(sh['peak_bytes']):.1f} / {mib(sh['budget_bytes']):.0f} | {sh.get('marking_passes', 0)} | "
-                  f"{s['buckets']} | {s.get('host_waits', '—')} |" + ratio)
+                  f"{s['buckets']} | {s.get('host_waits', '—')} | {s.get('kernel_launches', '—')} |" + ratio)
     names = {c.name for c in cases}
     for a, b in suite.ratios:
         if a in names and b in names:

@@ -11,6 +11,7 @@
 //   launch_us           one of 1000 empty kernels enqueued back to back, one
 //                       clFinish at the end (what a launch costs when the
 //                       host never waits)
+//   enqueue_us          of that, the host's own time in clEnqueueNDRangeKernel
 //   read_pinned_gbs     32 MiB read into host memory the driver pinned
 //                       (CL_MEM_ALLOC_HOST_PTR, mapped)
 //   read_pageable_gbs   32 MiB read into ordinary host memory
@@ -74,11 +75,16 @@ int main(int argc, char** argv) {
       q.enqueueReadBuffer(word, CL_TRUE, 0, sizeof back, &back);
     });
     const int kLaunches = 1000;
+    std::vector<double> enqueue;
     const double launch_us = median_us(5, [&] {
+                               const auto start = Clock::now();
                                for (int i = 0; i < kLaunches; ++i) launch();
+                               enqueue.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
                                q.finish();
                              }) /
                              kLaunches;
+    enqueue.erase(enqueue.begin(), enqueue.begin() + 3);  // median_us's warm-up trials
+    const double enqueue_us = median(enqueue) / kLaunches;
 
     const size_t read_bytes = size_t(32) << 20;
     cl::Buffer image = session.allocate(read_bytes, "device_limits image");
@@ -105,8 +111,9 @@ int main(int argc, char** argv) {
     char text[1024];
     std::snprintf(text, sizeof text,
                   "{\"device\": \"%s\", \"round_trip_us\": %.2f, \"read_round_trip_us\": %.2f, \"launch_us\": %.3f, "
+                  "\"enqueue_us\": %.3f, "
                   "\"read_pinned_gbs\": %.2f, \"read_pageable_gbs\": %.2f, \"copy_gbs\": %.1f}\n",
-                  session.info().name.c_str(), round_trip, read_round_trip, launch_us, gbs(read_bytes, pinned_us),
+                  session.info().name.c_str(), round_trip, read_round_trip, launch_us, enqueue_us, gbs(read_bytes, pinned_us),
                   gbs(read_bytes, pageable_us), gbs(2 * copy_bytes, copy_us));
     std::fputs(text, stdout);
     if (!json.empty()) std::ofstream(json) << text;

@@ -4,11 +4,7 @@
 # sanitized GoogleTest subset below, one CLI render, and the fuzz targets' CI
 # run when tests/fuzz provides them (docs/reliability.md).
 #
-#   scripts/check_sanitized.sh [BUILD_DIR] [--build-only]   (default: build-sanitize)
-#
-# --build-only configures and builds, and stops there (scripts/setup.sh test
-# builds the tree this way at idle priority while the other tests run; the
-# full run after them then finds it built).
+#   scripts/check_sanitized.sh [BUILD_DIR]     (default: build-sanitize)
 #
 # One clang build serves both the sanitized tests and the libFuzzer targets
 # (libFuzzer is clang's; Debian 12: clang, libclang-rt-14-dev). Any sanitizer
@@ -16,12 +12,7 @@
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-build_only=0
-args=()
-for arg in "$@"; do
-  if [[ $arg == --build-only ]]; then build_only=1; else args+=("$arg"); fi
-done
-build=$(realpath -m "${args[0]:-build-sanitize}")
+build=$(realpath -m "${1:-build-sanitize}")
 jobs=${MICROPOLY_JOBS:-2}
 start=$SECONDS
 
@@ -48,7 +39,6 @@ echo "== build (-j$jobs)"
 # texture_probe tool and, with MICROPOLY_FUZZ, the fuzz targets.
 cmake --build "$build" -j "$jobs"
 echo "   configure + build: $((SECONDS - start)) s"
-if ((build_only)); then exit 0; fi
 
 # Sanitizer settings for the tests and the render below (tests/fuzz/run_ci.sh
 # sets its own for the fuzz targets).

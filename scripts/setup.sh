@@ -79,22 +79,11 @@ case "$mode" in
     echo "wrote $here/demo.png and $here/teapot.png"
     ;;
   test)
-    # The sanitized tree (clang, ASan + UBSan, fuzz targets) compiles while
-    # the tests run, at idle priority (SCHED_IDLE): it takes only the time
-    # the tests leave a core unused (network, disk, waits), and the tests'
-    # own speed is unchanged.
-    echo "== building the sanitized tree at idle priority (build-sanitize/background-build.log)"
-    mkdir -p build-sanitize
-    # (its own process group, so that a failed test run stops all of it)
-    setsid -w chrt --idle 0 bash scripts/check_sanitized.sh build-sanitize --build-only \
-      >build-sanitize/background-build.log 2>&1 &
-    sanitized_build=$!
     echo "== running tests"
     # One test per core: much of a test is single-threaded (Blender's start,
     # the export, kernel builds), so two at a time finish sooner.
-    (cd build && ctest --output-on-failure -j "$jobs") || { kill -- "-$sanitized_build" 2>/dev/null; exit 1; }
+    (cd build && ctest --output-on-failure -j "$jobs")
     echo "== sanitizers (AddressSanitizer, UndefinedBehaviorSanitizer) and fuzzing"
-    wait "$sanitized_build" || { cat build-sanitize/background-build.log; exit 1; }
     bash scripts/check_sanitized.sh build-sanitize
     ;;
   *) echo "unknown mode '$mode' (demo, test or build)" >&2; exit 2 ;;

@@ -104,9 +104,9 @@ def main():
     env = dict(os.environ)
     # An incremental CMake build folder of its own, beside the developer one.
     env["SKBUILD_BUILD_DIR"] = os.path.join(build, "wheel-build")
-    settings = []
-    if args.core_archive:
-        settings = [f"--config-settings=cmake.define.MICROPOLY_CORE_ARCHIVE={os.path.abspath(args.core_archive)}"]
+    # Stated either way: the wheel's build folder keeps CMake's cache between runs.
+    archive = os.path.abspath(args.core_archive) if args.core_archive else ""
+    settings = [f"--config-settings=cmake.define.MICROPOLY_CORE_ARCHIVE={archive}"]
     run([python, "-m", "pip", "wheel", "-q", "--disable-pip-version-check", "--no-build-isolation", "--no-deps",
          "-w", raw] + settings + [source], env=env)
     built = glob.glob(os.path.join(raw, "micropoly_native-*.whl"))

@@ -82,9 +82,12 @@ struct RenderStats {
   // Times the host waited for the device during the frame (a finish, a
   // blocking read, write or map, an event), and how many in each phase
   // ("shadows/bound_split", ...; most first): each is a round trip in which
-  // a GPU runs dry (native/src/cl/host_waits.h).
+  // a GPU runs dry; and the kernels launched, in all and per phase
+  // (native/src/cl/queue_counts.h).
   size_t host_waits = 0;
   std::vector<std::pair<std::string, size_t>> host_waits_by_phase;
+  size_t kernel_launches = 0;
+  std::vector<std::pair<std::string, size_t>> kernel_launches_by_phase;
   // Buckets the frame was rendered in (RenderSettings::sample_memory_mib).
   size_t buckets = 1;
   double program_build_ms = 0;       // 0 when the binary cache was used... see program_cache_hit

@@ -1,7 +1,7 @@
 // The command queue every pipeline stage enqueues through: a
 // cl::CommandQueue whose enqueue and finish calls first pass the session's
-// fault injector (device_faults.h), and whose calls that hold the host until
-// the device is done are counted (host_waits.h). Callers hold it as
+// fault injector (device_faults.h), and whose launches and calls that hold
+// the host until the device is done are counted (queue_counts.h). Callers hold it as
 // DeviceQueue& (a cl::CommandQueue& would bypass both, as these hide, not
 // override).
 #pragma once
@@ -11,7 +11,7 @@
 
 #include "cl/cl.h"
 #include "cl/device_faults.h"
-#include "cl/host_waits.h"
+#include "cl/queue_counts.h"
 
 namespace mp {
 
@@ -19,12 +19,13 @@ class DeviceQueue : public cl::CommandQueue {
  public:
   DeviceQueue() = default;
   DeviceQueue(const cl::CommandQueue& queue, FaultInjector& faults, const std::vector<const char*>& activities,
-              HostWaits& waits)
-      : cl::CommandQueue(queue), faults_(&faults), activities_(&activities), waits_(&waits) {}
+              QueueCounts& counts)
+      : cl::CommandQueue(queue), faults_(&faults), activities_(&activities), counts_(&counts) {}
 
   template <typename... A>
   cl_int enqueueNDRangeKernel(A&&... a) const {
     check(DeviceOp::Launch, "clEnqueueNDRangeKernel");
+    if (counts_) counts_->launches.note(*activities_);
     return cl::CommandQueue::enqueueNDRangeKernel(std::forward<A>(a)...);
   }
   template <typename... A>
@@ -75,11 +76,11 @@ class DeviceQueue : public cl::CommandQueue {
     if (faults_ && faults_->armed()) faults_->hit(op, call, activities_->empty() ? "" : activities_->back());
   }
   void waited() const {
-    if (waits_) waits_->note(*activities_);
+    if (counts_) counts_->waits.note(*activities_);
   }
   FaultInjector* faults_ = nullptr;
   const std::vector<const char*>* activities_ = nullptr;
-  HostWaits* waits_ = nullptr;
+  QueueCounts* counts_ = nullptr;
 };
 
 }  // namespace mp

@@ -77,9 +77,10 @@ class DeviceSession {
   bool responds();
 
   FaultInjector& faults() { return faults_; }
-  // The host's waits on the device (host_waits.h); the renderer resets
-  // them at each frame's start and reports them in its stats.
-  HostWaits& host_waits() { return host_waits_; }
+  // The queue's launches and the host's waits on the device
+  // (queue_counts.h); the renderer resets them at each frame's start and
+  // reports them in its stats.
+  QueueCounts& queue_counts() { return queue_counts_; }
 
  private:
   void open(const std::string& selector);
@@ -89,7 +90,7 @@ class DeviceSession {
   cl::Context context_;
   FaultInjector faults_;
   std::vector<const char*> activities_;
-  HostWaits host_waits_;
+  QueueCounts queue_counts_;
   std::string failed_activity_;
   DeviceQueue queue_;
   cl::Program program_;

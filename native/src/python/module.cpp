@@ -86,10 +86,15 @@ py::dict stats_dict(const RenderStats& s) {
   d["bound_split_peak_bytes"] = s.bound_split_peak_bytes;
   d["bound_split_launches"] = s.bound_split_launches;
   d["batches"] = s.batches;
+  auto by_phase = [](const std::vector<std::pair<std::string, size_t>>& counts) {
+    py::dict out;
+    for (const auto& [phase, count] : counts) out[py::str(phase)] = count;
+    return out;
+  };
   d["host_waits"] = s.host_waits;
-  py::dict waits;
-  for (const auto& [phase, count] : s.host_waits_by_phase) waits[py::str(phase)] = count;
-  d["host_waits_by_phase"] = waits;
+  d["host_waits_by_phase"] = by_phase(s.host_waits_by_phase);
+  d["kernel_launches"] = s.kernel_launches;
+  d["kernel_launches_by_phase"] = by_phase(s.kernel_launches_by_phase);
   d["buckets"] = s.buckets;
   d["program_build_ms"] = s.program_build_ms;
   d["program_cache_hit"] = s.program_cache_hit;

@@ -29,6 +29,14 @@ std::string num(double v) {
   return buf;
 }
 
+// {"phase": count, ...} in the order given.
+std::string json_counts(const std::vector<std::pair<std::string, size_t>>& counts) {
+  std::string j = "{";
+  for (size_t i = 0; i < counts.size(); ++i)
+    j += std::string(i ? ", " : "") + json_string(counts[i].first) + ": " + std::to_string(counts[i].second);
+  return j + "}";
+}
+
 }  // namespace
 
 std::string RenderStats::to_json() const {
@@ -57,11 +65,9 @@ std::string RenderStats::to_json() const {
   j += "  \"bound_split_launches\": " + std::to_string(bound_split_launches) + ",\n";
   j += "  \"batches\": " + std::to_string(batches) + ",\n";
   j += "  \"host_waits\": " + std::to_string(host_waits) + ",\n";
-  j += "  \"host_waits_by_phase\": {";
-  for (size_t i = 0; i < host_waits_by_phase.size(); ++i)
-    j += std::string(i ? ", " : "") + json_string(host_waits_by_phase[i].first) + ": " +
-         std::to_string(host_waits_by_phase[i].second);
-  j += "},\n";
+  j += "  \"host_waits_by_phase\": " + json_counts(host_waits_by_phase) + ",\n";
+  j += "  \"kernel_launches\": " + std::to_string(kernel_launches) + ",\n";
+  j += "  \"kernel_launches_by_phase\": " + json_counts(kernel_launches_by_phase) + ",\n";
   j += "  \"buckets\": " + std::to_string(buckets) + ",\n";
   j += "  \"program_build_ms\": " + num(program_build_ms) + ",\n";
   j += "  \"program_cache_hit\": " + std::string(program_cache_hit ? "true" : "false") + ",\n";

@@ -102,8 +102,10 @@ struct Renderer::Impl {
   std::vector<Light> upload(const Scene& scene, RenderStats& st);
   GridBuffers& frame_grids(const FrameParams& f);
   static std::vector<Bucket> frame_buckets(const Scene& scene, const FrameParams& f, DeviceSession& s);
-  static void stop(RenderResult& out, std::chrono::steady_clock::time_point started);
+  void stop(RenderResult& out, std::chrono::steady_clock::time_point started);
   void read_back(const Scene& scene, const FrameSetup& frame, RenderResult& out);
+  // The frame's host waits and launches (queue_counts.h) into its stats.
+  void collect_queue_counts(RenderStats& st);
   void collect_stage_times(StageTimer& timer, RenderStats& st);
   // After a frame failed: waits for what the queue still holds (it may point
   // into host memory that is about to go), then frees the frame's device
@@ -249,8 +251,7 @@ void Renderer::Impl::render_frame(const Scene& scene, RenderResult& out, const P
   }
   read_back(scene, frame, out);
   collect_stage_times(timer, st);
-  st.host_waits = s.host_waits().total();
-  st.host_waits_by_phase = s.host_waits().by_phase();
+  collect_queue_counts(st);
   st.timings_ms.total = ms_since(started);
   if (progress) progress(1.0f);
 }
@@ -259,7 +260,7 @@ RenderStats& Renderer::Impl::begin_stats(RenderResult& out) {
   out.stats = RenderStats{};
   RenderStats& st = out.stats;
   st.device = session->info().name;
-  session->host_waits().reset();
+  session->queue_counts().reset();
   if (first_render) {
     st.program_build_ms = session->program_build_ms();
     st.program_cache_hit = session->program_cache_hit();
@@ -356,8 +357,17 @@ std::vector<Bucket> Renderer::Impl::frame_buckets(const Scene& scene, const Fram
   return plan_buckets(f.width, f.height, f.spp_x * f.spp_y, reach, max_samples);
 }
 
+void Renderer::Impl::collect_queue_counts(RenderStats& st) {
+  const QueueCounts& counts = session->queue_counts();
+  st.host_waits = counts.waits.total();
+  st.host_waits_by_phase = counts.waits.by_phase();
+  st.kernel_launches = counts.launches.total();
+  st.kernel_launches_by_phase = counts.launches.by_phase();
+}
+
 void Renderer::Impl::stop(RenderResult& out, std::chrono::steady_clock::time_point started) {
   out.stats.cancelled = true;
+  collect_queue_counts(out.stats);
   out.stats.timings_ms.total = ms_since(started);
   out.width = out.height = 0;
   out.rgba.clear(), out.depth.clear(), out.normal.clear();

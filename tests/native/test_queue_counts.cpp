@@ -1,5 +1,6 @@
-// The count of the host's waits on the device (native/src/cl/host_waits.h):
-// what the device queue counts as a wait, by phase, and what a frame reports.
+// The counts of the host's waits on the device and of kernel launches
+// (native/src/cl/queue_counts.h): what the device queue counts, by phase,
+// and what a frame reports.
 #include <gtest/gtest.h>
 
 #include <numeric>
@@ -12,8 +13,8 @@
 namespace mp::test {
 namespace {
 
-TEST(HostWaits, CountsByPhasePathMostFirst) {
-  HostWaits w;
+TEST(QueueCounts, CountsByPhasePathMostFirst) {
+  PhaseCounts w;
   const char* outer = "shadows";
   const char* inner = "dice";
   w.note({outer, inner});
@@ -30,15 +31,20 @@ TEST(HostWaits, CountsByPhasePathMostFirst) {
   EXPECT_TRUE(w.by_phase().empty());
 }
 
-TEST(HostWaits, TheQueueCountsWhatHoldsTheHostAndNothingElse) {
+TEST(QueueCounts, TheQueueCountsLaunchesAndWhatHoldsTheHostAndNothingElse) {
   DeviceSession session("");
-  HostWaits& waits = session.host_waits();
-  waits.reset();
+  QueueCounts& counts = session.queue_counts();
+  counts.reset();
+  cl::Program program(session.context(), "__kernel void nothing(__global uint* x) { if (x[0] == 7u) x[0] = 8u; }");
+  program.build({session.device()});
+  cl::Kernel nothing(program, "nothing");
   cl::Buffer buffer = session.allocate(64, "test buffer");
   cl_uint sent[4] = {1u, 2u, 3u, 4u}, back[4] = {};
   {
     DeviceSession::Activity outer(session, "upload");
     DeviceSession::Activity inner(session, "probe");
+    nothing.setArg(0, buffer);
+    session.queue().enqueueNDRangeKernel(nothing, cl::NullRange, cl::NDRange(1), cl::NullRange);  // a launch
     session.queue().enqueueWriteBuffer(buffer, CL_FALSE, 0, sizeof sent, sent);  // not a wait
     cl::Event read;
     session.queue().enqueueReadBuffer(buffer, CL_FALSE, 0, sizeof back, back, nullptr, &read);  // not a wait
@@ -47,21 +53,26 @@ TEST(HostWaits, TheQueueCountsWhatHoldsTheHostAndNothingElse) {
   }
   session.queue().finish();  // a wait outside any phase
   EXPECT_EQ(back[3], 4u);
-  EXPECT_EQ(waits.total(), 3u);
-  const auto phases = waits.by_phase();
+  EXPECT_EQ(counts.waits.total(), 3u);
+  const auto phases = counts.waits.by_phase();
   ASSERT_EQ(phases.size(), 2u);
   EXPECT_EQ(phases[0], (std::pair<std::string, size_t>{"upload/probe", 2}));
   EXPECT_EQ(phases[1], (std::pair<std::string, size_t>{"(no phase)", 1}));
+  ASSERT_EQ(counts.launches.by_phase().size(), 1u);
+  EXPECT_EQ(counts.launches.by_phase()[0], (std::pair<std::string, size_t>{"upload/probe", 1}));
 }
 
-using FrameHostWaits = SharedRendererTest;
+using FrameQueueCounts = SharedRendererTest;
 
-TEST_F(FrameHostWaits, AFrameReportsItsWaitsByPhaseAndStartsFromNone) {
+TEST_F(FrameQueueCounts, AFrameReportsItsWaitsAndLaunchesByPhaseAndStartsFromNone) {
   Scene s = base_scene(160, 120, 4);
   s.camera = look_at({2.5f, 2.0f, 4.0f}, {0, 0, 0});
   s.meshes.push_back(grid_mesh(6, 4.0f, SubdivScheme::CatmullClark));
   s.meshes.push_back(cube_mesh(SubdivScheme::CatmullClark));
   s.settings.shadows = true;
+  // Auto would choose by measured kernel times, and with it how many passes
+  // (and waits) a frame takes.
+  s.settings.visibility_first = VisibilityFirst::Off;
   RenderResult first, second;
   renderer_->render(s, first);
   renderer_->render(s, second);
@@ -78,9 +89,17 @@ TEST_F(FrameHostWaits, AFrameReportsItsWaitsByPhaseAndStartsFromNone) {
     EXPECT_EQ(sum, st.host_waits);
     EXPECT_TRUE(readback);
     EXPECT_NE(st.to_json().find("\"host_waits\": " + std::to_string(st.host_waits)), std::string::npos);
+    // Every stage launches: at least bound & split, dicing, shading,
+    // sampling and the resolve, each in its phase.
+    size_t launched = 0;
+    for (const auto& [phase, count] : st.kernel_launches_by_phase) launched += count;
+    EXPECT_EQ(launched, st.kernel_launches);
+    EXPECT_GE(st.kernel_launches_by_phase.size(), 3u);
+    EXPECT_GE(st.kernel_launches, st.bound_split_launches + 4u);
   }
-  // Each frame counts its own waits: the second's are not added to the first's.
+  // Each frame counts its own: the second's are not added to the first's.
   EXPECT_LE(second.stats.host_waits, first.stats.host_waits);
+  EXPECT_LE(second.stats.kernel_launches, first.stats.kernel_launches);
 }
 
 }  // namespace
