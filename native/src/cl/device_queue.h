@@ -1,9 +1,9 @@
 // The command queue every pipeline stage enqueues through: a
 // cl::CommandQueue whose enqueue and finish calls first pass the session's
 // fault injector (device_faults.h), and whose launches and calls that hold
-// the host until the device is done are counted (queue_counts.h). Callers hold it as
-// DeviceQueue& (a cl::CommandQueue& would bypass both, as these hide, not
-// override).
+// the host until the device is done are counted (queue_counts.h). Callers
+// hold it as DeviceQueue& (a cl::CommandQueue& would bypass both, as these
+// hide, not override).
 #pragma once
 
 #include <utility>

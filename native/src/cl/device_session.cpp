@@ -120,7 +120,8 @@ void DeviceSession::open(const std::string& selector) {
     if (ext.find("cl_khr_int64_extended_atomics") == std::string::npos)
       throw Error("OpenCL device '" + info_.name + "' lacks cl_khr_int64_extended_atomics, which the rasteriser needs");
     context_ = cl::Context(device_);
-    queue_ = DeviceQueue(cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE), faults_, activities_, queue_counts_);
+    queue_ = DeviceQueue(cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE), faults_, activities_,
+                         queue_counts_);
     max_alloc_ = device_.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
     tile_sampler_ = compiles_tile_sampler(cl::Platform(device_.getInfo<CL_DEVICE_PLATFORM>()).getInfo<CL_PLATFORM_VERSION>());
     auto built = build_program_cached(context_, device_, assemble_program_source(),

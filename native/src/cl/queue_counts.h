@@ -10,7 +10,7 @@
 // A frame counts from its start (the renderer resets the counts there):
 // setting up a device's stages before the first frame is not in them.
 // bench/device_limits measures both costs on a device (docs/performance.md,
-// "Host waits and launches").
+// "Host waits and kernel launches").
 #pragma once
 
 #include <algorithm>
