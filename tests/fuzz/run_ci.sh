@@ -33,12 +33,21 @@ export LSAN_OPTIONS="suppressions=$here/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}
 export POCL_KERNEL_CACHE=0
 export MICROPOLY_CACHE_DIR="$work/cache"
 
-# name  binary  seconds  libFuzzer options
+# name  binary  seconds  libFuzzer options  extra LeakSanitizer options
+#
+# material_program: LeakSanitizer does not scan thread-local storage there.
+# The target loads PoCL, whose LLVM and per-program kernel libraries are
+# dlopen'ed with thread-local data; on some kernels and CPUs compiler-rt 14's
+# walk over glibc's dynamic TLS vector meets an entry that is not a block and
+# its tracer thread dies (SIGSEGV "Tracer caught signal 11", then "LeakSanitizer
+# has encountered a fatal error") before any leak is judged. Without TLS as a
+# root the check only grows stricter: an allocation that only a thread-local
+# holds is then reported as a leak, none is hidden.
 targets=(
-  "rib_reader|fuzz_rib_reader|$seconds|-max_len=8192 -timeout=10 -rss_limit_mb=2048 -dict=$here/rib.dict"
-  "rib_round_trip|fuzz_rib_round_trip|$seconds|-max_len=8192 -timeout=10 -rss_limit_mb=2048 -dict=$here/rib.dict"
-  "scene_validation|fuzz_scene_validation|$seconds|-max_len=4096 -timeout=10 -rss_limit_mb=2048 -close_fd_mask=1"
-  "material_program|fuzz_material_program|$program_seconds|-max_len=1024 -timeout=60 -rss_limit_mb=4096 -dict=$here/opencl.dict"
+  "rib_reader|fuzz_rib_reader|$seconds|-max_len=8192 -timeout=10 -rss_limit_mb=2048 -dict=$here/rib.dict|"
+  "rib_round_trip|fuzz_rib_round_trip|$seconds|-max_len=8192 -timeout=10 -rss_limit_mb=2048 -dict=$here/rib.dict|"
+  "scene_validation|fuzz_scene_validation|$seconds|-max_len=4096 -timeout=10 -rss_limit_mb=2048 -close_fd_mask=1|"
+  "material_program|fuzz_material_program|$program_seconds|-max_len=1024 -timeout=60 -rss_limit_mb=4096 -dict=$here/opencl.dict|use_tls=0"
 )
 
 failed=0
@@ -70,7 +79,8 @@ done
 printf '%-18s %8s %10s %8s %14s\n' target seconds executions exec/s "corpus in>out"
 summary=""
 for entry in "${targets[@]}"; do
-  IFS='|' read -r name exe_name secs opts <<< "$entry"
+  IFS='|' read -r name exe_name secs opts lsan_extra <<< "$entry"
+  lsan="$LSAN_OPTIONS${lsan_extra:+:$lsan_extra}"
   exe="$bin/$exe_name"
   if [ ! -x "$exe" ]; then
     fail "$exe_name is not built in $1"
@@ -79,7 +89,7 @@ for entry in "${targets[@]}"; do
   regressions=("$here"/regressions/"$name"_*)
   if [ -e "${regressions[0]}" ]; then
     # shellcheck disable=SC2086
-    if ! "$exe" $opts -runs=1 "${regressions[@]}" > "$work/$name.regressions.log" 2>&1; then
+    if ! LSAN_OPTIONS="$lsan" "$exe" $opts -runs=1 "${regressions[@]}" > "$work/$name.regressions.log" 2>&1; then
       fail "$name: a saved reproducer still fails"
       grep -E "ERROR|SUMMARY|Running:|differs|round trip" "$work/$name.regressions.log" | head -n 20 >&2
     fi
@@ -89,7 +99,7 @@ for entry in "${targets[@]}"; do
   before=$(ls "$work/$name/corpus" | wc -l)
   start=$(date +%s)
   # shellcheck disable=SC2086
-  "$exe" $opts -max_total_time="$secs" -print_final_stats=1 \
+  LSAN_OPTIONS="$lsan" "$exe" $opts -max_total_time="$secs" -print_final_stats=1 \
     -artifact_prefix="$work/$name/artifacts/" "$work/$name/corpus" > "$work/$name.log" 2>&1
   rc=$?
   elapsed=$(( $(date +%s) - start ))
