@@ -217,6 +217,9 @@ MP_INLINE float mp_blackman_harris(float x, float width) {
   return 0.35875f - 0.48829f * cos(t) + 0.14128f * cos(2.0f * t) - 0.01168f * cos(3.0f * t);
 }
 
+/* Pixels a side of the tiled resolve's work-groups (resolve.cl, ResolveStage). */
+#define MP_RESOLVE_TILE 8
+
 /* Pixels on each side whose samples a pixel filter of this full width
  * reads (the resolve's neighbourhood; a bucket's margin). */
 MP_INLINE int mp_filter_reach(float width) {

@@ -32,6 +32,8 @@ __kernel void clear_samples(__global ulong* keys, ulong n) {
   f, filter_type, filter_width, offsets, weights, use_weights, keys, colors, normals, cam_to_world_x, cam_to_world_y, \
       cam_to_world_z, rgba, depth, normal_out, want_passes, region, origin, out_width
 
+inline void mp_resolve_write(MP_RESOLVE_ARGS, int px, int py, float4 sum, float wsum);
+
 /* `lanes` (a constant in each kernel below): planar sample colors
  * (FrameParams.planar_colors, the tile sampler's) summed 8 at a time; the
  * other kernel carries none of that code, whose registers cost GPUs
@@ -103,6 +105,13 @@ inline void mp_resolve(MP_RESOLVE_ARGS, const int lanes) {
     sum += (float4)(MP_SUM8(r8), MP_SUM8(g8), MP_SUM8(b8), MP_SUM8(a8));
   }
 #undef MP_SUM8
+  mp_resolve_write(MP_RESOLVE_PASS, px, py, sum, wsum);
+}
+
+/* Writes pixel (px, py)'s filtered colour and alpha, and its Depth and
+ * Normal (from its own samples) when want_passes. */
+inline void mp_resolve_write(MP_RESOLVE_ARGS, int px, int py, float4 sum, float wsum) {
+  int spp = f.spp_x * f.spp_y;
   ulong pixel = (ulong)py * (ulong)f.width + (ulong)px;
   ulong out = (ulong)(py + origin.y) * (ulong)out_width + (ulong)(px + origin.x);
   rgba[out] = wsum > 0.0f ? sum / wsum : (float4)(0.0f);
@@ -126,3 +135,56 @@ __kernel void resolve_pixels(MP_RESOLVE_ARGS) { mp_resolve(MP_RESOLVE_PASS, 0); 
 
 /* Planar sample colors (the tile sampler's). */
 __kernel void resolve_pixels_planar(MP_RESOLVE_ARGS) { mp_resolve(MP_RESOLVE_PASS, 1); }
+
+/* The resolve by tiles (RenderSettings::resolver, made for GPUs): a
+ * work-group of MP_RESOLVE_TILE x MP_RESOLVE_TILE pixels first loads the
+ * samples of its pixels and of the filter's reach around them into local
+ * memory, each as what the filter sums of it (colour, and the alpha it
+ * shows; zero where nothing covers it), then each pixel sums its
+ * neighbourhood from there. A sample is read from device memory once a tile
+ * instead of once for every pixel whose filter reaches it ((2 reach + 1)^2
+ * times), and neighbouring work-items read neighbouring samples. `records`
+ * holds (MP_RESOLVE_TILE + 2 reach)^2 spp float4s; `weights` must be given
+ * (use_weights). The sums are those of mp_resolve in another order. */
+__kernel __attribute__((reqd_work_group_size(MP_RESOLVE_TILE, MP_RESOLVE_TILE, 1))) void resolve_pixels_tiled(
+    MP_RESOLVE_ARGS, __local float4* records) {
+  int spp = f.spp_x * f.spp_y;
+  int reach = mp_filter_reach(filter_width);
+  int side = MP_RESOLVE_TILE + 2 * reach, fside = 2 * reach + 1; /* the tile's and the filter's */
+  int x0 = region.x + (int)get_group_id(0) * MP_RESOLVE_TILE - reach;
+  int y0 = region.y + (int)get_group_id(1) * MP_RESOLVE_TILE - reach;
+  int total = side * side * spp;
+  for (int j = (int)(get_local_id(1) * MP_RESOLVE_TILE + get_local_id(0)); j < total;
+       j += MP_RESOLVE_TILE * MP_RESOLVE_TILE) {
+    int p = j / spp, s = j - p * spp;
+    int qx = x0 + p % side, qy = y0 + p / side;
+    float4 r = (float4)(0.0f);
+    if (qx >= 0 && qy >= 0 && qx < f.width && qy < f.height) {
+      ulong q = (ulong)qy * (ulong)f.width + (ulong)qx;
+      if (keys[q * (ulong)spp + (ulong)s] != (ulong)0xffffffffffffffffUL) {
+        float3 col = mp_load_color(colors, q, s, spp, f);
+        r = (float4)(col, f.holdout_covers || !f.holdouts ? 1.0f : 1.0f - mp_unpack_holdout(col.z));
+      }
+    }
+    records[j] = r;
+  }
+  barrier(CLK_LOCAL_MEM_FENCE);
+  int px = region.x + (int)get_global_id(0), py = region.y + (int)get_global_id(1);
+  if (px >= region.z || py >= region.w) return;
+  int tile = ((py + f.crop_y0) & (MP_SAMPLE_TILE - 1)) * MP_SAMPLE_TILE + ((px + f.crop_x0) & (MP_SAMPLE_TILE - 1));
+  float4 sum = (float4)(0.0f);
+  float wsum = 0.0f;
+  for (int qy = max(py - reach, 0); qy <= min(py + reach, f.height - 1); ++qy)
+    for (int qx = max(px - reach, 0); qx <= min(px + reach, f.width - 1); ++qx) {
+      __global const float* wrow = weights + ((ulong)tile * (ulong)(fside * fside) +
+                                              (ulong)((qy - py + reach) * fside + (qx - px + reach))) * (ulong)spp;
+      __local const float4* rec = records + ((qy - y0) * side + (qx - x0)) * spp;
+      for (int s = 0; s < spp; ++s) {
+        float w = wrow[s];
+        if (w <= 0.0f) continue;
+        wsum += w;
+        sum += w * rec[s];
+      }
+    }
+  mp_resolve_write(MP_RESOLVE_PASS, px, py, sum, wsum);
+}

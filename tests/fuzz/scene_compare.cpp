@@ -111,6 +111,7 @@ void compare_settings(Diff& d, const RenderSettings& a, const RenderSettings& b)
   d.eq("settings.shadow_shading_rate", a.shadow_shading_rate, b.shadow_shading_rate);
   d.eq("settings.occlusion_culling", a.occlusion_culling, b.occlusion_culling);
   d.eq("settings.holdout_covers", a.holdout_covers, b.holdout_covers);
+  d.eq("settings.resolver", a.resolver, b.resolver);
 }
 
 void compare_camera(Diff& d, const Camera& a, const Camera& b) {

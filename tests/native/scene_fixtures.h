@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cmath>
+#include <string>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -137,6 +138,22 @@ inline Mesh uv_sphere_mesh(int rings, int segments) {
     s.face_vertex_indices.insert(s.face_vertex_indices.end(), {top, id(rings - 1, k), id(rings - 1, k + 1)});
   }
   return s;
+}
+
+// Adds a material shaded by a program whose surface is a diffuse `colour`
+// and then `then` (OpenCL C, with g and s in scope).
+inline void add_program_material(Scene& s, const char* name, const char* colour, const std::string& then, bool alpha) {
+  s.material_programs.push_back(
+      {name, std::string("float3 mp_node_displacement(const MpNodeGlobals* g) { return (float3)(0.0f); }\n"
+                         "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {"
+                         " mp_add_diffuse(s, (float3)(") +
+                 colour + "), 0, 0.0f); " + then + " }\n"});
+  Material m;
+  m.model = Material::Model::Principled;
+  m.program = int(s.material_programs.size()) - 1;
+  m.program_shades = true;
+  m.program_alpha = alpha;
+  s.materials.push_back(m);
 }
 
 }  // namespace mp::test

@@ -75,6 +75,7 @@ void expect_same_settings(const RenderSettings& a, const RenderSettings& b) {
   EXPECT_EQ(a.occlusion_culling, b.occlusion_culling);
   EXPECT_EQ(a.holdout_covers, b.holdout_covers);
   EXPECT_EQ(a.visibility_first, b.visibility_first);
+  EXPECT_EQ(a.resolver, b.resolver);
 }
 
 void expect_same_camera(const Camera& a, const Camera& b) {
@@ -310,6 +311,7 @@ Scene full_scene() {
   st.occlusion_culling = false;
   st.holdout_covers = true;
   st.visibility_first = VisibilityFirst::Off;
+  st.resolver = Resolver::Tiles;
 
   s.camera = look_at({1.3f, 2.1f, 7.7f}, {0.1f, 0.2f, 0.0f}, 47.3f);
   s.camera.screen_left = -1.4f, s.camera.screen_right = 1.3f;
@@ -1075,6 +1077,8 @@ TEST(RibWriter, SamplerAndSampleMemoryRoundTrip) {
   EXPECT_EQ(back.settings.sample_memory_mib, 96.5f);
   s.settings.sampler = Sampler::Tiles;
   EXPECT_EQ(round_trip(s).settings.sampler, Sampler::Tiles);
+  s.settings.resolver = Resolver::Pixels;
+  EXPECT_EQ(round_trip(s).settings.resolver, Resolver::Pixels);
   // The defaults are left out of the file.
   EXPECT_EQ(to_rib(defocused_scene()).find("samplememory"), std::string::npos);
 }

@@ -37,22 +37,6 @@ class VisibilityFirstTest : public SharedRendererTest {
   }
 };
 
-// Adds a material shaded by a program whose surface is a diffuse `colour`
-// and then `then` (OpenCL C, with g and s in scope).
-void add_program_material(Scene& s, const char* name, const char* colour, const std::string& then, bool alpha) {
-  s.material_programs.push_back(
-      {name, std::string("float3 mp_node_displacement(const MpNodeGlobals* g) { return (float3)(0.0f); }\n"
-                         "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {"
-                         " mp_add_diffuse(s, (float3)(") +
-                 colour + "), 0, 0.0f); " + then + " }\n"});
-  Material m;
-  m.model = Material::Model::Principled;
-  m.program = int(s.material_programs.size()) - 1;
-  m.program_shades = true;
-  m.program_alpha = alpha;
-  s.materials.push_back(m);
-}
-
 // Closed Catmull-Clark cubes of half size 1, 1.5, 2, ... around the camera:
 // the innermost half transparent, the next cut by an alpha program, the
 // third held out where its Generated x passes one half, the rest opaque.

@@ -52,6 +52,7 @@ struct ShadowStats {
 
 struct RenderStats {
   std::string device;
+  std::string resolver;  // the resolve's kernel: "tiles" or "pixels" (RenderSettings::resolver)
   int width = 0, height = 0, spp = 0;
   size_t patches = 0;
   size_t subpatches_diced = 0;

@@ -252,6 +252,14 @@ enum class BoundSplitMethod { Bounded, Breadth };
 // micropolygon with atomics (kernels/stages/sample.cl, made for GPUs). Both give
 // the same image; Auto picks by the device's type.
 enum class Sampler { Auto, Tiles, Micropolygons };
+// The resolve (kernels/stages/resolve.cl): tiles of pixels that first load
+// their samples and the filter's reach around them into local memory (made
+// for GPUs: each sample is read from device memory once a tile, not once
+// for every pixel its filter reaches), or one work-item per pixel reading
+// its neighbours' samples itself (made for CPUs, vectorised over samples).
+// Both give the same image to float rounding; Auto picks by the device's
+// type.
+enum class Resolver { Auto, Tiles, Pixels };
 // Visibility first (docs/pipeline.md, step 5): each batch of the camera's
 // view finds the depth of its opaque grids before shading and shades only
 // those that own a sample; the image is the same either way. It costs a
@@ -305,6 +313,7 @@ struct RenderSettings {
   // filter width); 0 reads the point each vertex lands on, unfiltered.
   float texture_filter_width = 1.0f;
   Sampler sampler = Sampler::Auto;
+  Resolver resolver = Resolver::Auto;
   VisibilityFirst visibility_first = VisibilityFirst::Auto;
   // Device memory the frame's samples may take (24 bytes each, 20 without
   // the Normal pass): a frame that needs more is rendered in buckets that

@@ -20,7 +20,7 @@ const char* kUsage =
     "                        [--bound-split-memory MIB] [--shadows on|off] [--shadow-memory MIB]\n"
     "                        [--fresh-shadows] [--occlusion-culling on|off] [--stats FILE.json]\n"
     "                        [--sampler auto|tiles|micropolygons] [--sample-memory MIB]\n"
-    "                        [--visibility-first auto|on|off]\n"
+    "                        [--visibility-first auto|on|off] [--resolver auto|tiles|pixels]\n"
     "                        [--texture-filter-width W]\n"
     "                        [--repeat N] [--allow-path DIR]... [--allow-any-path]\n"
     "       micropoly-render --list-devices\n"
@@ -30,7 +30,7 @@ const char* kUsage =
     "both rules (docs/rib.md, \"Untrusted scene files\").\n";
 
 struct Options {
-  std::string scene, output, device, stats, bound_split, shadows, occlusion, sampler, visibility_first;
+  std::string scene, output, device, stats, bound_split, shadows, occlusion, sampler, visibility_first, resolver;
   int spp = 0, repeat = 1;
   float shading_rate = 0, memory_mib = 0, shadow_memory_mib = 0, sample_memory_mib = 0;
   float texture_filter_width = -1;  // below 0: the scene's
@@ -84,6 +84,10 @@ Options parse(int argc, char** argv) {
       o.sampler = value();
       if (o.sampler != "auto" && o.sampler != "tiles" && o.sampler != "micropolygons")
         usage_error("--sampler is auto, tiles or micropolygons");
+    } else if (a == "--resolver") {
+      o.resolver = value();
+      if (o.resolver != "auto" && o.resolver != "tiles" && o.resolver != "pixels")
+        usage_error("--resolver is auto, tiles or pixels");
     } else if (a == "--visibility-first") {
       o.visibility_first = value();
       if (o.visibility_first != "auto" && o.visibility_first != "on" && o.visibility_first != "off")
@@ -140,6 +144,10 @@ int main(int argc, char** argv) {
       scene.settings.sampler = o.sampler == "tiles"           ? mp::Sampler::Tiles
                                : o.sampler == "micropolygons" ? mp::Sampler::Micropolygons
                                                               : mp::Sampler::Auto;
+    if (!o.resolver.empty())
+      scene.settings.resolver = o.resolver == "tiles"    ? mp::Resolver::Tiles
+                                : o.resolver == "pixels" ? mp::Resolver::Pixels
+                                                         : mp::Resolver::Auto;
     if (!o.visibility_first.empty())
       scene.settings.visibility_first = o.visibility_first == "on"    ? mp::VisibilityFirst::On
                                         : o.visibility_first == "off" ? mp::VisibilityFirst::Off

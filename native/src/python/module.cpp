@@ -68,6 +68,7 @@ glm::vec3 to_vec3(const std::vector<float>& v, const char* what) {
 py::dict stats_dict(const RenderStats& s) {
   py::dict d, t;
   d["device"] = s.device;
+  d["resolver"] = s.resolver;
   d["width"] = s.width;
   d["height"] = s.height;
   d["spp"] = s.spp;
@@ -175,6 +176,10 @@ PYBIND11_MODULE(_native, m) {
       .value("AUTO", Sampler::Auto)
       .value("TILES", Sampler::Tiles)
       .value("MICROPOLYGONS", Sampler::Micropolygons);
+  py::enum_<Resolver>(m, "Resolver")
+      .value("AUTO", Resolver::Auto)
+      .value("TILES", Resolver::Tiles)
+      .value("PIXELS", Resolver::Pixels);
   py::enum_<VisibilityFirst>(m, "VisibilityFirst")
       .value("AUTO", VisibilityFirst::Auto)
       .value("ON", VisibilityFirst::On)
@@ -215,6 +220,7 @@ PYBIND11_MODULE(_native, m) {
       .def_readwrite("texture_filter_width", &RenderSettings::texture_filter_width)
       .def_readwrite("dof_dice_factor", &RenderSettings::dof_dice_factor)
       .def_readwrite("sampler", &RenderSettings::sampler)
+      .def_readwrite("resolver", &RenderSettings::resolver)
       .def_readwrite("visibility_first", &RenderSettings::visibility_first)
       .def_readwrite("sample_memory_mib", &RenderSettings::sample_memory_mib);
 

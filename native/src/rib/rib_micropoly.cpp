@@ -91,6 +91,9 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   s.sampler = string_choice(args, params, "sampler", {{"auto", Sampler::Auto}, {"tiles", Sampler::Tiles},
                                                        {"micropolygons", Sampler::Micropolygons}},
                             s.sampler);
+  s.resolver = string_choice(args, params, "resolver",
+                             {{"auto", Resolver::Auto}, {"tiles", Resolver::Tiles}, {"pixels", Resolver::Pixels}},
+                             s.resolver);
   s.visibility_first = string_choice(args, params, "visibilityfirst",
                                      {{"auto", VisibilityFirst::Auto}, {"on", VisibilityFirst::On},
                                       {"off", VisibilityFirst::Off}},
@@ -123,7 +126,7 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
                {"boundsplit", "boundsplitmemory", "maxgridsize", "maxsplitdepth", "backfaceculling",
                 "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate", "occlusionculling", "holdoutcovers",
                 "worldshadowdirections", "texturefilterwidth", "apertureblades", "aperturerotation", "apertureratio",
-                "focusfactor", "shuttercurve", "sampler", "samplememory", "visibilityfirst"},
+                "focusfactor", "shuttercurve", "sampler", "samplememory", "visibilityfirst", "resolver"},
                [&](const std::string& name) {
                  warn_once("option-micropoly:" + name, line,
                            "Option \"micropoly\": parameter \"" + name + "\" is ignored");

@@ -93,7 +93,8 @@ bool render_camera_bucket(MicropolygonPass& pass, const CameraStages& stages, co
   activity.emplace(s, "resolve");
   const auto started = std::chrono::steady_clock::now();
   stages.resolve.run(sample, frame, fb, bucket, scene.settings.filter, scene.settings.filter_width,
-                     scene.settings.depth_and_normal_passes, timer);
+                     scene.settings.depth_and_normal_passes, scene.settings.resolver, timer);
+  st.resolver = stages.resolve.ran_tiled() ? "tiles" : "pixels";
   st.timings_ms.readback += ms_since(started);
   return true;
 }

@@ -351,8 +351,11 @@ void SampleStage::run(const cl::Buffer& diceable, cl_uint first, cl_uint count, 
 ResolveStage::ResolveStage(DeviceSession& session)
     : session_(session),
       scalar_kernel_(session.program(), "resolve_pixels"),
-      planar_kernel_(session.program(), "resolve_pixels_planar") {
+      planar_kernel_(session.program(), "resolve_pixels_planar"),
+      tiled_kernel_(session.program(), "resolve_pixels_tiled") {
   use_pinned_ = !session.device().getInfo<CL_DEVICE_HOST_UNIFIED_MEMORY>();
+  gpu_ = (session.device().getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_GPU) != 0;
+  local_bytes_ = session.device().getInfo<CL_DEVICE_LOCAL_MEM_SIZE>();
 }
 
 ResolveStage::~ResolveStage() {
@@ -367,7 +370,7 @@ ResolveStage::~ResolveStage() {
 }
 
 void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, const FrameParams& fb, const Bucket& b,
-                       PixelFilter filter, float filter_width, bool passes, StageTimer& timer) {
+                       PixelFilter filter, float filter_width, bool passes, Resolver resolver, StageTimer& timer) {
   const FrameParams& f = frame.params;
   size_t pixels = static_cast<size_t>(f.width) * static_cast<size_t>(f.height);
   if (pixels != pixels_) {
@@ -412,13 +415,28 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, cons
     session_.queue().enqueueWriteBuffer(weights_, CL_TRUE, 0, w.size() * sizeof(float), w.data());
     weights_type_ = type, weights_width_ = filter_width, weights_pattern_ = pattern;
   }
-  // The 16-lane kernel for planar colors of 16 samples or more; below that
-  // the scalar one, which PoCL vectorises across pixels instead.
-  cl::Kernel& k = fb.planar_colors && fb.spp_x * fb.spp_y >= 16 ? planar_kernel_ : scalar_kernel_;
-  bind_args(k, fb, type, filter_width, samples.offsets(), weights_, use_weights_ ? 1 : 0, samples.keys(),
-            samples.colors(), samples.normals(), row(0), row(1), row(2), rgba_, depth_, normal_, passes ? 1 : 0,
-            cl_int4{{b.x0 - b.sx0, b.y0 - b.sy0, b.x1 - b.sx0, b.y1 - b.sy0}}, cl_int2{{b.sx0, b.sy0}},
-            cl_int(f.width));
+  // Tiles: a tile of MP_RESOLVE_TILE pixels a side and the filter's reach
+  // around it, one float4 a sample, in local memory (a quarter of it left to
+  // the compiler). Otherwise the 16-lane kernel for planar colors of 16
+  // samples or more; below that the scalar one, which PoCL vectorises across
+  // pixels instead.
+  const size_t tile_side = MP_RESOLVE_TILE + 2 * static_cast<size_t>(mp_filter_reach(filter_width));
+  const size_t tile_bytes = tile_side * tile_side * static_cast<size_t>(fb.spp_x * fb.spp_y) * sizeof(cl_float4);
+  const bool tiles = (resolver == Resolver::Tiles || (resolver == Resolver::Auto && gpu_)) && use_weights_ &&
+                     tile_bytes <= local_bytes_ / 4 * 3;
+  ran_tiled_ = tiles;
+  cl::Kernel& k = tiles                                          ? tiled_kernel_
+                  : fb.planar_colors && fb.spp_x * fb.spp_y >= 16 ? planar_kernel_
+                                                                  : scalar_kernel_;
+  const cl_int4 region{{b.x0 - b.sx0, b.y0 - b.sy0, b.x1 - b.sx0, b.y1 - b.sy0}};
+  const auto args = arg_pack(fb, type, filter_width, samples.offsets(), weights_, use_weights_ ? 1 : 0,
+                             samples.keys(), samples.colors(), samples.normals(), row(0), row(1), row(2), rgba_,
+                             depth_, normal_, passes ? 1 : 0, region, cl_int2{{b.sx0, b.sy0}}, cl_int(f.width));
+  if (tiles)
+    bind_args(k, args, cl::Local(tile_bytes));
+  else
+    bind_args(k, args);
+  static_assert(MP_RESOLVE_TILE == 8, "both kernels run in work-groups of 8 x 8 pixels");
   size_t gx = ((static_cast<size_t>(b.x1 - b.x0) + 7) / 8) * 8, gy = ((static_cast<size_t>(b.y1 - b.y0) + 7) / 8) * 8;
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(gx, gy), cl::NDRange(8, 8), nullptr, &e);

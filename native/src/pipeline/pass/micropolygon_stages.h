@@ -219,15 +219,24 @@ class ResolveStage {
   ResolveStage(const ResolveStage&) = delete;
   ResolveStage& operator=(const ResolveStage&) = delete;
   // Resolves bucket b's pixels (its samples in `samples`, of frame fb) into
-  // the image of `frame`; Depth and Normal only if `passes`.
+  // the image of `frame`; Depth and Normal only if `passes`. `resolver`
+  // picks the kernel (RenderSettings::resolver); Tiles falls back to the
+  // pixels' kernel where its tile of samples does not fit the device's
+  // local memory or the filter's weight table is not kept.
   void run(const SampleStage& samples, const FrameSetup& frame, const FrameParams& fb, const Bucket& b,
-           PixelFilter filter, float filter_width, bool passes, StageTimer& timer);
+           PixelFilter filter, float filter_width, bool passes, Resolver resolver, StageTimer& timer);
+  // Whether the last run took the tiled kernel (tests).
+  bool ran_tiled() const { return ran_tiled_; }
   // Reads the image (and the passes) back once every bucket is resolved.
   void read_back(const FrameSetup& frame, bool passes, RenderResult& out);
 
  private:
   DeviceSession& session_;
   cl::Kernel scalar_kernel_, planar_kernel_;  // sample colors sample by sample, or planar (mp_sample.h)
+  cl::Kernel tiled_kernel_;                   // resolve_pixels_tiled
+  bool gpu_ = false;                          // Resolver::Auto takes tiles
+  size_t local_bytes_ = 0;                    // the device's local memory a work-group may take
+  bool ran_tiled_ = false;
   cl::Buffer rgba_, depth_, normal_;
   size_t pixels_ = 0;
   // Filter weights per tile position, neighbour and sample (see resolve.cl),
