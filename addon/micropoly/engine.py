@@ -216,10 +216,11 @@ class MicropolyRenderEngine(bpy.types.RenderEngine):
         rgba = result["rgba"]
         height, width = rgba.shape[:2]
         if not scene.render.film_transparent:
-            # An opaque film shows the world color behind objects, as Cycles does.
+            # An opaque film shows the world color behind objects, as Cycles does
+            # (a world program the renderer has laid behind them already: its
+            # alpha is 1 and its exported background colour black).
             alpha = rgba[..., 3:4]
-            behind = result.get("background", exported.background)  # a baked world's, per pixel
-            rgba = np.concatenate([rgba[..., :3] + (1.0 - alpha) * behind,
+            rgba = np.concatenate([rgba[..., :3] + (1.0 - alpha) * exported.background,
                                    np.ones_like(alpha)], axis=-1)
         x0, y0 = exported.crop_origin_bottom_left(width, height)
         render_result = self.begin_result(x0, y0, width, height, layer=view_layer.name)

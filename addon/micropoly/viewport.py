@@ -325,10 +325,10 @@ class ViewportSession:
                 if result["stats"]["cancelled"] or not self._current(generation):
                     return
                 rgba = result["rgba"]
-                if not exported.transparent:
+                if not exported.transparent:  # a world program lies behind already (alpha 1)
                     alpha = rgba[..., 3:4]
-                    behind = result.get("background", exported.background)  # a baked world's, per pixel
-                    rgba = np.concatenate([rgba[..., :3] + (1.0 - alpha) * behind, np.ones_like(alpha)], axis=-1)
+                    rgba = np.concatenate([rgba[..., :3] + (1.0 - alpha) * exported.background,
+                                           np.ones_like(alpha)], axis=-1)
                 image = ViewportImage(np.ascontiguousarray(rgba[::-1], dtype=np.float32), w, h, view.crop, spp,
                                       k == len(passes) - 1, generation, time.perf_counter() - requested,
                                       result["stats"])

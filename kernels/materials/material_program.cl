@@ -339,10 +339,12 @@ __kernel void bake_world(MP_SCENE_PARAMS uint width, uint height, __global float
   out[i] = (float4)(mp_world_radiance(mp_env_equirect_direction(u, v), &in, 0, zero, zero), 1.0f);
 }
 
-/* The world behind each pixel of the frame (its crop): the mean of 2 x 2
- * stratified rays through the pixel, the raster mapping of FrameParams
- * inverted, turned into the world by rows r0..r2 (camera to world). */
-__kernel void world_pixels(MP_SCENE_PARAMS FrameParams f, float4 r0, float4 r1, float4 r2, __global float* out) {
+/* The world behind each pixel of the frame (its crop), laid under the
+ * resolved image `rgba` in place as an opaque film shows it (colour plus
+ * the world times what alpha leaves, alpha 1): the mean of 2 x 2 stratified
+ * rays through the pixel, the raster mapping of FrameParams inverted, turned
+ * into the world by rows r0..r2 (camera to world). */
+__kernel void world_pixels(MP_SCENE_PARAMS FrameParams f, float4 r0, float4 r1, float4 r2, __global float4* rgba) {
   uint i = get_global_id(0);
   if (i >= (uint)f.width * (uint)f.height) return;
   float px = (float)(i % (uint)f.width), py = (float)(i / (uint)f.width);
@@ -364,6 +366,7 @@ __kernel void world_pixels(MP_SCENE_PARAMS FrameParams f, float4 r0, float4 r1, 
                              (float3)(dn.x, dn.y, -dn.z), window);
   }
   sum *= 0.25f;
-  out[3 * i] = sum.x, out[3 * i + 1] = sum.y, out[3 * i + 2] = sum.z;
+  float4 c = rgba[i];
+  rgba[i] = (float4)(c.xyz + (1.0f - c.w) * sum, 1.0f);
 }
 #endif

@@ -103,15 +103,14 @@ struct RenderStats {
 };
 
 // Pixels are stored top row first. rgba: 4 floats per pixel, premultiplied,
-// scene-linear; depth: camera-space depth (1e10 where empty); normal: 3 floats
-// per pixel, world space. depth and normal are empty when the settings turn
-// those passes off.
+// scene-linear; where the camera sees the scene's world (World::camera, an
+// opaque film) it lies behind the objects already and alpha is 1. depth:
+// camera-space depth (1e10 where empty); normal: 3 floats per pixel, world
+// space. depth and normal are empty when the settings turn those passes off
+// (normal also without RenderSettings::normal_pass).
 struct RenderResult {
   int width = 0, height = 0;
   std::vector<float> rgba, depth, normal;
-  // What the camera sees of the world behind objects (RGB, rows as rgba),
-  // for an opaque film; empty without a world or when the camera does not see it.
-  std::vector<float> background;
   RenderStats stats;
 };
 

@@ -173,14 +173,6 @@ int main(int argc, char** argv) {
     }
     if (o.repeat > 1) all_stats += "]\n";
     else all_stats = result.stats.to_json();
-    // The world behind objects, as an opaque film in Blender shows it.
-    if (!result.background.empty() && result.background.size() * 4 == result.rgba.size() * 3) {
-      for (size_t i = 0; i < result.rgba.size() / 4; ++i) {
-        const float a = result.rgba[4 * i + 3];
-        for (int c = 0; c < 3; ++c) result.rgba[4 * i + size_t(c)] += (1.0f - a) * result.background[3 * i + size_t(c)];
-        result.rgba[4 * i + 3] = 1.0f;
-      }
-    }
     mp::write_image(output, result);
     if (!o.stats.empty()) {
       std::ofstream f(o.stats);

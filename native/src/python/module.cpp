@@ -152,7 +152,6 @@ py::dict result_dict(RenderResult&& r) {
   d["rgba"] = Array<float>({h, w, py::ssize_t(4)}, r.rgba.data());
   if (!r.depth.empty()) d["depth"] = Array<float>({h, w}, r.depth.data());
   if (!r.normal.empty()) d["normal"] = Array<float>({h, w, py::ssize_t(3)}, r.normal.data());
-  if (!r.background.empty()) d["background"] = Array<float>({h, w, py::ssize_t(3)}, r.background.data());
   d["stats"] = stats_dict(r.stats);
   return d;
 }

@@ -377,14 +377,15 @@ void Renderer::Impl::read_back(const Scene& scene, const FrameSetup& frame, Rend
   DeviceStages& d = *stages;
   const auto started = std::chrono::steady_clock::now();
   DeviceSession::Activity activity(*session, "readback");
+  // The world behind the frame where the camera sees it (an opaque film):
+  // its program, evaluated per pixel on the device (finer than the baked
+  // map) and laid under the image before it is read, or the map a scene
+  // gave, laid under it here.
+  const bool world_seen = scene.world.present() && scene.world.camera;
+  if (world_seen && scene.world.program >= 0)
+    d.programs.composite_world(scene, *d.scene_buffers, frame.params, d.resolve.image());
   d.resolve.read_back(frame, scene.settings.depth_and_normal_passes, out);
-  // The world behind the frame: its program, evaluated per pixel on the
-  // device (finer than the baked map), or the map a scene gave.
-  if (scene.world.present() && scene.world.camera)
-    out.background = scene.world.program >= 0 ? d.programs.world_background(scene, *d.scene_buffers, frame.params)
-                                              : world_background(world_map, frame, scene.camera);
-  else
-    out.background.clear();
+  if (world_seen && scene.world.program < 0) composite_world_map(world_map, frame, scene.camera, out.rgba);
   out.stats.timings_ms.readback += ms_since(started);
   out.stats.surface_record_bytes = d.programs.record_pool_bytes();
 }

@@ -107,20 +107,15 @@ WorldMap MaterialPrograms::bake_world(const Scene& scene, const SceneBuffers& bu
   return map;
 }
 
-std::vector<float> MaterialPrograms::world_background(const Scene& scene, const SceneBuffers& buffers,
-                                                     const FrameParams& f) {
-  if (!world_) return {};
+void MaterialPrograms::composite_world(const Scene& scene, const SceneBuffers& buffers, const FrameParams& f,
+                                       const cl::Buffer& image) {
+  if (!world_) return;
   const size_t pixels = size_t(f.width) * size_t(f.height);
-  cl::Buffer out = session_.allocate(pixels * 3 * sizeof(float), "world background");
   // Camera to world: the inverse of the view's rotation, by rows.
   const glm::mat3 to_world = glm::inverse(glm::mat3(scene.camera.world_to_camera));
   auto row = [&](int r) { return cl_float4{{to_world[0][r], to_world[1][r], to_world[2][r], 0.0f}}; };
-  cl::Kernel& k = world_->world_pixels.bind(buffers, f, row(0), row(1), row(2), out);
-  DeviceQueue& q = session_.queue();
-  q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(cl_uint(pixels)), cl::NDRange(64));
-  std::vector<float> host(pixels * 3);
-  q.enqueueReadBuffer(out, CL_TRUE, 0, host.size() * sizeof(float), host.data());
-  return host;
+  cl::Kernel& k = world_->world_pixels.bind(buffers, f, row(0), row(1), row(2), image);
+  session_.queue().enqueueNDRangeKernel(k, cl::NullRange, round_up_range(cl_uint(pixels)), cl::NDRange(64));
 }
 
 void MaterialPrograms::launch(cl::Kernel& kernel, cl_uint count, GridBuffers& grids, Stage stage, StageTimer& timer) {

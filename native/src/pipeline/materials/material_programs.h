@@ -39,9 +39,10 @@ class MaterialPrograms {
   // The world program's radiance map (scene.h, World), baked on the device
   // with the scene's images; empty when the world has no program.
   WorldMap bake_world(const Scene& scene, const SceneBuffers& buffers);
-  // The world program behind every pixel of the frame (its crop), RGB rows
-  // (world_pixels in material_program.cl); empty without a world program.
-  std::vector<float> world_background(const Scene& scene, const SceneBuffers& buffers, const FrameParams& f);
+  // Lays the world program behind every pixel of the frame (its crop) under
+  // the resolved `image` (float4 rows) in place, as an opaque film shows it
+  // (world_pixels in material_program.cl); nothing without a world program.
+  void composite_world(const Scene& scene, const SceneBuffers& buffers, const FrameParams& f, const cl::Buffer& image);
   // Only the alpha (grid_c's w) of the vertices whose programs compute it:
   // what a shadow view needs.
   void alpha(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,

@@ -448,31 +448,51 @@ void ResolveStage::read_back(const FrameSetup& frame, bool passes, RenderResult&
   const size_t pixels = static_cast<size_t>(f.width) * static_cast<size_t>(f.height);
   out.width = f.width;
   out.height = f.height;
+  // Only the passes asked for: Depth with `passes`, Normal with them where
+  // the samples kept normals (RenderSettings::normal_pass).
+  const bool normals = passes && f.normal_pass;
   out.rgba.resize(pixels * 4);
-  const size_t rgba_bytes = pixels * sizeof(cl_float4);
-  if (use_pinned_) {
-    if (pinned_bytes_ != rgba_bytes) {
-      if (pinned_ptr_) session_.queue().enqueueUnmapMemObject(pinned_, pinned_ptr_);
-      pinned_ = session_.allocate(rgba_bytes, "image readback buffer", CL_MEM_READ_WRITE | CL_MEM_ALLOC_HOST_PTR);
-      pinned_ptr_ = static_cast<float*>(
-          session_.queue().enqueueMapBuffer(pinned_, CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0, rgba_bytes));
-      pinned_bytes_ = rgba_bytes;
-    }
-    session_.queue().enqueueReadBuffer(rgba_, CL_FALSE, 0, rgba_bytes, pinned_ptr_);
-  } else {
-    session_.queue().enqueueReadBuffer(rgba_, CL_FALSE, 0, rgba_bytes, out.rgba.data());
+  out.depth.resize(passes ? pixels : 0);
+  out.normal.resize(normals ? pixels * 3 : 0);
+  struct Part {
+    const cl::Buffer& buffer;
+    std::vector<float>& host;
+  };
+  const Part parts[] = {{rgba_, out.rgba}, {depth_, out.depth}, {normal_, out.normal}};
+  DeviceQueue& q = session_.queue();
+  size_t total = 0;
+  for (const Part& p : parts) total += p.host.size() * sizeof(float);
+  if (!use_pinned_) {
+    for (const Part& p : parts)
+      if (!p.host.empty()) q.enqueueReadBuffer(p.buffer, CL_FALSE, 0, p.host.size() * sizeof(float), p.host.data());
+    q.finish();
+    return;
   }
-  if (!passes) {
-    out.depth.clear();
-    out.normal.clear();
-  } else {
-    out.depth.resize(pixels);
-    out.normal.resize(pixels * 3);
-    session_.queue().enqueueReadBuffer(depth_, CL_FALSE, 0, pixels * sizeof(cl_float), out.depth.data());
-    session_.queue().enqueueReadBuffer(normal_, CL_FALSE, 0, pixels * 3 * sizeof(cl_float), out.normal.data());
+  // Discrete GPUs: every pass through one pinned staging buffer, which the
+  // driver fills at full bus speed (a pageable read runs at a fifth of it:
+  // docs/performance.md), then copied out over a few threads.
+  if (pinned_bytes_ < total) {
+    if (pinned_ptr_) q.enqueueUnmapMemObject(pinned_, pinned_ptr_);
+    pinned_ptr_ = nullptr;
+    pinned_bytes_ = 0;
+    pinned_ = cl::Buffer();
+    pinned_ = session_.allocate(total, "image readback buffer", CL_MEM_READ_WRITE | CL_MEM_ALLOC_HOST_PTR);
+    pinned_ptr_ = static_cast<float*>(q.enqueueMapBuffer(pinned_, CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0, total));
+    pinned_bytes_ = total;
   }
-  session_.queue().finish();
-  if (use_pinned_) parallel_copy(out.rgba.data(), pinned_ptr_, rgba_bytes);
+  size_t at = 0;
+  for (const Part& p : parts) {
+    if (p.host.empty()) continue;
+    q.enqueueReadBuffer(p.buffer, CL_FALSE, 0, p.host.size() * sizeof(float), pinned_ptr_ + at);
+    at += p.host.size();
+  }
+  q.finish();
+  at = 0;
+  for (const Part& p : parts) {
+    if (p.host.empty()) continue;
+    parallel_copy(p.host.data(), pinned_ptr_ + at, p.host.size() * sizeof(float));
+    at += p.host.size();
+  }
 }
 
 }  // namespace mp

@@ -225,6 +225,8 @@ class ResolveStage {
   // local memory or the filter's weight table is not kept.
   void run(const SampleStage& samples, const FrameSetup& frame, const FrameParams& fb, const Bucket& b,
            PixelFilter filter, float filter_width, bool passes, Resolver resolver, StageTimer& timer);
+  // The resolved image (float4 per pixel of the frame, rows top first).
+  const cl::Buffer& image() const { return rgba_; }
   // Whether the last run took the tiled kernel (tests).
   bool ran_tiled() const { return ran_tiled_; }
   // Reads the image (and the passes) back once every bucket is resolved.

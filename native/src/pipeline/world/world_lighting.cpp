@@ -287,10 +287,10 @@ std::vector<glm::vec4> world_glossy_maps(const WorldMap& map) {
   return out;
 }
 
-std::vector<float> world_background(const WorldMap& map, const FrameSetup& frame, const Camera& camera) {
+void composite_world_map(const WorldMap& map, const FrameSetup& frame, const Camera& camera, std::vector<float>& rgba) {
   const FrameParams& f = frame.params;
-  std::vector<float> out(size_t(f.width) * size_t(f.height) * 3, 0.0f);
-  if (map.width <= 0 || map.height <= 0) return out;
+  if (rgba.size() != size_t(f.width) * size_t(f.height) * 4) return;
+  const bool empty = map.width <= 0 || map.height <= 0;
   const glm::mat3 to_world = glm::inverse(glm::mat3(camera.world_to_camera));
   for (int y = 0; y < f.height; ++y)
     for (int x = 0; x < f.width; ++x) {
@@ -298,11 +298,11 @@ std::vector<float> world_background(const WorldMap& map, const FrameSetup& frame
       // FrameParams): a perspective ray through it, or the view axis.
       glm::vec3 d(0.0f, 0.0f, -1.0f);
       if (!f.ortho) d = glm::vec3((x + 0.5f - f.bx) / f.ax, (y + 0.5f - f.by) / f.ay, -1.0f);
-      const glm::vec3 c = map_lookup(map, to_world * d);
-      float* o = &out[(size_t(y) * size_t(f.width) + size_t(x)) * 3];
-      o[0] = c.x, o[1] = c.y, o[2] = c.z;
+      const glm::vec3 c = empty ? glm::vec3(0.0f) : map_lookup(map, to_world * d);
+      float* o = &rgba[(size_t(y) * size_t(f.width) + size_t(x)) * 4];
+      const float leave = 1.0f - o[3];
+      o[0] += leave * c.x, o[1] += leave * c.y, o[2] += leave * c.z, o[3] = 1.0f;
     }
-  return out;
 }
 
 }  // namespace mp

@@ -64,7 +64,10 @@ std::vector<glm::vec4> world_glossy_maps(const WorldMap& map);
 // A World's own radiance array as a map.
 WorldMap given_world_map(const World& world);
 
-// The world behind every pixel of the frame (its crop), bilinear in the map.
-std::vector<float> world_background(const WorldMap& map, const FrameSetup& frame, const Camera& camera);
+// Lays the world behind every pixel of the frame (its crop), bilinear in
+// the map, under the image `rgba` (4 floats a pixel, rows top first) as an
+// opaque film shows it: colour plus the world times what alpha leaves,
+// alpha 1.
+void composite_world_map(const WorldMap& map, const FrameSetup& frame, const Camera& camera, std::vector<float>& rgba);
 
 }  // namespace mp
