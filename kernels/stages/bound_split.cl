@@ -115,7 +115,12 @@ __kernel void bs_breadth_scatter(__global const SubPatch* queue, uint n, __globa
 #define BS_RING_TAIL0 9
 #define BS_DONATE 10     /* children a launch may hand out (its idle workers) */
 #define BS_ROOT_LIMIT 11 /* the roots taken so far (occlusion culling takes them in waves) */
-#define BS_COUNTERS 12
+#define BS_ACTIVE 12     /* workers that run: those below it (a chained launch covers a fixed range) */
+/* Chained launches (bs_bounded_control): */
+#define BS_OCCLUDED_SUM 13 /* BS_OCCLUDED summed over the chain's launches */
+#define BS_STOP 14         /* set where the host must decide: the batch is full or the roots taken are done */
+#define BS_STEPS 15        /* launches of the chain that ran before it stopped */
+#define BS_COUNTERS 16
 
 __kernel void bs_bounded_step(MP_SCENE_PARAMS __global const uint* root_order, FrameParams f,
                               __global const FrameParams* views, uint view_count, __global const uchar* page_masks,
@@ -124,9 +129,10 @@ __kernel void bs_bounded_step(MP_SCENE_PARAMS __global const uint* root_order, F
                               __global SubPatch* ring, uint ring_capacity,
                               __global SubPatch* diceable, uint dice_capacity,
                               volatile __global uint* counters, uint steps) {
+  uint w = get_global_id(0);
+  if (counters[BS_STOP] != 0u || w >= counters[BS_ACTIVE]) return;
   const uint ring_head0 = counters[BS_RING_HEAD0], ring_tail0 = counters[BS_RING_TAIL0];
   const uint donate_limit = counters[BS_DONATE], root_limit = counters[BS_ROOT_LIMIT];
-  uint w = get_global_id(0);
   __global SubPatch* stack = stacks + (ulong)w * stack_depth;
   uint size = stack_sizes[w];
   for (uint step = 0; step < steps; ++step) {
@@ -177,4 +183,48 @@ __kernel void bs_bounded_step(MP_SCENE_PARAMS __global const uint* root_order, F
   stack_sizes[w] = size;
   atomic_inc(&counters[size > 0u ? BS_BUSY : BS_IDLE]);
   if (size > 0u) atomic_max(&counters[BS_MAX_BUSY], w + 1u);
+}
+
+/* Between two chained launches of bs_bounded_step, one work-item does what
+ * the host does between two launches (bound_split_bounded.cpp): it takes
+ * the launch's counters, and unless the dice batch is full or the roots
+ * taken so far are all done (then it sets BS_STOP and leaves the counters
+ * as the launch left them, for the host to read), it sets them for the
+ * next launch: the ring's head and tail, the workers that run (those left
+ * with work, plus room to double, within `useful` and whole work-groups of
+ * 64, at most `workers`) and the children they may hand out. The host's
+ * rules and these are the same, so a chain of launches splits exactly as
+ * launches read back one by one. */
+__kernel void bs_bounded_control(volatile __global uint* counters, uint ring_capacity, uint dice_capacity,
+                                 uint workers, uint useful) {
+  if (get_global_id(0) != 0u || counters[BS_STOP] != 0u) return;
+  counters[BS_STEPS] += 1u;
+  counters[BS_OCCLUDED_SUM] += counters[BS_OCCLUDED];
+  const uint head0 = counters[BS_RING_HEAD0], tail0 = counters[BS_RING_TAIL0];
+  const uint hungry0 = counters[BS_DONATE], root_limit = counters[BS_ROOT_LIMIT];
+  uint head = min(counters[BS_POOL_HEAD], tail0);
+  uint tail = min(min(counters[BS_POOL_TAIL], tail0 + hungry0), head0 + ring_capacity);
+  const uint next_root = min(counters[BS_NEXT_ROOT], root_limit);
+  const uint dice = min(counters[BS_DICE_COUNT], dice_capacity);
+  const uint busy = counters[BS_BUSY];
+  if (head == tail) head = tail = 0u;
+  if (dice == dice_capacity || (busy == 0u && head == tail && next_root >= root_limit)) {
+    counters[BS_STOP] = 1u;
+    return;
+  }
+  const ulong pending = (ulong)(tail - head) + (ulong)(root_limit - next_root);
+  const ulong wanted = max((ulong)counters[BS_MAX_BUSY], min(2ul * busy + pending, (ulong)useful));
+  const uint launch = (uint)min((ulong)workers, max(64ul, (wanted + 63ul) / 64ul * 64ul));
+  counters[BS_POOL_HEAD] = head;
+  counters[BS_POOL_TAIL] = tail;
+  counters[BS_NEXT_ROOT] = next_root;
+  counters[BS_DICE_COUNT] = dice;
+  counters[BS_BUSY] = 0u;
+  counters[BS_IDLE] = 0u;
+  counters[BS_MAX_BUSY] = 0u;
+  counters[BS_OCCLUDED] = 0u;
+  counters[BS_RING_HEAD0] = head;
+  counters[BS_RING_TAIL0] = tail;
+  counters[BS_DONATE] = launch > busy ? launch - busy : 0u;
+  counters[BS_ACTIVE] = launch;
 }

@@ -76,6 +76,7 @@ void expect_same_settings(const RenderSettings& a, const RenderSettings& b) {
   EXPECT_EQ(a.holdout_covers, b.holdout_covers);
   EXPECT_EQ(a.visibility_first, b.visibility_first);
   EXPECT_EQ(a.resolver, b.resolver);
+  EXPECT_EQ(a.bound_split_chain, b.bound_split_chain);
 }
 
 void expect_same_camera(const Camera& a, const Camera& b) {
@@ -312,6 +313,7 @@ Scene full_scene() {
   st.holdout_covers = true;
   st.visibility_first = VisibilityFirst::Off;
   st.resolver = Resolver::Tiles;
+  st.bound_split_chain = 5;
 
   s.camera = look_at({1.3f, 2.1f, 7.7f}, {0.1f, 0.2f, 0.0f}, 47.3f);
   s.camera.screen_left = -1.4f, s.camera.screen_right = 1.3f;

@@ -220,6 +220,7 @@ PYBIND11_MODULE(_native, m) {
       .def_readwrite("dof_dice_factor", &RenderSettings::dof_dice_factor)
       .def_readwrite("sampler", &RenderSettings::sampler)
       .def_readwrite("resolver", &RenderSettings::resolver)
+      .def_readwrite("bound_split_chain", &RenderSettings::bound_split_chain)
       .def_readwrite("visibility_first", &RenderSettings::visibility_first)
       .def_readwrite("sample_memory_mib", &RenderSettings::sample_memory_mib);
 

@@ -91,6 +91,7 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   s.sampler = string_choice(args, params, "sampler", {{"auto", Sampler::Auto}, {"tiles", Sampler::Tiles},
                                                        {"micropolygons", Sampler::Micropolygons}},
                             s.sampler);
+  params.get_int("boundsplitchain", 0, 1024, &s.bound_split_chain);
   s.resolver = string_choice(args, params, "resolver",
                              {{"auto", Resolver::Auto}, {"tiles", Resolver::Tiles}, {"pixels", Resolver::Pixels}},
                              s.resolver);
@@ -126,7 +127,7 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
                {"boundsplit", "boundsplitmemory", "maxgridsize", "maxsplitdepth", "backfaceculling",
                 "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate", "occlusionculling", "holdoutcovers",
                 "worldshadowdirections", "texturefilterwidth", "apertureblades", "aperturerotation", "apertureratio",
-                "focusfactor", "shuttercurve", "sampler", "samplememory", "visibilityfirst", "resolver"},
+                "focusfactor", "shuttercurve", "sampler", "samplememory", "visibilityfirst", "resolver", "boundsplitchain"},
                [&](const std::string& name) {
                  warn_once("option-micropoly:" + name, line,
                            "Option \"micropoly\": parameter \"" + name + "\" is ignored");

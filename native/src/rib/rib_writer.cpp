@@ -256,6 +256,8 @@ void write_options(std::string& o, const RenderSettings& s, const Camera& c) {
     param(o, "float texturefilterwidth", s.texture_filter_width);
   if (s.sampler != def.sampler)
     param(o, "string sampler", s.sampler == Sampler::Tiles ? "tiles" : "micropolygons");
+  if (s.bound_split_chain != def.bound_split_chain)
+    param(o, "integer boundsplitchain", static_cast<long long>(s.bound_split_chain));
   if (s.resolver != def.resolver) param(o, "string resolver", s.resolver == Resolver::Tiles ? "tiles" : "pixels");
   if (differs(s.sample_memory_mib, def.sample_memory_mib)) param(o, "float samplememory", s.sample_memory_mib);
   if (s.visibility_first != def.visibility_first)

@@ -116,14 +116,21 @@ struct BoundSplitContext {
 // current budget asks for.
 struct BoundedWorkspace {
   SceneKernel step;  // bs_bounded_step, made on first use and kept with its scene data bound
+  cl::Kernel control;  // bs_bounded_control (chained launches), made on first use
   cl::Buffer stacks, sizes, ring, diceable, counters;
   size_t stacks_bytes = 0, sizes_bytes = 0, ring_bytes = 0, diceable_bytes = 0, counters_bytes = 0;
 };
 
+// The longest chain of bounded launches Auto takes on a GPU
+// (RenderSettings::bound_split_chain).
+constexpr int kAutoBoundSplitChain = 16;
+
 // Weber, Wimmer & Owens 2015: fixed worker pool, depth-first per worker,
 // memory fixed by `budget_bytes` (never exceeded; throws if too small).
+// Up to `max_chain` launches are chained on the device between two reads
+// of the counters (1: a read after every launch).
 BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes, cl_uint dice_capacity,
-                                     BoundedWorkspace& workspace);
+                                     BoundedWorkspace& workspace, cl_uint max_chain);
 // Patney & Owens 2008: whole queue per iteration, compacted by prefix sums.
 BoundSplitResult bound_split_breadth(BoundSplitContext& ctx, cl_uint dice_capacity);
 

@@ -11,6 +11,19 @@
 // sub-patches, plus room to double, so the active pool ramps up as the split
 // tree widens (a few big patches at first) and a large budget costs no time on
 // scenes that cannot use all its workers.
+//
+// Chained launches (RenderSettings::bound_split_chain; GPUs): the host
+// enqueues several launches at once, each followed by bs_bounded_control,
+// which sets the next launch's counters on the device by the host's rules
+// and stops the chain where the host must decide (a full dice batch, the
+// roots taken so far done). The host reads the counters once per chain
+// instead of once per launch: on a GPU a read-back costs 16-29 us and a
+// launch 10-16 us of host time, and the launches of a chain run while the
+// host enqueues the next. Chained launches cover a fixed range of workers,
+// of which those beyond BS_ACTIVE return at once. The chain's length
+// follows the launches between the last two stops (at least 2), so few
+// launches are enqueued past a stop; the images are the same for any
+// length.
 #include <algorithm>
 #include <string>
 
@@ -24,7 +37,8 @@ namespace {
 // Counter slots, as BS_* in kernels/stages/bound_split.cl.
 enum Counter {
   kPoolHead = 0, kPoolTail = 1, kNextRoot = 2, kDiceCount = 3, kBusy = 4, kIdle = 5, kMaxBusy = 6, kOccluded = 7,
-  kRingHead0 = 8, kRingTail0 = 9, kDonate = 10, kRootLimit = 11, kCounters = 12
+  kRingHead0 = 8, kRingTail0 = 9, kDonate = 10, kRootLimit = 11, kActive = 12, kOccludedSum = 13, kStop = 14,
+  kSteps = 15, kCounters = 16
 };
 constexpr cl_uint kStepsPerLaunch = 16;  // sub-patches a worker handles per launch
 constexpr size_t kMaxWorkers = size_t(1) << 20;
@@ -62,7 +76,7 @@ void ensure(DeviceSession& s, cl::Buffer& buffer, size_t& held, size_t bytes) {
 }  // namespace
 
 BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes, cl_uint dice_capacity,
-                                     BoundedWorkspace& ws) {
+                                     BoundedWorkspace& ws, cl_uint max_chain) {
   DeviceSession& s = ctx.session;
   DeviceQueue& queue = s.queue();
   const size_t rec = sizeof(SubPatch);
@@ -91,6 +105,7 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
 
     const PassOcclusion& occ = ctx.occlusion;
     if (!ws.step.kernel()()) ws.step = SceneKernel(s.program(), "bs_bounded_step");
+    if (max_chain > 1 && !ws.control()) ws.control = cl::Kernel(s.program(), "bs_bounded_control");
     cl::Kernel& step =
         ws.step.bind(ctx.scene, occ.on() ? occ.root_order : cl::Buffer(), ctx.frame, ctx.views.views, ctx.views.count,
                      ctx.views.page_masks, occ.on() ? occ.pyramid : cl::Buffer(), occ.params, ws.stacks, ws.sizes,
@@ -106,18 +121,56 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
     const size_t useful = 4 * static_cast<size_t>(dice_capacity);
     size_t launch = whole_groups(std::min<size_t>(root_limit, useful));
     cl_uint head = 0, tail = 0, next_root = 0, dice_count = 0, hungry = static_cast<cl_uint>(launch);
+    // Chained launches cover every worker a launch can take (a launch is at
+    // most the larger of the last one and `useful`, in whole groups).
+    const size_t chain_range = whole_groups(std::max(launch, useful));
+    if (max_chain > 1)
+      bind_args(ws.control, ws.counters, ring_capacity, dice_capacity, static_cast<cl_uint>(workers),
+                static_cast<cl_uint>(useful));
+    cl_uint chain = std::min<cl_uint>(max_chain, 2), since_stop = 0;
     for (;;) {
       // The counters, and what changes per launch: the ring's head and tail,
       // the donation limit (at most as many children as there will be idle
-      // workers) and the roots taken so far.
-      cl_uint c[kCounters] = {head, tail, next_root, dice_count, 0, 0, 0, 0, head, tail, hungry, root_limit};
+      // workers), the roots taken so far and the workers that run.
+      cl_uint c[kCounters] = {head, tail, next_root, dice_count, 0, 0, 0, 0, head, tail, hungry, root_limit,
+                              static_cast<cl_uint>(launch), 0, 0, 0};
       queue.enqueueWriteBuffer(ws.counters, CL_FALSE, 0, sizeof c, c);
-      cl::Event e;
-      queue.enqueueNDRangeKernel(step, cl::NullRange, cl::NDRange(launch), cl::NDRange(64), nullptr, &e);
-      ctx.timer.add(Stage::BoundSplit, e);
-      ++result.launches;
+      for (cl_uint k = 0; k < chain; ++k) {
+        cl::Event e;
+        queue.enqueueNDRangeKernel(step, cl::NullRange, cl::NDRange(chain > 1 ? chain_range : launch), cl::NDRange(64),
+                                   nullptr, &e);
+        ctx.timer.add(Stage::BoundSplit, e);
+        if (chain > 1) {
+          queue.enqueueNDRangeKernel(ws.control, cl::NullRange, cl::NDRange(1), cl::NullRange, nullptr, &e);
+          ctx.timer.add(Stage::BoundSplit, e);
+        }
+      }
       queue.enqueueReadBuffer(ws.counters, CL_TRUE, 0, sizeof c, c);
       ctx.timer.collect();
+      const cl_uint ran = chain > 1 ? c[kSteps] : 1;
+      result.launches += ran;
+      since_stop += ran;
+      if (chain > 1 && !c[kStop]) {
+        // Every launch of the chain ran and the device set the next one's
+        // counters: go on from there, with a longer chain.
+        head = c[kRingHead0], tail = c[kRingTail0], next_root = c[kNextRoot], dice_count = c[kDiceCount];
+        hungry = c[kDonate], launch = c[kActive];
+        result.occluded += c[kOccludedSum];
+        chain = std::min(max_chain, 2 * chain);
+        if (ctx.progress && !ctx.progress(0.95f * static_cast<float>(next_root) / static_cast<float>(std::max(root_count, 1u)))) {
+          result.cancelled = true;
+          break;
+        }
+        continue;
+      }
+      // A stop (or a single launch): the counters are as the last launch
+      // left them, and the host decides as below.
+      if (chain > 1) {
+        head = c[kRingHead0], tail = c[kRingTail0], hungry = c[kDonate];  // as the last launch started
+        c[kOccluded] = c[kOccludedSum];
+      }
+      if (max_chain > 1) chain = std::clamp<cl_uint>(since_stop, 2, max_chain);
+      since_stop = 0;
 
       const cl_uint head0 = head;
       head = std::min(c[kPoolHead], tail);
@@ -126,7 +179,7 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
       dice_count = std::min(c[kDiceCount], dice_capacity);
       result.occluded += c[kOccluded];
       const size_t busy = c[kBusy];
-      if (head == tail) head = tail = 0;  // keep ring indices small
+      if (head == tail) head = tail = 0;  // keep ring indices small (bs_bounded_control alike)
       const bool wave_done = busy == 0 && head == tail && next_root >= root_limit;
       const bool done = wave_done && root_limit >= root_count;
       // A wave ends in a flush once it has kMinWave sub-patches to dice (or
