@@ -20,10 +20,12 @@
 // instead of once per launch: on a GPU a read-back costs 16-29 us and a
 // launch 10-16 us of host time, and the launches of a chain run while the
 // host enqueues the next. Chained launches cover a fixed range of workers,
-// of which those beyond BS_ACTIVE return at once. The chain's length
-// follows the launches between the last two stops (at least 2), so few
-// launches are enqueued past a stop; the images are the same for any
-// length.
+// of which those beyond BS_ACTIVE return at once. A chain is as long as
+// the launches between the last two stops (the first is one launch, and
+// one that runs through doubles the next): where every launch ends in a
+// stop (a full batch each, as in many lights' views) the launches are read
+// one by one as without chains, with no control launches or launches past
+// a stop; the images are the same for any length.
 #include <algorithm>
 #include <string>
 
@@ -127,7 +129,7 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
     if (max_chain > 1)
       bind_args(ws.control, ws.counters, ring_capacity, dice_capacity, static_cast<cl_uint>(workers),
                 static_cast<cl_uint>(useful));
-    cl_uint chain = std::min<cl_uint>(max_chain, 2), since_stop = 0;
+    cl_uint chain = 1, since_stop = 0;
     for (;;) {
       // The counters, and what changes per launch: the ring's head and tail,
       // the donation limit (at most as many children as there will be idle
@@ -169,8 +171,6 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
         head = c[kRingHead0], tail = c[kRingTail0], hungry = c[kDonate];  // as the last launch started
         c[kOccluded] = c[kOccludedSum];
       }
-      if (max_chain > 1) chain = std::clamp<cl_uint>(since_stop, 2, max_chain);
-      since_stop = 0;
 
       const cl_uint head0 = head;
       head = std::min(c[kPoolHead], tail);
@@ -186,6 +186,14 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
       // it is the last); smaller ones are carried into the next wave.
       // The seen roots' wave (first_wave) is sampled whole before any other.
       const bool seen_done = wave_done && root_limit == first_wave;
+      // The next chain: as long as the launches since the last stop, or twice
+      // as long as this one where it ran through (bs_bounded_control's rule).
+      if (dice_count == dice_capacity || wave_done) {
+        chain = std::clamp<cl_uint>(since_stop, 1, max_chain);
+        since_stop = 0;
+      } else {
+        chain = std::min(max_chain, 2 * chain);
+      }
       if (dice_count == dice_capacity ||
           (wave_done && dice_count > 0 && (done || seen_done || dice_count >= kMinWave))) {
         ctx.sink(ws.diceable, dice_count);
