@@ -54,8 +54,22 @@ GridLayoutStage::GridLayoutStage(DeviceSession& session, cl_uint capacity)
   counts_ = device_buffer(session, 2 * size_t(capacity) * sizeof(cl_uint), "grid counts");
 }
 
+GridLayoutStage::~GridLayoutStage() {
+  try {
+    if (written_()) written_.wait();  // the host arrays outlive the writes from them
+  } catch (const cl::Error&) {
+    // A lost device: nothing is written any more.
+  }
+}
+
 void GridLayoutStage::run(const cl::Buffer& diceable, cl_uint count, const FrameParams& f, GridBuffers& grids,
                           StageTimer& timer) {
+  // The last batch's offsets go to the device without blocking; the host
+  // arrays they are written from are reused only once the writes are done.
+  if (written_()) {
+    if (written_.getInfo<CL_EVENT_COMMAND_EXECUTION_STATUS>() != CL_COMPLETE) session_.queue().wait(written_);
+    written_ = cl::Event();
+  }
   grids.vertex_total = 0;
   grids.micropolygon_offsets_host.assign(count + 1, 0);
   if (count == 0) return;
@@ -78,10 +92,12 @@ void GridLayoutStage::run(const cl::Buffer& diceable, cl_uint count, const Frame
   grids.micropolygon_offsets_host[count] = micropolygons;
   grids.vertex_total = vertices;
   micropolygons_ += micropolygons;
-  session_.queue().enqueueWriteBuffer(grids.vertex_offsets, CL_TRUE, 0, (count + 1) * sizeof(cl_uint),
+  // Without blocking: a GPU's round trip costs more than the batch's
+  // layout (the read above is the batch's one wait).
+  session_.queue().enqueueWriteBuffer(grids.vertex_offsets, CL_FALSE, 0, (count + 1) * sizeof(cl_uint),
                                       vertex_offsets_host_.data());
-  session_.queue().enqueueWriteBuffer(grids.micropolygon_offsets, CL_TRUE, 0, (count + 1) * sizeof(cl_uint),
-                                      grids.micropolygon_offsets_host.data());
+  session_.queue().enqueueWriteBuffer(grids.micropolygon_offsets, CL_FALSE, 0, (count + 1) * sizeof(cl_uint),
+                                      grids.micropolygon_offsets_host.data(), nullptr, &written_);
 }
 
 DiceStage::DiceStage(DeviceSession& session)

@@ -68,6 +68,9 @@ struct GridBuffers {
 class GridLayoutStage {
  public:
   GridLayoutStage(DeviceSession& session, cl_uint capacity);
+  ~GridLayoutStage();
+  GridLayoutStage(const GridLayoutStage&) = delete;
+  GridLayoutStage& operator=(const GridLayoutStage&) = delete;
   void run(const cl::Buffer& diceable, cl_uint count, const FrameParams& f, GridBuffers& grids, StageTimer& timer);
   void begin_frame() { micropolygons_ = 0; }
   size_t micropolygons() const { return micropolygons_; }  // diced this frame
@@ -77,6 +80,7 @@ class GridLayoutStage {
   cl::Kernel kernel_;
   cl::Buffer counts_;                 // vertices and micropolygons per grid, interleaved
   std::vector<cl_uint> counts_host_, vertex_offsets_host_;
+  cl::Event written_;  // the last batch's offsets written (from vertex_offsets_host_ and the grids')
   size_t micropolygons_ = 0;
 };
 
