@@ -280,9 +280,10 @@ struct RenderSettings {
   BoundSplitMethod bound_split = BoundSplitMethod::Bounded;
   float bound_split_memory_mib = 64.0f;        // budget of the bounded method
   // The bounded method's launches chained on the device between two host
-  // reads of its counters (at most this many; 0: Auto, 16 on GPUs and 1 on
-  // CPUs); the image is the same for any value.
-  int bound_split_chain = 0;
+  // reads of its counters (at most this many); the image is the same for
+  // any value. 1 (no chains): on the H100 a launch costs the host nearly
+  // what a read does, and chains did not pay (docs/performance.md).
+  int bound_split_chain = 1;
   int max_grid_size = 16;                      // micropolygons per grid side
   int max_split_depth = 26;                    // eye-split and runaway limit
   bool backface_culling = true;                // for single-sided surfaces

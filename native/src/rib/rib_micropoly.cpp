@@ -91,7 +91,7 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   s.sampler = string_choice(args, params, "sampler", {{"auto", Sampler::Auto}, {"tiles", Sampler::Tiles},
                                                        {"micropolygons", Sampler::Micropolygons}},
                             s.sampler);
-  params.get_int("boundsplitchain", 0, 1024, &s.bound_split_chain);
+  params.get_int("boundsplitchain", 1, 1024, &s.bound_split_chain);
   s.resolver = string_choice(args, params, "resolver",
                              {{"auto", Resolver::Auto}, {"tiles", Resolver::Tiles}, {"pixels", Resolver::Pixels}},
                              s.resolver);

@@ -212,8 +212,8 @@ void validate_scene(const Scene& scene) {
     throw Error("crop window must satisfy 0 <= min < max <= 1");
   if (!(s.bound_split_memory_mib > 0) || !std::isfinite(s.bound_split_memory_mib))
     throw Error("bound & split memory budget must be a positive number of MiB");
-  if (s.bound_split_chain < 0 || s.bound_split_chain > 1024)
-    throw Error("bound & split chain must be 0 (auto) to 1024 launches");
+  if (s.bound_split_chain < 1 || s.bound_split_chain > 1024)
+    throw Error("bound & split chain must be 1 to 1024 launches");
   if (!(s.shadow_memory_mib > 0) || !std::isfinite(s.shadow_memory_mib))
     throw Error("shadow map memory budget must be a positive number of MiB");
   if (!(s.shadow_shading_rate > 0) || !std::isfinite(s.shadow_shading_rate))

@@ -121,10 +121,6 @@ struct BoundedWorkspace {
   size_t stacks_bytes = 0, sizes_bytes = 0, ring_bytes = 0, diceable_bytes = 0, counters_bytes = 0;
 };
 
-// The longest chain of bounded launches Auto takes on a GPU
-// (RenderSettings::bound_split_chain).
-constexpr int kAutoBoundSplitChain = 16;
-
 // Weber, Wimmer & Owens 2015: fixed worker pool, depth-first per worker,
 // memory fixed by `budget_bytes` (never exceeded; throws if too small).
 // Up to `max_chain` launches are chained on the device between two reads

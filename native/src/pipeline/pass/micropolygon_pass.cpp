@@ -29,12 +29,8 @@ BoundSplitResult MicropolygonPass::run(const PassView& view, const ViewTarget& t
   DeviceSession::Activity activity(session_, "bound_split");
   if (settings_.bound_split == BoundSplitMethod::Bounded) {
     const size_t budget = static_cast<size_t>(std::max(0.0f, settings_.bound_split_memory_mib) * 1048576.0);
-    // Chained launches on GPUs, where a read-back costs more than a launch
-    // runs (bound_split_bounded.cpp); a read after every launch on CPUs.
-    const int chain = settings_.bound_split_chain > 0 ? settings_.bound_split_chain
-                      : session_.info().type == "gpu"  ? kAutoBoundSplitChain
-                                                       : 1;
-    result = bound_split_bounded(ctx, budget, grids.capacity, stages_.bounded, static_cast<cl_uint>(chain));
+    result = bound_split_bounded(ctx, budget, grids.capacity, stages_.bounded,
+                                 static_cast<cl_uint>(std::max(settings_.bound_split_chain, 1)));
   } else {
     result = bound_split_breadth(ctx, grids.capacity);
   }
