@@ -60,19 +60,23 @@ void write_png(const std::string& path, const RenderResult& r) {
 void write_exr(const std::string& path, const RenderResult& r) {
   try {
     Imf::Header header(r.width, r.height);
+    // Colour always; Depth (Z) and Normal (N.*) each where the result has it.
     const char* names[] = {"R", "G", "B", "A", "Z", "N.X", "N.Y", "N.Z"};
-    const bool passes = !r.depth.empty() && !r.normal.empty();
-    for (int c = 0; c < (passes ? 8 : 4); ++c) header.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
+    const bool depth = !r.depth.empty(), normal = !r.normal.empty();
+    for (int c = 0; c < 8; ++c)
+      if (c < 4 || (c == 4 && depth) || (c > 4 && normal)) header.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
     Imf::FrameBuffer fb;
     const size_t xs4 = 4 * sizeof(float), ys4 = xs4 * r.width;
     char* rgba = reinterpret_cast<char*>(const_cast<float*>(r.rgba.data()));
     for (int c = 0; c < 4; ++c) fb.insert(names[c], Imf::Slice(Imf::FLOAT, rgba + c * sizeof(float), xs4, ys4));
-    if (passes) {
-    fb.insert("Z", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(r.depth.data())), sizeof(float),
-                              sizeof(float) * r.width));
-    char* n = reinterpret_cast<char*>(const_cast<float*>(r.normal.data()));
-    for (int c = 0; c < 3; ++c)
-      fb.insert(names[5 + c], Imf::Slice(Imf::FLOAT, n + c * sizeof(float), 3 * sizeof(float), 3 * sizeof(float) * r.width));
+    if (depth)
+      fb.insert("Z", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(r.depth.data())), sizeof(float),
+                                sizeof(float) * r.width));
+    if (normal) {
+      char* n = reinterpret_cast<char*>(const_cast<float*>(r.normal.data()));
+      for (int c = 0; c < 3; ++c)
+        fb.insert(names[5 + c],
+                  Imf::Slice(Imf::FLOAT, n + c * sizeof(float), 3 * sizeof(float), 3 * sizeof(float) * r.width));
     }
     Imf::OutputFile file(path.c_str(), header);
     file.setFrameBuffer(fb);
