@@ -20,8 +20,9 @@
 // instead of once per launch (on the H100 a read-back costs 17-28 us and
 // a launch of this kernel 19 us of host time). Measured there, chains of
 // up to 16 halve the bound & split reads but add as much launch time as
-// they save (0.87-1.03 of unchained frames), so they are off by default. Chained launches cover a fixed range of workers,
-// of which those beyond BS_ACTIVE return at once. A chain is as long as
+// they save (0.87-1.03 of unchained frames), so they are off by default.
+// Chained launches cover a fixed range of workers, of which those beyond
+// BS_ACTIVE return at once. A chain is as long as
 // the launches between the last two stops (the first is one launch, and
 // one that runs through doubles the next): where every launch ends in a
 // stop (a full batch each, as in many lights' views) the launches are read
@@ -131,6 +132,11 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
       bind_args(ws.control, ws.counters, ring_capacity, dice_capacity, static_cast<cl_uint>(workers),
                 static_cast<cl_uint>(useful));
     cl_uint chain = 1, since_stop = 0;
+    // The roots taken so far as the pass's progress; false once cancelled.
+    auto keep_going = [&] {
+      return !ctx.progress ||
+             ctx.progress(0.95f * static_cast<float>(next_root) / static_cast<float>(std::max(root_count, 1u)));
+    };
     for (;;) {
       // The counters, and what changes per launch: the ring's head and tail,
       // the donation limit (at most as many children as there will be idle
@@ -160,7 +166,7 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
         hungry = c[kDonate], launch = c[kActive];
         result.occluded += c[kOccludedSum];
         chain = std::min(max_chain, 2 * chain);
-        if (ctx.progress && !ctx.progress(0.95f * static_cast<float>(next_root) / static_cast<float>(std::max(root_count, 1u)))) {
+        if (!keep_going()) {
           result.cancelled = true;
           break;
         }
@@ -228,7 +234,7 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
       const size_t pending = (tail - head) + (root_limit - next_root);
       launch = whole_groups(std::max<size_t>(c[kMaxBusy], std::min(2 * busy + pending, useful)));
       hungry = static_cast<cl_uint>(launch > busy ? launch - busy : 0);
-      if (ctx.progress && !ctx.progress(0.95f * static_cast<float>(next_root) / static_cast<float>(std::max(root_count, 1u)))) {
+      if (!keep_going()) {
         result.cancelled = true;
         break;
       }
