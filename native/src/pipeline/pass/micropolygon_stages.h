@@ -252,8 +252,9 @@ class ResolveStage {
   int weights_type_ = -1;
   SamplePattern weights_pattern_;
   float weights_width_ = 0;
-  // On discrete GPUs the image is read back through a pinned (page-locked)
-  // staging buffer, which the driver copies into at full bus speed.
+  // On discrete GPUs the image and its passes are read back through one
+  // pinned (page-locked) staging buffer, which the driver copies into at
+  // full bus speed; it grows to the largest frame read and is kept.
   bool use_pinned_ = false;
   cl::Buffer pinned_;
   float* pinned_ptr_ = nullptr;
