@@ -16,7 +16,11 @@ difference is the trees' cost. Before and after builds take turns.
   MICROPOLY_ADDON_DIR=build/addons blender -b --factory-startup \\
       --python bench/program_build_bench.py -- --make-rib
   python3 bench/program_build_bench.py --cli build/micropoly-render \\
-      --before OLD/micropoly-render [--rounds 5] [--json FILE]
+      --before OLD/micropoly-render [--rounds 5] [--json FILE] [--cold]
+
+--cold also times the first render from empty caches (Micropoly's and
+PoCL's both new each round): the stages' program, the light program and
+every tree built, what a fresh install's first F12 pays.
 """
 
 import json
@@ -84,7 +88,7 @@ def render(cli, rib, out, env, stats):
         return seconds, json.load(f).get("program_build_ms", 0.0) / 1000.0
 
 
-def run(clis, rounds):
+def run(clis, rounds, cold=False):
     with open(RIB) as f:
         text = f.read()
     trees = len(PROGRAM.findall(text))
@@ -116,13 +120,28 @@ def run(clis, rounds):
                 results[name]["build"].append(round(build, 3))
             os.remove(rib)
     finally:
-        shutil.rmtree(work, ignore_errors=True)
+        if not cold:
+            shutil.rmtree(work, ignore_errors=True)
     summary = {"scene": os.path.basename(RIB), "trees": trees, "rounds": rounds}
+    if cold:
+        for k in range(rounds):
+            for name, cli in clis.items():
+                env = dict(os.environ)
+                env["MICROPOLY_CACHE_DIR"] = os.path.join(work, f"{name}-cold{k}")
+                env["POCL_CACHE_DIR"] = os.path.join(work, f"{name}-cold-pocl{k}")
+                seconds, build = render(cli, RIB, os.path.join(work, "cold.png"), env, os.path.join(work, "s.json"))
+                results[name].setdefault("cold", []).append(round(seconds, 3))
+                results[name].setdefault("cold_build", []).append(round(build, 3))
+                shutil.rmtree(env["MICROPOLY_CACHE_DIR"], ignore_errors=True)
+                shutil.rmtree(env["POCL_CACHE_DIR"], ignore_errors=True)
+        shutil.rmtree(work, ignore_errors=True)
     for name, r in results.items():
         per_tree = [(n - c) / trees for n, c in zip(r["new"], r["cached"])]
         summary[name] = dict(r, median_new_s=statistics.median(r["new"]),
                              median_cached_s=statistics.median(r["cached"]),
                              median_per_tree_s=round(statistics.median(per_tree), 3))
+        if cold:
+            summary[name]["median_cold_s"] = statistics.median(r["cold"])
     return summary
 
 
@@ -134,7 +153,7 @@ def main(argv):
     if "--before" in argv:
         clis = {"before": argv[argv.index("--before") + 1], **clis}
     rounds = int(argv[argv.index("--rounds") + 1]) if "--rounds" in argv else 5
-    summary = run(clis, rounds)
+    summary = run(clis, rounds, cold="--cold" in argv)
     print(json.dumps(summary, indent=1))
     if "--json" in argv:
         with open(argv[argv.index("--json") + 1], "w") as f:

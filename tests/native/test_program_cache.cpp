@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <unistd.h>
 
 #include "cl/build_context.h"
 #include "cl/device_session.h"
@@ -65,6 +66,56 @@ TEST(ProgramCache, CorruptCacheEntriesAreRebuilt) {
   DeviceSession session("");
   EXPECT_FALSE(session.program_cache_hit());
   std::filesystem::remove_all(dir);
+}
+
+// PoCL keeps compiled programs in its own kernel cache; asking it for a
+// binary would make it compile every kernel's generic variant first. There
+// Micropoly's entry is only a record of the build; elsewhere (and on PoCL
+// with its cache off) the binary itself, which a second build loads.
+TEST(ProgramCache, PoclKeepsARecordOtherDriversTheBinary) {
+  DeviceSession session("");
+  const std::string platform =
+      cl::Platform(session.device().getInfo<CL_DEVICE_PLATFORM>()).getInfo<CL_PLATFORM_NAME>();
+  const bool pocl = platform.find("Portable Computing Language") != std::string::npos;
+  // A source no cache holds yet.
+  const std::string source = "__kernel void one(__global float* x) { x[0] = " + std::to_string(::getpid()) +
+                             ".0f; }\n__kernel void two(__global float* x) { x[1] = 2.0f; }\n";
+  auto entries = [](const std::filesystem::path& dir, const std::string& ext) {
+    int n = 0;
+    if (std::filesystem::exists(dir))
+      for (auto& e : std::filesystem::directory_iterator(dir)) n += e.path().extension() == ext;
+    return n;
+  };
+  for (const char* kernel_cache : {"1", "0"}) {
+    auto dir = fresh_dir(kernel_cache[0] == '1' ? "micropoly-cache-record-" : "micropoly-cache-binary-");
+    ScopedEnv env("MICROPOLY_CACHE_DIR", dir.string());
+    ScopedEnv pocl_env("POCL_KERNEL_CACHE", kernel_cache);
+    const bool record = pocl && kernel_cache[0] == '1';
+    BuiltProgram first = build_program_cached(session.context(), session.device(), source, "-cl-std=CL1.2");
+    EXPECT_FALSE(first.from_cache);
+    EXPECT_EQ(entries(dir, ".built"), record ? 1 : 0) << platform << " POCL_KERNEL_CACHE=" << kernel_cache;
+    EXPECT_EQ(entries(dir, ".bin"), record ? 0 : 1) << platform << " POCL_KERNEL_CACHE=" << kernel_cache;
+    BuiltProgram second = build_program_cached(session.context(), session.device(), source, "-cl-std=CL1.2");
+    EXPECT_TRUE(second.from_cache);
+    // Either way the program runs.
+    cl::Buffer x(session.context(), CL_MEM_READ_WRITE, 2 * sizeof(float));
+    cl::Kernel one(second.program, "one");
+    one.setArg(0, x);
+    cl::CommandQueue queue(session.context(), session.device());
+    queue.enqueueNDRangeKernel(one, cl::NullRange, cl::NDRange(1));
+    float got[2] = {0, 0};
+    queue.enqueueReadBuffer(x, CL_TRUE, 0, sizeof got, got);
+    EXPECT_EQ(got[0], static_cast<float>(::getpid()));
+    // A record of another identity (a foreign or older entry) is no hit.
+    if (record) {
+      for (auto& e : std::filesystem::directory_iterator(dir)) {
+        std::ofstream out(e.path(), std::ios::trunc);
+        out << "another device|0000\n";
+      }
+      EXPECT_FALSE(build_program_cached(session.context(), session.device(), source, "-cl-std=CL1.2").from_cache);
+    }
+    std::filesystem::remove_all(dir);
+  }
 }
 
 TEST(ProgramCache, KernelBuildFailureIsAClearError) {

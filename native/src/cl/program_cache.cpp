@@ -55,6 +55,21 @@ fs::path cache_dir() {
   return {};
 }
 
+// Whether the driver keeps compiled programs itself, so that Micropoly keeps
+// only a record that it built this source. PoCL does (its kernel cache, on
+// unless POCL_KERNEL_CACHE=0: the program's bitcode by source, then every
+// kernel's code per launch shape as it first runs). Asking PoCL for a binary
+// (CL_PROGRAM_BINARIES) makes it compile a generic variant of every kernel in
+// the program first, launched or not: that doubled a cold build of the
+// stages' program (about 36 s against 18 s for a first render on 2 cores),
+// while a later session found everything in PoCL's cache either way.
+bool driver_caches_programs(const cl::Device& device) {
+  const std::string platform = cl::Platform(device.getInfo<CL_DEVICE_PLATFORM>()).getInfo<CL_PLATFORM_NAME>();
+  if (platform.find("Portable Computing Language") == std::string::npos) return false;
+  const char* cache = std::getenv("POCL_KERNEL_CACHE");
+  return !(cache && std::string(cache) == "0");
+}
+
 std::string build_log(const cl::Program& program, const cl::Device& device) {
   try {
     return program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device);
@@ -147,11 +162,27 @@ BuiltProgram build_program_cached(const cl::Context& context, const cl::Device& 
   char key[32];
   std::snprintf(key, sizeof key, "%016llx", static_cast<unsigned long long>(fnv1a(source, fnv1a(identity))));
   fs::path dir = cache_dir();
-  fs::path file = dir.empty() ? fs::path() : dir / (std::string(key) + ".bin");
+  // Where the driver caches programs itself, the entry is a record of the
+  // build (its identity), not a binary (driver_caches_programs).
+  const bool record_only = driver_caches_programs(device);
+  fs::path file = dir.empty() ? fs::path() : dir / (std::string(key) + (record_only ? ".built" : ".bin"));
   std::vector<cl::Device> devices{device};
   auto elapsed = [&] { return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count(); };
+  auto write_atomically = [&](const char* data, size_t size) {
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    fs::path tmp = file;
+    tmp += ".tmp" + std::to_string(::getpid());
+    {
+      std::ofstream out(tmp, std::ios::binary);
+      out.write(data, static_cast<std::streamsize>(size));
+    }
+    fs::rename(tmp, file, ec);  // atomic: concurrent renders never read half a file
+    if (ec) fs::remove(tmp, ec);
+  };
+  const std::string record = identity + "|" + key + "\n";
 
-  if (!file.empty()) {
+  if (!file.empty() && !record_only) {
     std::ifstream in(file, std::ios::binary);
     std::vector<unsigned char> binary((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (!binary.empty()) {
@@ -186,26 +217,29 @@ BuiltProgram build_program_cached(const cl::Context& context, const cl::Device& 
                 build_context(device) + "): " +
                 first_build_error(log) + where);
   }
-  if (!file.empty()) {
+  bool built_before = false;
+  if (!file.empty() && record_only) {
+    // The driver found its own cached build of this source, or made one;
+    // the record says whether this source was built here before.
+    std::ifstream in(file, std::ios::binary);
+    built_before = std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()) == record;
+    if (!built_before) {
+      try {
+        write_atomically(record.data(), record.size());
+      } catch (const std::exception&) {
+        // The record is an optimisation only.
+      }
+    }
+  } else if (!file.empty()) {
     try {
       auto binaries = program.getInfo<CL_PROGRAM_BINARIES>();
-      if (!binaries.empty() && !binaries[0].empty()) {
-        std::error_code ec;
-        fs::create_directories(dir, ec);
-        fs::path tmp = file;
-        tmp += ".tmp" + std::to_string(::getpid());
-        {
-          std::ofstream out(tmp, std::ios::binary);
-          out.write(reinterpret_cast<const char*>(binaries[0].data()), static_cast<std::streamsize>(binaries[0].size()));
-        }
-        fs::rename(tmp, file, ec);  // atomic: concurrent renders never read half a file
-        if (ec) fs::remove(tmp, ec);
-      }
+      if (!binaries.empty() && !binaries[0].empty())
+        write_atomically(reinterpret_cast<const char*>(binaries[0].data()), binaries[0].size());
     } catch (const std::exception&) {
       // The cache is an optimisation only.
     }
   }
-  return {program, false, elapsed()};
+  return {program, built_before, elapsed()};
 }
 
 }  // namespace mp

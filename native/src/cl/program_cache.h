@@ -1,7 +1,10 @@
 // Builds the embedded kernel sources into a program, caching the device
 // binary on disk per device, driver and source hash so a second run does not
-// recompile. Cache folder: $MICROPOLY_CACHE_DIR, else $XDG_CACHE_HOME/micropoly,
-// else ~/.cache/micropoly. A cache that cannot be read or written is ignored.
+// recompile. On PoCL, whose own kernel cache keeps the program and each
+// kernel's code, the entry is only a record that this source was built (a
+// binary would cost a compile of every kernel first; program_cache.cpp).
+// Cache folder: $MICROPOLY_CACHE_DIR, else $XDG_CACHE_HOME/micropoly, else
+// ~/.cache/micropoly. A cache that cannot be read or written is ignored.
 #pragma once
 
 #include <string>
@@ -35,7 +38,7 @@ std::string first_build_error(const std::string& log);
 
 struct BuiltProgram {
   cl::Program program;
-  bool from_cache = false;
+  bool from_cache = false;  // a cached binary, or (PoCL) a source built here before
   double build_ms = 0;
 };
 
