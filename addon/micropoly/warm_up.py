@@ -13,7 +13,8 @@ open file's materials (those that read no image; at most MAX_PROGRAMS), and
 again when a file is opened. It renders on the renderer final renders keep
 (final_renderers.FinalRenderers), so the first F12 finds its programs built and its
 kernels loaded; what it builds also lands in the caches every later renderer
-reads (Micropoly's program binaries, the driver's compiled kernels), so the
+reads (the driver's compiled programs and kernels: PoCL's own cache; other
+drivers' program binaries in Micropoly's), so the
 first Rendered viewport finds them too. A render that starts while it runs
 waits for it rather than building the same things beside it. Blender's
 status bar shows it while it runs (docs/install.md).

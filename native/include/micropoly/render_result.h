@@ -91,7 +91,7 @@ struct RenderStats {
   std::vector<std::pair<std::string, size_t>> kernel_launches_by_phase;
   // Buckets the frame was rendered in (RenderSettings::sample_memory_mib).
   size_t buckets = 1;
-  double program_build_ms = 0;       // 0 when the binary cache was used... see program_cache_hit
+  double program_build_ms = 0;       // includes loads from the program cache (program_cache_hit)
   bool program_cache_hit = false;
   bool cancelled = false;
   // The scene's device buffers were those of the previous render (same

@@ -1,6 +1,6 @@
 // A device session: the chosen OpenCL device with its context, in-order
-// profiling queue and the built Micropoly program (from the binary cache when
-// possible).
+// profiling queue and the built Micropoly program (from the program cache when
+// possible: program_cache.h).
 #pragma once
 
 #include <string>

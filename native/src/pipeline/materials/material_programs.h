@@ -1,7 +1,7 @@
 // Material programs: each distinct node tree's OpenCL C, built into its own
 // program (kernels/materials/material_program.cl) and kept across frames,
 // so an unchanged tree is never rebuilt and a changed one rebuilds alone
-// (from the on-disk binary cache when it was built before).
+// (from the program cache when it was built before: program_cache.h).
 #pragma once
 
 #include <memory>
@@ -78,7 +78,7 @@ class MaterialPrograms {
   // changes (a link made, a node added, a mode switched) builds a new
   // program, and keeping them all would grow without limit (about 8 MiB each
   // on PoCL). A few are kept for scenes that switch back and forth; the rest
-  // are rebuilt from the on-disk binary cache when they return.
+  // are rebuilt from the program cache when they return (program_cache.h).
   static constexpr size_t kSparePrograms = 8;
   void evict_unused();
   struct Active {
