@@ -118,7 +118,7 @@ void MaterialPrograms::composite_world(const Scene& scene, const SceneBuffers& b
   session_.queue().enqueueNDRangeKernel(k, cl::NullRange, round_up_range(cl_uint(pixels)), cl::NDRange(64));
 }
 
-void MaterialPrograms::launch(cl::Kernel& kernel, cl_uint count, GridBuffers& grids, Stage stage, StageTimer& timer) {
+void MaterialPrograms::launch(cl::Kernel& kernel, const GridBuffers& grids, Stage stage, StageTimer& timer) {
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64),
                                         nullptr, &e);
@@ -130,12 +130,11 @@ void MaterialPrograms::displace(const cl::Buffer& diceable, cl_uint count, const
   if (!displaces_) return;
   for (Active& a : active_) {
     if (!a.displaces) continue;
-    launch(a.built->displace.bind(scene, diceable, count, f, a.index, grids.p, grids.n, grids.vertex_offsets), count,
-           grids, Stage::Dice, timer);
+    launch(a.built->displace.bind(scene, diceable, count, f, a.index, grids.p, grids.n, grids.vertex_offsets), grids,
+           Stage::Dice, timer);
   }
   if (!normals) return;
-  launch(normals_.bind(scene, diceable, count, f, grids.p, grids.n, grids.vertex_offsets), count, grids, Stage::Dice,
-         timer);
+  launch(normals_.bind(scene, diceable, count, f, grids.p, grids.n, grids.vertex_offsets), grids, Stage::Dice, timer);
 }
 
 void MaterialPrograms::shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
@@ -157,7 +156,7 @@ void MaterialPrograms::run_shade(const cl::Buffer& diceable, cl_uint count, cons
       if (!a.alpha) continue;
       launch(a.built->shade.bind(scene, diceable, count, f, a.index, grids.p, grids.n, grids.c, grids.vertex_offsets,
                                  cl_uint(1), visible, cl::Buffer(), cl_uint(0)),
-             count, grids, Stage::Shade, timer);
+             grids, Stage::Shade, timer);
     }
     return;
   }

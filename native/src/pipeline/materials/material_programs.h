@@ -89,7 +89,8 @@ class MaterialPrograms {
   // The program of a material's tree, or (`world`) of the world's: each
   // holds only its own kernels (material_program.cl).
   Built* build(const MaterialProgram& mp, bool world, const char* owner, RenderStats& stats);
-  void launch(cl::Kernel& kernel, cl_uint count, GridBuffers& grids, Stage stage, StageTimer& timer);
+  // One work-item per vertex of the batch's grids.
+  void launch(cl::Kernel& kernel, const GridBuffers& grids, Stage stage, StageTimer& timer);
   void run_shade(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
                  GridBuffers& grids, const ShadowInputs& shadows, const cl::Buffer& visible, bool alpha_only,
                  StageTimer& timer);
