@@ -119,22 +119,19 @@ def run(clis, rounds, cold=False):
                 results[name]["cached"].append(round(cached, 3))
                 results[name]["build"].append(round(build, 3))
             os.remove(rib)
+        if cold:
+            for k in range(rounds):
+                for name, cli in clis.items():
+                    env = dict(os.environ)
+                    env["MICROPOLY_CACHE_DIR"] = os.path.join(work, f"{name}-cold{k}")
+                    env["POCL_CACHE_DIR"] = os.path.join(work, f"{name}-cold-pocl{k}")
+                    seconds, build = render(cli, RIB, os.path.join(work, "cold.png"), env,
+                                            os.path.join(work, "s.json"))
+                    results[name].setdefault("cold", []).append(round(seconds, 3))
+                    results[name].setdefault("cold_build", []).append(round(build, 3))
     finally:
-        if not cold:
-            shutil.rmtree(work, ignore_errors=True)
-    summary = {"scene": os.path.basename(RIB), "trees": trees, "rounds": rounds}
-    if cold:
-        for k in range(rounds):
-            for name, cli in clis.items():
-                env = dict(os.environ)
-                env["MICROPOLY_CACHE_DIR"] = os.path.join(work, f"{name}-cold{k}")
-                env["POCL_CACHE_DIR"] = os.path.join(work, f"{name}-cold-pocl{k}")
-                seconds, build = render(cli, RIB, os.path.join(work, "cold.png"), env, os.path.join(work, "s.json"))
-                results[name].setdefault("cold", []).append(round(seconds, 3))
-                results[name].setdefault("cold_build", []).append(round(build, 3))
-                shutil.rmtree(env["MICROPOLY_CACHE_DIR"], ignore_errors=True)
-                shutil.rmtree(env["POCL_CACHE_DIR"], ignore_errors=True)
         shutil.rmtree(work, ignore_errors=True)
+    summary = {"scene": os.path.basename(RIB), "trees": trees, "rounds": rounds}
     for name, r in results.items():
         per_tree = [(n - c) / trees for n, c in zip(r["new"], r["cached"])]
         summary[name] = dict(r, median_new_s=statistics.median(r["new"]),
