@@ -4,13 +4,13 @@ build of micropoly-render, or two side by side (--before), in interleaved
 rounds so that the machine's noise falls on every case and build alike.
 Per case and build it reports the median over rounds of each round's
 per-frame median (frames after the first, which builds programs and
-uploads the scene), the stages' medians, the last frame's counts and every
+uploads the scene; with --first, that first frame instead), the stages' medians, the last frame's counts and every
 pool's peak against its budget; with two builds, after / before; and the
 suite's ratios between cases.
 
   python3 bench/bench.py SUITE --cli build/micropoly-render [--before OLD_CLI]
       [--device cpu|gpu] [--rounds 3] [--repeat N] [--only CASE,CASE]
-      [--size WxH] [--scenes DIR] [--json FILE]
+      [--size WxH] [--scenes DIR] [--json FILE] [--first]
 
   python3 bench/bench.py --list
 
@@ -62,8 +62,8 @@ def resized(rib, size):
     return copy
 
 
-def median_frames(runs, key):
-    later = runs[1:] or runs
+def median_frames(runs, key, first=False):
+    later = runs[:1] if first else runs[1:] or runs
     return statistics.median(r["timings_ms"].get(key, 0.0) for r in later)
 
 
@@ -115,6 +115,9 @@ def main():
     ap.add_argument("--size", default="", help="WxH: every scene at this size")
     ap.add_argument("--scenes", default=os.path.join(HERE, "out"))
     ap.add_argument("--json", default="", help="also write every frame's times and the last stats here")
+    ap.add_argument("--first", action="store_true",
+                    help="time each run's first frame (a new process: programs from the cache, the scene and its "
+                         "world uploaded, baked and prefiltered) instead of the frames after it")
     ap.add_argument("--list", action="store_true")
     a = ap.parse_args()
     if a.list or not a.suite:
@@ -147,12 +150,12 @@ def main():
         for case in cases:
             for build, cli in builds:
                 runs = run_frames(cli, ribs[case.name], tmp, a.device, repeat, case.options)
-                times[(case.name, build)].append({s: median_frames(runs, s) for s in stages})
+                times[(case.name, build)].append({s: median_frames(runs, s, a.first) for s in stages})
                 frames.setdefault(f"{case.name}/{build}", []).append([r["timings_ms"]["total"] for r in runs])
                 last[(case.name, build)] = runs[-1]
     device = next(iter(last.values()))["device"] if last else ""
     print(f"{a.suite}: {suite.about}; {device}, {a.rounds} rounds of {repeat} frames"
-          + (f", {size[0]}x{size[1]}" if size else ""))
+          + (f", {size[0]}x{size[1]}" if size else "") + (", the first frame of each" if a.first else ""))
     report(suite, cases, builds, times, suite.stages, last)
     if a.json:
         with open(a.json, "w") as f:

@@ -11,6 +11,7 @@
 #include "geometry/mp_patch.h"
 #include "pipeline/pass/stage_timer.h"
 #include "textures/mp_tex_image.h"
+#include "closures/mp_world.h"
 
 namespace mp {
 namespace {
@@ -407,12 +408,28 @@ void upload_lights(DeviceSession& session, const std::vector<Light>& lights, con
   });
 }
 
-void upload_world_glossy(DeviceSession& session, const std::vector<glm::vec4>& maps, SceneBuffers& buffers) {
+cl::Buffer prefilter_world_glossy(DeviceSession& session, const WorldMap& map) {
+  const size_t texels = size_t(mp_world_glossy_offset(MP_WORLD_GLOSSY_LEVELS));
+  cl::Buffer out = session.allocate(texels * sizeof(glm::vec4), "world glossy maps");
+  DeviceQueue& q = session.queue();
+  const std::vector<glm::vec4> mips = world_map_mips(map);
   upload_or_drain(session, [&] {
-    buffers.world_glossy = upload(session, maps);
-    buffers.version = session.next_data_version();
-    session.queue().finish();  // `maps` is the caller's; the write must end while it lives
+    if (mips.empty()) {
+      q.enqueueFillBuffer(out, cl_float(0.0f), 0, texels * sizeof(glm::vec4));
+    } else {
+      cl::Buffer source = upload(session, mips);
+      cl::Kernel k(session.program(), "prefilter_world_glossy");
+      bind_args(k, source, cl_int(map.width), cl_int(map.height), out);
+      q.enqueueNDRangeKernel(k, cl::NullRange, round_up_range(texels), cl::NDRange(64));
+    }
+    q.finish();  // `mips` lives only for the call
   });
+  return out;
+}
+
+void set_world_glossy(DeviceSession& session, const cl::Buffer& maps, SceneBuffers& buffers) {
+  buffers.world_glossy = maps;
+  buffers.version = session.next_data_version();
 }
 
 SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data) {

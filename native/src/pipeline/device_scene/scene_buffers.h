@@ -9,6 +9,7 @@
 #include "core/mp_scene_data.h"
 #include "pipeline/device_scene/patch_cache.h"
 #include "pipeline/materials/refraction_proxy.h"
+#include "pipeline/world/world_lighting.h"
 #include "subdiv/patch_buffer.h"
 
 namespace mp {
@@ -63,9 +64,12 @@ struct SceneBuffers {
 #undef MP_HOST_SCENE_BUFFER
 #undef MP_HOST_SCENE_VALUE
 SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data);
-// Replaces the world's glossy maps (world_lighting.h, world_glossy_maps).
-void upload_world_glossy(DeviceSession& session, const std::vector<glm::vec4>& maps,
-                         SceneBuffers& buffers);
+// The world's glossy maps (kernels/closures/mp_world.h) prefiltered from
+// `map` on the device (kernels/stages/world_glossy.cl); zeros for an empty map.
+cl::Buffer prefilter_world_glossy(DeviceSession& session, const WorldMap& map);
+// Replaces the buffers' world glossy maps with `maps` (prefilter_world_glossy),
+// which a renderer keeps while its world stays the same.
+void set_world_glossy(DeviceSession& session, const cl::Buffer& maps, SceneBuffers& buffers);
 // Replaces the buffers' lights (the scene's and its world's, device_lights).
 void upload_lights(DeviceSession& session, const std::vector<Light>& lights,
                    const glm::mat4& world_to_camera, SceneBuffers& buffers);

@@ -119,11 +119,12 @@ struct Renderer::Impl {
   SessionHealth health = SessionHealth::Good;
   bool first_render = true;
   // The world's map and the lights derived from it (world-space, so a
-  // moving camera keeps them), kept while the world stays the same. Host
-  // memory only, and world_key is set once all three are complete.
+  // moving camera keeps them), kept while the world stays the same; world_key
+  // is set once both are complete. Its glossy maps are device memory, made
+  // again when absent (a new world, or the device's memory dropped).
   WorldMap world_map;
   std::vector<Light> world_lights;
-  std::vector<glm::vec4> world_glossy;
+  cl::Buffer world_glossy;
   uint64_t world_key = 0;
   // Object-space patches of the last scenes' shapes: a moved camera or
   // object re-places them instead of rebuilding (patch_cache.h). Host
@@ -139,6 +140,7 @@ DeviceSession& Renderer::Impl::ready_session() {
     // one fault is not planted again by the new session.
     const FaultInjector faults = session ? session->faults().reopened() : FaultInjector();
     stages.reset();
+    world_glossy = cl::Buffer();
     session.reset();
     try {
       session = std::make_unique<DeviceSession>(selector, faults);
@@ -161,6 +163,7 @@ DeviceSession& Renderer::Impl::ready_session() {
 void Renderer::Impl::recover(SessionHealth failed) {
   if (session) session->queue().drain();
   stages.reset();
+  world_glossy = cl::Buffer();
   health = failed;
 }
 
@@ -322,14 +325,15 @@ std::vector<Light> Renderer::Impl::upload(const Scene& scene, RenderStats& st) {
         world_map = scene.world.program >= 0 ? d.programs.bake_world(scene, *d.scene_buffers)
                                              : given_world_map(scene.world);
         world_lights = mp::world_lights(world_map, scene.world, scene.settings.world_probes);
-        world_glossy = world_glossy_maps(world_map);
+        world_glossy = cl::Buffer();
         world_key = wkey;
       }
+      if (!world_glossy()) world_glossy = prefilter_world_glossy(s, world_map);
     }
     lights.insert(lights.end(), world_lights.begin(), world_lights.end());
     if (fresh) {
       upload_lights(s, lights, scene.camera.world_to_camera, *d.scene_buffers);
-      upload_world_glossy(s, world_glossy, *d.scene_buffers);
+      set_world_glossy(s, world_glossy, *d.scene_buffers);
     }
   }
   if (fresh) d.scene_key = key;

@@ -180,6 +180,39 @@ WorldMap given_world_map(const World& world) {
   return map;
 }
 
+std::vector<glm::vec4> world_map_mips(const WorldMap& map) {
+  std::vector<glm::vec4> out;
+  if (map.width <= 0 || map.height <= 0) return out;
+  out.reserve(size_t(map.width) * size_t(map.height) * 4 / 3 + 16);
+  for (const glm::vec3& c : map.radiance) out.emplace_back(c, 1.0f);
+  // Each level from the one before it, which starts at `above`.
+  size_t above = 0;
+  for (int w = map.width, h = map.height; w >= 16 && h >= 2; w /= 2, h /= 2) {
+    const int hw = w / 2, hh = h / 2;
+    auto at = [&](int x, int y) { return out[above + size_t(std::min(y, h - 1)) * size_t(w) + size_t(x % w)]; };
+    const size_t start = out.size();
+    for (int y = 0; y < hh; ++y)
+      for (int x = 0; x < hw; ++x)
+        out.push_back(0.25f * (at(2 * x, 2 * y) + at(2 * x + 1, 2 * y) + at(2 * x, 2 * y + 1) + at(2 * x + 1, 2 * y + 1)));
+    above = start;
+  }
+  return out;
+}
+
+std::vector<glm::vec4> world_glossy_maps(const WorldMap& map) {
+  std::vector<glm::vec4> out(size_t(mp_world_glossy_offset(MP_WORLD_GLOSSY_LEVELS)), glm::vec4(0.0f));
+  if (map.width <= 0 || map.height <= 0) return out;
+  const std::vector<glm::vec4> mips = world_map_mips(map);
+  for (int k = 0; k < MP_WORLD_GLOSSY_LEVELS; ++k) {
+    const int w = mp_world_glossy_width(k), h = w / 2;
+    glm::vec4* level = out.data() + mp_world_glossy_offset(k);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        level[size_t(y) * w + x] = glm::vec4(mp_world_glossy_texel(mips.data(), map.width, map.height, k, x, y), 1.0f);
+  }
+  return out;
+}
+
 namespace {
 
 glm::vec3 map_texel(const WorldMap& m, int x, int y) {
@@ -197,95 +230,7 @@ glm::vec3 map_lookup(const WorldMap& m, const glm::vec3& d) {
                   glm::mix(map_texel(m, x0, y0 + 1), map_texel(m, x0 + 1, y0 + 1), fx), fy);
 }
 
-// The map and its box-filtered halvings, down to 8 texels wide.
-std::vector<WorldMap> map_mips(const WorldMap& map) {
-  std::vector<WorldMap> mips{map};
-  while (mips.back().width >= 16 && mips.back().height >= 2) {
-    const WorldMap& a = mips.back();
-    WorldMap b;
-    b.width = a.width / 2, b.height = a.height / 2;
-    b.radiance.resize(size_t(b.width) * size_t(b.height));
-    for (int y = 0; y < b.height; ++y)
-      for (int x = 0; x < b.width; ++x)
-        b.radiance[size_t(y) * b.width + x] =
-            0.25f * (map_texel(a, 2 * x, 2 * y) + map_texel(a, 2 * x + 1, 2 * y) + map_texel(a, 2 * x, 2 * y + 1) +
-                     map_texel(a, 2 * x + 1, 2 * y + 1));
-    mips.push_back(std::move(b));
-  }
-  return mips;
-}
-
-// Radiance at direction d from the mip chain at fractional level `lod`.
-glm::vec3 mip_lookup(const std::vector<WorldMap>& mips, const glm::vec3& d, float lod) {
-  lod = std::clamp(lod, 0.0f, float(mips.size() - 1));
-  const int a = int(lod), b = std::min(a + 1, int(mips.size()) - 1);
-  return glm::mix(map_lookup(mips[size_t(a)], d), map_lookup(mips[size_t(b)], d), lod - float(a));
-}
-
-// A frame around unit n: two unit tangents.
-void tangent_frame(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
-  const glm::vec3 up = std::fabs(n.z) < 0.999f ? glm::vec3(0.0f, 0.0f, 1.0f) : glm::vec3(1.0f, 0.0f, 0.0f);
-  t = glm::normalize(glm::cross(up, n));
-  b = glm::cross(n, t);
-}
-
 }  // namespace
-
-std::vector<glm::vec4> world_glossy_maps(const WorldMap& map) {
-  std::vector<glm::vec4> out(size_t(mp_world_glossy_offset(MP_WORLD_GLOSSY_LEVELS)), glm::vec4(0.0f));
-  if (map.width <= 0 || map.height <= 0) return out;
-  const std::vector<WorldMap> mips = map_mips(map);
-  // The source's texel solid angle at the equator, mip 0.
-  const double texel0 = (2.0 * kPi / map.width) * (kPi / map.height);
-  for (int k = 0; k < MP_WORLD_GLOSSY_LEVELS; ++k) {
-    // Narrow lobes read finer mips with few samples (the fine levels hold
-    // most of the texels); wide ones take more.
-    const int kSamples = k <= 2 ? 16 : k == 3 ? 32 : 64;
-    const int w = mp_world_glossy_width(k), h = w / 2;
-    glm::vec4* level = out.data() + mp_world_glossy_offset(k);
-    const float roughness = float(k) / float(MP_WORLD_GLOSSY_LEVELS - 1);
-    const double alpha = std::max(double(roughness) * roughness, 1e-4), a2 = alpha * alpha;
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        const glm::vec3 n = world_map_direction(w, h, float(x), float(y));
-        glm::vec3 c(0.0f);
-        if (k == 0) {
-          // The map resampled, averaged over the level texel's footprint.
-          c = mip_lookup(mips, n, float(std::log2(std::max(double(map.width) / w, 1.0))));
-        } else {
-          glm::vec3 t, b;
-          tangent_frame(n, t, b);
-          glm::dvec3 sum(0.0);
-          double weight = 0.0;
-          for (int i = 0; i < kSamples; ++i) {
-            // Hammersley point i: (i + 1/2) / N and the radical inverse of i.
-            const double u1 = (i + 0.5) / kSamples;
-            double u2 = 0.0, f = 0.5;
-            for (int bits = i; bits; bits >>= 1, f *= 0.5) u2 += f * (bits & 1);
-            // GGX half vector (Walter et al. 2007), mirrored about it.
-            const double phi = 2.0 * kPi * u1;
-            const double cos_h = std::sqrt((1.0 - u2) / (1.0 + (a2 - 1.0) * u2));
-            const double sin_h = std::sqrt(std::max(0.0, 1.0 - cos_h * cos_h));
-            const glm::dvec3 hv = glm::dvec3(t) * (sin_h * std::cos(phi)) + glm::dvec3(b) * (sin_h * std::sin(phi)) +
-                                  glm::dvec3(n) * cos_h;
-            const glm::dvec3 l = 2.0 * cos_h * hv - glm::dvec3(n);
-            const double nl = glm::dot(glm::dvec3(n), l);
-            if (nl <= 0.0) continue;
-            // pdf(l) = D(h) cos_h / (4 l.h) = D(h) / 4 with view = normal.
-            const double q = cos_h * cos_h * (a2 - 1.0) + 1.0;
-            const double pdf = a2 / (kPi * q * q) / 4.0;
-            const double lat_cos = std::max(std::sqrt(std::max(0.0, 1.0 - l.z * l.z)), 1e-3);
-            const double lod = 0.5 * std::log2(1.0 / (kSamples * pdf) / (texel0 * lat_cos)) + 1.0;
-            sum += glm::dvec3(mip_lookup(mips, glm::vec3(l), float(lod))) * nl;
-            weight += nl;
-          }
-          if (weight > 0.0) c = glm::vec3(sum / weight);
-        }
-        level[size_t(y) * w + x] = glm::vec4(c, 1.0f);
-      }
-  }
-  return out;
-}
 
 void composite_world_map(const WorldMap& map, const FrameSetup& frame, const Camera& camera, std::vector<float>& rgba) {
   const FrameParams& f = frame.params;

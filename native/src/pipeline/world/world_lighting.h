@@ -53,12 +53,15 @@ std::vector<WorldRegion> median_cut(const WorldMap& map, int regions);
 // environment light.
 std::vector<Light> world_lights(const WorldMap& map, const World& world, int probes);
 
-// The world's glossy maps (kernels/closures/mp_world.h, MP_WORLD_GLOSSY_LEVELS):
-// level 0 the map resampled, level k the map convolved with the GGX lobe of
-// roughness k / 8 around each direction (view = normal = the direction, as
-// the split-sum approximation assumes), by filtered importance sampling
-// (Krivanek & Colbert 2008): GGX samples read a mip of the map whose texel
-// is as large as the sample's share of the lobe, weighted by the cosine.
+// The map and its box-filtered halvings, one after another, as the
+// glossy prefilter reads them (kernels/closures/mp_world.h,
+// mp_world_mip_count); empty for an empty map.
+std::vector<glm::vec4> world_map_mips(const WorldMap& map);
+
+// The world's glossy maps (kernels/closures/mp_world.h, MP_WORLD_GLOSSY_LEVELS)
+// on the host, texel by texel through mp_world_glossy_texel: what the
+// device's prefilter (scene_buffers.h, prefilter_world_glossy) computes, for
+// tests to hold it to.
 std::vector<glm::vec4> world_glossy_maps(const WorldMap& map);
 
 // A World's own radiance array as a map.
