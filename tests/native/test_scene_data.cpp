@@ -111,7 +111,7 @@ TEST(SceneData, AKernelBindsTheSceneAgainOnlyWhenItsBuffersChange) {
   r = roots(session, init, b, 6);
   EXPECT_EQ(r[2].info >> 24, 1u);
 
-  // A replaced buffer takes a new version (upload_lights, upload_world_glossy).
+  // A replaced buffer takes a new version (upload_lights, set_world_glossy).
   b.version = session.next_data_version();
   r = roots(session, init, b, 6);
   EXPECT_EQ(r[2].patch, 2u);
