@@ -47,6 +47,7 @@ inline float length(glm::vec3 a) { return glm::length(a); }
 inline glm::vec3 normalize(glm::vec3 a) { return glm::normalize(a); }
 inline glm::vec3 fmin(glm::vec3 a, glm::vec3 b) { return glm::min(a, b); }
 inline glm::vec3 fmax(glm::vec3 a, glm::vec3 b) { return glm::max(a, b); }
+inline glm::vec3 fabs(glm::vec3 a) { return glm::abs(a); }
 inline float fmin(float a, float b) { return std::fmin(a, b); }
 inline float fmax(float a, float b) { return std::fmax(a, b); }
 inline float clamp(float x, float a, float b) { return std::min(std::max(x, a), b); }

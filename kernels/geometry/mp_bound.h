@@ -203,6 +203,54 @@ MP_INLINE MpBound mp_bound_boxes(const float3* lo, const float3* hi, int count, 
   return b;
 }
 
+/* A plane that view-space boxes lie beyond (mp_occlusion.h,
+ * mp_plane_near_depth): every point p of them, and so of the sub-patch
+ * whose net they bound and of every micropolygon diced from it, has
+ * dot(n, p) >= h, h the least of that linear function over the boxes. n is
+ * the net's normal, from its diagonals between the corner boxes of a 4 x 4
+ * net (16 boxes), or the direction to a single box; it faces away from the
+ * eye. Zero where it would tell nothing beyond the nearest depth (a single
+ * box seen orthographically, a normal that vanishes). */
+MP_INLINE float4 mp_net_plane(const float3* lo, const float3* hi, int count, FrameParams f) {
+  float3 g = MP_F3(0.0f, 0.0f, 0.0f);
+  for (int k = 0; k < count; ++k) g += 0.5f * (lo[k] + hi[k]);
+  g = g / (float)count;
+  float3 n;
+  if (count == 16) {
+    float3 d1 = 0.5f * (lo[15] + hi[15] - lo[0] - hi[0]), d2 = 0.5f * (lo[12] + hi[12] - lo[3] - hi[3]);
+    n = cross(d1, d2);
+  } else {
+    if (f.ortho) return MP_F4(0.0f, 0.0f, 0.0f, 0.0f);
+    n = g;
+  }
+  float len = length(n);
+  if (!(len > 0.0f)) return MP_F4(0.0f, 0.0f, 0.0f, 0.0f);
+  n = n / len;
+  if (f.ortho ? n.z > 0.0f : dot(n, g) < 0.0f) n = -n;
+  float3 an = fabs(n);
+  float h = 3.0e38f, size = 0.0f;
+  for (int k = 0; k < count; ++k) {
+    float3 c = 0.5f * (lo[k] + hi[k]), e = 0.5f * (hi[k] - lo[k]);
+    float along = dot(n, c), reach = dot(an, e);
+    h = fmin(h, along - reach);
+    size = fmax(size, fabs(along) + reach);
+  }
+  /* Rounding of the products above, relative to their size. */
+  return MP_F4(n.x, n.y, n.z, h - size * (1.0f / 16384.0f));
+}
+
+/* Occlusion culling tests sub-patches against their plane as well as
+ * their nearest depth where the stages are built with MP_OCCLUSION_PLANES:
+ * on CPU devices (DeviceSession), which take the roots in waves and so cull
+ * much. A GPU takes the roots at once and culls little; there the planes
+ * cost more than they save (docs/performance.md, "Planes for occlusion
+ * culling"), and a zero plane leaves the test the nearest depth's. */
+#ifdef MP_OCCLUSION_PLANES
+#define MP_CULLING_PLANE(lo, hi, count, f) mp_net_plane(lo, hi, count, f)
+#else
+#define MP_CULLING_PLANE(lo, hi, count, f) MP_F4(0.0f, 0.0f, 0.0f, 0.0f)
+#endif
+
 /* Camera-space lengths of the net along u and v: the split direction for a
  * sub-patch that straddles the eye plane, where screen lengths do not exist. */
 MP_INLINE void mp_net_space_lengths(const float3* lo, const float3* hi, float* lu, float* lv) {
@@ -481,7 +529,9 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
     mp_boxes_to_view(&blo, &bhi, 1, f);
     MpBound bb = mp_bound_boxes(&blo, &bhi, 1, f);
     if (mp_bound_culled(bb, &blo, &bhi, 1, f, page_masks, can_split)) return MP_CULL;
-    if (mp_occluded(occlusion, occ, f, bb.xmin, bb.ymin, bb.xmax, bb.ymax, bb.dmin)) return MP_CULL_OCCLUDED;
+    if (occ.levels > 0 && mp_occluded(occlusion, occ, f, bb.xmin, bb.ymin, bb.xmax, bb.ymax, bb.dmin,
+                                      MP_CULLING_PLANE(&blo, &bhi, 1, f)))
+      return MP_CULL_OCCLUDED;
   }
   float3 lo[16], hi[16];
   mp_subpatch_hull(cp, type, sp, lo, hi);
@@ -489,7 +539,9 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
   MpBound b = mp_bound_boxes(lo, hi, 16, f);
   if (mp_bound_culled(b, lo, hi, 16, f, page_masks, can_split)) return MP_CULL;
   int straddles = !f.ortho && b.dmin <= f.eye_epsilon;
-  if (!straddles && mp_occluded(occlusion, occ, f, b.xmin, b.ymin, b.xmax, b.ymax, b.dmin)) return MP_CULL_OCCLUDED;
+  if (!straddles && occ.levels > 0 &&
+      mp_occluded(occlusion, occ, f, b.xmin, b.ymin, b.xmax, b.ymax, b.dmin, MP_CULLING_PLANE(lo, hi, 16, f)))
+    return MP_CULL_OCCLUDED;
 
   /* Rate every edge that has none yet; score = length in target edges. */
   uint codes[4];

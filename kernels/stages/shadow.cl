@@ -303,7 +303,8 @@ __kernel void marking_roots_seen(MP_SCENE_PARAMS __global const uint* order, uin
   uint p = order[i];
   float3 lo = patch_bounds[2 * (ulong)p].xyz, hi = patch_bounds[2 * (ulong)p + 1].xyz;
   MpBound b = mp_bound_boxes(&lo, &hi, 1, f);
-  seen[i] = mp_bound_culled(b, &lo, &hi, 1, f, 0, 1) || !mp_occluded(depth, o, f, b.xmin, b.ymin, b.xmax, b.ymax, b.dmin)
+  seen[i] = mp_bound_culled(b, &lo, &hi, 1, f, 0, 1) ||
+                    !mp_occluded(depth, o, f, b.xmin, b.ymin, b.xmax, b.ymax, b.dmin, (float4)(0.0f))
                 ? 1u
                 : 0u;
 }

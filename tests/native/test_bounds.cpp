@@ -16,6 +16,12 @@ namespace {
 struct Checked {
   size_t diced = 0, vertices = 0, gregory = 0, violations = 0;
   std::string first_violation;
+  // The net's plane (mp_net_plane, mp_plane_near_depth): points of
+  // micropolygons nearer than its bound over the pixel they fall in, and
+  // points where that bound exceeds the sub-patch's nearest depth by more
+  // than a thousandth (where it culls what the nearest depth cannot).
+  size_t plane_points = 0, plane_violations = 0, plane_tighter = 0;
+  std::string first_plane_violation;
 };
 
 // Runs bound & split on the host and checks every diced grid vertex.
@@ -49,6 +55,28 @@ Checked check_scene(const Scene& scene) {
                             std::to_string(g.uv[k].x) + ", " + std::to_string(g.uv[k].y) + ")";
       ++c.vertices;
     }
+    // Points of every micropolygon (corners, edge middles, centre: convex
+    // combinations of its vertices, as the rasteriser's samples are) keep
+    // to the plane's depth bound over the pixel they project into.
+    const float4 plane = mp_net_plane(lo, hi, 16, f);
+    const bool straddles = !f.ortho && bound.dmin <= f.eye_epsilon;
+    if (!straddles && (plane.x != 0.0f || plane.y != 0.0f || plane.z != 0.0f))
+      for (const auto& poly : g.polygons) {
+        const glm::vec3 a = g.slot_p[poly[0]], b = g.slot_p[poly[1]], cc = g.slot_p[poly[2]], d = g.slot_p[poly[3]];
+        for (const glm::vec3& P : {a, b, cc, d, 0.5f * (a + b), 0.5f * (b + cc), 0.5f * (a + cc),
+                                   0.25f * (a + b + cc + d), (a + 2.0f * b + cc) * 0.25f}) {
+          const glm::vec2 r = mp_project(P, f);
+          if (!(std::abs(r.x) < 1e6f && std::abs(r.y) < 1e6f)) continue;
+          const float x0 = std::floor(r.x), y0 = std::floor(r.y);
+          const float near = mp_plane_near_depth(plane, f, x0, y0, x0 + 1.0f, y0 + 1.0f);
+          const float depth = -P.z;
+          ++c.plane_points;
+          if (near > 1.001f * bound.dmin) ++c.plane_tighter;
+          if (depth < near * (1.0f - 1.0f / 4096.0f) && c.plane_violations++ == 0)
+            c.first_plane_violation = "patch " + std::to_string(sp.patch) + ": depth " + std::to_string(depth) +
+                                      " nearer than the plane's bound " + std::to_string(near);
+        }
+      }
     ++c.diced;
   });
   return c;
@@ -66,6 +94,9 @@ TEST(Bounds, DicedVerticesLieInsideTheirSubPatchBounds) {
   s.meshes.push_back(flat);
   Checked c = check_scene(s);
   EXPECT_EQ(c.violations, 0u) << c.first_violation;
+  EXPECT_EQ(c.plane_violations, 0u) << c.first_plane_violation;
+  // Most points of a sub-patch lie deeper than its nearest (89% here).
+  EXPECT_GT(c.plane_tighter, c.plane_points / 2) << "the plane's bound seldom tells more than the nearest depth";
   EXPECT_GT(c.diced, 100u);
   EXPECT_GT(c.gregory, 10u);  // Gregory patches around the cube's corners
   EXPECT_GT(c.vertices, 10000u);
@@ -77,13 +108,64 @@ TEST(Bounds, OrthographicAndNearCameraBoundsAreConservative) {
   s.meshes.push_back(cube_mesh(SubdivScheme::CatmullClark));
   Checked near = check_scene(s);
   EXPECT_EQ(near.violations, 0u) << near.first_violation;
+  EXPECT_EQ(near.plane_violations, 0u) << near.first_plane_violation;
   EXPECT_GT(near.diced, 50u);
   s.camera = look_at({3.0f, 2.0f, 4.0f}, {0, 0, 0});
   s.camera.projection = Camera::Projection::Orthographic;
   s.camera.screen_left = -2.5f, s.camera.screen_right = 2.5f, s.camera.screen_bottom = -2.0f, s.camera.screen_top = 2.0f;
   Checked ortho = check_scene(s);
   EXPECT_EQ(ortho.violations, 0u) << ortho.first_violation;
+  EXPECT_EQ(ortho.plane_violations, 0u) << ortho.first_plane_violation;
+  EXPECT_GT(ortho.plane_tighter, ortho.plane_points / 4);  // 65% here
   EXPECT_GT(ortho.diced, 50u);
+}
+
+TEST(Bounds, APlaneCullsALayerTheNearestDepthCannot) {
+  // A 64 x 64 view (raster = 64 x / d + 32) over two tilted planes, depth
+  // d = c / (1 - v / 2) along the ray of slope v, c = 2 for the top layer
+  // and 2.5 below it. The pyramid (cells of 4 pixels, three levels) holds
+  // the top layer's farthest depth per cell. A sub-patch of the lower layer
+  // filling the view has its nearest depth (2.0) in front of the top's
+  // farthest in the far cells (2.67), so that bound alone keeps it; its
+  // plane's depth in each cell lies behind the top's there, so with the
+  // plane it is culled. A layer 2 % below the top is kept either way.
+  FrameParams f{};
+  f.width = f.height = 64;
+  f.ax = f.ay = 64.0f, f.bx = f.by = 32.0f;
+  f.view_kind = MP_VIEW_CAMERA;
+  f.eye_epsilon = 1e-4f;
+  OcclusionParams o{};
+  o.levels = 3, o.cell_shift = 2, o.base_w = o.base_h = 16;
+  std::vector<uint> pyramid(mp_occlusion_cells(o));
+  for (int k = 0; k < o.levels; ++k) {
+    const int side = mp_occlusion_side(16, k), cell = 4 << k;
+    for (int y = 0; y < side; ++y)
+      for (int x = 0; x < side; ++x) {
+        const float v_far = (float((y + 1) * cell) - f.by) / f.ay;  // the depth grows with v
+        pyramid[mp_occlusion_offset(o, k) + uint(y * side + x)] = as_uint(2.0f / (1.0f - 0.5f * v_far));
+      }
+  }
+  auto layer = [&](float c, float3* lo, float3* hi) {
+    // A 4 x 4 net over the view: points of the plane through the rays at
+    // the view's corners, spread bilinearly (a plane's bilinear patch).
+    auto at = [&](float u, float v) { const float d = c / (1.0f - 0.5f * v); return glm::vec3(u * d, v * d, -d); };
+    const glm::vec3 p00 = at(-0.5f, -0.5f), p10 = at(0.5f, -0.5f), p01 = at(-0.5f, 0.5f), p11 = at(0.5f, 0.5f);
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i) {
+        const float s = float(i) / 3.0f, t = float(j) / 3.0f;
+        lo[4 * j + i] = hi[4 * j + i] = (1 - t) * ((1 - s) * p00 + s * p10) + t * ((1 - s) * p01 + s * p11);
+      }
+  };
+  const float4 none(0.0f);
+  for (const float c : {2.5f, 2.04f}) {
+    float3 lo[16], hi[16];
+    layer(c, lo, hi);
+    const MpBound b = mp_bound_boxes(lo, hi, 16, f);
+    const float4 plane = mp_net_plane(lo, hi, 16, f);
+    EXPECT_NEAR(b.dmin, c / 1.25f, 1e-4f);
+    EXPECT_FALSE(mp_occluded(pyramid.data(), o, f, b.xmin, b.ymin, b.xmax, b.ymax, b.dmin, none)) << c;
+    EXPECT_EQ(mp_occluded(pyramid.data(), o, f, b.xmin, b.ymin, b.xmax, b.ymax, b.dmin, plane), c > 2.2f) << c;
+  }
 }
 
 }  // namespace

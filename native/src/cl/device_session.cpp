@@ -124,8 +124,12 @@ void DeviceSession::open(const std::string& selector) {
                          queue_counts_);
     max_alloc_ = device_.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
     tile_sampler_ = compiles_tile_sampler(cl::Platform(device_.getInfo<CL_DEVICE_PLATFORM>()).getInfo<CL_PLATFORM_VERSION>());
-    auto built = build_program_cached(context_, device_, assemble_program_source(),
-                                      tile_sampler_ ? "-cl-std=CL1.2" : "-cl-std=CL1.2 -DMP_NO_TILE_SAMPLER");
+    // Occlusion culling's planes (kernels/geometry/mp_bound.h) where the
+    // roots are taken in waves: on CPU devices.
+    std::string options = "-cl-std=CL1.2";
+    if (!tile_sampler_) options += " -DMP_NO_TILE_SAMPLER";
+    if (info_.type == "cpu") options += " -DMP_OCCLUSION_PLANES";
+    auto built = build_program_cached(context_, device_, assemble_program_source(), options);
     program_ = built.program;
     build_ms_ = built.build_ms;
     cache_hit_ = built.from_cache;
