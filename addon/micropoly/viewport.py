@@ -173,13 +173,21 @@ def live_sessions():
     return list(_LIVE)
 
 
+# How long quitting waits for a render in flight to reach its next progress
+# check. A kernel or program build checks none until it ends: on a CPU
+# device with empty caches that is several seconds, more on a loaded
+# machine (a test suite's quit mid-render, with two tests per core, outwaited
+# 2 s and crashed). Quitting waits for it rather than crash.
+CLOSE_AT_EXIT_S = 120.0
+
+
 def _close_live_sessions():
     # When Python shuts down (Blender quits, or a background script fails)
     # with a render in flight, a worker thread inside the native renderer
     # would be torn down as it next takes the GIL, which aborts the process.
     # Stop every session first: each returns at its next progress check.
     for session in list(_LIVE):
-        session.close(timeout=2.0)
+        session.close(timeout=CLOSE_AT_EXIT_S)
 
 
 atexit.register(_close_live_sessions)

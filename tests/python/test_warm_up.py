@@ -8,6 +8,7 @@ import importlib.util
 import os
 import sys
 import threading
+import time
 import types
 
 import pytest
@@ -149,6 +150,12 @@ def test_a_render_drops_the_queue_and_waits_for_the_job_running(warm_up):
     gate = threading.Event()
     renderers = FakeRenderers(gate=gate)
     warm_up.start("", renderers)
+    # The first job has begun (its thread waits at the gate) before the
+    # others are queued: a thread slow to start would otherwise still have
+    # it queued, and the render drops the jobs not yet begun.
+    deadline = time.monotonic() + 10.0
+    while warm_up._state["step"] != "building the kernels" and time.monotonic() < deadline:
+        time.sleep(0.005)
     for _ in range(3):
         warm_up._queue((), "", renderers)
     threading.Timer(0.2, gate.set).start()
