@@ -64,8 +64,14 @@ def _plain(prop, value):
 
 def _walk(struct, depth, out, prefix=""):
     """Appends `name=value` lines for struct's RNA properties; pointers to
-    IDs by name, other pointers and collections down to `depth` levels."""
-    for prop in struct.bl_rna.properties:
+    IDs by name, other pointers and collections down to `depth` levels.
+    Micropoly's own settings come last, where registering the add-on after
+    Blender's own add-ons puts them: Blender lists an add-on's properties in
+    the order add-ons registered them, and resetting the factory settings
+    registers Blender's again while Micropoly's stay."""
+    props = list(struct.bl_rna.properties)
+    props.sort(key=lambda prop: prop.identifier == "micropoly")  # stable: all else keeps its order
+    for prop in props:
         name = prop.identifier
         if name in _SKIPPED:
             continue

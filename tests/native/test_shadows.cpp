@@ -503,6 +503,49 @@ TEST_F(ShadowRenderTest, PagesAreKeptBetweenFramesWhileLightsAndGeometryStay) {
   EXPECT_EQ(turned.rgba, fresh.render(s).rgba);
 }
 
+TEST_F(ShadowRenderTest, PagesAreKeptWhileOnlyShadingChanges) {
+  // The occluder's node tree changes from one frame to the next. While it
+  // only shades (an artist grading a material and pressing F12 again), the
+  // pages are kept: none is rendered, the image is what a renderer that
+  // never saw the first tree makes, and a new name changes nothing either.
+  // Once the tree displaces, every page is new.
+  Light sun;
+  sun.type = Light::Type::Distant;
+  sun.direction = glm::normalize(glm::vec3(0.3f, 0.2f, -1.0f));
+  Scene s = floor_scene(sun);
+  s.meshes.push_back(occluder(-1.0f, -1.0f, 1.0f, 1.0f, 1.0f));
+  s.meshes.back().visible_camera = true;  // its colour shows
+  const std::string flat = "float3 mp_node_displacement(const MpNodeGlobals* g) { return (float3)(0.0f); }\n";
+  auto shading = [&](const char* name, const char* colour) {
+    s.material_programs = {{name, flat + "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {"
+                                         " mp_add_emission(s, (float3)(" + colour + ")); }\n"}};
+    s.materials.resize(1);
+    s.materials.push_back(s.materials[0]);
+    s.materials[1].program = 0;
+    s.materials[1].program_shades = true;
+    s.meshes.back().material = 1;
+  };
+  shading("red", "0.5f, 0.0f, 0.0f");
+  const RenderResult red = renderer_->render(s);
+  ASSERT_GT(red.stats.shadows.pages_rendered, 0u);
+  shading("green", "0.0f, 0.5f, 0.0f");
+  s.meshes.back().name = "renamed";
+  const RenderResult green = renderer_->render(s);
+  EXPECT_EQ(green.stats.shadows.pages_rendered, 0u) << "a tree that only shades rendered the shadow pages again";
+  EXPECT_EQ(green.stats.shadows.pages_requested, red.stats.shadows.pages_requested);
+  EXPECT_NE(green.rgba, red.rgba);
+  EXPECT_EQ(green.rgba, Renderer().render(s).rgba);
+  // The same tree now lifts the occluder: its shadow moves.
+  s.material_programs[0].source =
+      "float3 mp_node_displacement(const MpNodeGlobals* g) { return (float3)(0.0f, 0.0f, 0.5f); }\n"
+      "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {}\n";
+  s.materials[1].program_displaces = true;
+  s.materials[1].displacement_bound = 0.5f;
+  const RenderResult lifted = renderer_->render(s);
+  EXPECT_EQ(lifted.stats.shadows.pages_rendered, lifted.stats.shadows.pages_requested);
+  EXPECT_EQ(lifted.rgba, Renderer().render(s).rgba);
+}
+
 TEST_F(ShadowRenderTest, KeptPagesAreRenderedAgainWhereTheirReceiversNowLieFarther) {
   // The first frame sees only a tile high above the floor, so its pages
   // hold only what lies in front of the tile, and an occluder below it is

@@ -1,5 +1,6 @@
 #include "pipeline/device_scene/scene_fingerprint.h"
 
+#include <algorithm>
 #include <cstring>
 #include <type_traits>
 
@@ -80,14 +81,23 @@ uint64_t patch_set_shape_key(const BezierPatches& set, int uv_layers) {
 
 namespace {
 
+// Whether the shadow views run a material's program: it displaces the
+// surface or computes its alpha (opacity).
+bool program_in_shadows(const Material& m) { return m.program >= 0 && (m.program_displaces || m.program_alpha); }
+
 // Surfaces, materials and images (scene_fingerprint and geometry_fingerprint).
-// For shadows only what a shadow view reads of a material counts: its
-// opacity, and the node values of programs that displace or compute the
-// alpha; a colour edited in a material keeps the shadow maps.
+// For shadows only what a shadow view reads counts: the surfaces' shapes,
+// placement and motion, the materials' opacity, and the programs that
+// displace or compute the alpha, with the node values, object info and
+// images those may read. A material's shading edited (its colour, or a node
+// tree that only shades) keeps the shadow maps, as do an object's name and
+// its camera visibility.
 void hash_surfaces(Hasher& h, const Scene& scene, bool shadows_only) {
+  const bool programs_in_shadows =
+      !shadows_only || std::any_of(scene.materials.begin(), scene.materials.end(), program_in_shadows);
   h.value(scene.meshes.size());
   for (const Mesh& m : scene.meshes) {
-    h.text(m.name);
+    if (!shadows_only) h.text(m.name), h.value(m.visible_camera);
     hash_mesh_shape(h, m);
     h.value(m.material);
     h.values(m.face_materials);
@@ -95,9 +105,8 @@ void hash_surfaces(Hasher& h, const Scene& scene, bool shadows_only) {
     h.value(m.double_sided);
     h.value(m.texspace_location);
     h.value(m.texspace_size);
-    h.value(m.visible_camera);
     h.value(m.cast_shadows);
-    h.value(m.info.color), h.value(m.info.pass_index), h.value(m.info.random);
+    if (programs_in_shadows) h.value(m.info.color), h.value(m.info.pass_index), h.value(m.info.random);
     h.value(m.motion_points.size());
     for (const std::vector<glm::vec3>& step : m.motion_points) h.values(step);
     h.values(m.motion_object_to_world);
@@ -111,29 +120,41 @@ void hash_surfaces(Hasher& h, const Scene& scene, bool shadows_only) {
     h.value(b.material);
     h.value(b.object_to_world);
     h.value(b.double_sided);
-    h.value(b.visible_camera);
+    if (!shadows_only) h.value(b.visible_camera);
     h.value(b.cast_shadows);
-    h.value(b.info.color), h.value(b.info.pass_index), h.value(b.info.random);
+    if (programs_in_shadows) h.value(b.info.color), h.value(b.info.pass_index), h.value(b.info.random);
   }
   h.value(scene.materials.size());
   for (const Material& m : scene.materials) {
     h.value(m.opacity);
-    h.value(m.program), h.value(m.program_displaces), h.value(m.program_shades), h.value(m.displacement_bound);
-    h.value(m.displacement_bound_world), h.value(m.program_alpha), h.value(m.program_alpha_cut);
-    if (!shadows_only || m.program_displaces || m.program_alpha)
-      h.value(m.program_params.size()), h.values(m.program_params);
-    if (shadows_only) continue;
+    h.value(m.program_displaces), h.value(m.displacement_bound), h.value(m.displacement_bound_world);
+    h.value(m.program_alpha), h.value(m.program_alpha_cut);
+    if (shadows_only) {
+      // The program by its source, not its index: the index moves when
+      // another material's tree changes.
+      if (program_in_shadows(m) && size_t(m.program) < scene.material_programs.size()) {
+        h.text(scene.material_programs[size_t(m.program)].source);
+        h.value(m.program_params.size()), h.values(m.program_params);
+      }
+      continue;
+    }
+    h.value(m.program), h.value(m.program_shades);
+    h.value(m.program_params.size()), h.values(m.program_params);
     h.value(m.model);
     h.value(m.color);
     h.value(m.ka), h.value(m.kd), h.value(m.ks), h.value(m.roughness);
     h.value(m.specular_color), h.value(m.metallic), h.value(m.specular), h.value(m.emission);
   }
-  h.value(scene.material_programs.size());
-  for (const MaterialProgram& p : scene.material_programs) h.text(p.source);
-  h.value(scene.images.size());
-  for (const Image& im : scene.images) {
-    h.value(im.width), h.value(im.height), h.value(im.srgb);
-    h.values(im.pixels);
+  if (!shadows_only) {
+    h.value(scene.material_programs.size());
+    for (const MaterialProgram& p : scene.material_programs) h.text(p.source);
+  }
+  if (programs_in_shadows) {
+    h.value(scene.images.size());
+    for (const Image& im : scene.images) {
+      h.value(im.width), h.value(im.height), h.value(im.srgb);
+      h.values(im.pixels);
+    }
   }
 }
 

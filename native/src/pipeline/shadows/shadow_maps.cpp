@@ -337,12 +337,16 @@ const cl::Buffer& ShadowMaps::light_order(int light, const FrameParams& v, const
   static const cl::Buffer none;
   if (orders_.size() <= size_t(light)) orders_.resize(size_t(light) + 1);
   LightOrder& o = orders_[size_t(light)];
-  uint64_t key = scene_key ^ 0x9e3779b97f4a7c15ull;
+  // Any permutation of the patches renders the same pages (the order only
+  // decides what culling sees first), so an order stays while the geometry
+  // and the number of patches do, even where the patches were uploaded in
+  // another order (the geometry's key leaves out what only the camera sees).
+  const size_t patches = buffers.host_patch_bounds.size() / 2;
+  uint64_t key = (scene_key ^ 0x9e3779b97f4a7c15ull ^ uint64_t(patches)) * 0x100000001b3ull;
   for (float x : v.view) key = (key ^ uint64_t(as_uint(x))) * 0x100000001b3ull;
   key = (key ^ uint64_t(v.ortho)) * 0x100000001b3ull;
   if (o.order() && o.key == key) return o.order;
   o = LightOrder{};
-  const size_t patches = buffers.host_patch_bounds.size() / 2;
   const size_t bytes = std::max<size_t>(patches, 1) * sizeof(cl_uint);
   size_t held = 0;
   for (const LightOrder& other : orders_) held += other.bytes;
