@@ -7,8 +7,13 @@ node's Scale). Prints one JSON line: the seconds of each render after the
 first two (warm-up), their median, and the median program build time the
 renderer reported.
 
+With --relink the edit is to the tree instead: Suzanne's Noise texture
+drives, in turn, her Base Color and her Roughness (two programs that only
+shade, each built once in the first two renders), as an artist trying a
+material's wiring does; the shadow maps' pages stay.
+
   MICROPOLY_ADDON_DIR=build/addons blender -b --factory-startup \
-      --python bench/value_edit.py -- [--renders 12]
+      --python bench/value_edit.py -- [--renders 12] [--relink]
 
 Run it against an older build by pointing MICROPOLY_ADDON_DIR at that
 build's add-on folder (bench/results/history.md, "Node values as parameters").
@@ -40,11 +45,19 @@ def main(argv):
     noise = next(n for n in suzanne.nodes if n.type == "TEX_NOISE")
     torus = bpy.data.materials["Torus"].node_tree
     displacement = next(n for n in torus.nodes if n.type == "DISPLACEMENT")
+    relink = "--relink" in argv
     seconds, builds = [], []
     for i in range(renders):
         t = i / renders
         which = i % 3
-        if which == 0:
+        if relink:
+            for link in [l for l in suzanne.links if l.from_node == noise]:
+                suzanne.links.remove(link)
+            if i % 2:
+                suzanne.links.new(noise.outputs["Fac"], bsdf.inputs["Roughness"])
+            else:
+                suzanne.links.new(noise.outputs["Color"], bsdf.inputs["Base Color"])
+        elif which == 0:
             bsdf.inputs["Roughness"].default_value = 0.3 + 0.4 * t
         elif which == 1:
             noise.inputs["Scale"].default_value = 5.0 + 3.0 * t
@@ -57,7 +70,7 @@ def main(argv):
     kept = seconds[2:]
     known = [b for b in builds[2:] if b is not None]
     print("VALUE_EDIT " + json.dumps({
-        "blender": bpy.app.version_string, "renders": renders, "seconds": [round(s, 3) for s in kept],
+        "blender": bpy.app.version_string, "edit": "relink" if relink else "values", "renders": renders, "seconds": [round(s, 3) for s in kept],
         "median_s": round(statistics.median(kept), 3),
         "median_program_build_s": round(statistics.median(known), 3) if known else None}))
     return 0
