@@ -483,12 +483,19 @@ TEST_F(ShadowRenderTest, DisplacementMovesTheShadow) {
   EXPECT_NEAR(got.area_px / (kPx * kPx), 1.0, 0.03);
 }
 
-TEST_F(ShadowRenderTest, PagesAreKeptBetweenFramesWhileLightsAndGeometryStay) {
+// A slanted sun over the floor and a square occluder, for the tests of
+// pages kept from frame to frame.
+Scene slanted_sun_over_occluder() {
   Light sun;
   sun.type = Light::Type::Distant;
   sun.direction = glm::normalize(glm::vec3(0.3f, 0.2f, -1.0f));
   Scene s = floor_scene(sun);
   s.meshes.push_back(occluder(-1.0f, -1.0f, 1.0f, 1.0f, 1.0f));
+  return s;
+}
+
+TEST_F(ShadowRenderTest, PagesAreKeptBetweenFramesWhileLightsAndGeometryStay) {
+  Scene s = slanted_sun_over_occluder();
   Renderer fresh;
   RenderResult first = renderer_->render(s), again = renderer_->render(s);
   ASSERT_GT(first.stats.shadows.pages_rendered, 0u);
@@ -509,11 +516,7 @@ TEST_F(ShadowRenderTest, PagesAreKeptWhileOnlyShadingChanges) {
   // pages are kept: none is rendered, the image is what a renderer that
   // never saw the first tree makes, and a new name changes nothing either.
   // Once the tree displaces, every page is new.
-  Light sun;
-  sun.type = Light::Type::Distant;
-  sun.direction = glm::normalize(glm::vec3(0.3f, 0.2f, -1.0f));
-  Scene s = floor_scene(sun);
-  s.meshes.push_back(occluder(-1.0f, -1.0f, 1.0f, 1.0f, 1.0f));
+  Scene s = slanted_sun_over_occluder();
   s.meshes.back().visible_camera = true;  // its colour shows
   const std::string flat = "float3 mp_node_displacement(const MpNodeGlobals* g) { return (float3)(0.0f); }\n";
   auto shading = [&](const char* name, const char* colour) {
