@@ -140,7 +140,8 @@ def write_metadata(root, version):
 def pack(root, out):
     """Zips the unpacked wheel under root (one .dist-info) into out as a
     linux_x86_64 wheel, with its RECORD written anew; auditwheel then gives
-    it the manylinux tag its libraries allow."""
+    it the manylinux tag its libraries allow. Stored, not compressed: only
+    auditwheel reads it, and it writes the compressed wheel itself."""
     info = glob.glob(os.path.join(root, "*.dist-info"))[0]
     with open(os.path.join(info, "WHEEL")) as f:
         wheel_meta = re.sub(r"(?m)^Tag: .*$", f"Tag: {TAG}", f.read())
@@ -155,10 +156,20 @@ def pack(root, out):
         f.write("\n".join(lines) + "\n")
     base = os.path.basename(info)[:-len(".dist-info")]
     wheel = os.path.join(out, f"{base}-{TAG}.whl")
-    with zipfile.ZipFile(wheel, "w", zipfile.ZIP_DEFLATED) as z:
+    with zipfile.ZipFile(wheel, "w", zipfile.ZIP_STORED) as z:
         for path in files + [record]:
             z.write(path, os.path.relpath(path, root))
     return wheel
+
+
+def compressed(wheel, out):
+    """Copies a stored wheel into out with every member deflated (the
+    members' bytes, and so RECORD's hashes, unchanged)."""
+    with zipfile.ZipFile(wheel) as src, zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as dst:
+        for info in src.infolist():
+            data = src.read(info)
+            info.compress_type = zipfile.ZIP_DEFLATED
+            dst.writestr(info, data)
 
 
 def drop_version_need(library, version):
@@ -267,13 +278,15 @@ def build(out, venv, cache=None):
         stages = [os.path.join(tmp, d) for d in ("raw", "repaired", "raw2")]
         for d in stages:
             os.makedirs(d)
-        run([auditwheel, "repair", "-w", stages[1], pack(root, stages[0])], env=tools)
+        # The first repair's wheel is unpacked again below: stored (-z 0),
+        # and compressed once at the end, by the second repair or here.
+        run([auditwheel, "repair", "-z", "0", "-w", stages[1], pack(root, stages[0])], env=tools)
         repaired = glob.glob(os.path.join(stages[1], "*.whl"))[0]
         patched = without_arc4random_236(repaired, tmp, venv, tools)
         if patched:
             run([auditwheel, "repair", "-w", out, pack(patched, stages[2])], env=tools)
         else:
-            shutil.copy2(repaired, out)
+            compressed(repaired, os.path.join(out, os.path.basename(repaired)))
     found = glob.glob(os.path.join(out, f"{NAME}-*.whl"))
     if len(found) != 1:
         raise SystemExit(f"expected one repaired {NAME} wheel, found {found}")

@@ -17,7 +17,8 @@ if [ $# -ne 1 ] || [ ! -d "$1" ]; then
   exit 2
 fi
 here=$(cd "$(dirname "$0")" && pwd)
-bin=$(cd "$1" && pwd)/tests/fuzz
+build_dir=$(cd "$1" && pwd)
+bin=$build_dir/tests/fuzz
 seconds=${MICROPOLY_FUZZ_SECONDS:-30}
 program_seconds=${MICROPOLY_FUZZ_PROGRAM_SECONDS:-60}
 work=$(mktemp -d "${TMPDIR:-/tmp}/micropoly-fuzz.XXXXXX")
@@ -75,27 +76,28 @@ for t in rib_reader rib_round_trip scene_validation; do
 done
 
 # 2. Saved reproducers (regressions/<target>_*) must no longer fail, then
-# 3. each target fuzzes for its time from a copy of its seed corpus.
-printf '%-18s %8s %10s %8s %14s\n' target seconds executions exec/s "corpus in>out"
-summary=""
-for entry in "${targets[@]}"; do
-  IFS='|' read -r name exe_name secs opts lsan_extra <<< "$entry"
-  lsan="$LSAN_OPTIONS${lsan_extra:+:$lsan_extra}"
-  exe="$bin/$exe_name"
+# 3. each target fuzzes for its time from a copy of its seed corpus. A target
+# is one process on one core, and its time is fixed, so targets run side by
+# side, one per core (MICROPOLY_FUZZ_JOBS, default: the cores), the longest
+# first; each writes its row and its failures into the work folder.
+fuzz_target() {
+  local name=$1 exe_name=$2 secs=$3 opts=$4 lsan_extra=$5
+  local lsan="$LSAN_OPTIONS${lsan_extra:+:$lsan_extra}" exe="$bin/$exe_name" failures="$work/$name.failures"
   if [ ! -x "$exe" ]; then
-    fail "$exe_name is not built in $1"
-    continue
+    echo "FAIL: $exe_name is not built in $build_dir" > "$failures"
+    return
   fi
-  regressions=("$here"/regressions/"$name"_*)
+  local regressions=("$here"/regressions/"$name"_*)
   if [ -e "${regressions[0]}" ]; then
     # shellcheck disable=SC2086
     if ! LSAN_OPTIONS="$lsan" "$exe" $opts -runs=1 "${regressions[@]}" > "$work/$name.regressions.log" 2>&1; then
-      fail "$name: a saved reproducer still fails"
-      grep -E "ERROR|SUMMARY|Running:|differs|round trip" "$work/$name.regressions.log" | head -n 20 >&2
+      { echo "FAIL: $name: a saved reproducer still fails"
+        grep -E "ERROR|SUMMARY|Running:|differs|round trip" "$work/$name.regressions.log" | head -n 20; } >> "$failures"
     fi
   fi
   mkdir -p "$work/$name/corpus" "$work/$name/artifacts"
   cp "$here/corpus/$name"/* "$work/$name/corpus/" 2>/dev/null
+  local before start rc elapsed runs rate after
   before=$(ls "$work/$name/corpus" | wc -l)
   start=$(date +%s)
   # shellcheck disable=SC2086
@@ -106,11 +108,31 @@ for entry in "${targets[@]}"; do
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$work/$name.log" | tail -n 1)
   rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$work/$name.log" | tail -n 1)
   after=$(ls "$work/$name/corpus" | wc -l)
-  summary+=$(printf '%-18s %8s %10s %8s %14s' "$name" "$elapsed" "${runs:-?}" "${rate:-?}" "$before>$after")$'\n'
-  printf '%-18s %8s %10s %8s %14s\n' "$name" "$elapsed" "${runs:-?}" "${rate:-?}" "$before>$after"
+  printf '%-18s %8s %10s %8s %14s\n' "$name" "$elapsed" "${runs:-?}" "${rate:-?}" "$before>$after" > "$work/$name.row"
   if [ $rc -ne 0 ]; then
-    fail "$name: exit $rc; the input is saved in $work/$name/artifacts (set MICROPOLY_FUZZ_KEEP=1 to keep it)"
-    grep -v '^#\|^INFO\|^"' "$work/$name.log" | tail -n 60 >&2
+    { echo "FAIL: $name: exit $rc; the input is saved in $work/$name/artifacts (set MICROPOLY_FUZZ_KEEP=1 to keep it)"
+      grep -v '^#\|^INFO\|^"' "$work/$name.log" | tail -n 60; } >> "$failures"
+  fi
+}
+
+jobs=${MICROPOLY_FUZZ_JOBS:-$(nproc)}
+mapfile -t ordered < <(printf '%s\n' "${targets[@]}" | sort -t '|' -k3,3nr)
+for entry in "${ordered[@]}"; do
+  IFS='|' read -r name exe_name secs opts lsan_extra <<< "$entry"
+  while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n; done
+  fuzz_target "$name" "$exe_name" "$secs" "$opts" "$lsan_extra" &
+done
+wait
+printf '%-18s %8s %10s %8s %14s\n' target seconds executions exec/s "corpus in>out"
+for entry in "${targets[@]}"; do
+  IFS='|' read -r name _ <<< "$entry"
+  cat "$work/$name.row" 2>/dev/null
+done
+for entry in "${targets[@]}"; do
+  IFS='|' read -r name _ <<< "$entry"
+  if [ -s "$work/$name.failures" ]; then
+    cat "$work/$name.failures" >&2
+    failed=1
   fi
 done
 
