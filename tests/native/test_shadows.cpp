@@ -538,15 +538,74 @@ TEST_F(ShadowRenderTest, PagesAreKeptWhileOnlyShadingChanges) {
   EXPECT_EQ(green.stats.shadows.pages_requested, red.stats.shadows.pages_requested);
   EXPECT_NE(green.rgba, red.rgba);
   EXPECT_EQ(green.rgba, Renderer().render(s).rgba);
-  // The same tree now lifts the occluder: its shadow moves.
+  // The same tree now lifts the occluder: its shadow moves, and the pages
+  // it reaches are rendered again.
   s.material_programs[0].source =
       "float3 mp_node_displacement(const MpNodeGlobals* g) { return (float3)(0.0f, 0.0f, 0.5f); }\n"
       "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {}\n";
   s.materials[1].program_displaces = true;
   s.materials[1].displacement_bound = 0.5f;
   const RenderResult lifted = renderer_->render(s);
-  EXPECT_EQ(lifted.stats.shadows.pages_rendered, lifted.stats.shadows.pages_requested);
+  EXPECT_GT(lifted.stats.shadows.pages_rendered, 0u);
   EXPECT_EQ(lifted.rgba, Renderer().render(s).rgba);
+}
+
+TEST_F(ShadowRenderTest, ACancelledFrameLeavesNoUnrenderedPageBehind) {
+  // Cancelled at each of its first progress calls (some fall while the
+  // pages are rendered), the renderer then renders the frame as a renderer
+  // that never saw the cancelled one.
+  Scene s = slanted_sun_over_occluder();
+  int asked = 0;
+  const RenderResult fresh = Renderer().render(s, [&](float) { return ++asked > 0; });
+  bool cancelled_in_shadows = false;
+  for (int at = 2; at <= std::min(asked, 12); ++at) {
+    Renderer r;
+    int calls = 0;
+    const RenderResult cancelled = r.render(s, [&](float) { return ++calls < at; });
+    ASSERT_TRUE(cancelled.stats.cancelled) << at;
+    cancelled_in_shadows = cancelled_in_shadows || cancelled.stats.shadows.pages_rendered > 0;
+    EXPECT_EQ(r.render(s).rgba, fresh.rgba) << "cancelled at progress call " << at;
+  }
+  EXPECT_TRUE(cancelled_in_shadows) << "no cancel fell after pages were granted (" << asked << " progress calls)";
+}
+
+TEST_F(ShadowRenderTest, PagesOutsideAChangedSurfaceAreKept) {
+  // A soft sun and a point lamp with a radius (a clipmap and a cube) over
+  // two occluders far apart. One moves, then another is added and the
+  // first removed, as in a viewport's edits: each time only the pages the
+  // changed surface reaches, where it was or where it is, are rendered
+  // again, and the image is what a renderer that never saw the frames
+  // before makes.
+  Light sun;
+  sun.type = Light::Type::Distant;
+  sun.direction = glm::normalize(glm::vec3(0.3f, 0.2f, -1.0f));
+  sun.angle = 0.05f;
+  Scene s = floor_scene(sun);
+  Light lamp;
+  lamp.type = Light::Type::Point;
+  lamp.intensity = 40.0f;
+  lamp.position = glm::vec3(0.5f, -0.5f, 5.0f);
+  lamp.radius = 0.2f;
+  s.lights.push_back(lamp);
+  s.meshes.push_back(occluder(-3.5f, -2.5f, -2.5f, -1.5f, 1.0f));
+  s.meshes.push_back(occluder(2.0f, 1.0f, 3.0f, 2.0f, 1.0f));
+  const RenderResult first = renderer_->render(s);
+  ASSERT_GT(first.stats.shadows.pages_rendered, 0u);
+  auto expect_partly_kept = [&](const char* what) {
+    const RenderResult now = renderer_->render(s);
+    EXPECT_GT(now.stats.shadows.pages_rendered, 0u) << what;
+    EXPECT_LT(now.stats.shadows.pages_rendered, now.stats.shadows.pages_requested) << what;
+    EXPECT_EQ(now.rgba, Renderer().render(s).rgba) << what;
+  };
+  s.meshes[2].object_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(0.3f, -0.2f, 0.0f));
+  expect_partly_kept("the second occluder moved");
+  s.meshes.push_back(occluder(-3.0f, 1.5f, -2.6f, 1.9f, 0.5f));
+  expect_partly_kept("an occluder added");
+  s.meshes.erase(s.meshes.begin() + 1);
+  expect_partly_kept("the first occluder removed");
+  // The same surfaces in another order change nothing.
+  std::swap(s.meshes[1], s.meshes[2]);
+  EXPECT_EQ(renderer_->render(s).stats.shadows.pages_rendered, 0u);
 }
 
 TEST_F(ShadowRenderTest, KeptPagesAreRenderedAgainWhereTheirReceiversNowLieFarther) {

@@ -85,19 +85,12 @@ namespace {
 // surface or computes its alpha (opacity).
 bool program_in_shadows(const Material& m) { return m.program >= 0 && (m.program_displaces || m.program_alpha); }
 
-// Surfaces, materials and images (scene_fingerprint and geometry_fingerprint).
-// For shadows only what a shadow view reads counts: the surfaces' shapes,
-// placement and motion, the materials' opacity, and the programs that
-// displace or compute the alpha, with the node values, object info and
-// images those may read. A material's shading edited (its colour, or a node
-// tree that only shades) keeps the shadow maps, as do an object's name and
-// its camera visibility.
-void hash_surfaces(Hasher& h, const Scene& scene, bool shadows_only) {
-  const bool programs_in_shadows =
-      !shadows_only || std::any_of(scene.materials.begin(), scene.materials.end(), program_in_shadows);
+// Surfaces, materials and images, as the camera's view reads them
+// (scene_fingerprint).
+void hash_surfaces(Hasher& h, const Scene& scene) {
   h.value(scene.meshes.size());
   for (const Mesh& m : scene.meshes) {
-    if (!shadows_only) h.text(m.name), h.value(m.visible_camera);
+    h.text(m.name), h.value(m.visible_camera);
     hash_mesh_shape(h, m);
     h.value(m.material);
     h.values(m.face_materials);
@@ -106,7 +99,7 @@ void hash_surfaces(Hasher& h, const Scene& scene, bool shadows_only) {
     h.value(m.texspace_location);
     h.value(m.texspace_size);
     h.value(m.cast_shadows);
-    if (programs_in_shadows) h.value(m.info.color), h.value(m.info.pass_index), h.value(m.info.random);
+    h.value(m.info.color), h.value(m.info.pass_index), h.value(m.info.random);
     h.value(m.motion_points.size());
     for (const std::vector<glm::vec3>& step : m.motion_points) h.values(step);
     h.values(m.motion_object_to_world);
@@ -120,24 +113,15 @@ void hash_surfaces(Hasher& h, const Scene& scene, bool shadows_only) {
     h.value(b.material);
     h.value(b.object_to_world);
     h.value(b.double_sided);
-    if (!shadows_only) h.value(b.visible_camera);
+    h.value(b.visible_camera);
     h.value(b.cast_shadows);
-    if (programs_in_shadows) h.value(b.info.color), h.value(b.info.pass_index), h.value(b.info.random);
+    h.value(b.info.color), h.value(b.info.pass_index), h.value(b.info.random);
   }
   h.value(scene.materials.size());
   for (const Material& m : scene.materials) {
     h.value(m.opacity);
     h.value(m.program_displaces), h.value(m.displacement_bound), h.value(m.displacement_bound_world);
     h.value(m.program_alpha), h.value(m.program_alpha_cut);
-    if (shadows_only) {
-      // The program by its source, not its index: the index moves when
-      // another material's tree changes.
-      if (program_in_shadows(m) && size_t(m.program) < scene.material_programs.size()) {
-        h.text(scene.material_programs[size_t(m.program)].source);
-        h.value(m.program_params.size()), h.values(m.program_params);
-      }
-      continue;
-    }
     h.value(m.program), h.value(m.program_shades);
     h.value(m.program_params.size()), h.values(m.program_params);
     h.value(m.model);
@@ -145,17 +129,56 @@ void hash_surfaces(Hasher& h, const Scene& scene, bool shadows_only) {
     h.value(m.ka), h.value(m.kd), h.value(m.ks), h.value(m.roughness);
     h.value(m.specular_color), h.value(m.metallic), h.value(m.specular), h.value(m.emission);
   }
-  if (!shadows_only) {
-    h.value(scene.material_programs.size());
-    for (const MaterialProgram& p : scene.material_programs) h.text(p.source);
+  h.value(scene.material_programs.size());
+  for (const MaterialProgram& p : scene.material_programs) h.text(p.source);
+  h.value(scene.images.size());
+  for (const Image& im : scene.images) {
+    h.value(im.width), h.value(im.height), h.value(im.srgb);
+    h.values(im.pixels);
   }
-  if (programs_in_shadows) {
-    h.value(scene.images.size());
-    for (const Image& im : scene.images) {
-      h.value(im.width), h.value(im.height), h.value(im.srgb);
-      h.values(im.pixels);
+}
+
+// For shadows only what a shadow view reads counts: the surfaces' shapes,
+// placement and motion, the materials' opacity, and the programs that
+// displace or compute the alpha, with the node values, object info and
+// images those may read. A material's shading edited (its colour, or a node
+// tree that only shades) keeps the shadow maps, as do an object's name and
+// its camera visibility.
+//
+// A material as the shadow views see it: its program by its source, not its
+// index (the index moves when another material's tree changes).
+uint64_t material_shadow_key(const Scene& scene, const Material& m) {
+  Hasher h;
+  h.value(m.opacity);
+  h.value(m.program_displaces), h.value(m.displacement_bound), h.value(m.displacement_bound_world);
+  h.value(m.program_alpha), h.value(m.program_alpha_cut);
+  if (program_in_shadows(m) && size_t(m.program) < scene.material_programs.size()) {
+    h.text(scene.material_programs[size_t(m.program)].source);
+    h.value(m.program_params.size()), h.values(m.program_params);
+  }
+  return h.result();
+}
+
+// The materials a surface's faces use, as (index, key) pairs in index
+// order; whether any of them runs its program in the shadow views.
+bool hash_used_materials(Hasher& h, const Scene& scene, const std::vector<uint64_t>& keys, int material,
+                         const std::vector<int>& face_materials) {
+  std::vector<bool> used(scene.materials.size(), false);
+  bool outside = false;
+  auto use = [&](int i) {
+    if (i >= 0 && size_t(i) < used.size()) used[size_t(i)] = true;
+    else outside = true;
+  };
+  if (face_materials.empty()) use(material);
+  for (int i : face_materials) use(i);
+  bool programs = false;
+  for (size_t i = 0; i < used.size(); ++i)
+    if (used[i]) {
+      h.value(i), h.value(keys[i]);
+      programs = programs || program_in_shadows(scene.materials[i]);
     }
-  }
+  h.value(outside);
+  return programs;
 }
 
 void hash_light(Hasher& h, const Light& l) {
@@ -167,9 +190,70 @@ void hash_light(Hasher& h, const Light& l) {
 
 }  // namespace
 
-uint64_t geometry_fingerprint(const Scene& scene) {
+ShadowGeometryKeys shadow_geometry_keys(const Scene& scene) {
+  ShadowGeometryKeys out;
+  std::vector<uint64_t> materials;
+  materials.reserve(scene.materials.size());
+  bool programs_anywhere = false;
+  for (const Material& m : scene.materials) {
+    materials.push_back(material_shadow_key(scene, m));
+    programs_anywhere = programs_anywhere || program_in_shadows(m);
+  }
+  // Object info and the texture space enter only where the surface's own
+  // materials run a program in the shadow views.
+  out.meshes.reserve(scene.meshes.size());
+  for (const Mesh& m : scene.meshes) {
+    Hasher h;
+    h.value(uint32_t(1));
+    hash_mesh_shape(h, m);
+    h.values(m.face_materials);
+    const bool programs = hash_used_materials(h, scene, materials, m.material, m.face_materials);
+    h.value(m.object_to_world);
+    h.value(m.double_sided);
+    h.value(m.cast_shadows);
+    if (programs) {
+      h.value(m.texspace_location), h.value(m.texspace_size);
+      h.value(m.info.color), h.value(m.info.pass_index), h.value(m.info.random);
+    }
+    h.value(m.motion_points.size());
+    for (const std::vector<glm::vec3>& step : m.motion_points) h.values(step);
+    h.values(m.motion_object_to_world);
+    out.meshes.push_back(h.result());
+  }
+  out.patch_sets.reserve(scene.bezier_patches.size());
+  for (const BezierPatches& b : scene.bezier_patches) {
+    Hasher h;
+    h.value(uint32_t(2));
+    h.values(b.control_points);
+    const bool programs = hash_used_materials(h, scene, materials, b.material, {});
+    h.value(b.object_to_world);
+    h.value(b.double_sided);
+    h.value(b.cast_shadows);
+    if (programs) h.value(b.info.color), h.value(b.info.pass_index), h.value(b.info.random);
+    out.patch_sets.push_back(h.result());
+  }
+  Hasher g;
+  g.value(scene.motion_steps);
+  g.values(scene.shutter_curve);
+  g.values(scene.camera.motion_world_to_camera);
+  if (programs_anywhere) {
+    g.value(scene.images.size());
+    for (const Image& im : scene.images) {
+      g.value(im.width), g.value(im.height), g.value(im.srgb);
+      g.values(im.pixels);
+    }
+  }
+  out.global = g.result();
+  return out;
+}
+
+uint64_t geometry_fingerprint(const Scene& scene) { return geometry_fingerprint(shadow_geometry_keys(scene)); }
+
+uint64_t geometry_fingerprint(const ShadowGeometryKeys& keys) {
   Hasher h;
-  hash_surfaces(h, scene, true);
+  h.value(keys.global);
+  h.values(keys.meshes);
+  h.values(keys.patch_sets);
   return h.result();
 }
 
@@ -205,7 +289,7 @@ uint64_t scene_fingerprint(const Scene& scene) {
   // Device light records include the world's (world_lighting.h).
   h.value(scene.world.present() ? world_fingerprint(scene) : uint64_t(0));
   h.value(scene.camera.world_to_camera);
-  hash_surfaces(h, scene, false);
+  hash_surfaces(h, scene);
   h.value(scene.lights.size());
   for (const Light& l : scene.lights) {
     hash_light(h, l);

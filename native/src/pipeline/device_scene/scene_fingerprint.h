@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "micropoly/scene.h"
 
@@ -18,14 +19,26 @@ uint64_t scene_fingerprint(const Scene& scene);
 uint64_t world_fingerprint(const Scene& scene);
 
 // What the scene's shadow maps' contents depend on besides each light
-// (kernels/shadow/mp_shadow.h): the surfaces in world space, with their materials'
-// displacement and opacity and the images displacement can read. Not the
-// camera, and not the lights.
+// (kernels/shadow/mp_shadow.h), split so that a frame can tell which
+// surfaces changed (shadow_changes.h): `global`, what every surface's
+// shadow depends on (the shutter, and the images that displacing or alpha
+// programs may read), then one key per surface (in Scene order): its shape
+// and placement in world space, motion, whether it casts shadows, its
+// materials' opacity, displacement and alpha programs, and the object info
+// those programs may read. Not the camera, and not the lights.
+struct ShadowGeometryKeys {
+  uint64_t global = 0;
+  std::vector<uint64_t> meshes, patch_sets;
+};
+ShadowGeometryKeys shadow_geometry_keys(const Scene& scene);
+// All of them in one.
 uint64_t geometry_fingerprint(const Scene& scene);
+uint64_t geometry_fingerprint(const ShadowGeometryKeys& keys);
 
-// What one light's shadow pages depend on: the geometry, the light's place,
-// shape and size, the settings that dice the shadow views, and (suns) the
-// depth their maps count from.
+// What one light's shadow pages depend on besides the surfaces they hold:
+// `geometry_key` (ShadowGeometryKeys::global), the light's place, shape and
+// size, the settings that dice the shadow views, and (suns) the depth their
+// maps count from.
 uint64_t shadow_light_key(const Light& light, uint64_t geometry_key, const RenderSettings& settings, float z_top);
 
 // Fingerprints of what a surface's object-space patches depend on (its

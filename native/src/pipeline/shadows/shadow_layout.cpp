@@ -105,6 +105,55 @@ WorldBounds world_bounds(const Scene& scene) {
   return b;
 }
 
+WorldBounds surface_bounds(const Scene& scene, const Mesh& mesh) {
+  WorldBounds b;
+  const float reach = displacement_reach(scene, mesh.material, mesh.face_materials, mesh.object_to_world);
+  grow(b, mesh.points, mesh.object_to_world, reach);
+  for (const std::vector<glm::vec3>& step : mesh.motion_points) grow(b, step, mesh.object_to_world, reach);
+  return b;
+}
+
+WorldBounds surface_bounds(const Scene& scene, const BezierPatches& set) {
+  WorldBounds b;
+  grow(b, set.control_points, set.object_to_world,
+       displacement_reach(scene, set.material, {}, set.object_to_world));
+  return b;
+}
+
+bool shadow_page_touches(const Light& light, int32_t map_id, int32_t x, int32_t y, const WorldBounds& box) {
+  if (box.empty()) return false;
+  // The box in the light's space (as the views' to_light rows place it).
+  const glm::dmat3 basis = light_basis(light);
+  const bool sun = light.type == Light::Type::Distant;
+  const glm::dvec3 origin = sun ? glm::dvec3(0.0) : glm::dvec3(light.position);
+  glm::dvec3 lo(1e300), hi(-1e300);
+  for (int k = 0; k < 8; ++k) {
+    const glm::dvec3 c((k & 1) ? box.hi.x : box.lo.x, (k & 2) ? box.hi.y : box.lo.y, (k & 4) ? box.hi.z : box.lo.z);
+    const glm::dvec3 q = basis * (c - origin);
+    lo = glm::min(lo, q), hi = glm::max(hi, q);
+  }
+  // Two texels of margin: the views reach light space through the camera's
+  // in single precision, and a micropolygon on the box's edge covers the
+  // texels whose centres it holds.
+  constexpr double kMarginTexels = 2.0;
+  double x0, y0, x1, y1;
+  if (sun) {
+    // A level's absolute page (x, y) holds light-space x in [x, x + 1) pages.
+    const double texel = std::ldexp(1.0, map_id), page = texel * MP_PAGE_SIZE;
+    x0 = (lo.x - kMarginTexels * texel) / page, x1 = (hi.x + kMarginTexels * texel) / page;
+    y0 = (lo.y - kMarginTexels * texel) / page, y1 = (hi.y + kMarginTexels * texel) / page;
+  } else {
+    const int face = map_id / MP_CUBE_MIPS, mip = map_id % MP_CUBE_MIPS;
+    float fx0, fy0, fx1, fy1;
+    if (!mp_cube_face_box(face, glm::vec3(lo), glm::vec3(hi), float(mp_cube_mip_texels(mip)), &fx0,
+                          &fy0, &fx1, &fy1))
+      return false;
+    x0 = (fx0 - kMarginTexels) / MP_PAGE_SIZE, x1 = (fx1 + kMarginTexels) / MP_PAGE_SIZE;
+    y0 = (fy0 - kMarginTexels) / MP_PAGE_SIZE, y1 = (fy1 + kMarginTexels) / MP_PAGE_SIZE;
+  }
+  return x >= std::floor(x0) && x <= std::floor(x1) && y >= std::floor(y0) && y <= std::floor(y1);
+}
+
 void ShadowLayout::page_position(const ShadowMapInfo& m, int sx, int sy, int32_t* x, int32_t* y) const {
   *x = m.page_x + ((sx - m.origin_x) & (m.side - 1));
   *y = m.page_y + ((sy - m.origin_y) & (m.side - 1));

@@ -20,6 +20,9 @@ struct WorldBounds {
   bool empty() const { return !(lo.x <= hi.x); }
 };
 WorldBounds world_bounds(const Scene& scene);
+// One surface's box, displacement and deformation motion included.
+WorldBounds surface_bounds(const Scene& scene, const Mesh& mesh);
+WorldBounds surface_bounds(const Scene& scene, const BezierPatches& set);
 
 // Levels (or mips) coarser than the pixel footprint asks for, that marking
 // falls back to when the shadow memory budget is short; suns keep clipmap
@@ -53,10 +56,15 @@ struct ShadowLayout {
 // The layout for a scene seen by `frame` (the camera's view), for `lights`
 // (the scene's and its world's, world_lighting.h). Lights cast
 // shadows when the settings and the light allow it and the scene has
-// surfaces. `geometry_key` fingerprints what the maps' contents depend on
-// (geometry_fingerprint).
+// surfaces. `geometry_key` fingerprints what every page's contents depend
+// on besides the surfaces it holds (ShadowGeometryKeys::global).
 ShadowLayout make_shadow_layout(const Scene& scene, const std::vector<Light>& lights, const FrameSetup& frame,
                                 const WorldBounds& bounds, uint64_t geometry_key);
+
+// Whether the page of `light`'s maps at map `map_id` (ShadowMapInfo) and
+// absolute position (x, y) may hold a part of the world-space `box`
+// (conservatively: with a margin of two texels).
+bool shadow_page_touches(const Light& light, int32_t map_id, int32_t x, int32_t y, const WorldBounds& box);
 
 // Sets every shadowed light's level bias (levels coarser than the
 // footprint asks for), in the records the kernels read.

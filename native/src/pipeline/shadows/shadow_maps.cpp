@@ -455,6 +455,38 @@ bool ShadowMaps::render_views(const std::vector<FrameParams>& views, const std::
 
 bool ShadowMaps::render(const Scene& scene, const std::vector<Light>& lights, const FrameSetup& frame,
                         MicropolygonPass& pass, const cl::Buffer& camera_order, ShadowStats& stats) {
+  pending_.clear();
+  if (render_maps(scene, lights, frame, pass, camera_order, stats)) return true;
+  // Cancelled: the pages granted for rendering this frame may hold nothing
+  // their keys name; the others stay.
+  std::unordered_set<ShadowPageKey, ShadowPageKeyHash> pending(pending_.begin(), pending_.end());
+  pool_.forget_if([&](const ShadowPageKey& k) { return pending.count(k) > 0; });
+  return false;
+}
+
+void ShadowMaps::forget_changed_pages(const ShadowLayout& layout, const std::vector<Light>& lights,
+                                      ShadowCasters casters) {
+  const std::optional<std::vector<WorldBounds>> boxes = shadow_changes(casters_, casters);
+  casters_ = std::move(casters);
+  if (!boxes) {
+    pool_.clear();
+    return;
+  }
+  if (boxes->empty() || pool_.resident() == 0) return;
+  std::unordered_map<uint64_t, size_t> light_of;
+  for (size_t i = 0; i < layout.light_keys.size(); ++i)
+    if (layout.light_keys[i]) light_of[layout.light_keys[i]] = i;
+  pool_.forget_if([&](const ShadowPageKey& k) {
+    const auto it = light_of.find(k.light);
+    if (it == light_of.end()) return true;
+    for (const WorldBounds& box : *boxes)
+      if (shadow_page_touches(lights[it->second], k.map, k.x, k.y, box)) return true;
+    return false;
+  });
+}
+
+bool ShadowMaps::render_maps(const Scene& scene, const std::vector<Light>& lights, const FrameSetup& frame,
+                             MicropolygonPass& pass, const cl::Buffer& camera_order, ShadowStats& stats) {
   const SceneBuffers& buffers = pass.scene();
   stats = ShadowStats{};
   depth_.seen_first(cl::Buffer(), 0, buffers, frame.params, pass.timer());  // none until the marking orders them
@@ -462,8 +494,9 @@ bool ShadowMaps::render(const Scene& scene, const std::vector<Light>& lights, co
   stats.budget_bytes = size_t(double(settings.shadow_memory_mib) * 1048576.0);
   inputs_.enabled = false;
   if (!settings.shadows || buffers.patch_count == 0) return true;
-  scene_key_ = geometry_fingerprint(scene);
-  ShadowLayout layout = make_shadow_layout(scene, lights, frame, world_bounds(scene), scene_key_);
+  ShadowCasters casters = shadow_casters(scene);
+  scene_key_ = casters.all;
+  ShadowLayout layout = make_shadow_layout(scene, lights, frame, world_bounds(scene), casters.global);
   if (layout.shadowed_lights == 0) {
     pool_.clear();
     return true;
@@ -527,6 +560,8 @@ bool ShadowMaps::render(const Scene& scene, const std::vector<Light>& lights, co
     for (uint64_t k : layout.light_keys)
       if (k) present.insert(k);
   pool_.keep_only(present);
+  // A light's pages outlive changes to surfaces they do not reach.
+  forget_changed_pages(layout, lights, std::move(casters));
 
   // First: hard shadows' pages and soft shadows' first search round's; a
   // budget too short for them coarsens every light.
@@ -605,7 +640,10 @@ bool ShadowMaps::allocate_and_render(const ShadowLayout& layout, const std::vect
     }
     table[entries[i]] = g.physical | MP_PAGE_RESIDENT | (g.render ? MP_PAGE_RENDER : 0u);
     writes.push_back({{entries[i], table[entries[i]]}});
-    if (g.render) fresh.push_back(g.physical), fresh_caps.push_back(capped_ ? request_caps_[i] : ShadowPagePool::kUncapped);
+    if (g.render) {
+      fresh.push_back(g.physical), pending_.push_back(keys[i]);
+      fresh_caps.push_back(capped_ ? request_caps_[i] : ShadowPagePool::kUncapped);
+    }
   }
   if (stats.pages_missing > 0 && capped_) {
     for (size_t i = 0; i < keys.size(); ++i)

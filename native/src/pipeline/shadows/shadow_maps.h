@@ -37,6 +37,7 @@
 #include "pipeline/device_scene/scene_buffers.h"
 #include "pipeline/shadows/marking_depth.h"
 #include "pipeline/shadows/shadow_layout.h"
+#include "pipeline/shadows/shadow_changes.h"
 #include "pipeline/shadows/shadow_page_pool.h"
 #include "pipeline/pass/stage_timer.h"
 
@@ -57,6 +58,14 @@ class ShadowMaps {
   CameraRoots camera_roots();
 
  private:
+  // render's work; where it is cancelled, render forgets the pages granted
+  // for rendering this frame (pending_), which may hold nothing their keys name.
+  bool render_maps(const Scene& scene, const std::vector<Light>& lights, const FrameSetup& frame,
+                   MicropolygonPass& pass, const cl::Buffer& camera_order, ShadowStats& stats);
+  // Forgets the kept pages that a surface changed since the last frame may
+  // reach (all of them where that cannot be told: shadow_changes.h), and
+  // records this frame's surfaces for the next.
+  void forget_changed_pages(const ShadowLayout& layout, const std::vector<Light>& lights, ShadowCasters casters);
   // The camera's coarse view: its depth (culling what it hides, where
   // `camera_order` is given) and its vertices, kept within their share of
   // the budget (with their normals where `soft`) for the markings; past
@@ -147,6 +156,8 @@ class ShadowMaps {
   };
   std::vector<LightOrder> orders_;
   uint64_t scene_key_ = 0;
+  ShadowCasters casters_;  // the surfaces the pool's pages were rendered from
+  std::vector<ShadowPageKey> pending_;
 };
 
 }  // namespace mp

@@ -16,14 +16,21 @@ void ShadowPagePool::clear() {
 }
 
 void ShadowPagePool::keep_only(const std::unordered_set<uint64_t>& lights) {
+  forget_if([&](const ShadowPageKey& k) { return lights.count(k.light) == 0; });
+}
+
+size_t ShadowPagePool::forget_if(const std::function<bool(const ShadowPageKey&)>& stale) {
+  size_t forgotten = 0;
   for (auto it = pages_.begin(); it != pages_.end();) {
-    if (lights.count(it->first.light)) {
+    if (!stale(it->first)) {
       ++it;
     } else {
       free_.push_back(it->second.physical);
       it = pages_.erase(it);
+      ++forgotten;
     }
   }
+  return forgotten;
 }
 
 uint32_t ShadowPagePool::take_free() {

@@ -46,6 +46,8 @@ class ShadowPagePool {
   size_t capacity() const { return capacity_; }
   // Forgets the pages of every light not in `lights` (changed or gone).
   void keep_only(const std::unordered_set<uint64_t>& lights);
+  // Forgets the pages for which `stale` holds; returns how many.
+  size_t forget_if(const std::function<bool(const ShadowPageKey&)>& stale);
   void clear();
   // Gives the requests pages, in order: resident ones keep theirs, new ones
   // take free pages or those least recently used by earlier frames. Grants
