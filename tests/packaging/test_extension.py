@@ -2,7 +2,8 @@
 CPU device's compiler does not know.
 
 Builds the zip (`cmake --build BUILD --target extension`), then for each bpy
-version: makes a fresh virtual environment with only that bpy module, hides
+version: takes a virtual environment with only that bpy module (the
+developer one's files linked where it holds nothing else), hides
 Debian's OpenCL loader, PoCL, OpenSubdiv, libpng and OpenEXR libraries and
 its OpenCL driver registry from the loader (bind mounts in a private mount
 namespace: the files are there but empty), installs the zip as an extension
@@ -111,11 +112,38 @@ def psnr(a, b):
     return float("inf") if mse == 0.0 else 10.0 * np.log10(1.0 / mse)
 
 
+# Run inside a venv: whether it holds bpy==argv[1], what bpy depends on
+# (its requirements, recursively, without extras) and pip and setuptools,
+# and nothing else.
+ONLY_BPY = """
+import importlib.metadata as md, re, sys
+def norm(n): return re.sub(r"[-_.]+", "-", n).lower()
+have = {norm(d.metadata["Name"]): d for d in md.distributions()}
+need, todo = {"pip", "setuptools"}, ["bpy"]
+while todo:
+    n = todo.pop()
+    if n in need or n not in have: continue
+    need.add(n)
+    for r in have[n].requires or []:
+        if "extra ==" not in r: todo.append(norm(re.match(r"[A-Za-z0-9_.-]+", r).group(0)))
+sys.exit(0 if "bpy" in have and have["bpy"].version == sys.argv[1] and set(have) <= need else 1)
+"""
+
+
 def fresh_bpy_venv(version, folder):
-    """A new venv with only bpy==version (and what it depends on)."""
+    """A venv with only bpy==version (and what it depends on). The
+    developer venv (BUILD/bpy-VERSION, which scripts/setup.sh installs the
+    same way) is linked file by file when it holds exactly that: the
+    extension installs into Blender's user folders, never into the venv, so
+    the copy stays as pip made it. Otherwise pip installs a new one."""
+    shutil.rmtree(folder, ignore_errors=True)
+    developer = os.path.realpath(os.path.join(BUILD, f"bpy-{version}"))
+    python = os.path.join(folder, "bin", "python3")
+    if (subprocess.run([os.path.join(developer, "bin", "python3"), "-c", ONLY_BPY, version]).returncode == 0 and
+            subprocess.run(["cp", "-al", developer, folder]).returncode == 0):  # fails across file systems
+        return python
     shutil.rmtree(folder, ignore_errors=True)
     subprocess.run(["/usr/bin/python3", "-m", "venv", folder], check=True)
-    python = os.path.join(folder, "bin", "python3")
     subprocess.run([python, "-m", "pip", "install", "-q", "--disable-pip-version-check", f"bpy=={version}"],
                    check=True)
     return python
@@ -139,7 +167,7 @@ def check_version(version, zip_path, work):
         return False
     t0 = time.time()
     python = fresh_bpy_venv(version, os.path.join(work, f"venv-{version}"))
-    log(f"bpy {version}: fresh venv in {time.time() - t0:.0f} s")
+    log(f"bpy {version}: a venv with only bpy in {time.time() - t0:.0f} s")
     render = os.path.join(HERE, "render_demo.py")
 
     # The developer build: Debian's libraries, the add-on from BUILD/addons.
