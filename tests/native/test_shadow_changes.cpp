@@ -19,6 +19,8 @@ Mesh square(float x, float y, float z, float half) {
   return polygon({{x - half, y - half, z}, {x + half, y - half, z}, {x + half, y + half, z}, {x - half, y + half, z}});
 }
 
+ShadowCasters casters(const Scene& s) { return shadow_casters(s, shadow_geometry_keys(s)); }
+
 Scene two_squares() {
   Scene s;
   s.materials.push_back(Material{});
@@ -32,7 +34,7 @@ TEST(ShadowChanges, SameSurfacesInAnyOrderChangeNothing) {
   std::swap(b.meshes[0], b.meshes[1]);
   b.meshes[0].name = "renamed";
   b.meshes[1].visible_camera = false;
-  const auto boxes = shadow_changes(shadow_casters(a), shadow_casters(b));
+  const auto boxes = shadow_changes(casters(a), casters(b));
   ASSERT_TRUE(boxes.has_value());
   EXPECT_TRUE(boxes->empty());
 }
@@ -40,7 +42,7 @@ TEST(ShadowChanges, SameSurfacesInAnyOrderChangeNothing) {
 TEST(ShadowChanges, AMovedSurfaceGivesWhereItWasAndWhereItIs) {
   Scene a = two_squares(), b = a;
   b.meshes[1].object_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(0, 3, 0));
-  const auto boxes = shadow_changes(shadow_casters(a), shadow_casters(b));
+  const auto boxes = shadow_changes(casters(a), casters(b));
   ASSERT_TRUE(boxes.has_value());
   ASSERT_EQ(boxes->size(), 2u);
   bool was = false, is = false;
@@ -57,12 +59,12 @@ TEST(ShadowChanges, SurfacesThatCastNoShadowDoNotCount) {
   Scene a = two_squares(), b = a;
   a.meshes[1].cast_shadows = b.meshes[1].cast_shadows = false;
   b.meshes[1].object_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(0, 3, 0));
-  const auto boxes = shadow_changes(shadow_casters(a), shadow_casters(b));
+  const auto boxes = shadow_changes(casters(a), casters(b));
   ASSERT_TRUE(boxes.has_value());
   EXPECT_TRUE(boxes->empty());
   // Casting again: it appears where it is.
   b.meshes[1].cast_shadows = true;
-  const auto appeared = shadow_changes(shadow_casters(a), shadow_casters(b));
+  const auto appeared = shadow_changes(casters(a), casters(b));
   ASSERT_TRUE(appeared.has_value());
   EXPECT_EQ(appeared->size(), 1u);
 }
@@ -73,11 +75,11 @@ TEST(ShadowChanges, WhatCannotBeBoundedChangesEverything) {
   Scene moving = a;
   moving.motion_steps = 2;
   moving.meshes[1].motion_object_to_world = {glm::mat4(1.0f), glm::rotate(glm::mat4(1.0f), 1.0f, glm::vec3(0, 0, 1))};
-  EXPECT_FALSE(shadow_changes(shadow_casters(a), shadow_casters(moving)).has_value());
+  EXPECT_FALSE(shadow_changes(casters(a), casters(moving)).has_value());
   // More surfaces changed than are told apart.
   Scene many = a;
   for (size_t i = 0; i <= kMaxShadowChanges; ++i) many.meshes.push_back(square(float(i), 10, 1, 0.5f));
-  EXPECT_FALSE(shadow_changes(shadow_casters(a), shadow_casters(many)).has_value());
+  EXPECT_FALSE(shadow_changes(casters(a), casters(many)).has_value());
   // An image that a displacing program may read.
   Scene displaced = a;
   displaced.material_programs.push_back({"lift", "float3 mp_node_displacement(const MpNodeGlobals* g) "
@@ -88,9 +90,9 @@ TEST(ShadowChanges, WhatCannotBeBoundedChangesEverything) {
   Scene repainted = displaced;
   repainted.images[0].pixels = {glm::vec4(1.0f, 0.0f, 0.0f, 1.0f)};
   repainted.images[0].width = repainted.images[0].height = 1;
-  EXPECT_FALSE(shadow_changes(shadow_casters(displaced), shadow_casters(repainted)).has_value());
+  EXPECT_FALSE(shadow_changes(casters(displaced), casters(repainted)).has_value());
   // The first frame: nothing to compare with.
-  EXPECT_FALSE(shadow_changes(ShadowCasters{}, shadow_casters(a)).has_value());
+  EXPECT_FALSE(shadow_changes(ShadowCasters{}, casters(a)).has_value());
 }
 
 TEST(ShadowPageTouches, ASunsPagesUnderTheBoxAndNoOthers) {

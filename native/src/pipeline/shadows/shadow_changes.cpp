@@ -2,12 +2,10 @@
 
 #include <algorithm>
 
-#include "pipeline/device_scene/scene_fingerprint.h"
 
 namespace mp {
 
-ShadowCasters shadow_casters(const Scene& scene) {
-  const ShadowGeometryKeys keys = shadow_geometry_keys(scene);
+ShadowCasters shadow_casters(const Scene& scene, const ShadowGeometryKeys& keys) {
   ShadowCasters out;
   out.global = keys.global;
   out.all = geometry_fingerprint(keys);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "micropoly/scene.h"
+#include "pipeline/device_scene/scene_fingerprint.h"
 #include "pipeline/shadows/shadow_layout.h"
 
 namespace mp {
@@ -29,7 +30,8 @@ struct ShadowCasters {
   std::vector<ShadowCaster> surfaces;  // those that cast shadows, by key
 };
 
-ShadowCasters shadow_casters(const Scene& scene);
+// The scene's shadow-casting surfaces, from its keys (shadow_geometry_keys).
+ShadowCasters shadow_casters(const Scene& scene, const ShadowGeometryKeys& keys);
 
 // At most this many changed surfaces are told apart; more change everything.
 constexpr size_t kMaxShadowChanges = 64;

@@ -494,9 +494,9 @@ bool ShadowMaps::render_maps(const Scene& scene, const std::vector<Light>& light
   stats.budget_bytes = size_t(double(settings.shadow_memory_mib) * 1048576.0);
   inputs_.enabled = false;
   if (!settings.shadows || buffers.patch_count == 0) return true;
-  ShadowCasters casters = shadow_casters(scene);
-  scene_key_ = casters.all;
-  ShadowLayout layout = make_shadow_layout(scene, lights, frame, world_bounds(scene), casters.global);
+  const ShadowGeometryKeys geometry = shadow_geometry_keys(scene);
+  scene_key_ = geometry_fingerprint(geometry);
+  ShadowLayout layout = make_shadow_layout(scene, lights, frame, world_bounds(scene), geometry.global);
   if (layout.shadowed_lights == 0) {
     pool_.clear();
     return true;
@@ -560,8 +560,9 @@ bool ShadowMaps::render_maps(const Scene& scene, const std::vector<Light>& light
     for (uint64_t k : layout.light_keys)
       if (k) present.insert(k);
   pool_.keep_only(present);
-  // A light's pages outlive changes to surfaces they do not reach.
-  forget_changed_pages(layout, lights, std::move(casters));
+  // A light's pages outlive changes to surfaces they do not reach (the
+  // surfaces' boxes are found only when some surface changed).
+  if (scene_key_ != casters_.all) forget_changed_pages(layout, lights, shadow_casters(scene, geometry));
 
   // First: hard shadows' pages and soft shadows' first search round's; a
   // budget too short for them coarsens every light.
