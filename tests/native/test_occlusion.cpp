@@ -192,6 +192,31 @@ TEST_F(OcclusionTest, DisplacedSurfacesRenderTheSame) {
   EXPECT_GT(blue, 1000u);
 }
 
+TEST_F(OcclusionTest, TheWorldsProbeSunsCullInOnePassAndRenderTheSame) {
+  // Stacked quads over a floor under a uniform world whose eight probe suns
+  // cast shadows: their views share one culling pass (ShadowLayout's
+  // cull_group), each culling against its own pages; the image is the
+  // same as without culling, and the stack's hidden quads are culled.
+  Scene s = top_view();
+  for (int k = 0; k < 6; ++k) {
+    Mesh layer = grid_mesh(8, 6.0f, SubdivScheme::None);
+    layer.object_to_world = glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.0f, 0.2f * float(k)));
+    s.meshes.push_back(layer);
+  }
+  s.world.width = 2, s.world.height = 1;
+  s.world.radiance.assign(8, 1.0f);
+  s.world.cast_shadows = true;
+  s.settings.world_probes = 8;
+  s.settings.keep_shadow_pages = false;  // every render renders its pages
+  const Pair p = render_both(s);
+  EXPECT_GT(p.on.stats.shadows.lights, 1);
+  EXPECT_GT(p.on.stats.shadows.views, 1u);
+  if (takes_waves()) {
+    EXPECT_GT(p.on.stats.shadows.subpatches_occluded, 0u);
+    EXPECT_LT(p.on.stats.shadows.micropolygons, p.off.stats.shadows.micropolygons);
+  }
+}
+
 TEST_F(OcclusionTest, TestScenesRenderTheSame) {
   for (const char* name : {"teapot.rib", "torus_closeup.rib", "subdiv_creases.rib"}) {
     SCOPED_TRACE(name);

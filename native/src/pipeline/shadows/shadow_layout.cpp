@@ -167,6 +167,8 @@ ShadowLayout make_shadow_layout(const Scene& scene, const std::vector<Light>& li
   out.shadows.resize(lights.size());
   out.light_keys.assign(lights.size(), 0);
   out.own_bias.assign(lights.size(), 0);
+  out.cull_group.resize(lights.size());
+  for (size_t i = 0; i < lights.size(); ++i) out.cull_group[i] = lights[i].world_probe ? -1 : int(i);
   for (DeviceShadow& d : out.shadows) d = DeviceShadow{}, d.kind = MP_SHADOW_NONE, d.cone_cos = -2.0f;
   if (!s.shadows || bounds.empty()) return out;
 

@@ -46,6 +46,11 @@ struct ShadowLayout {
   std::vector<DeviceShadowLevel> levels;    // the suns' clipmap levels
   std::vector<uint64_t> light_keys;         // per scene light: what its pages' contents depend on (0: none)
   std::vector<int> own_bias;                // per scene light: levels coarser than its footprint asks for
+  // Per scene light: the lights whose views share a culling pass have the
+  // same group (the world's probe suns: many small coarse views, whose
+  // passes of their own would cost more in launches than culling saves);
+  // every other light is a group of its own.
+  std::vector<int> cull_group;
   std::vector<ShadowMapInfo> maps;
   uint32_t table_entries = 0;
   int shadowed_lights = 0;

@@ -361,6 +361,7 @@ const cl::Buffer& ShadowMaps::light_order(int light, const FrameParams& v, const
 }
 
 bool ShadowMaps::render_views(const std::vector<FrameParams>& views, const std::vector<int>& lights,
+                              const std::vector<int>& groups,
                               const std::vector<uint8_t>& masks, const FrameSetup& frame, MicropolygonPass& pass,
                               ShadowStats& stats, bool culling, cl_uint fresh_pages) {
   StageTimer& timer = pass.timer();
@@ -395,11 +396,14 @@ bool ShadowMaps::render_views(const std::vector<FrameParams>& views, const std::
     timer.add(Stage::Sample, e);
   };
   for (size_t first = 0; first < views.size();) {
-    // A pass takes up to MP_MAX_PASS_VIEWS views; with culling, one light's
-    // only, whose patches it takes near to far from that light.
+    // A pass takes up to MP_MAX_PASS_VIEWS views; with culling, one culling
+    // group's only (ShadowLayout::cull_group: one light's, or the world's
+    // probe suns'), whose patches it takes near to far from its first
+    // light. Any order culls correctly (each view tests against its own
+    // pages); a near-to-far one culls most.
     size_t count = 1;
     while (first + count < views.size() && count < MP_MAX_PASS_VIEWS &&
-           (!culling || lights[first + count] == lights[first]))
+           (!culling || groups[first + count] == groups[first]))
       ++count;
     session_.reserve(views_, views_capacity_, MP_MAX_PASS_VIEWS * sizeof(FrameParams), "shadow views");
     q.enqueueWriteBuffer(views_, CL_TRUE, 0, count * sizeof(FrameParams), views.data() + first);
@@ -698,17 +702,23 @@ bool ShadowMaps::allocate_and_render(const ShadowLayout& layout, const std::vect
     view_lights.push_back(m.light);
   }
   stats.views += views.size();
+  std::vector<int> view_groups;
+  for (int l : view_lights) view_groups.push_back(layout.cull_group[size_t(l)]);
   if (culling) {
-    // Each light's views together: a culling pass takes one light's.
-    std::vector<size_t> by_light(views.size());
-    std::iota(by_light.begin(), by_light.end(), size_t(0));
-    std::stable_sort(by_light.begin(), by_light.end(),
-                     [&](size_t a, size_t b) { return view_lights[a] < view_lights[b]; });
+    // Each culling group's views together, a light's within it: a culling
+    // pass takes one group's.
+    std::vector<size_t> by_group(views.size());
+    std::iota(by_group.begin(), by_group.end(), size_t(0));
+    std::stable_sort(by_group.begin(), by_group.end(), [&](size_t a, size_t b) {
+      return view_groups[a] != view_groups[b] ? view_groups[a] < view_groups[b] : view_lights[a] < view_lights[b];
+    });
     std::vector<FrameParams> sorted_views;
-    std::vector<int> sorted_lights;
-    for (size_t i : by_light) sorted_views.push_back(views[i]), sorted_lights.push_back(view_lights[i]);
+    std::vector<int> sorted_lights, sorted_groups;
+    for (size_t i : by_group)
+      sorted_views.push_back(views[i]), sorted_lights.push_back(view_lights[i]), sorted_groups.push_back(view_groups[i]);
     views.swap(sorted_views);
     view_lights.swap(sorted_lights);
+    view_groups.swap(sorted_groups);
   }
 
   StageTimer::Redirect to(timer, Stage::ShadowBoundSplit);
@@ -722,7 +732,7 @@ bool ShadowMaps::allocate_and_render(const ShadowLayout& layout, const std::vect
   q.enqueueNDRangeKernel(clear_, cl::NullRange, round_up_range(texels, 256), cl::NDRange(256), nullptr, &e);
   timer.add(Stage::ShadowSample, e);
   pass.layout().begin_frame();
-  if (!render_views(views, view_lights, masks, frame, pass, stats, culling, cl_uint(fresh.size())))
+  if (!render_views(views, view_lights, view_groups, masks, frame, pass, stats, culling, cl_uint(fresh.size())))
     return false;
   stats.micropolygons += pass.layout().micropolygons();
   return true;

@@ -102,9 +102,11 @@ class ShadowMaps {
                            const std::vector<uint32_t>& entries, const FrameSetup& frame, MicropolygonPass& pass,
                            ShadowStats& stats, bool culling);
   void upload_records(const ShadowLayout& layout);
-  // Renders the views (of light `lights[i]` each) into their fresh pages,
-  // a pass per light where occlusion culling is on (`culling`).
+  // Renders the views (of light `lights[i]` each, in culling group
+  // `groups[i]`) into their fresh pages, a pass per group where occlusion
+  // culling is on (`culling`).
   bool render_views(const std::vector<FrameParams>& views, const std::vector<int>& lights,
+                    const std::vector<int>& groups,
                     const std::vector<uint8_t>& masks, const FrameSetup& frame, MicropolygonPass& pass,
                     ShadowStats& stats, bool culling, cl_uint fresh_pages);
   void ensure_pool(uint32_t pages);
