@@ -2,7 +2,6 @@
 
 #include <algorithm>
 
-
 namespace mp {
 
 ShadowCasters shadow_casters(const Scene& scene, const ShadowGeometryKeys& keys) {
