@@ -163,13 +163,18 @@ uint64_t material_shadow_key(const Scene& scene, const Material& m) {
 // order; whether any of them runs its program in the shadow views.
 bool hash_used_materials(Hasher& h, const Scene& scene, const std::vector<uint64_t>& keys, int material,
                          const std::vector<int>& face_materials) {
+  if (face_materials.empty()) {  // one material: no table of them (the same hash as below)
+    const bool inside = material >= 0 && size_t(material) < scene.materials.size();
+    if (inside) h.value(size_t(material)), h.value(keys[size_t(material)]);
+    h.value(!inside);
+    return inside && program_in_shadows(scene.materials[size_t(material)]);
+  }
   std::vector<bool> used(scene.materials.size(), false);
   bool outside = false;
   auto use = [&](int i) {
     if (i >= 0 && size_t(i) < used.size()) used[size_t(i)] = true;
     else outside = true;
   };
-  if (face_materials.empty()) use(material);
   for (int i : face_materials) use(i);
   bool programs = false;
   for (size_t i = 0; i < used.size(); ++i)
