@@ -69,6 +69,12 @@ MP_INLINE long mp_to_fixed(float r) { return (long)floor(r * (float)MP_SUBPIXEL_
  * the grid touches. */
 #define MP_TILE_RUN 16
 
+/* A micropolygon whose raster bound spans at most this many fixed-point
+ * units per axis is tested in int32 arithmetic by both samplers (sample.cl,
+ * sample_tiles.cl): its edge values at the samples they test stay far
+ * below 2^31, so they equal mp_edge's 64-bit ones exactly. */
+#define MP_FAST_SPAN (32 << MP_SUBPIXEL_BITS)
+
 /* The samplers' passes over a batch's grids (sample.cl; the tile sampler
  * does depth and attributes in one pass, MP_SAMPLE_ATTRIBUTES). Visibility
  * first (docs/pipeline.md, step 5): before shading, the nearest keys of the

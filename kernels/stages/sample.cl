@@ -44,6 +44,73 @@ inline void mp_sample_write(const MpTriangle* t, float la, float lb, float lc, i
   }
 }
 
+/* A triangle's corners relative to its quad's raster bound corner, in
+ * int32 (mp_raster_quad_small). */
+typedef struct {
+  int ax, ay, bx, by, cx, cy;
+} MpSmallTriangle;
+
+inline MpSmallTriangle mp_small_triangle(const MpEdgeTriangle* t, long x0, long y0) {
+  MpSmallTriangle r;
+  r.ax = (int)(t->a.x - x0), r.ay = (int)(t->a.y - y0);
+  r.bx = (int)(t->b.x - x0), r.by = (int)(t->b.y - y0);
+  r.cx = (int)(t->c.x - x0), r.cy = (int)(t->c.y - y0);
+  return r;
+}
+
+/* mp_edge_triangle_covers for a sample (sx, sy) inside the bound, in the
+ * same relative coordinates: every factor is a difference of two points of
+ * the bound, at most MP_FAST_SPAN (2^13) apart, so each edge value stays
+ * below 2^27 in magnitude and equals mp_edge's 64-bit one exactly (as do
+ * the barycentrics made from it). */
+inline int mp_small_covers(const MpEdgeTriangle* t, const MpSmallTriangle* r, int sx, int sy, float* la, float* lb,
+                           float* lc) {
+  if (!t->valid) return 0;
+  int e0 = (r->cy - r->by) * (sx - r->bx) - (r->cx - r->bx) * (sy - r->by);
+  int e1 = (r->ay - r->cy) * (sx - r->cx) - (r->ax - r->cx) * (sy - r->cy);
+  int e2 = (r->by - r->ay) * (sx - r->ax) - (r->bx - r->ax) * (sy - r->ay);
+  if (!((e0 > 0 || (e0 == 0 && t->own0)) && (e1 > 0 || (e1 == 0 && t->own1)) && (e2 > 0 || (e2 == 0 && t->own2))))
+    return 0;
+  *la = (float)e0 * t->inv_area;
+  *lb = (float)e1 * t->inv_area;
+  *lc = (float)e2 * t->inv_area;
+  return 1;
+}
+
+/* mp_raster_quad for a quad whose raster bound [xmin, xmax] x [ymin, ymax]
+ * spans at most MP_FAST_SPAN per axis (nearly every micropolygon): the
+ * same samples tested in the same order with the same results, in 32-bit
+ * integers relative to the bound's corner. 64-bit integer arithmetic is
+ * several instructions per operation on GPUs, and these tests are the
+ * sampler's inner loop. */
+inline void mp_raster_quad_small(const MpTriangle* tris, long xmin, long ymin, int span_x, int span_y, int px0, int px1,
+                                 int py0, int py1, uint mp_id, MpCover cover, FrameParams f,
+                                 __global const ushort* offsets, uint pass, volatile __global ulong* keys,
+                                 __global float* colors, __global uint* normals, __global uchar* mark, uint* tests) {
+  MpSmallTriangle r0 = mp_small_triangle(&tris[0].e, xmin, ymin), r1 = mp_small_triangle(&tris[1].e, xmin, ymin);
+  int spp = f.spp_x * f.spp_y;
+  /* Raster positions fit in int32 (the guard band: MP_RASTER_GUARD). */
+  int row0 = (int)(((long)py0 << MP_SUBPIXEL_BITS) - ymin), col0 = (int)(((long)px0 << MP_SUBPIXEL_BITS) - xmin);
+  for (int py = py0, ry = row0; py <= py1; ++py, ry += MP_SUBPIXEL_ONE) {
+    int ty = ((py + f.crop_y0) & (MP_SAMPLE_TILE - 1)) * MP_SAMPLE_TILE;
+    for (int px = px0, rx = col0; px <= px1; ++px, rx += MP_SUBPIXEL_ONE) {
+      __global const ushort* o = offsets + (ty + ((px + f.crop_x0) & (MP_SAMPLE_TILE - 1))) * spp;
+      for (int s = 0; s < spp; ++s) {
+        uint packed = o[s];
+        int sx = rx + (int)(packed & 0xffu), sy = ry + (int)(packed >> 8);
+        if (sx < 0 || sx > span_x || sy < 0 || sy > span_y) continue;
+        ++*tests;
+        float la, lb, lc;
+        int k = mp_small_covers(&tris[0].e, &r0, sx, sy, &la, &lb, &lc)   ? 0
+                : mp_small_covers(&tris[1].e, &r1, sx, sy, &la, &lb, &lc) ? 1
+                                                                           : -1;
+        if (k >= 0)
+          mp_sample_write(&tris[k], la, lb, lc, px, py, s, spp, mp_id, cover, f, pass, keys, colors, normals, mark);
+      }
+    }
+  }
+}
+
 /* Rasterises the quad v[0..3]'s triangles that `keep` selects
  * (mp_setup_quad). */
 inline void mp_raster_quad(const MpRasterVertex* v, uint keep, uint mp_id, MpCover cover, FrameParams f,
@@ -55,6 +122,11 @@ inline void mp_raster_quad(const MpRasterVertex* v, uint keep, uint mp_id, MpCov
   long ymin = min(min(v[0].p.y, v[1].p.y), min(v[2].p.y, v[3].p.y)), ymax = max(max(v[0].p.y, v[1].p.y), max(v[2].p.y, v[3].p.y));
   int px0 = (int)max(xmin >> MP_SUBPIXEL_BITS, (long)0), px1 = (int)min(xmax >> MP_SUBPIXEL_BITS, (long)f.width - 1);
   int py0 = (int)max(ymin >> MP_SUBPIXEL_BITS, (long)0), py1 = (int)min(ymax >> MP_SUBPIXEL_BITS, (long)f.height - 1);
+  if (xmax - xmin <= MP_FAST_SPAN && ymax - ymin <= MP_FAST_SPAN) {
+    mp_raster_quad_small(tris, xmin, ymin, (int)(xmax - xmin), (int)(ymax - ymin), px0, px1, py0, py1, mp_id, cover, f,
+                         offsets, pass, keys, colors, normals, mark, tests);
+    return;
+  }
   int spp = f.spp_x * f.spp_y;
   for (int py = py0; py <= py1; ++py)
     for (int px = px0; px <= px1; ++px)

@@ -156,7 +156,6 @@ inline uint mp_sample_tile_slow(const MpTriangle* tris, long xmin, long xmax, lo
  * sample within a pixel of its bound below 2^28, so the int32 sums equal
  * mp_edge's 64-bit ones exactly and coverage stays watertight. */
 #define MP_LANES 16
-#define MP_FAST_SPAN (32 << MP_SUBPIXEL_BITS)
 
 /* An edge u -> v of a triangle as the 16-lane tests use it: its value at
  * the corner of the first pixel of the micropolygon's range, and its steps

@@ -92,6 +92,11 @@ TEST_F(SampleTilesTest, SlowPathsAgreeToo) {
   Scene coarse = test_scene(320, 240, 4);
   coarse.settings.shading_rate = 2500.0f;
   expect_samplers_agree(coarse, "micropolygons of 50 px");
+  // Micropolygons about 30 px across, whose bounds fall on both sides of
+  // MP_FAST_SPAN (32 px): each sampler's int32 path and its 64-bit one.
+  Scene edge = test_scene(320, 240, 4);
+  edge.settings.shading_rate = 900.0f;
+  expect_samplers_agree(edge, "micropolygons of 30 px");
   // A crop window: the sample pattern follows whole-image pixels.
   Scene crop = test_scene(320, 240, 16);
   crop.settings.crop_x0 = 0.3f, crop.settings.crop_x1 = 0.85f;
