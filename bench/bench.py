@@ -11,20 +11,24 @@ suite's ratios between cases.
   python3 bench/bench.py SUITE --cli build/micropoly-render [--before OLD_CLI]
       [--device cpu|gpu] [--rounds 3] [--repeat N] [--only CASE,CASE]
       [--size WxH] [--scenes DIR] [--json FILE] [--first]
+      [--args "OPTIONS"] [--before-args "OPTIONS"]
 
   python3 bench/bench.py --list
 
 Scenes are read from DIR (default: bench/out, where the generators write
 them with --rib-only; on the GPU machine the bundle's folder, .device/).
 --size renders every scene at that size (a copy of each RIB beside it with
-its Format replaced). Only Python's standard library is used: the GPU
-machine has no packages. Results go to bench/results/<device>/ by hand,
+its Format replaced). --args and --before-args add CLI options to each
+build's runs: one binary twice with two settings is a before/after too
+(--cli X --before X --before-args "--occlusion-waves off"). Only Python's
+standard library is used: the GPU machine has no packages. Results go to bench/results/<device>/ by hand,
 with the command that made them."""
 
 import argparse
 import json
 import os
 import re
+import shlex
 import statistics
 import subprocess
 import sys
@@ -75,8 +79,8 @@ def report(suite, cases, builds, times, stages, last):
     two = len(builds) == 2
     print(f"| case | build | frame ms | {' | '.join(stages)} | micropolygons | shadow micropolygons | "
           f"micropolygons per pixel of surface | bound & split MiB peak | shadows MiB peak / budget | marking passes | buckets | "
-          f"host waits | kernel launches |" + (" after / before |" if two else ""))
-    print("|---|---|---|" + "---|" * len(stages) + "---|---|---|---|---|---|---|---|---|" + ("---|" if two else ""))
+          f"camera waves (root overlap) | host waits | kernel launches |" + (" after / before |" if two else ""))
+    print("|---|---|---|" + "---|" * len(stages) + "---|---|---|---|---|---|---|---|---|---|" + ("---|" if two else ""))
     frame = {}
     for case in cases:
         for build, _ in builds:
@@ -94,7 +98,8 @@ def report(suite, cases, builds, times, stages, last):
                   f" | {s['micropolygons']:,} | {sh['micropolygons']:,} | "
                   f"{s['micropolygons_sampled'] / max(s['sampled_area_px'], 1e-9):.2f} | {mib(s['bound_split_peak_bytes']):.1f} | "
                   f"{mib(sh['peak_bytes']):.1f} / {mib(sh['budget_bytes']):.0f} | {sh.get('marking_passes', 0)} | "
-                  f"{s['buckets']} | {s.get('host_waits', '—')} | {s.get('kernel_launches', '—')} |" + ratio)
+                  f"{s['buckets']} | {s.get('waves', '—')} ({s.get('root_overlap', 0):.1f}) | "
+                  f"{s.get('host_waits', '—')} | {s.get('kernel_launches', '—')} |" + ratio)
     names = {c.name for c in cases}
     for a, b in suite.ratios:
         if a in names and b in names:
@@ -108,6 +113,8 @@ def main():
     ap.add_argument("suite", nargs="?", choices=sorted(suites.SUITES))
     ap.add_argument("--cli", default=os.path.join(HERE, "..", "build", "micropoly-render"))
     ap.add_argument("--before", default="", help="an earlier build's micropoly-render, run beside --cli")
+    ap.add_argument("--args", default="", help="options added to --cli's command (e.g. \"--occlusion-waves on\")")
+    ap.add_argument("--before-args", default="", help="options added to --before's command")
     ap.add_argument("--device", default="")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--repeat", type=int, default=0, help="frames per run (default: the suite's)")
@@ -142,6 +149,7 @@ def main():
         ribs[case.name] = rib
     # Two builds: the earlier first in each round.
     builds = [("before", a.before), ("after", a.cli)] if a.before else [("build", a.cli)]
+    extra = {"before": shlex.split(a.before_args), "after": shlex.split(a.args), "build": shlex.split(a.args)}
     stages = ("total",) + tuple(suite.stages)
     times = {(c.name, b): [] for c in cases for b, _ in builds}
     frames, last = {}, {}
@@ -149,7 +157,7 @@ def main():
     for _ in range(a.rounds):
         for case in cases:
             for build, cli in builds:
-                runs = run_frames(cli, ribs[case.name], tmp, a.device, repeat, case.options)
+                runs = run_frames(cli, ribs[case.name], tmp, a.device, repeat, list(case.options) + extra[build])
                 times[(case.name, build)].append({s: median_frames(runs, s, a.first) for s in stages})
                 frames.setdefault(f"{case.name}/{build}", []).append([r["timings_ms"]["total"] for r in runs])
                 last[(case.name, build)] = runs[-1]

@@ -112,6 +112,7 @@ void compare_settings(Diff& d, const RenderSettings& a, const RenderSettings& b)
   d.eq("settings.occlusion_culling", a.occlusion_culling, b.occlusion_culling);
   d.eq("settings.holdout_covers", a.holdout_covers, b.holdout_covers);
   d.eq("settings.resolver", a.resolver, b.resolver);
+  d.eq("settings.occlusion_waves", a.occlusion_waves, b.occlusion_waves);
   d.eq("settings.bound_split_chain", a.bound_split_chain, b.bound_split_chain);
 }
 

@@ -5,6 +5,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "micropoly/renderer.h"
+#include "pipeline/frame/camera_view.h"
 #include "renderer_fixture.h"
 #include "rib/rib_reader.h"
 #include "scene_fixtures.h"
@@ -114,6 +115,43 @@ TEST_F(OcclusionTest, TheShadowMarkingsDepthBringsTheSeenShellFirstOnEveryDevice
   // Taken at once without that wave (a GPU), eight shells diced 7.9 times
   // one shell's micropolygons; with it, 1.55 times.
   EXPECT_LT(eight.on.stats.micropolygons, 2 * one.on.stats.micropolygons);
+}
+
+TEST_F(OcclusionTest, WavesOnAndOffRenderTheSameAndWavesCullTheHiddenShells) {
+  // RenderSettings::occlusion_waves forced either way on any device: the
+  // image is the same; taken at once (no shadows, so no seen wave first),
+  // eight shells are diced whole in one batch, while waves sample the
+  // inner shell before the outer ones are split.
+  Scene s = nested_shells(8);
+  s.settings.shadows = false;
+  s.settings.occlusion_waves = OcclusionWaves::On;
+  const RenderResult on = renderer_->render(s);
+  s.settings.occlusion_waves = OcclusionWaves::Off;
+  const RenderResult off = renderer_->render(s);
+  EXPECT_EQ(on.rgba, off.rgba);
+  EXPECT_EQ(on.depth, off.depth);
+  EXPECT_TRUE(on.stats.occlusion_waves);
+  EXPECT_FALSE(off.stats.occlusion_waves);
+  EXPECT_GT(on.stats.waves, 2u);
+  EXPECT_EQ(off.stats.waves, 1u);
+  EXPECT_LT(on.stats.micropolygons, off.stats.micropolygons / 3);
+  // The estimate Auto reads: boxes around the camera count as covering the
+  // whole frame, so eight shells' 48 patches overlap deeply.
+  EXPECT_GT(off.stats.root_overlap, 8.0);
+}
+
+TEST(CameraWaves, AutoTakesThemOnCpusAndOnGpusWhereTheRootsOverlapDeeply) {
+  RenderSettings s;
+  DeviceInfo cpu, gpu;
+  cpu.type = "cpu", gpu.type = "gpu";
+  EXPECT_TRUE(camera_takes_waves(s, cpu, 1.0));
+  EXPECT_FALSE(camera_takes_waves(s, gpu, 13.0));
+  EXPECT_TRUE(camera_takes_waves(s, gpu, kGpuWavesFromOverlap));
+  EXPECT_TRUE(camera_takes_waves(s, gpu, 1332.0));
+  s.occlusion_waves = OcclusionWaves::Off;
+  EXPECT_FALSE(camera_takes_waves(s, cpu, 1332.0));
+  s.occlusion_waves = OcclusionWaves::On;
+  EXPECT_TRUE(camera_takes_waves(s, gpu, 1.0));
 }
 
 TEST_F(OcclusionTest, TheFarSurfaceShowsThroughASmallHole) {

@@ -76,6 +76,7 @@ void expect_same_settings(const RenderSettings& a, const RenderSettings& b) {
   EXPECT_EQ(a.holdout_covers, b.holdout_covers);
   EXPECT_EQ(a.visibility_first, b.visibility_first);
   EXPECT_EQ(a.resolver, b.resolver);
+  EXPECT_EQ(a.occlusion_waves, b.occlusion_waves);
   EXPECT_EQ(a.bound_split_chain, b.bound_split_chain);
 }
 
@@ -313,6 +314,7 @@ Scene full_scene() {
   st.holdout_covers = true;
   st.visibility_first = VisibilityFirst::Off;
   st.resolver = Resolver::Tiles;
+  st.occlusion_waves = OcclusionWaves::On;
   st.bound_split_chain = 5;
 
   s.camera = look_at({1.3f, 2.1f, 7.7f}, {0.1f, 0.2f, 0.0f}, 47.3f);
@@ -1081,6 +1083,10 @@ TEST(RibWriter, SamplerAndSampleMemoryRoundTrip) {
   EXPECT_EQ(round_trip(s).settings.sampler, Sampler::Tiles);
   s.settings.resolver = Resolver::Pixels;
   EXPECT_EQ(round_trip(s).settings.resolver, Resolver::Pixels);
+  for (const OcclusionWaves w : {OcclusionWaves::On, OcclusionWaves::Off}) {
+    s.settings.occlusion_waves = w;
+    EXPECT_EQ(round_trip(s).settings.occlusion_waves, w);
+  }
   // The defaults are left out of the file.
   EXPECT_EQ(to_rib(defocused_scene()).find("samplememory"), std::string::npos);
 }

@@ -71,6 +71,12 @@ struct RenderStats {
   // complexity (surface layers rasterised per covered pixel).
   size_t subpatches_occluded = 0;
   size_t covered_pixels = 0;
+  // The camera's roots: how many of their boxes cover a point of the frame
+  // on average (an estimate from above of its depth complexity), whether
+  // they were taken in waves (OcclusionWaves) and in how many.
+  double root_overlap = 0;
+  bool occlusion_waves = false;
+  size_t waves = 0;
   // Visibility first (RenderSettings::visibility_first): diced sub-patches
   // whose opaque grids owned no sample before shading, left unshaded.
   size_t subpatches_unshaded = 0;

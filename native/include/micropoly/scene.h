@@ -267,6 +267,14 @@ enum class Resolver { Auto, Tiles, Pixels };
 // grids: Auto takes it where the view's roots overlap enough to hide much
 // (CameraView's rule), On and Off always and never.
 enum class VisibilityFirst { Auto, On, Off };
+// Whether the camera's view takes its roots in waves with occlusion culling
+// (pipeline/pass/bound_split_bounded.cpp, docs/pipeline.md step 3): the
+// nearest first, sampled before the next are split, so the pyramid hides
+// what lies behind them early. Each wave costs a partly filled dice batch,
+// which on a GPU is launches and host waits: Auto takes waves on CPU
+// devices, and on GPUs where the roots' boxes overlap deeply (camera_view.cpp).
+// The image is the same either way.
+enum class OcclusionWaves { Auto, On, Off };
 
 struct RenderSettings {
   int width = 640, height = 480;
@@ -320,6 +328,7 @@ struct RenderSettings {
   Sampler sampler = Sampler::Auto;
   Resolver resolver = Resolver::Auto;
   VisibilityFirst visibility_first = VisibilityFirst::Auto;
+  OcclusionWaves occlusion_waves = OcclusionWaves::Auto;
   // Device memory the frame's samples may take (24 bytes each, 20 without
   // the Normal pass): a frame that needs more is rendered in buckets that
   // fit, each with the pixel filter's reach of samples around it.

@@ -22,6 +22,7 @@ const char* kUsage =
     "                        [--fresh-shadows] [--occlusion-culling on|off] [--stats FILE.json]\n"
     "                        [--sampler auto|tiles|micropolygons] [--sample-memory MIB]\n"
     "                        [--visibility-first auto|on|off] [--resolver auto|tiles|pixels]\n"
+    "                        [--occlusion-waves auto|on|off]\n"
     "                        [--texture-filter-width W]\n"
     "                        [--repeat N] [--allow-path DIR]... [--allow-any-path]\n"
     "       micropoly-render --list-devices\n"
@@ -32,6 +33,7 @@ const char* kUsage =
 
 struct Options {
   std::string scene, output, device, stats, bound_split, shadows, occlusion, sampler, visibility_first, resolver;
+  std::string occlusion_waves;
   int spp = 0, repeat = 1, bound_split_chain = 0;
   float shading_rate = 0, memory_mib = 0, shadow_memory_mib = 0, sample_memory_mib = 0;
   float texture_filter_width = -1;  // below 0: the scene's
@@ -90,6 +92,10 @@ Options parse(int argc, char** argv) {
       o.resolver = value();
       if (o.resolver != "auto" && o.resolver != "tiles" && o.resolver != "pixels")
         usage_error("--resolver is auto, tiles or pixels");
+    } else if (a == "--occlusion-waves") {
+      o.occlusion_waves = value();
+      if (o.occlusion_waves != "auto" && o.occlusion_waves != "on" && o.occlusion_waves != "off")
+        usage_error("--occlusion-waves is auto, on or off");
     } else if (a == "--visibility-first") {
       o.visibility_first = value();
       if (o.visibility_first != "auto" && o.visibility_first != "on" && o.visibility_first != "off")
@@ -151,6 +157,10 @@ int main(int argc, char** argv) {
       scene.settings.resolver = o.resolver == "tiles"    ? mp::Resolver::Tiles
                                 : o.resolver == "pixels" ? mp::Resolver::Pixels
                                                          : mp::Resolver::Auto;
+    if (!o.occlusion_waves.empty())
+      scene.settings.occlusion_waves = o.occlusion_waves == "on"    ? mp::OcclusionWaves::On
+                                       : o.occlusion_waves == "off" ? mp::OcclusionWaves::Off
+                                                                    : mp::OcclusionWaves::Auto;
     if (!o.visibility_first.empty())
       scene.settings.visibility_first = o.visibility_first == "on"    ? mp::VisibilityFirst::On
                                         : o.visibility_first == "off" ? mp::VisibilityFirst::Off

@@ -79,6 +79,9 @@ py::dict stats_dict(const RenderStats& s) {
   d["sample_tests"] = s.sample_tests;
   d["sampled_area_px"] = s.sampled_area_px;
   d["subpatches_occluded"] = s.subpatches_occluded;
+  d["root_overlap"] = s.root_overlap;
+  d["occlusion_waves"] = s.occlusion_waves;
+  d["waves"] = s.waves;
   d["covered_pixels"] = s.covered_pixels;
   d["subpatches_unshaded"] = s.subpatches_unshaded;
   d["depth_complexity"] = s.covered_pixels ? s.sampled_area_px / double(s.covered_pixels) : 0.0;
@@ -179,6 +182,10 @@ PYBIND11_MODULE(_native, m) {
       .value("AUTO", Resolver::Auto)
       .value("TILES", Resolver::Tiles)
       .value("PIXELS", Resolver::Pixels);
+  py::enum_<OcclusionWaves>(m, "OcclusionWaves")
+      .value("AUTO", OcclusionWaves::Auto)
+      .value("ON", OcclusionWaves::On)
+      .value("OFF", OcclusionWaves::Off);
   py::enum_<VisibilityFirst>(m, "VisibilityFirst")
       .value("AUTO", VisibilityFirst::Auto)
       .value("ON", VisibilityFirst::On)
@@ -222,6 +229,7 @@ PYBIND11_MODULE(_native, m) {
       .def_readwrite("resolver", &RenderSettings::resolver)
       .def_readwrite("bound_split_chain", &RenderSettings::bound_split_chain)
       .def_readwrite("visibility_first", &RenderSettings::visibility_first)
+      .def_readwrite("occlusion_waves", &RenderSettings::occlusion_waves)
       .def_readwrite("sample_memory_mib", &RenderSettings::sample_memory_mib);
 
   py::class_<Scene>(m, "Scene")

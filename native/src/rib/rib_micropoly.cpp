@@ -95,6 +95,10 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   s.resolver = string_choice(args, params, "resolver",
                              {{"auto", Resolver::Auto}, {"tiles", Resolver::Tiles}, {"pixels", Resolver::Pixels}},
                              s.resolver);
+  s.occlusion_waves = string_choice(args, params, "occlusionwaves",
+                                    {{"auto", OcclusionWaves::Auto}, {"on", OcclusionWaves::On},
+                                     {"off", OcclusionWaves::Off}},
+                                    s.occlusion_waves);
   s.visibility_first = string_choice(args, params, "visibilityfirst",
                                      {{"auto", VisibilityFirst::Auto}, {"on", VisibilityFirst::On},
                                       {"off", VisibilityFirst::Off}},
@@ -127,7 +131,7 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
                {"boundsplit", "boundsplitmemory", "maxgridsize", "maxsplitdepth", "backfaceculling",
                 "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate", "occlusionculling", "holdoutcovers",
                 "worldshadowdirections", "texturefilterwidth", "apertureblades", "aperturerotation", "apertureratio",
-                "focusfactor", "shuttercurve", "sampler", "samplememory", "visibilityfirst", "resolver", "boundsplitchain"},
+                "focusfactor", "shuttercurve", "sampler", "samplememory", "visibilityfirst", "resolver", "boundsplitchain", "occlusionwaves"},
                [&](const std::string& name) {
                  warn_once("option-micropoly:" + name, line,
                            "Option \"micropoly\": parameter \"" + name + "\" is ignored");

@@ -259,6 +259,8 @@ void write_options(std::string& o, const RenderSettings& s, const Camera& c) {
   if (s.bound_split_chain != def.bound_split_chain)
     param(o, "integer boundsplitchain", static_cast<long long>(s.bound_split_chain));
   if (s.resolver != def.resolver) param(o, "string resolver", s.resolver == Resolver::Tiles ? "tiles" : "pixels");
+  if (s.occlusion_waves != def.occlusion_waves)
+    param(o, "string occlusionwaves", s.occlusion_waves == OcclusionWaves::On ? "on" : "off");
   if (differs(s.sample_memory_mib, def.sample_memory_mib)) param(o, "float samplememory", s.sample_memory_mib);
   if (s.visibility_first != def.visibility_first)
     param(o, "string visibilityfirst", s.visibility_first == VisibilityFirst::On ? "on" : "off");

@@ -14,6 +14,17 @@ constexpr cl_uint kSampleChunk = 256;
 
 }  // namespace
 
+// The threshold (kGpuWavesFromOverlap) from the H200: waves cost 1.35x at an
+// overlap of 13 (16 stacked sheets), 1.4x at 6.7 (one shell around the
+// camera) and 2.4-4.4x on the standard scenes (1-8), and gave 0.58x at 104
+// (16 nested shells), 0.94x at 469 (64 shells) and 0.68x at 1,332 (1,000
+// stacked layers): each wave's partly filled batch costs a GPU launches and
+// host waits, which only much hidden work repays (docs/performance.md).
+bool camera_takes_waves(const RenderSettings& settings, const DeviceInfo& device, double root_overlap) {
+  if (settings.occlusion_waves != OcclusionWaves::Auto) return settings.occlusion_waves == OcclusionWaves::On;
+  return device.type == "cpu" || root_overlap >= kGpuWavesFromOverlap;
+}
+
 bool render_camera_bucket(MicropolygonPass& pass, const CameraStages& stages, const Scene& scene,
                           const FrameSetup& frame, const Bucket& bucket, const ShadowInputs& shadows,
                           const CameraRoots& roots, uint64_t scene_key, RenderStats& st) {
@@ -42,7 +53,9 @@ bool render_camera_bucket(MicropolygonPass& pass, const CameraStages& stages, co
     view.occlusion.params = occ.params();
     view.occlusion.root_order = occ.root_order(buffers.host_patch_bounds, scene_key, fb);
     if (roots.seen > 0) view.occlusion.root_order = roots.order, view.occlusion.first_wave = roots.seen;
-    view.occlusion.waves = s.info().type == "cpu";
+    st.root_overlap = occ.root_overlap();
+    view.occlusion.waves = camera_takes_waves(scene.settings, s.info(), st.root_overlap);
+    st.occlusion_waves = view.occlusion.waves;
     sample.mark_occlusion_cells(occ.dirty(), occ.params());
     view.occlusion.refresh = [&] {
       if (!progress.cancelled()) occ.refresh(sample.keys(), fb, timer);
@@ -86,6 +99,7 @@ bool render_camera_bucket(MicropolygonPass& pass, const CameraStages& stages, co
   };
   const BoundSplitResult bs = pass.run(view, target);
   st.subpatches_occluded += bs.occluded;
+  st.waves += bs.waves;
   if (bs.cancelled) return false;
 
   activity.emplace(s, "occlusion");

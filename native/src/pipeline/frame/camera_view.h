@@ -1,7 +1,8 @@
 // The camera's view of one bucket (buckets.h): the micropolygon pass
 // shades and samples each batch into the bucket's sample buffer, culling
 // against the occlusion pyramid those samples build (waves near to far on
-// CPU devices), then the bucket is resolved into the image.
+// CPU devices, and on GPUs where the roots overlap deeply), then the
+// bucket is resolved into the image.
 #pragma once
 
 #include <cstdint>
@@ -34,6 +35,13 @@ struct CameraRoots {
   cl::Buffer order;
   cl_uint seen = 0;
 };
+
+// Whether the camera's view takes its roots in waves (RenderSettings::
+// occlusion_waves): Auto on CPU devices, and on others where the roots'
+// boxes overlap at least kGpuWavesFromOverlap deep on average
+// (OcclusionCulling::root_overlap).
+constexpr double kGpuWavesFromOverlap = 64.0;
+bool camera_takes_waves(const RenderSettings& settings, const DeviceInfo& device, double root_overlap);
 
 // Renders bucket `bucket` of `frame` (shading reads `shadows`) and resolves
 // it; false when the caller cancelled. `scene_key` keys the patches' order.

@@ -57,6 +57,9 @@ std::string RenderStats::to_json() const {
   j += "  \"sampled_area_px\": " + num(sampled_area_px) + ",\n";
   j += "  \"subpatches_occluded\": " + std::to_string(subpatches_occluded) + ",\n";
   j += "  \"covered_pixels\": " + std::to_string(covered_pixels) + ",\n";
+  j += "  \"root_overlap\": " + num(root_overlap) + ",\n";
+  j += "  \"occlusion_waves\": " + std::string(occlusion_waves ? "true" : "false") + ",\n";
+  j += "  \"waves\": " + std::to_string(waves) + ",\n";
   j += "  \"subpatches_unshaded\": " + std::to_string(subpatches_unshaded) + ",\n";
   j += "  \"depth_complexity\": " + num(covered_pixels ? sampled_area_px / double(covered_pixels) : 0.0) + ",\n";
   j += "  \"micropolygons_per_covered_pixel\": " +

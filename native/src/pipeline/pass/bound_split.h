@@ -23,6 +23,7 @@ struct BoundSplitResult {
   size_t peak_bytes = 0;  // device memory the strategy held at its peak
   size_t launches = 0;    // bound & split kernel launches
   size_t occluded = 0;    // sub-patches culled by occlusion
+  size_t waves = 0;       // waves the roots were taken in (bounded method)
   bool cancelled = false;
 };
 
@@ -81,7 +82,7 @@ struct PassViews {
 
 // Occlusion culling of a pass over the camera's view (occlusion_culling.h):
 // the roots are taken near to far, in waves while the pyramid is young (CPU
-// devices), and
+// devices; GPUs where the roots overlap deeply, OcclusionWaves), and
 // after a batch that more work follows, `refresh` (dice, shade and sample
 // have run) rebuilds the pyramid the later sub-patches are tested against.
 struct PassOcclusion {

@@ -60,8 +60,10 @@ constexpr size_t kMaxWorkers = size_t(1) << 20;
 // less than 1/kWorthwhile of its sub-patches hidden ends the waves and the
 // rest are taken at once. A partly filled batch costs about a millisecond
 // of launches and host round trips on a GPU, more than rasterising a few
-// hidden layers there, so waves are for CPU devices (PassOcclusion::waves);
-// on a GPU the pyramid is rebuilt at the batches' natural ends only. Where
+// hidden layers there, so waves are for CPU devices (PassOcclusion::waves),
+// and for GPUs only where the camera's roots overlap deeply enough to hide
+// much (OcclusionWaves, camera_view.cpp); otherwise a GPU rebuilds the
+// pyramid at the batches' natural ends only. Where
 // an earlier look (the shadow marking's coarse depth) put the roots it may
 // see first (PassOcclusion::first_wave), those are one wave on any device,
 // sampled before the rest are taken: the rest are then tested against what
@@ -118,6 +120,7 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
     const cl_uint first_wave = occ.on() && occ.first_wave < root_count ? occ.first_wave : 0;
     cl_uint root_limit = occ.on() && occ.waves ? std::min<cl_uint>(root_count, 1) : root_count;
     if (first_wave > 0) root_limit = std::min(root_limit, first_wave);
+    result.waves = 1;
     size_t diced = 0, wave_roots = root_limit, diced_before_wave = 0, occluded_before_wave = 0;
     auto whole_groups = [&](size_t n) { return std::min(workers, std::max<size_t>(64, (n + 63) / 64 * 64)); };
     // More workers than a few dice batches' worth would mostly hold work they
@@ -228,6 +231,7 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
         if (root_limit < first_wave) roots = std::min<size_t>(roots, first_wave - root_limit);
         wave_roots = std::min<size_t>(roots, root_count - root_limit);
         root_limit += static_cast<cl_uint>(wave_roots);
+        ++result.waves;
         diced_before_wave = diced;
         occluded_before_wave = result.occluded;
       }
