@@ -16,11 +16,13 @@ namespace {
 class OcclusionTest : public SharedRendererTest {
  protected:
   // On CPU devices bound & split takes the roots in waves, sampling the
-  // nearest before the rest are split (bound_split_bounded.cpp); on GPUs the
-  // pyramid is rebuilt only between full dice batches, so a scene that fits
-  // one batch culls nothing there. How much is culled is checked on CPUs;
-  // that the image does not change, everywhere.
-  static bool takes_waves() { return renderer_->device().type == "cpu"; }
+  // nearest before the rest are split (bound_split_bounded.cpp); the
+  // lights' views take them in waves on CPUs only, and the camera on GPUs
+  // only where its roots overlap deeply (stats.occlusion_waves). Elsewhere
+  // the pyramid is rebuilt only between full dice batches, so a scene that
+  // fits one batch culls nothing. How much is culled is checked where
+  // waves ran; that the image does not change, everywhere.
+  static bool lights_take_waves() { return renderer_->device().type == "cpu"; }
   struct Pair {
     RenderResult on, off;
   };
@@ -78,7 +80,7 @@ Material colored(glm::vec3 c) {
 TEST_F(OcclusionTest, NestedShellsRenderTheSameWithTheHiddenOnesCulled) {
   Pair one = render_both(nested_shells(1));
   Pair eight = render_both(nested_shells(8));
-  if (!takes_waves()) GTEST_SKIP() << "the images agree; culling in a single batch is for CPU devices";
+  if (!eight.on.stats.occlusion_waves) GTEST_SKIP() << "the images agree; culling in a single batch needs waves";
   EXPECT_GT(eight.on.stats.subpatches_occluded, 0u);
   // Without culling, eight shells dice about eight times one; with it, the
   // outer seven cost little.
@@ -97,9 +99,10 @@ TEST_F(OcclusionTest, NestedShellsRenderTheSameWithTheHiddenOnesCulled) {
 TEST_F(OcclusionTest, TheShadowMarkingsDepthBringsTheSeenShellFirstOnEveryDevice) {
   // With a shadowed lamp, the shadow marking's coarse depth finds the roots
   // the camera may see; the camera takes those as a wave of their own, so
-  // the outer shells are culled on every device, a GPU that takes the rest
-  // at once included, and the image is the one without culling.
+  // the outer shells are culled on every device, with the rest taken at
+  // once (no waves after it), and the image is the one without culling.
   auto lit = [](Scene s) {
+    s.settings.occlusion_waves = OcclusionWaves::Off;
     Light lamp;
     lamp.type = Light::Type::Point;
     lamp.intensity = 20.0f;
@@ -171,7 +174,7 @@ TEST_F(OcclusionTest, TheFarSurfaceShowsThroughASmallHole) {
     s.meshes.push_back(m);
   }
   Pair p = render_both(s);
-  if (takes_waves()) EXPECT_GT(p.on.stats.subpatches_occluded, 0u);
+  if (p.on.stats.occlusion_waves) EXPECT_GT(p.on.stats.subpatches_occluded, 0u);
   const size_t centre = (128 * 256 + 128) * 4;
   EXPECT_GT(p.on.rgba[centre], 2 * p.on.rgba[centre + 2]) << "the hole does not show the red far plane";
   const size_t beside = (128 * 256 + 100) * 4;
@@ -249,7 +252,7 @@ TEST_F(OcclusionTest, TheWorldsProbeSunsCullInOnePassAndRenderTheSame) {
   const Pair p = render_both(s);
   EXPECT_GT(p.on.stats.shadows.lights, 1);
   EXPECT_GT(p.on.stats.shadows.views, 1u);
-  if (takes_waves()) {
+  if (lights_take_waves()) {
     EXPECT_GT(p.on.stats.shadows.subpatches_occluded, 0u);
     EXPECT_LT(p.on.stats.shadows.micropolygons, p.off.stats.shadows.micropolygons);
   }
