@@ -180,8 +180,47 @@ inline float3 mp_blur_position(int i, float t, int steps, const float4* p, float
   return (ps[i][k] + w * (ps[i][k + 1] - ps[i][k])).xyz;
 }
 
+/* Whether triangle (a, b, c) of relative int32 positions (the sample at the
+ * origin) covers the sample, by mp_edge_triangle's orientation and tie
+ * rule and mp_edge_triangle_covers' test. */
+inline int mp_small_triangle_covers(int2 a, int2 b, int2 c) {
+  int area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+  if (area == 0) return 0;
+  if (area > 0) {
+    int2 t = b;
+    b = c;
+    c = t;
+  }
+  int e0 = (c.x - b.x) * b.y - (c.y - b.y) * b.x;
+  int e1 = (a.x - c.x) * c.y - (a.y - c.y) * c.x;
+  int e2 = (b.x - a.x) * a.y - (b.y - a.y) * a.x;
+  int own0 = c.y - b.y > 0 || (c.y == b.y && c.x - b.x < 0);
+  int own1 = a.y - c.y > 0 || (a.y == c.y && a.x - c.x < 0);
+  int own2 = b.y - a.y > 0 || (b.y == a.y && b.x - a.x < 0);
+  return (e0 > 0 || (e0 == 0 && own0)) && (e1 > 0 || (e1 == 0 && own1)) && (e2 > 0 || (e2 == 0 && own2));
+}
+
+/* Whether sample q surely misses the quad v[0..3]'s triangles that `keep`
+ * selects (mp_setup_quad), told in 32-bit integers relative to the sample
+ * where every vertex lies within MP_FAST_SPAN of it: the areas and edge
+ * values then stay below 2^29 and equal mp_edge's 64-bit ones exactly, so
+ * this answers as mp_quad_covers would. 0 (not sure) otherwise. */
+inline int mp_quad_misses_small(const MpRasterVertex* v, uint keep, MpFixed2 q) {
+  int2 r[4];
+  for (int i = 0; i < 4; ++i) {
+    long dx = v[i].p.x - q.x, dy = v[i].p.y - q.y;
+    if (dx < -MP_FAST_SPAN || dx > MP_FAST_SPAN || dy < -MP_FAST_SPAN || dy > MP_FAST_SPAN) return 0;
+    r[i] = (int2)((int)dx, (int)dy);
+  }
+  if ((keep & 1u) && mp_small_triangle_covers(r[0], r[1], r[2])) return 0;
+  if ((keep & 2u) && mp_small_triangle_covers(r[0], r[2], r[3])) return 0;
+  return 1;
+}
+
 /* One sample of a blurred quad: its four vertices at the sample's time and
- * lens position, a cheap box rejection, then the fixed-point edge tests. */
+ * lens position, a cheap box rejection, a test in 32-bit integers that
+ * drops the samples the quad misses (most of those inside its box), then
+ * the attributes' set-up and the fixed-point edge tests. */
 inline void mp_blur_sample(int px, int py, int s, int spp, MpFixed2 sq, float4 e, int steps, const float4* p,
                            float4 ps[4][MP_BLUR_LOCAL_STEPS], __global const float4* pm, const ulong* idx, ulong stride,
                            float8* still, const float4* c, const float4* n, uint keep, uint mp_id, MpCover cover,
@@ -215,6 +254,7 @@ inline void mp_blur_sample(int px, int py, int s, int spp, MpFixed2 sq, float4 e
       sq.y < min(min(v[0].p.y, v[1].p.y), min(v[2].p.y, v[3].p.y)) ||
       sq.y > max(max(v[0].p.y, v[1].p.y), max(v[2].p.y, v[3].p.y)))
     return;
+  if (mp_quad_misses_small(v, keep, sq)) return;
   for (int i = 0; i < 4; ++i) {
     float w = f.ortho ? 1.0f : v[i].inv_d;
     v[i].c_over_d = c[i] * w;
