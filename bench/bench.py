@@ -75,7 +75,7 @@ def mib(x):
     return x / 2**20
 
 
-def report(suite, cases, builds, times, stages, last):
+def report(suite, cases, builds, times, stages, last, frame_key="total"):
     two = len(builds) == 2
     print(f"| case | build | frame ms | {' | '.join(stages)} | micropolygons | shadow micropolygons | "
           f"micropolygons per pixel of surface | bound & split MiB peak | shadows MiB peak / budget | marking passes | buckets | "
@@ -85,7 +85,7 @@ def report(suite, cases, builds, times, stages, last):
     for case in cases:
         for build, _ in builds:
             key = (case.name, build)
-            frame[key] = statistics.median(t["total"] for t in times[key])
+            frame[key] = statistics.median(t[frame_key] for t in times[key])
             stage_ms = [statistics.median(t[s] for t in times[key]) for s in stages]
             s = last[key]
             sh = s["shadows"]
@@ -125,6 +125,10 @@ def main():
     ap.add_argument("--first", action="store_true",
                     help="time each run's first frame (a new process: programs from the cache, the scene and its "
                          "world uploaded, baked and prefiltered) instead of the frames after it")
+    ap.add_argument("--frame", default="total", choices=("total", "interval"),
+                    help="the frame time: each render call's wall time (total), or the wall time from one frame's "
+                         "start to the next's (interval: a loop's throughput, each frame's read-back overlapping the "
+                         "next frame's work; builds before it report 0)")
     ap.add_argument("--list", action="store_true")
     a = ap.parse_args()
     if a.list or not a.suite:
@@ -150,7 +154,7 @@ def main():
     # Two builds: the earlier first in each round.
     builds = [("before", a.before), ("after", a.cli)] if a.before else [("build", a.cli)]
     extra = {"before": shlex.split(a.before_args), "after": shlex.split(a.args), "build": shlex.split(a.args)}
-    stages = ("total",) + tuple(suite.stages)
+    stages = tuple(dict.fromkeys((a.frame,) + tuple(suite.stages)))
     times = {(c.name, b): [] for c in cases for b, _ in builds}
     frames, last = {}, {}
     repeat = a.repeat or suite.repeat
@@ -159,12 +163,13 @@ def main():
             for build, cli in builds:
                 runs = run_frames(cli, ribs[case.name], tmp, a.device, repeat, list(case.options) + extra[build])
                 times[(case.name, build)].append({s: median_frames(runs, s, a.first) for s in stages})
-                frames.setdefault(f"{case.name}/{build}", []).append([r["timings_ms"]["total"] for r in runs])
+                frames.setdefault(f"{case.name}/{build}", []).append([r["timings_ms"][a.frame] for r in runs])
                 last[(case.name, build)] = runs[-1]
     device = next(iter(last.values()))["device"] if last else ""
     print(f"{a.suite}: {suite.about}; {device}, {a.rounds} rounds of {repeat} frames"
-          + (f", {size[0]}x{size[1]}" if size else "") + (", the first frame of each" if a.first else ""))
-    report(suite, cases, builds, times, suite.stages, last)
+          + (f", {size[0]}x{size[1]}" if size else "") + (", the first frame of each" if a.first else "")
+          + (", frame ms from one frame's start to the next's" if a.frame == "interval" else ""))
+    report(suite, cases, builds, times, suite.stages, last, a.frame)
     if a.json:
         with open(a.json, "w") as f:
             json.dump({"suite": a.suite, "device": device, "rounds": a.rounds, "repeat": repeat,

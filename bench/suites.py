@@ -17,7 +17,7 @@ import scenes
 
 Case = namedtuple("Case", "name scene options")
 
-CORE_STAGES = ("bound_split", "dice", "shade", "sample", "resolve", "readback")
+CORE_STAGES = ("bound_split", "dice", "shade", "sample", "resolve", "readback", "readback_wait")
 SHADOW_STAGES = ("shadow_mark", "shadow", "shadow_bound_split", "shadow_dice", "shadow_sample", "shadows_wall")
 
 

@@ -313,6 +313,8 @@ class ViewportSession:
                 self._cond.notify_all()
 
     def _refine(self, renderer, generation, exported, view, samples, shading_rate, requested):
+        from . import _native
+
         native = exported.scene
         passes = refinement_passes(samples, shading_rate)
         try:
@@ -324,6 +326,8 @@ class ViewportSession:
                 native.settings.samples = spp
                 native.settings.shading_rate = rate
                 native.settings.depth_and_normal_passes = False  # the viewport draws colour only
+                # It draws half floats (viewport_draw.py), so half the bytes come back.
+                native.settings.read_back = _native.ReadBack.HALF
                 # The preview's penumbrae read the pages the first marking makes
                 # (coarser near contact); the final pass adds the finer ones. Its
                 # shadow maps keep the final pass's dicing, so that the pages of

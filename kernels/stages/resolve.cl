@@ -188,3 +188,11 @@ __kernel __attribute__((reqd_work_group_size(MP_RESOLVE_TILE, MP_RESOLVE_TILE, 1
     }
   mp_resolve_write(MP_RESOLVE_PASS, px, py, sum, wsum);
 }
+
+// The image as half floats for a read-back in half the bytes
+// (RenderSettings::read_back, ReadBack::Half): rounded to nearest even, as
+// the host's own conversion of a float image to half would round.
+__kernel void image_to_half(__global const float4* rgba, __global half* out, uint pixels) {
+  const uint i = get_global_id(0);
+  if (i < pixels) vstore_half4_rte(rgba[i], i, out);
+}

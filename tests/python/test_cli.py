@@ -45,6 +45,27 @@ def test_exr_output_and_breadth_first(tmp_path):
         assert f.read(4) == b"\x76\x2f\x31\x01"  # OpenEXR magic number
 
 
+def test_repeated_frames_overlap_their_read_back_and_none_writes_no_image(tmp_path):
+    teapot = os.path.join(SCENES, "teapot.rib")
+    once, again = tmp_path / "once.png", tmp_path / "again.png"
+    assert run(teapot, "-o", str(once), "--spp", "1").returncode == 0
+    stats = tmp_path / "stats.json"
+    r = run(teapot, "-o", str(again), "--spp", "1", "--repeat", "3", "--stats", str(stats))
+    assert r.returncode == 0, r.stderr
+    assert again.read_bytes() == once.read_bytes()  # the last overlapped frame, whole
+    frames = json.loads(stats.read_text())
+    assert len(frames) == 3
+    for f in frames:  # each frame's interval covers its own render call
+        assert f["timings_ms"]["interval"] >= f["timings_ms"]["total"] > 0
+        assert f["timings_ms"]["readback"] > 0
+    none = tmp_path / "none.png"
+    r = run(teapot, "-o", str(none), "--spp", "1", "--readback", "none", "--stats", str(stats))
+    assert r.returncode == 0, r.stderr
+    assert not none.exists() and json.loads(stats.read_text())["timings_ms"]["readback"] == 0
+    r = run(teapot, "-o", str(none), "--readback", "halves")
+    assert r.returncode == 2 and "--readback is float, half or none" in r.stderr
+
+
 def test_malformed_rib_names_file_and_line(tmp_path):
     bad = tmp_path / "bad.rib"
     bad.write_text('Format 64 64 1\nWorldBegin\nPolygon "P" [0 0 0 1 0\n')

@@ -11,8 +11,13 @@
 namespace mp {
 
 // Device time per stage (OpenCL profiling) except `upload` (host patch
-// building and transfer), `readback` (wall time of resolve plus the copy of
-// the image to the host) and `total` (wall time of the whole render call).
+// building and transfer), `readback` (wall time from the read-back's start,
+// once every bucket is resolved, until the image is in the result),
+// `readback_wait` (how long of that the caller's thread waited: all of it
+// with Renderer::render; with render_overlapped only what was left when the
+// caller asked for the pixels), `total` (wall time of the render call) and
+// `interval` (set by a caller that renders frames in a loop, as the CLI's
+// --repeat does: wall time from this frame's start to the next's).
 // shadow_mark: marking the shadow pages the camera needs; shadow: rendering
 // the lights' views, the sum of its bound & split, dicing (with displacement
 // and alpha) and sampling; shadows_wall: wall time of marking and rendering
@@ -21,6 +26,7 @@ struct StageTimings {
   double upload = 0, bound_split = 0, dice = 0, shade = 0, sample = 0, resolve = 0, readback = 0, total = 0;
   double shadow_mark = 0, shadow = 0, shadow_bound_split = 0, shadow_dice = 0, shadow_sample = 0, shadows_wall = 0;
   double occlusion = 0;  // building the occlusion pyramid (and counting covered pixels)
+  double readback_wait = 0, interval = 0;
 };
 
 // Shadow maps of one light (kernels/shadow/mp_shadow.h).

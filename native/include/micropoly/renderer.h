@@ -42,6 +42,17 @@ class Renderer {
   // Same, into `out`, reusing its memory: a caller that renders many frames
   // of one size pays for allocating (and faulting in) the image only once.
   void render(const Scene& scene, RenderResult& out, const ProgressCallback& progress = {});
+  // Frames in a loop (the CLI's --repeat): returns once the frame is
+  // resolved on the device and its pixels are on their way to `out`, so the
+  // caller's next frame runs beside their transfer and copy
+  // (docs/pipeline.md, step 8). `out` is complete, with its stats, once
+  // finish_frame() returns or the next render of either kind has started its
+  // own read-back; until then it must stay alive and untouched, so a loop
+  // alternates between two results. A failure on the way is thrown by
+  // whichever of those calls waits for it.
+  void render_overlapped(const Scene& scene, RenderResult& out, const ProgressCallback& progress = {});
+  // Waits for the last render_overlapped frame's pixels (nothing if none).
+  void finish_frame();
 
   // For tests of device-failure handling only: plants one OpenCL failure
   // in the coming frames, as the MICROPOLY_CL_FAULT environment variable

@@ -275,6 +275,13 @@ enum class VisibilityFirst { Auto, On, Off };
 // devices, and on GPUs where the roots' boxes overlap deeply (camera_view.cpp).
 // The image is the same either way.
 enum class OcclusionWaves { Auto, On, Off };
+// How the image comes back to the host: its colour as floats; its colour
+// rounded to half floats on the device, half the bytes to carry (what the
+// viewport asks: it draws half-float textures; the result still holds
+// floats, each the nearest half to the float image's); or not at all, for
+// benchmarks of the frame without its read-back (the result holds no
+// pixels). Depth and Normal always come back as floats.
+enum class ReadBack { Float, Half, None };
 
 struct RenderSettings {
   int width = 640, height = 480;
@@ -297,6 +304,7 @@ struct RenderSettings {
   bool backface_culling = true;                // for single-sided surfaces
   bool depth_and_normal_passes = true;         // resolve and return Depth and Normal
   bool normal_pass = true;                     // with them, samples keep normals (Depth needs none)
+  ReadBack read_back = ReadBack::Float;
   // Shadow maps (kernels/shadow/mp_shadow.h): on for lights that cast shadows; the
   // device memory their pages, page tables and requests may take; the area
   // of a shadow view's micropolygons in texels of its map.

@@ -122,6 +122,8 @@ void DeviceSession::open(const std::string& selector) {
     context_ = cl::Context(device_);
     queue_ = DeviceQueue(cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE), faults_, activities_,
                          queue_counts_);
+    transfer_queue_ = DeviceQueue(cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE), faults_,
+                                  activities_, queue_counts_);
     max_alloc_ = device_.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
     tile_sampler_ = compiles_tile_sampler(cl::Platform(device_.getInfo<CL_DEVICE_PLATFORM>()).getInfo<CL_PLATFORM_VERSION>());
     // Occlusion culling's planes (kernels/geometry/mp_bound.h) where the

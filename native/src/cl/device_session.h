@@ -31,6 +31,10 @@ class DeviceSession {
   const DeviceInfo& info() const { return info_; }
   cl::Context& context() { return context_; }
   DeviceQueue& queue() { return queue_; }
+  // A second in-order queue for the image's read-back, so that its transfer
+  // overlaps the next frame's kernels (on a GPU the copy engine runs beside
+  // the compute units); the two queues order their work through events.
+  DeviceQueue& transfer_queue() { return transfer_queue_; }
   cl::Program& program() { return program_; }
   cl::Device& device() { return device_; }
   double program_build_ms() const { return build_ms_; }
@@ -93,6 +97,7 @@ class DeviceSession {
   QueueCounts queue_counts_;
   std::string failed_activity_;
   DeviceQueue queue_;
+  DeviceQueue transfer_queue_;
   cl::Program program_;
   double build_ms_ = 0;
   bool cache_hit_ = false;

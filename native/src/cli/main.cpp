@@ -1,5 +1,6 @@
 // micropoly-render: renders a RIB file to PNG or EXR.
 // Exit codes: 0 success, 1 rendering failed (device, memory), 2 bad usage or input.
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -24,7 +25,8 @@ const char* kUsage =
     "                        [--visibility-first auto|on|off] [--resolver auto|tiles|pixels]\n"
     "                        [--occlusion-waves auto|on|off]\n"
     "                        [--texture-filter-width W]\n"
-    "                        [--repeat N] [--allow-path DIR]... [--allow-any-path]\n"
+    "                        [--repeat N] [--readback float|half|none]\n"
+    "                        [--allow-path DIR]... [--allow-any-path]\n"
     "       micropoly-render --list-devices\n"
     "A scene may read archives and textures only inside its own folder and the\n"
     "folders given with --allow-path, and its material programs may not include\n"
@@ -34,6 +36,7 @@ const char* kUsage =
 struct Options {
   std::string scene, output, device, stats, bound_split, shadows, occlusion, sampler, visibility_first, resolver;
   std::string occlusion_waves;
+  std::string readback;  // float (default), half, none (no image written: benchmarks)
   int spp = 0, repeat = 1, bound_split_chain = 0;
   float shading_rate = 0, memory_mib = 0, shadow_memory_mib = 0, sample_memory_mib = 0;
   float texture_filter_width = -1;  // below 0: the scene's
@@ -105,6 +108,11 @@ Options parse(int argc, char** argv) {
       o.texture_filter_width = static_cast<float>(parse_number(a, value(), 0, 16));
     else if (a == "--stats") o.stats = value();
     else if (a == "--repeat") o.repeat = static_cast<int>(parse_number(a, value(), 1, 10000));
+    else if (a == "--readback") {
+      o.readback = value();
+      if (o.readback != "float" && o.readback != "half" && o.readback != "none")
+        usage_error("--readback is float, half or none");
+    }
     else if (a == "--list-devices") o.list_devices = true;
     else if (a == "--allow-path") o.rib.allowed_roots.push_back(value());
     else if (a == "--allow-any-path") o.rib.allow_any_path = true;
@@ -177,16 +185,40 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "micropoly-render: %s: %s\n", o.scene.c_str(), e.what());
       return 2;
     }
+    if (!o.readback.empty())
+      scene.settings.read_back = o.readback == "half"   ? mp::ReadBack::Half
+                                 : o.readback == "none" ? mp::ReadBack::None
+                                                        : mp::ReadBack::Float;
     mp::Renderer renderer(o.device);
-    mp::RenderResult result;
-    std::string all_stats;
+    // --repeat renders frames back to back, each one's read-back beside the
+    // next one's work (Renderer::render_overlapped), into two results in
+    // turn; a frame's stats are complete once the next has started.
+    mp::RenderResult results[2];
+    std::vector<std::string> frame_stats;
+    using Clock = std::chrono::steady_clock;
+    Clock::time_point last_start;
+    auto interval_ms = [](Clock::time_point from) {
+      return std::chrono::duration<double, std::milli>(Clock::now() - from).count();
+    };
     for (int i = 0; i < o.repeat; ++i) {
-      renderer.render(scene, result);  // reuses the image memory across --repeat
-      if (o.repeat > 1) all_stats += (i ? ",\n" : "[\n") + result.stats.to_json();
+      const Clock::time_point start = Clock::now();
+      if (i) results[(i - 1) % 2].stats.timings_ms.interval = std::chrono::duration<double, std::milli>(start - last_start).count();
+      renderer.render_overlapped(scene, results[i % 2]);
+      if (i) frame_stats.push_back(results[(i - 1) % 2].stats.to_json());
+      last_start = start;
     }
-    if (o.repeat > 1) all_stats += "]\n";
-    else all_stats = result.stats.to_json();
-    mp::write_image(output, result);
+    renderer.finish_frame();
+    mp::RenderResult& result = results[(o.repeat - 1) % 2];
+    result.stats.timings_ms.interval = interval_ms(last_start);
+    frame_stats.push_back(result.stats.to_json());
+    std::string all_stats;
+    if (o.repeat > 1) {
+      for (size_t i = 0; i < frame_stats.size(); ++i) all_stats += (i ? ",\n" : "[\n") + frame_stats[i];
+      all_stats += "]\n";
+    } else {
+      all_stats = frame_stats[0];
+    }
+    if (scene.settings.read_back != mp::ReadBack::None) mp::write_image(output, result);
     if (!o.stats.empty()) {
       std::ofstream f(o.stats);
       if (!f) throw mp::Error("cannot write stats file '" + o.stats + "'");

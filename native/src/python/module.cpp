@@ -137,6 +137,7 @@ py::dict stats_dict(const RenderStats& s) {
   t["sample"] = s.timings_ms.sample;
   t["resolve"] = s.timings_ms.resolve;
   t["readback"] = s.timings_ms.readback;
+  t["readback_wait"] = s.timings_ms.readback_wait;
   t["shadow_mark"] = s.timings_ms.shadow_mark;
   t["shadow"] = s.timings_ms.shadow;
   t["shadow_bound_split"] = s.timings_ms.shadow_bound_split;
@@ -152,6 +153,7 @@ py::dict stats_dict(const RenderStats& s) {
 py::dict result_dict(RenderResult&& r) {
   py::dict d;
   auto h = static_cast<py::ssize_t>(r.height), w = static_cast<py::ssize_t>(r.width);
+  if (r.rgba.size() != static_cast<size_t>(h * w * 4)) h = w = 0;  // no pixels: cancelled, or ReadBack::None
   d["rgba"] = Array<float>({h, w, py::ssize_t(4)}, r.rgba.data());
   if (!r.depth.empty()) d["depth"] = Array<float>({h, w}, r.depth.data());
   if (!r.normal.empty()) d["normal"] = Array<float>({h, w, py::ssize_t(3)}, r.normal.data());
@@ -186,6 +188,10 @@ PYBIND11_MODULE(_native, m) {
       .value("AUTO", OcclusionWaves::Auto)
       .value("ON", OcclusionWaves::On)
       .value("OFF", OcclusionWaves::Off);
+  py::enum_<ReadBack>(m, "ReadBack")
+      .value("FLOAT", ReadBack::Float)
+      .value("HALF", ReadBack::Half)
+      .value("NONE", ReadBack::None);
   py::enum_<VisibilityFirst>(m, "VisibilityFirst")
       .value("AUTO", VisibilityFirst::Auto)
       .value("ON", VisibilityFirst::On)
@@ -230,6 +236,7 @@ PYBIND11_MODULE(_native, m) {
       .def_readwrite("bound_split_chain", &RenderSettings::bound_split_chain)
       .def_readwrite("visibility_first", &RenderSettings::visibility_first)
       .def_readwrite("occlusion_waves", &RenderSettings::occlusion_waves)
+      .def_readwrite("read_back", &RenderSettings::read_back)
       .def_readwrite("sample_memory_mib", &RenderSettings::sample_memory_mib);
 
   py::class_<Scene>(m, "Scene")

@@ -109,7 +109,6 @@ bool render_camera_bucket(MicropolygonPass& pass, const CameraStages& stages, co
   stages.resolve.run(sample, frame, fb, bucket, scene.settings.filter, scene.settings.filter_width,
                      scene.settings.depth_and_normal_passes, scene.settings.resolver, timer);
   st.resolver = stages.resolve.ran_tiled() ? "tiles" : "pixels";
-  st.timings_ms.readback += ms_since(started);
   return true;
 }
 

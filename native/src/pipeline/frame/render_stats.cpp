@@ -102,6 +102,7 @@ std::string RenderStats::to_json() const {
        ", \"shadow_bound_split\": " + num(timings_ms.shadow_bound_split) +
        ", \"shadow_dice\": " + num(timings_ms.shadow_dice) + ", \"shadow_sample\": " + num(timings_ms.shadow_sample) +
        ", \"shadows_wall\": " + num(timings_ms.shadows_wall) + ", \"occlusion\": " + num(timings_ms.occlusion) +
+       ", \"readback_wait\": " + num(timings_ms.readback_wait) + ", \"interval\": " + num(timings_ms.interval) +
        ", \"total\": " + num(timings_ms.total) + "}\n";
   j += "}\n";
   return j;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <optional>
 #include <utility>
 
@@ -14,6 +15,7 @@
 #include "pipeline/frame/buckets.h"
 #include "pipeline/frame/camera_view.h"
 #include "pipeline/frame/frame_params.h"
+#include "pipeline/frame/image_read_back.h"
 #include "pipeline/materials/material_programs.h"
 #include "pipeline/pass/micropolygon_pass.h"
 #include "pipeline/pass/micropolygon_stages.h"
@@ -57,6 +59,7 @@ struct DeviceStages {
         shade(session),
         sample(session),
         resolve(session),
+        read_back(session),
         programs(session),
         shadow_maps(session),
         occlusion(session) {}
@@ -65,6 +68,7 @@ struct DeviceStages {
   ShadeStage shade;
   SampleStage sample;
   ResolveStage resolve;
+  ImageReadBack read_back;
   MaterialPrograms programs;
   ShadowMaps shadow_maps;
   OcclusionCulling occlusion;
@@ -93,8 +97,12 @@ struct Renderer::Impl {
   // stages are built anew.
   DeviceSession& ready_session();
   // The frame: upload, the lights' views, the camera's view bucket by
-  // bucket, read back; the steps below.
-  void render_frame(const Scene& scene, RenderResult& out, const ProgressCallback& progress);
+  // bucket, read back (left in flight when `overlapped`); the steps below.
+  void render_frame(const Scene& scene, RenderResult& out, const ProgressCallback& progress, bool overlapped);
+  // Runs `frame` (a render, or the wait for an overlapped one's pixels),
+  // turning a device error into an mp::Error and readying the session for
+  // the next frame after any failure.
+  void guarded(const std::function<void()>& frame);
   RenderStats& begin_stats(RenderResult& out);
   static FrameSetup setup_frame(const Scene& scene, const DeviceInfo& device, bool tile_sampler, RenderStats& st);
   // The scene, its lights and its world on the device (kept while the scene
@@ -103,7 +111,8 @@ struct Renderer::Impl {
   GridBuffers& frame_grids(const FrameParams& f);
   static std::vector<Bucket> frame_buckets(const Scene& scene, const FrameParams& f, DeviceSession& s);
   void stop(RenderResult& out, std::chrono::steady_clock::time_point started);
-  void read_back(const Scene& scene, const FrameSetup& frame, RenderResult& out);
+  // Starts the image's read-back; ends it too unless `overlapped`.
+  void read_back(const Scene& scene, const FrameSetup& frame, RenderResult& out, bool overlapped);
   // The frame's host waits and launches (queue_counts.h) into its stats.
   void collect_queue_counts(RenderStats& st);
   void collect_stage_times(StageTimer& timer, RenderStats& st);
@@ -161,8 +170,8 @@ DeviceSession& Renderer::Impl::ready_session() {
 }
 
 void Renderer::Impl::recover(SessionHealth failed) {
-  if (session) session->queue().drain();
-  stages.reset();
+  if (session) session->queue().drain(), session->transfer_queue().drain();
+  stages.reset();  // waits for a read-back's worker
   world_glossy = cl::Buffer();
   health = failed;
 }
@@ -189,33 +198,62 @@ RenderResult Renderer::render(const Scene& scene, const ProgressCallback& progre
 void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallback& progress) {
   validate_scene(scene);
   Impl& impl = *impl_;
-  try {
+  impl.guarded([&] {
     impl.ready_session();
-    impl.render_frame(scene, out, progress);
+    impl.render_frame(scene, out, progress, false);
+  });
+}
+
+void Renderer::render_overlapped(const Scene& scene, RenderResult& out, const ProgressCallback& progress) {
+  validate_scene(scene);
+  Impl& impl = *impl_;
+  impl.guarded([&] {
+    impl.ready_session();
+    impl.render_frame(scene, out, progress, true);
+  });
+}
+
+void Renderer::finish_frame() {
+  Impl& impl = *impl_;
+  if (!impl.stages) return;  // a failed frame took its read-back with it
+  impl.guarded([&] {
+    DeviceSession::Activity activity(*impl.session, "readback");
+    impl.stages->read_back.finish();
+  });
+}
+
+void Renderer::Impl::guarded(const std::function<void()>& frame) {
+  try {
+    frame();
   } catch (const cl::Error& e) {
     // A device error mid-frame: the frame's device state goes, and the
     // session is reopened (device lost) or tested (an out-of-resources
     // error, which some drivers also return for a faulted kernel) before the
     // next frame. The message names the phase of the frame that failed.
     const bool lost = cl_error_means_device_lost(e.err());
-    impl.recover(lost ? SessionHealth::Lost : SessionHealth::Suspect);
-    const std::string phase = impl.session ? impl.session->failed_activity() : std::string();
+    recover(lost ? SessionHealth::Lost : SessionHealth::Suspect);
+    const std::string phase = session ? session->failed_activity() : std::string();
     const std::string where = phase.empty() ? "" : " (" + phase + ")";
-    throw Error("rendering on '" + impl.info.name + "' failed" + where + ": " + describe_cl_error(e) +
+    throw Error("rendering on '" + info.name + "' failed" + where + ": " + describe_cl_error(e) +
                 (lost ? "; the next render reopens the device" : "; the frame's device memory was freed"));
   } catch (...) {
     // Any other failure (a buffer larger than the device allows, host
     // memory, a progress callback that raised) may also leave stages half
     // set up: the next frame builds them anew on the same session.
-    impl.recover(SessionHealth::Good);
+    recover(SessionHealth::Good);
     throw;
   }
 }
 
-void Renderer::Impl::render_frame(const Scene& scene, RenderResult& out, const ProgressCallback& progress) {
+void Renderer::Impl::render_frame(const Scene& scene, RenderResult& out, const ProgressCallback& progress,
+                                  bool overlapped) {
   const auto started = std::chrono::steady_clock::now();
   DeviceSession& s = *session;
   DeviceStages& d = *stages;
+  if (d.read_back.lands_in(out)) {  // the last overlapped frame's, into the same result
+    DeviceSession::Activity activity(s, "readback");
+    d.read_back.finish();
+  }
   RenderStats& st = begin_stats(out);
   const FrameSetup frame = setup_frame(scene, s.info(), s.tile_sampler(), st);
   StageTimer timer;
@@ -242,6 +280,7 @@ void Renderer::Impl::render_frame(const Scene& scene, RenderResult& out, const P
   const std::vector<Bucket> buckets = frame_buckets(scene, frame.params, s);
   st.buckets = buckets.size();
   d.layout.begin_frame();
+  d.read_back.before_resolve();  // the last frame's transfers read the image buffers
   const CameraStages camera{d.shade, d.programs, d.sample, d.resolve, d.occlusion};
   for (size_t b = 0; b < buckets.size() && going; ++b) {
     asks.set_share(float(b) / float(buckets.size()), 1.0f / float(buckets.size()));
@@ -252,7 +291,10 @@ void Renderer::Impl::render_frame(const Scene& scene, RenderResult& out, const P
     s.queue().finish();
     return stop(out, started);
   }
-  read_back(scene, frame, out);
+  read_back(scene, frame, out, overlapped);
+  // The kernels' times are read once they are done (a finished read-back
+  // waited for them); an overlapped one may go on.
+  if (overlapped || scene.settings.read_back == ReadBack::None) s.queue().finish();
   collect_stage_times(timer, st);
   collect_queue_counts(st);
   st.timings_ms.total = ms_since(started);
@@ -377,21 +419,29 @@ void Renderer::Impl::stop(RenderResult& out, std::chrono::steady_clock::time_poi
   out.rgba.clear(), out.depth.clear(), out.normal.clear();
 }
 
-void Renderer::Impl::read_back(const Scene& scene, const FrameSetup& frame, RenderResult& out) {
+void Renderer::Impl::read_back(const Scene& scene, const FrameSetup& frame, RenderResult& out, bool overlapped) {
   DeviceStages& d = *stages;
-  const auto started = std::chrono::steady_clock::now();
   DeviceSession::Activity activity(*session, "readback");
   // The world behind the frame where the camera sees it (an opaque film):
   // its program, evaluated per pixel on the device (finer than the baked
   // map) and laid under the image before it is read, or the map a scene
-  // gave, laid under it here.
+  // gave, laid under it on the host once the image is in.
   const bool world_seen = scene.world.present() && scene.world.camera;
-  if (world_seen && scene.world.program >= 0)
+  const ReadBack format = scene.settings.read_back;
+  if (world_seen && scene.world.program >= 0 && format != ReadBack::None)
     d.programs.composite_world(scene, *d.scene_buffers, frame.params, d.resolve.image());
-  d.resolve.read_back(frame, scene.settings.depth_and_normal_passes, out);
-  if (world_seen && scene.world.program < 0) composite_world_map(world_map, frame, scene.camera, out.rgba);
-  out.stats.timings_ms.readback += ms_since(started);
   out.stats.surface_record_bytes = d.programs.record_pool_bytes();
+  if (format == ReadBack::None) {
+    d.read_back.finish();  // an earlier frame's, if any
+    out.width = out.height = 0;  // no pixels (the stats keep the frame's size)
+    out.rgba.clear(), out.depth.clear(), out.normal.clear();
+    return;
+  }
+  d.read_back.start(d.resolve, frame, scene.settings.depth_and_normal_passes, format, out);
+  const bool map_behind = world_seen && scene.world.program < 0;
+  if (overlapped && !map_behind) return;
+  d.read_back.finish();
+  if (map_behind) composite_world_map(world_map, frame, scene.camera, out.rgba);
 }
 
 void Renderer::Impl::collect_stage_times(StageTimer& timer, RenderStats& st) {

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
-#include <thread>
 #include <vector>
 
 #include "cl/kernel_args.h"
@@ -14,26 +12,6 @@ namespace mp {
 namespace {
 
 cl::Buffer device_buffer(DeviceSession& s, size_t bytes, const char* what) { return s.allocate(bytes, what); }
-
-// memcpy over a few threads: one core copies a 1080p float image out of the
-// pinned buffer in about 3 ms, a fifth of a GPU frame.
-void parallel_copy(void* dst, const void* src, size_t bytes) {
-  const size_t min_chunk = size_t(4) << 20;
-  const size_t threads = std::min<size_t>({std::max(1u, std::thread::hardware_concurrency()), 8, bytes / min_chunk});
-  if (threads <= 1) {
-    std::memcpy(dst, src, bytes);
-    return;
-  }
-  const size_t chunk = (bytes / threads + 63) & ~size_t(63);
-  std::vector<std::thread> pool;
-  for (size_t t = 1; t < threads && t * chunk < bytes; ++t)
-    pool.emplace_back([=] {
-      std::memcpy(static_cast<char*>(dst) + t * chunk, static_cast<const char*>(src) + t * chunk,
-                  std::min(chunk, bytes - t * chunk));
-    });
-  std::memcpy(dst, src, std::min(chunk, bytes));
-  for (auto& th : pool) th.join();
-}
 
 }  // namespace
 
@@ -369,20 +347,8 @@ ResolveStage::ResolveStage(DeviceSession& session)
       scalar_kernel_(session.program(), "resolve_pixels"),
       planar_kernel_(session.program(), "resolve_pixels_planar"),
       tiled_kernel_(session.program(), "resolve_pixels_tiled") {
-  use_pinned_ = !session.device().getInfo<CL_DEVICE_HOST_UNIFIED_MEMORY>();
   gpu_ = (session.device().getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_GPU) != 0;
   local_bytes_ = session.device().getInfo<CL_DEVICE_LOCAL_MEM_SIZE>();
-}
-
-ResolveStage::~ResolveStage() {
-  if (pinned_ptr_) {
-    try {
-      session_.queue().enqueueUnmapMemObject(pinned_, pinned_ptr_);
-      session_.queue().finish();
-    } catch (const cl::Error&) {
-      // The context goes away with the session; nothing else to release.
-    }
-  }
 }
 
 void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, const FrameParams& fb, const Bucket& b,
@@ -457,58 +423,6 @@ void ResolveStage::run(const SampleStage& samples, const FrameSetup& frame, cons
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(gx, gy), cl::NDRange(8, 8), nullptr, &e);
   timer.add(Stage::Resolve, e);
-}
-
-void ResolveStage::read_back(const FrameSetup& frame, bool passes, RenderResult& out) {
-  const FrameParams& f = frame.params;
-  const size_t pixels = static_cast<size_t>(f.width) * static_cast<size_t>(f.height);
-  out.width = f.width;
-  out.height = f.height;
-  // Only the passes asked for: Depth with `passes`, Normal with them where
-  // the samples kept normals (RenderSettings::normal_pass).
-  const bool normals = passes && f.normal_pass;
-  out.rgba.resize(pixels * 4);
-  out.depth.resize(passes ? pixels : 0);
-  out.normal.resize(normals ? pixels * 3 : 0);
-  struct Part {
-    const cl::Buffer& buffer;
-    std::vector<float>& host;
-  };
-  const Part parts[] = {{rgba_, out.rgba}, {depth_, out.depth}, {normal_, out.normal}};
-  DeviceQueue& q = session_.queue();
-  size_t total = 0;
-  for (const Part& p : parts) total += p.host.size() * sizeof(float);
-  if (!use_pinned_) {
-    for (const Part& p : parts)
-      if (!p.host.empty()) q.enqueueReadBuffer(p.buffer, CL_FALSE, 0, p.host.size() * sizeof(float), p.host.data());
-    q.finish();
-    return;
-  }
-  // Discrete GPUs: every pass through one pinned staging buffer, which the
-  // driver fills at full bus speed (a pageable read runs at a fifth of it:
-  // docs/performance.md), then copied out over a few threads.
-  if (pinned_bytes_ < total) {
-    if (pinned_ptr_) q.enqueueUnmapMemObject(pinned_, pinned_ptr_);
-    pinned_ptr_ = nullptr;
-    pinned_bytes_ = 0;
-    pinned_ = cl::Buffer();
-    pinned_ = session_.allocate(total, "image readback buffer", CL_MEM_READ_WRITE | CL_MEM_ALLOC_HOST_PTR);
-    pinned_ptr_ = static_cast<float*>(q.enqueueMapBuffer(pinned_, CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0, total));
-    pinned_bytes_ = total;
-  }
-  size_t at = 0;
-  for (const Part& p : parts) {
-    if (p.host.empty()) continue;
-    q.enqueueReadBuffer(p.buffer, CL_FALSE, 0, p.host.size() * sizeof(float), pinned_ptr_ + at);
-    at += p.host.size();
-  }
-  q.finish();
-  at = 0;
-  for (const Part& p : parts) {
-    if (p.host.empty()) continue;
-    parallel_copy(p.host.data(), pinned_ptr_ + at, p.host.size() * sizeof(float));
-    at += p.host.size();
-  }
 }
 
 }  // namespace mp

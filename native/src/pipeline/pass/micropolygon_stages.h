@@ -219,7 +219,6 @@ class SampleStage {
 class ResolveStage {
  public:
   explicit ResolveStage(DeviceSession& session);
-  ~ResolveStage();
   ResolveStage(const ResolveStage&) = delete;
   ResolveStage& operator=(const ResolveStage&) = delete;
   // Resolves bucket b's pixels (its samples in `samples`, of frame fb) into
@@ -229,12 +228,14 @@ class ResolveStage {
   // local memory or the filter's weight table is not kept.
   void run(const SampleStage& samples, const FrameSetup& frame, const FrameParams& fb, const Bucket& b,
            PixelFilter filter, float filter_width, bool passes, Resolver resolver, StageTimer& timer);
-  // The resolved image (float4 per pixel of the frame, rows top first).
+  // The resolved image (float4 per pixel of the frame, rows top first),
+  // its Depth (a float per pixel) and Normal (3 floats) where resolved;
+  // image_read_back.h brings them to the host.
   const cl::Buffer& image() const { return rgba_; }
+  const cl::Buffer& depth() const { return depth_; }
+  const cl::Buffer& normal() const { return normal_; }
   // Whether the last run took the tiled kernel (tests).
   bool ran_tiled() const { return ran_tiled_; }
-  // Reads the image (and the passes) back once every bucket is resolved.
-  void read_back(const FrameSetup& frame, bool passes, RenderResult& out);
 
  private:
   DeviceSession& session_;
@@ -252,13 +253,6 @@ class ResolveStage {
   int weights_type_ = -1;
   SamplePattern weights_pattern_;
   float weights_width_ = 0;
-  // On discrete GPUs the image and its passes are read back through one
-  // pinned (page-locked) staging buffer, which the driver copies into at
-  // full bus speed; it grows to the largest frame read and is kept.
-  bool use_pinned_ = false;
-  cl::Buffer pinned_;
-  float* pinned_ptr_ = nullptr;
-  size_t pinned_bytes_ = 0;
 };
 
 }  // namespace mp
