@@ -114,6 +114,7 @@ void compare_settings(Diff& d, const RenderSettings& a, const RenderSettings& b)
   d.eq("settings.resolver", a.resolver, b.resolver);
   d.eq("settings.occlusion_waves", a.occlusion_waves, b.occlusion_waves);
   d.eq("settings.bound_split_chain", a.bound_split_chain, b.bound_split_chain);
+  d.eq("settings.bound_split_steps", a.bound_split_steps, b.bound_split_steps);
 }
 
 void compare_camera(Diff& d, const Camera& a, const Camera& b) {

@@ -100,5 +100,36 @@ TEST_F(BoundSplitChainTest, ChainsSplitAlikeWithinASmallBudget) {
   expect_same(s, "a 0.5 MiB budget without culling", true);
 }
 
+// Steps per launch (RenderSettings::bound_split_steps): 1 on GPUs, 16 on
+// CPUs by default. Fewer steps hand work out between launches sooner and
+// change which batch dices what, never the image; without culling, whose
+// pyramid follows the batches, nor what is diced.
+TEST_F(BoundSplitChainTest, StepsPerLaunchChangeNeitherTheImageNorWhatIsDiced) {
+  for (bool culling : {true, false}) {
+    Scene s = shells(4);
+    s.settings.occlusion_culling = culling;
+    s.settings.bound_split_steps = 16;
+    const RenderResult sixteen = renderer_->render(s);
+    for (int steps : {1, 3}) {
+      s.settings.bound_split_steps = steps;
+      const RenderResult r = renderer_->render(s);
+      const std::string at = std::to_string(steps) + " steps, culling " + (culling ? "on" : "off");
+      EXPECT_EQ(r.rgba, sixteen.rgba) << at;
+      EXPECT_EQ(r.depth, sixteen.depth) << at;
+      EXPECT_EQ(r.normal, sixteen.normal) << at;
+      if (!culling) {
+        EXPECT_EQ(r.stats.subpatches_diced, sixteen.stats.subpatches_diced) << at;
+        EXPECT_EQ(r.stats.shadows.micropolygons, sixteen.stats.shadows.micropolygons) << at;
+      }
+      // One step a launch takes more launches (three may take as many as
+      // sixteen where the device runs every worker the tree can use at once).
+      if (steps == 1)
+        EXPECT_GT(r.stats.bound_split_launches, sixteen.stats.bound_split_launches) << at;
+      else
+        EXPECT_GE(r.stats.bound_split_launches, sixteen.stats.bound_split_launches) << at;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace mp::test

@@ -78,6 +78,7 @@ void expect_same_settings(const RenderSettings& a, const RenderSettings& b) {
   EXPECT_EQ(a.resolver, b.resolver);
   EXPECT_EQ(a.occlusion_waves, b.occlusion_waves);
   EXPECT_EQ(a.bound_split_chain, b.bound_split_chain);
+  EXPECT_EQ(a.bound_split_steps, b.bound_split_steps);
 }
 
 void expect_same_camera(const Camera& a, const Camera& b) {
@@ -316,6 +317,7 @@ Scene full_scene() {
   st.resolver = Resolver::Tiles;
   st.occlusion_waves = OcclusionWaves::On;
   st.bound_split_chain = 5;
+  st.bound_split_steps = 3;
 
   s.camera = look_at({1.3f, 2.1f, 7.7f}, {0.1f, 0.2f, 0.0f}, 47.3f);
   s.camera.screen_left = -1.4f, s.camera.screen_right = 1.3f;

@@ -299,6 +299,14 @@ struct RenderSettings {
   // any value. 1 (no chains): on the H100 a launch costs the host nearly
   // what a read does, and chains did not pay (docs/performance.md).
   int bound_split_chain = 1;
+  // The sub-patches each worker of the bounded method handles per launch
+  // before the host reads the counters; the image is the same for any
+  // value. 0 (auto): 1 on GPUs, whose launches last as long as their
+  // busiest worker's steps, so short launches let handed-out work reach idle
+  // workers sooner (about half the bound & split time of 16 on the H200);
+  // 16 on CPUs, where a launch and its read cost more than a step
+  // (docs/performance.md, "Bound & split in short launches on GPUs").
+  int bound_split_steps = 0;
   int max_grid_size = 16;                      // micropolygons per grid side
   int max_split_depth = 26;                    // eye-split and runaway limit
   bool backface_culling = true;                // for single-sided surfaces

@@ -18,7 +18,8 @@ namespace {
 const char* kUsage =
     "usage: micropoly-render SCENE.rib -o OUT.(png|exr) [--spp N] [--shading-rate R]\n"
     "                        [--device cpu|gpu|INDEX] [--bound-split bounded|breadth]\n"
-    "                        [--bound-split-memory MIB] [--bound-split-chain N] [--shadows on|off]\n"
+    "                        [--bound-split-memory MIB] [--bound-split-chain N]\n"
+    "                        [--bound-split-steps N] [--shadows on|off]\n"
     "                        [--shadow-memory MIB]\n"
     "                        [--fresh-shadows] [--occlusion-culling on|off] [--stats FILE.json]\n"
     "                        [--sampler auto|tiles|micropolygons] [--sample-memory MIB]\n"
@@ -37,7 +38,7 @@ struct Options {
   std::string scene, output, device, stats, bound_split, shadows, occlusion, sampler, visibility_first, resolver;
   std::string occlusion_waves;
   std::string readback;  // float (default), half, none (no image written: benchmarks)
-  int spp = 0, repeat = 1, bound_split_chain = 0;
+  int spp = 0, repeat = 1, bound_split_chain = 0, bound_split_steps = -1;
   float shading_rate = 0, memory_mib = 0, shadow_memory_mib = 0, sample_memory_mib = 0;
   float texture_filter_width = -1;  // below 0: the scene's
   bool list_devices = false;
@@ -78,6 +79,7 @@ Options parse(int argc, char** argv) {
       if (o.bound_split != "bounded" && o.bound_split != "breadth") usage_error("--bound-split is bounded or breadth");
     } else if (a == "--bound-split-memory") o.memory_mib = static_cast<float>(parse_number(a, value(), 0.01, 1 << 20));
     else if (a == "--bound-split-chain") o.bound_split_chain = static_cast<int>(parse_number(a, value(), 1, 1024));
+    else if (a == "--bound-split-steps") o.bound_split_steps = static_cast<int>(parse_number(a, value(), 0, 1024));
     else if (a == "--shadows") {
       o.shadows = value();
       if (o.shadows != "on" && o.shadows != "off") usage_error("--shadows is on or off");
@@ -153,6 +155,7 @@ int main(int argc, char** argv) {
       scene.settings.bound_split = o.bound_split == "breadth" ? mp::BoundSplitMethod::Breadth : mp::BoundSplitMethod::Bounded;
     if (o.memory_mib > 0) scene.settings.bound_split_memory_mib = o.memory_mib;
     if (o.bound_split_chain > 0) scene.settings.bound_split_chain = o.bound_split_chain;
+    if (o.bound_split_steps >= 0) scene.settings.bound_split_steps = o.bound_split_steps;
     if (!o.shadows.empty()) scene.settings.shadows = o.shadows == "on";
     if (o.shadow_memory_mib > 0) scene.settings.shadow_memory_mib = o.shadow_memory_mib;
     if (o.fresh_shadows) scene.settings.keep_shadow_pages = false;

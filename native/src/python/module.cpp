@@ -234,6 +234,7 @@ PYBIND11_MODULE(_native, m) {
       .def_readwrite("sampler", &RenderSettings::sampler)
       .def_readwrite("resolver", &RenderSettings::resolver)
       .def_readwrite("bound_split_chain", &RenderSettings::bound_split_chain)
+      .def_readwrite("bound_split_steps", &RenderSettings::bound_split_steps)
       .def_readwrite("visibility_first", &RenderSettings::visibility_first)
       .def_readwrite("occlusion_waves", &RenderSettings::occlusion_waves)
       .def_readwrite("read_back", &RenderSettings::read_back)

@@ -92,6 +92,7 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
                                                        {"micropolygons", Sampler::Micropolygons}},
                             s.sampler);
   params.get_int("boundsplitchain", 1, 1024, &s.bound_split_chain);
+  params.get_int("boundsplitsteps", 0, 1024, &s.bound_split_steps);
   s.resolver = string_choice(args, params, "resolver",
                              {{"auto", Resolver::Auto}, {"tiles", Resolver::Tiles}, {"pixels", Resolver::Pixels}},
                              s.resolver);
@@ -131,7 +132,8 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
                {"boundsplit", "boundsplitmemory", "maxgridsize", "maxsplitdepth", "backfaceculling",
                 "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate", "occlusionculling", "holdoutcovers",
                 "worldshadowdirections", "texturefilterwidth", "apertureblades", "aperturerotation", "apertureratio",
-                "focusfactor", "shuttercurve", "sampler", "samplememory", "visibilityfirst", "resolver", "boundsplitchain", "occlusionwaves"},
+                "focusfactor", "shuttercurve", "sampler", "samplememory", "visibilityfirst", "resolver", "boundsplitchain", "occlusionwaves",
+                "boundsplitsteps"},
                [&](const std::string& name) {
                  warn_once("option-micropoly:" + name, line,
                            "Option \"micropoly\": parameter \"" + name + "\" is ignored");

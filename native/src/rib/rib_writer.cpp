@@ -258,6 +258,8 @@ void write_options(std::string& o, const RenderSettings& s, const Camera& c) {
     param(o, "string sampler", s.sampler == Sampler::Tiles ? "tiles" : "micropolygons");
   if (s.bound_split_chain != def.bound_split_chain)
     param(o, "integer boundsplitchain", static_cast<long long>(s.bound_split_chain));
+  if (s.bound_split_steps != def.bound_split_steps)
+    param(o, "integer boundsplitsteps", static_cast<long long>(s.bound_split_steps));
   if (s.resolver != def.resolver) param(o, "string resolver", s.resolver == Resolver::Tiles ? "tiles" : "pixels");
   if (s.occlusion_waves != def.occlusion_waves)
     param(o, "string occlusionwaves", s.occlusion_waves == OcclusionWaves::On ? "on" : "off");

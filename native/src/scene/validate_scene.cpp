@@ -214,6 +214,8 @@ void validate_scene(const Scene& scene) {
     throw Error("bound & split memory budget must be a positive number of MiB");
   if (s.bound_split_chain < 1 || s.bound_split_chain > 1024)
     throw Error("bound & split chain must be 1 to 1024 launches");
+  if (s.bound_split_steps < 0 || s.bound_split_steps > 1024)
+    throw Error("bound & split steps per launch must be 0 (auto) to 1024");
   if (!(s.shadow_memory_mib > 0) || !std::isfinite(s.shadow_memory_mib))
     throw Error("shadow map memory budget must be a positive number of MiB");
   if (!(s.shadow_shading_rate > 0) || !std::isfinite(s.shadow_shading_rate))

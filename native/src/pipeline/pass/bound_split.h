@@ -125,9 +125,10 @@ struct BoundedWorkspace {
 // Weber, Wimmer & Owens 2015: fixed worker pool, depth-first per worker,
 // memory fixed by `budget_bytes` (never exceeded; throws if too small).
 // Up to `max_chain` launches are chained on the device between two reads
-// of the counters (1: a read after every launch).
+// of the counters (1: a read after every launch); each worker handles up to
+// `steps` sub-patches per launch (RenderSettings::bound_split_steps).
 BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes, cl_uint dice_capacity,
-                                     BoundedWorkspace& workspace, cl_uint max_chain);
+                                     BoundedWorkspace& workspace, cl_uint max_chain, cl_uint steps);
 // Patney & Owens 2008: whole queue per iteration, compacted by prefix sums.
 BoundSplitResult bound_split_breadth(BoundSplitContext& ctx, cl_uint dice_capacity);
 

@@ -7,6 +7,11 @@
 // & split resumes where it stopped. All memory is allocated up front from the
 // budget, so the peak is the budget's allocation, whatever the scene.
 //
+// Each worker handles up to `steps` sub-patches per launch
+// (RenderSettings::bound_split_steps): on a GPU one, so that children handed
+// out reach idle workers at every step of the tree rather than every 16th
+// (a launch lasts as long as its busiest worker; docs/performance.md).
+//
 // Each launch runs only as many workers as can have work: those still holding
 // sub-patches, plus room to double, so the active pool ramps up as the split
 // tree widens (a few big patches at first) and a large budget costs no time on
@@ -44,7 +49,6 @@ enum Counter {
   kRingHead0 = 8, kRingTail0 = 9, kDonate = 10, kRootLimit = 11, kActive = 12, kOccludedSum = 13, kStop = 14,
   kSteps = 15, kCounters = 16
 };
-constexpr cl_uint kStepsPerLaunch = 16;  // sub-patches a worker handles per launch
 constexpr size_t kMaxWorkers = size_t(1) << 20;
 // With occlusion culling, the roots (near to far) are taken in waves: a
 // wave's sub-patches are diced, shaded and sampled and the pyramid rebuilt
@@ -82,7 +86,7 @@ void ensure(DeviceSession& s, cl::Buffer& buffer, size_t& held, size_t bytes) {
 }  // namespace
 
 BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes, cl_uint dice_capacity,
-                                     BoundedWorkspace& ws, cl_uint max_chain) {
+                                     BoundedWorkspace& ws, cl_uint max_chain, cl_uint steps) {
   DeviceSession& s = ctx.session;
   DeviceQueue& queue = s.queue();
   const size_t rec = sizeof(SubPatch);
@@ -115,7 +119,7 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
     cl::Kernel& step =
         ws.step.bind(ctx.scene, occ.on() ? occ.root_order : cl::Buffer(), ctx.frame, ctx.views.views, ctx.views.count,
                      ctx.views.page_masks, occ.on() ? occ.pyramid : cl::Buffer(), occ.params, ws.stacks, ws.sizes,
-                     stack_depth, ws.ring, ring_capacity, ws.diceable, dice_capacity, ws.counters, kStepsPerLaunch);
+                     stack_depth, ws.ring, ring_capacity, ws.diceable, dice_capacity, ws.counters, std::max(steps, 1u));
     const cl_uint root_count = ctx.root_count();
     const cl_uint first_wave = occ.on() && occ.first_wave < root_count ? occ.first_wave : 0;
     cl_uint root_limit = occ.on() && occ.waves ? std::min<cl_uint>(root_count, 1) : root_count;

@@ -29,8 +29,13 @@ BoundSplitResult MicropolygonPass::run(const PassView& view, const ViewTarget& t
   DeviceSession::Activity activity(session_, "bound_split");
   if (settings_.bound_split == BoundSplitMethod::Bounded) {
     const size_t budget = static_cast<size_t>(std::max(0.0f, settings_.bound_split_memory_mib) * 1048576.0);
+    // Steps per launch (RenderSettings::bound_split_steps): 1 on GPUs, 16 on
+    // CPUs unless the settings say.
+    const bool gpu = session_.info().type == "gpu";
+    const int steps = settings_.bound_split_steps > 0 ? settings_.bound_split_steps : gpu ? 1 : 16;
     result = bound_split_bounded(ctx, budget, grids.capacity, stages_.bounded,
-                                 static_cast<cl_uint>(std::max(settings_.bound_split_chain, 1)));
+                                 static_cast<cl_uint>(std::max(settings_.bound_split_chain, 1)),
+                                 static_cast<cl_uint>(steps));
   } else {
     result = bound_split_breadth(ctx, grids.capacity);
   }
