@@ -110,6 +110,11 @@ SUITES = {
                        [Case("trees", "material_trees_1080.rib", []),
                         Case("floor", "texture_floor.rib", []), Case("card", "texture_card.rib", [])],
                        repeat=10, stages=("upload",) + SHADOW_STAGES + CORE_STAGES),
+    "gpu_frame": Suite("the GPU frame's scenes (bench/gpu_frame_scenes.py): a tree outdoors and a colonnade, each under "
+                       "a soft sun, 1080p, 16 spp; shadow pages kept (a still view) and rendered every frame",
+                       [Case(f"{s}/{v}", f"{s}.rib", ["--spp", "16"] + o) for s in ("outdoor", "colonnade")
+                        for v, o in (("kept", []), ("fresh", ["--fresh-shadows"]))],
+                       repeat=20, stages=SHADOW_STAGES + CORE_STAGES),
     "culling": Suite("hidden layers in every view, shadows on: nested shells (lamp inside, lamp outside), "
                      "1,000 stacked layers (point lamp, sun), the rock field",
                      _culling_cases(), repeat=3, stages=SHADOW_STAGES + CORE_STAGES,
