@@ -115,6 +115,11 @@ SUITES = {
                        [Case(f"{s}/{v}", f"{s}.rib", ["--spp", "16"] + o) for s in ("outdoor", "colonnade")
                         for v, o in (("kept", []), ("fresh", ["--fresh-shadows"]))],
                        repeat=20, stages=SHADOW_STAGES + CORE_STAGES),
+    "viewport_loop": Suite("a Rendered viewport's loop in the CLI: 4 spp, half-float read-back, shadow pages kept, "
+                           "frames overlapped (time them with --frame interval)",
+                           [Case(n, n + ".rib", ["--spp", "4", "--readback", "half"])
+                            for n in ("outdoor", "colonnade", "shells_1", "shells_64", "layers_point")],
+                           repeat=10, stages=SHADOW_STAGES + CORE_STAGES),
     "culling": Suite("hidden layers in every view, shadows on: nested shells (lamp inside, lamp outside), "
                      "1,000 stacked layers (point lamp, sun), the rock field",
                      _culling_cases(), repeat=3, stages=SHADOW_STAGES + CORE_STAGES,
