@@ -148,7 +148,10 @@ void ImageReadBack::start(const ResolveStage& resolve, const FrameSetup& frame, 
   const bool staged = use_pinned_ || half;
   size_t total = 0;
   for (const Part& p : parts) total += p.bytes;
-  if (staged && pinned_bytes_ < total) {
+  // Grown to the frame, and made again where it holds more than four times
+  // what a frame needs (a viewport shrunk, or half floats after floats), so
+  // page-locked host memory follows the frames being read.
+  if (staged && (pinned_bytes_ < total || total < pinned_bytes_ / 4)) {
     if (pinned_ptr_) q.enqueueUnmapMemObject(pinned_, pinned_ptr_);
     pinned_ptr_ = nullptr;
     pinned_bytes_ = 0;

@@ -49,7 +49,8 @@ class ImageReadBack {
   size_t half_bytes_ = 0;
   // On discrete GPUs (and for half floats everywhere) the transfers go
   // through one pinned (page-locked) staging buffer, which the driver fills
-  // at full bus speed; it grows to the largest frame read and is kept.
+  // at full bus speed; it grows to the frame read and shrinks where it
+  // holds more than four times what a frame needs.
   // Elsewhere the reads land in the result directly.
   bool use_pinned_ = false;
   cl::Buffer pinned_;
