@@ -200,19 +200,19 @@ int main(int argc, char** argv) {
     std::vector<std::string> frame_stats;
     using Clock = std::chrono::steady_clock;
     Clock::time_point last_start;
-    auto interval_ms = [](Clock::time_point from) {
-      return std::chrono::duration<double, std::milli>(Clock::now() - from).count();
+    auto ms = [](Clock::time_point from, Clock::time_point to) {
+      return std::chrono::duration<double, std::milli>(to - from).count();
     };
     for (int i = 0; i < o.repeat; ++i) {
       const Clock::time_point start = Clock::now();
-      if (i) results[(i - 1) % 2].stats.timings_ms.interval = std::chrono::duration<double, std::milli>(start - last_start).count();
+      if (i) results[(i - 1) % 2].stats.timings_ms.interval = ms(last_start, start);
       renderer.render_overlapped(scene, results[i % 2]);
       if (i) frame_stats.push_back(results[(i - 1) % 2].stats.to_json());
       last_start = start;
     }
     renderer.finish_frame();
     mp::RenderResult& result = results[(o.repeat - 1) % 2];
-    result.stats.timings_ms.interval = interval_ms(last_start);
+    result.stats.timings_ms.interval = ms(last_start, Clock::now());
     frame_stats.push_back(result.stats.to_json());
     std::string all_stats;
     if (o.repeat > 1) {

@@ -1,7 +1,6 @@
 #include "pipeline/frame/camera_view.h"
 
 #include <algorithm>
-#include <chrono>
 #include <optional>
 
 #include "stages/mp_blur.h"
@@ -105,7 +104,6 @@ bool render_camera_bucket(MicropolygonPass& pass, const CameraStages& stages, co
   activity.emplace(s, "occlusion");
   st.covered_pixels += stages.occlusion.covered_pixels(sample.keys(), fb, timer, bucket);
   activity.emplace(s, "resolve");
-  const auto started = std::chrono::steady_clock::now();
   stages.resolve.run(sample, frame, fb, bucket, scene.settings.filter, scene.settings.filter_width,
                      scene.settings.depth_and_normal_passes, scene.settings.resolver, timer);
   st.resolver = stages.resolve.ran_tiled() ? "tiles" : "pixels";
