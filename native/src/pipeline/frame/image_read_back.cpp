@@ -2,17 +2,16 @@
 
 #include <algorithm>
 #include <cstring>
+#include <cstdint>
 #include <functional>
 #include <utility>
 #include <vector>
 
 #include "cl/kernel_args.h"
+#include "io/half_floats.h"
 #include "pipeline/frame/frame_params.h"
 #include "pipeline/pass/micropolygon_stages.h"
 
-#if defined(__x86_64__)
-#include <immintrin.h>
-#endif
 
 namespace mp {
 namespace {
@@ -37,47 +36,6 @@ void in_parallel(size_t n, size_t bytes_each, const std::function<void(size_t, s
     pool.emplace_back([&, t] { work(t * chunk, std::min(chunk, n - t * chunk)); });
   work(0, std::min(chunk, n));
   for (auto& th : pool) th.join();
-}
-
-// IEEE 754 binary16 to binary32, exactly (every half is a float).
-float half_to_float(uint16_t h) {
-  const uint32_t sign = uint32_t(h & 0x8000u) << 16;
-  uint32_t exponent = (h >> 10) & 0x1fu, mantissa = h & 0x3ffu, bits;
-  if (exponent == 0x1f) {
-    bits = sign | 0x7f800000u | (mantissa << 13);  // infinity, NaN
-  } else if (exponent != 0) {
-    bits = sign | ((exponent + 112) << 23) | (mantissa << 13);  // rebias 15 -> 127
-  } else if (mantissa == 0) {
-    bits = sign;
-  } else {  // subnormal: normalise the mantissa
-    exponent = 113;
-    while (!(mantissa & 0x400u)) mantissa <<= 1, --exponent;
-    bits = sign | (exponent << 23) | ((mantissa & 0x3ffu) << 13);
-  }
-  float f;
-  std::memcpy(&f, &bits, sizeof f);
-  return f;
-}
-
-void halves_to_floats_portable(const uint16_t* in, float* out, size_t n) {
-  for (size_t i = 0; i < n; ++i) out[i] = half_to_float(in[i]);
-}
-
-#if defined(__x86_64__)
-// The processor's own conversion (F16C, on x86 since 2012), eight at a time.
-__attribute__((target("avx,f16c"))) void halves_to_floats_f16c(const uint16_t* in, float* out, size_t n) {
-  size_t i = 0;
-  for (; i + 8 <= n; i += 8)
-    _mm256_storeu_ps(out + i, _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(in + i))));
-  halves_to_floats_portable(in + i, out + i, n - i);
-}
-#endif
-
-void halves_to_floats(const uint16_t* in, float* out, size_t n) {
-#if defined(__x86_64__)
-  if (__builtin_cpu_supports("f16c")) return halves_to_floats_f16c(in, out, n);
-#endif
-  halves_to_floats_portable(in, out, n);
 }
 
 }  // namespace
