@@ -76,6 +76,8 @@ sanitized=(env
 #     tile and per-micropolygon samplers          SampleTilesTest, TileSamplerGate
 #     shadows                                     ShadowRenderTest, ShadowPagePool
 #   device faults mid-frame and the recovery      DeviceFault
+#   the read-back's worker thread, frames overlapped
+#   and half floats widened                       ReadBackTest, HalfFloats
 #   after them (freed and rebuilt device state)
 #   the planted-bug self-test                     SanitizerSelfTest
 filter="RenderTest.*:SmoothShadingInput.*:Rib*:SubdivPatchEval.*:SubdivRobustness.*"
@@ -83,6 +85,7 @@ filter+=":PatchEvalMath.*:PolygonPatches.*:BezierPatches.*:PatchCache.*:Watertig
 filter+=":MaterialProgramTest.*:ProgramCache.*:SampleTilesTest.*:TileSamplerGate.*"
 filter+=":ShadowRenderTest.*:ShadowPagePool.*:WorldLighting.BadWorldsAreRefusedCleanly"
 filter+=":Untrusted*:ImageBounds.*:DeviceFault*:SanitizerSelfTest.*:RefractionTrace.*:RefractionRenderTest.*"
+filter+=":ReadBackTest.*:HalfFloats.*"
 # Left out to keep the step near ten minutes on two cores: the slowest
 # repeats of paths already covered above (bucketed tiles, and the watertight
 # renders under motion blur and depth of field).
