@@ -58,7 +58,7 @@ TEST_F(ReadBackTest, OverlappedFramesEqualFramesRenderedOneAtATime) {
   renderer_->render_overlapped(cube, r[0]);
   renderer_->render_overlapped(torus, r[1]);  // r[0] has landed once this starts its own read-back
   expect_same(r[0], cube_ref);
-  EXPECT_GE(r[0].stats.timings_ms.readback, r[0].stats.timings_ms.readback_wait);
+  EXPECT_GT(r[0].stats.timings_ms.readback, 0.0);
   renderer_->render_overlapped(cube, r[0]);
   expect_same(r[1], torus_ref);
   // The same result again: the renderer first lands what is in flight into it.

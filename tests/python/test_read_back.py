@@ -23,7 +23,8 @@ def test_half_floats_are_numpys_nearest_halves_of_the_float_image():
     np.testing.assert_array_equal(half["depth"], full["depth"])  # the passes stay floats
     np.testing.assert_array_equal(half["normal"], full["normal"])
     timings = half["stats"]["timings_ms"]
-    assert timings["readback"] >= timings["readback_wait"] > 0.0
+    # A frame rendered at once waits for its own read-back.
+    assert timings["readback"] > 0.0 and timings["readback_wait"] > 0.0
 
 
 def test_none_brings_back_no_pixels_and_the_next_frame_all_of_them():

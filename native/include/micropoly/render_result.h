@@ -13,8 +13,9 @@ namespace mp {
 // Device time per stage (OpenCL profiling) except `upload` (host patch
 // building and transfer), `readback` (wall time from the read-back's start,
 // once every bucket is resolved, until the image is in the result),
-// `readback_wait` (how long of that the caller's thread waited: all of it
-// with Renderer::render; with render_overlapped only what was left when the
+// `readback_wait` (how long the caller's thread waited for it, the worker's
+// exit and the transfer queue's last finish included: about all of it with
+// Renderer::render; with render_overlapped only what was left when the
 // caller asked for the pixels), `total` (wall time of the render call) and
 // `interval` (set by a caller that renders frames in a loop, as the CLI's
 // --repeat does: wall time from this frame's start to the next's).
