@@ -11,7 +11,7 @@ suite's ratios between cases.
   python3 bench/bench.py SUITE --cli build/micropoly-render [--before OLD_CLI]
       [--device cpu|gpu] [--rounds 3] [--repeat N] [--only CASE,CASE]
       [--size WxH] [--scenes DIR] [--json FILE] [--first]
-      [--args "OPTIONS"] [--before-args "OPTIONS"]
+      [--args "OPTIONS"] [--before-args "OPTIONS"] [--frame total|interval]
 
   python3 bench/bench.py --list
 

@@ -192,11 +192,12 @@ int main(int argc, char** argv) {
       scene.settings.read_back = o.readback == "half"   ? mp::ReadBack::Half
                                  : o.readback == "none" ? mp::ReadBack::None
                                                         : mp::ReadBack::Float;
-    mp::Renderer renderer(o.device);
     // --repeat renders frames back to back, each one's read-back beside the
     // next one's work (Renderer::render_overlapped), into two results in
-    // turn; a frame's stats are complete once the next has started.
+    // turn; a frame's stats are complete once the next has started. The
+    // results outlive the renderer, whose read-back may still write them.
     mp::RenderResult results[2];
+    mp::Renderer renderer(o.device);
     std::vector<std::string> frame_stats;
     using Clock = std::chrono::steady_clock;
     Clock::time_point last_start;

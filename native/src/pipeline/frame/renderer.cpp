@@ -99,6 +99,9 @@ struct Renderer::Impl {
   // The frame: upload, the lights' views, the camera's view bucket by
   // bucket, read back (left in flight when `overlapped`); the steps below.
   void render_frame(const Scene& scene, RenderResult& out, const ProgressCallback& progress, bool overlapped);
+  // A frame checked and rendered within guarded(); Renderer::render and
+  // render_overlapped.
+  void render(const Scene& scene, RenderResult& out, const ProgressCallback& progress, bool overlapped);
   // Runs `frame` (a render, or the wait for an overlapped one's pixels),
   // turning a device error into an mp::Error and readying the session for
   // the next frame after any failure.
@@ -196,20 +199,19 @@ RenderResult Renderer::render(const Scene& scene, const ProgressCallback& progre
 }
 
 void Renderer::render(const Scene& scene, RenderResult& out, const ProgressCallback& progress) {
-  validate_scene(scene);
-  Impl& impl = *impl_;
-  impl.guarded([&] {
-    impl.ready_session();
-    impl.render_frame(scene, out, progress, false);
-  });
+  impl_->render(scene, out, progress, false);
 }
 
 void Renderer::render_overlapped(const Scene& scene, RenderResult& out, const ProgressCallback& progress) {
+  impl_->render(scene, out, progress, true);
+}
+
+void Renderer::Impl::render(const Scene& scene, RenderResult& out, const ProgressCallback& progress,
+                            bool overlapped) {
   validate_scene(scene);
-  Impl& impl = *impl_;
-  impl.guarded([&] {
-    impl.ready_session();
-    impl.render_frame(scene, out, progress, true);
+  guarded([&] {
+    ready_session();
+    render_frame(scene, out, progress, overlapped);
   });
 }
 
