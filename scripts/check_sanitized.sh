@@ -74,6 +74,7 @@ sanitized=(env
 #   full renders on the default device (PoCL on CPU machines):
 #     bounded and breadth-first bound-and-split   RenderTest
 #     tile and per-micropolygon samplers          SampleTilesTest, TileSamplerGate
+#     the bins and their lists                    SampleBinsTest.BinsChoose*, SampleBins
 #     shadows                                     ShadowRenderTest, ShadowPagePool
 #   device faults mid-frame and the recovery      DeviceFault
 #   the read-back's worker thread, frames overlapped
@@ -85,7 +86,7 @@ filter+=":PatchEvalMath.*:PolygonPatches.*:BezierPatches.*:PatchCache.*:Watertig
 filter+=":MaterialProgramTest.*:ProgramCache.*:SampleTilesTest.*:TileSamplerGate.*"
 filter+=":ShadowRenderTest.*:ShadowPagePool.*:WorldLighting.BadWorldsAreRefusedCleanly"
 filter+=":Untrusted*:ImageBounds.*:DeviceFault*:SanitizerSelfTest.*:RefractionTrace.*:RefractionRenderTest.*"
-filter+=":ReadBackTest.*:HalfFloats.*"
+filter+=":ReadBackTest.*:HalfFloats.*:SampleBinsTest.BinsChoose*:SampleBins.*"
 # Left out to keep the step near ten minutes on two cores: the slowest
 # repeats of paths already covered above (bucketed tiles, and the watertight
 # renders under motion blur and depth of field).

@@ -69,6 +69,15 @@ MP_INLINE long mp_to_fixed(float r) { return (long)floor(r * (float)MP_SUBPIXEL_
  * the grid touches. */
 #define MP_TILE_RUN 16
 
+/* The binned sampler (sample_bins.cl): a work-group of
+ * MP_BIN_GROUP work-items per bin of screen pixels, whose samples' keys it
+ * holds in local memory (the bin's side is chosen per frame by the samples
+ * per pixel: SampleStage::bin_side). A run of micropolygons reaching more
+ * than MP_BIN_RUN_TILES bins is left to the per-micropolygon sampler, so
+ * the lists never hold more than that many entries per run. */
+#define MP_BIN_GROUP 256
+#define MP_BIN_RUN_TILES 8
+
 /* A micropolygon whose raster bound spans at most this many fixed-point
  * units per axis is tested in int32 arithmetic by both samplers (sample.cl,
  * sample_tiles.cl): its edge values at the samples they test stay far

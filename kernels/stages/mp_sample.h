@@ -12,6 +12,7 @@
 #include "core/mp_hash.h"
 #include "geometry/mp_patch.h"
 #include "stages/mp_raster.h"
+#include "geometry/mp_grid.h"
 
 typedef struct {
   MpFixed2 p;
@@ -208,6 +209,23 @@ inline float3 mp_load_color(__global const float* colors, ulong pixel, int s, in
   if (!f.planar_colors) return vload3(pixel * (ulong)spp + (ulong)s, colors);
   return (float3)(colors[mp_color_index(pixel, spp, 0) + (ulong)s], colors[mp_color_index(pixel, spp, 1) + (ulong)s],
                   colors[mp_color_index(pixel, spp, 2) + (ulong)s]);
+}
+
+/* Work-item gid's run of MP_TILE_RUN micropolygons among the batch's
+ * grids [first, first + count) (runs_per_grid a grid, in the grid's order):
+ * its grid's shape, the first slot of its vertices and its micropolygons
+ * [*m0, *m1); 0 past the batch. The tile sampler and the bins bound runs. */
+inline int mp_grid_run(__global const SubPatch* diceable, uint first, uint count, uint gid, uint runs_per_grid,
+                       FrameParams f, MpGridShape* g, ulong* base, uint* m0, uint* m1) {
+  uint k = gid / runs_per_grid, run = gid % runs_per_grid;
+  if (k >= count) return 0;
+  uint slot = first + k, stride = (uint)f.max_grid + 1u;
+  SubPatch sp = diceable[slot];
+  *g = mp_grid_shape(&sp, (uint)f.max_grid);
+  *base = (ulong)slot * stride * stride;
+  *m0 = run * MP_TILE_RUN;
+  *m1 = min(mp_grid_micropolygons(g), (run + 1u) * MP_TILE_RUN);
+  return 1;
 }
 
 /* Marks the occlusion pyramid's level-0 cells (mp_occlusion.h) under the

@@ -68,15 +68,12 @@ inline int mp_projected_micropolygon(__global const int4* projected, ulong base,
  * where none (clipped to the frame). */
 __kernel void bound_runs(__global const SubPatch* diceable, uint first, uint count, FrameParams f,
                          __global const int4* projected, uint runs_per_grid, __global int4* rects) {
-  uint gid = get_global_id(0), k = gid / runs_per_grid, run = gid % runs_per_grid;
-  if (k >= count) return;
-  uint slot = first + k, stride = (uint)f.max_grid + 1u;
-  SubPatch sp = diceable[slot];
-  MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
-  uint m1 = min(mp_grid_micropolygons(&g), (run + 1u) * MP_TILE_RUN);
-  ulong base = (ulong)slot * stride * stride;
+  uint gid = get_global_id(0), m0, m1;
+  MpGridShape g;
+  ulong base;
+  if (!mp_grid_run(diceable, first, count, gid, runs_per_grid, f, &g, &base, &m0, &m1)) return;
   int x0 = INT_MAX, y0 = INT_MAX, x1 = INT_MIN, y1 = INT_MIN;
-  for (uint m = run * MP_TILE_RUN; m < m1; ++m) {
+  for (uint m = m0; m < m1; ++m) {
     uint q[4];
     int4 r[4];
     if (!mp_projected_micropolygon(projected, base, &g, m, q, r)) continue;

@@ -103,7 +103,7 @@ class Decoder {
     s.shadow_memory_mib = real(1, 256), s.shadow_shading_rate = real(0.5f, 8.0f);
     s.world_probes = integer(0, 32);
     s.dof_dice_factor = real(0, 1);
-    s.sampler = enumerator(Sampler::Micropolygons);
+    s.sampler = enumerator(Sampler::Bins);
     s.sample_memory_mib = real(1, 2048);
     s.backface_culling = flag(), s.shadows = flag(), s.holdout_covers = flag();
     return s;

@@ -1083,6 +1083,8 @@ TEST(RibWriter, SamplerAndSampleMemoryRoundTrip) {
   EXPECT_EQ(back.settings.sample_memory_mib, 96.5f);
   s.settings.sampler = Sampler::Tiles;
   EXPECT_EQ(round_trip(s).settings.sampler, Sampler::Tiles);
+  s.settings.sampler = Sampler::Bins;
+  EXPECT_EQ(round_trip(s).settings.sampler, Sampler::Bins);
   s.settings.resolver = Resolver::Pixels;
   EXPECT_EQ(round_trip(s).settings.resolver, Resolver::Pixels);
   for (const OcclusionWaves w : {OcclusionWaves::On, OcclusionWaves::Off}) {

@@ -63,11 +63,12 @@ Scene shells() {
 }
 
 TEST_F(VisibilityFirstTest, SameImageWithEitherSampler) {
-  for (const Sampler sampler : {Sampler::Tiles, Sampler::Micropolygons}) {
+  for (const Sampler sampler : {Sampler::Tiles, Sampler::Micropolygons, Sampler::Bins}) {
     Scene s = shells();
     s.settings.sampler = sampler;
-    const char* what = sampler == Sampler::Tiles ? "tile sampler" : "micropolygon sampler";
+    const char* what = sampler == Sampler::Tiles ? "tile sampler" : sampler == Sampler::Bins ? "bins" : "micropolygon sampler";
     const RenderResult on = expect_same(s, what);
+    if (sampler == Sampler::Bins) EXPECT_EQ(on.stats.sampler, "bins");
     // Five opaque shells behind the cut ones: what culling leaves of them
     // owns no sample (about a sixth of the sub-patches diced).
     EXPECT_GT(on.stats.subpatches_unshaded, on.stats.subpatches_diced / 10) << what;

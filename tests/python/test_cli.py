@@ -99,7 +99,7 @@ def test_usage_errors_and_device_listing(tmp_path):
     r = run(os.path.join(SCENES, "teapot.rib"), "-o", str(tmp_path / "t.png"), "--occlusion-culling", "maybe")
     assert r.returncode == 2 and "--occlusion-culling is on or off" in r.stderr
     r = run(os.path.join(SCENES, "teapot.rib"), "-o", str(tmp_path / "t.png"), "--sampler", "fast")
-    assert r.returncode == 2 and "--sampler is auto, tiles or micropolygons" in r.stderr
+    assert r.returncode == 2 and "--sampler is auto, tiles, micropolygons or bins" in r.stderr
     r = run(os.path.join(SCENES, "teapot.rib"), "-o", str(tmp_path / "t.png"), "--visibility-first", "later")
     assert r.returncode == 2 and "--visibility-first is auto, on or off" in r.stderr
     assert run(os.path.join(SCENES, "teapot.rib"), "-o", str(tmp_path / "t.png"), "--sample-memory", "0").returncode == 2

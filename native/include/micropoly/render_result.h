@@ -60,6 +60,7 @@ struct ShadowStats {
 struct RenderStats {
   std::string device;
   std::string resolver;  // the resolve's kernel: "tiles" or "pixels" (RenderSettings::resolver)
+  std::string sampler;   // the camera's sampler: "tiles", "bins" or "micropolygons" (RenderSettings::sampler)
   int width = 0, height = 0, spp = 0;
   size_t patches = 0;
   size_t subpatches_diced = 0;

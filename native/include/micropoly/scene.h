@@ -248,10 +248,14 @@ struct Camera {
 enum class PixelFilter { Box, Gaussian, Triangle, BlackmanHarris };
 enum class BoundSplitMethod { Bounded, Breadth };
 // The sample stage: screen tiles, one work-item owning each tile's samples
-// (kernels/stages/sample_tiles.cl, made for CPUs), or one work-item per
-// micropolygon with atomics (kernels/stages/sample.cl, made for GPUs). Both give
-// the same image; Auto picks by the device's type.
-enum class Sampler { Auto, Tiles, Micropolygons };
+// (kernels/stages/sample_tiles.cl, made for CPUs); one work-item per
+// micropolygon with atomics on the frame's samples (kernels/stages/sample.cl);
+// or bins of pixels, a work-group per bin holding its samples' depths in
+// local memory (kernels/stages/sample_bins.cl; blurred frames, and sample
+// counts whose bin does not fit local memory, take sample.cl). All give the
+// same image; Auto takes tiles on CPUs and micropolygons on GPUs (where the
+// bins measured slower: docs/performance.md).
+enum class Sampler { Auto, Tiles, Micropolygons, Bins };
 // The resolve (kernels/stages/resolve.cl): tiles of pixels that first load
 // their samples and the filter's reach around them into local memory (made
 // for GPUs: each sample is read from device memory once a tile, not once

@@ -22,7 +22,7 @@ const char* kUsage =
     "                        [--bound-split-steps N] [--shadows on|off]\n"
     "                        [--shadow-memory MIB]\n"
     "                        [--fresh-shadows] [--occlusion-culling on|off] [--stats FILE.json]\n"
-    "                        [--sampler auto|tiles|micropolygons] [--sample-memory MIB]\n"
+    "                        [--sampler auto|tiles|micropolygons|bins] [--sample-memory MIB]\n"
     "                        [--visibility-first auto|on|off] [--resolver auto|tiles|pixels]\n"
     "                        [--occlusion-waves auto|on|off]\n"
     "                        [--texture-filter-width W]\n"
@@ -91,8 +91,8 @@ Options parse(int argc, char** argv) {
     }
     else if (a == "--sampler") {
       o.sampler = value();
-      if (o.sampler != "auto" && o.sampler != "tiles" && o.sampler != "micropolygons")
-        usage_error("--sampler is auto, tiles or micropolygons");
+      if (o.sampler != "auto" && o.sampler != "tiles" && o.sampler != "micropolygons" && o.sampler != "bins")
+        usage_error("--sampler is auto, tiles, micropolygons or bins");
     } else if (a == "--resolver") {
       o.resolver = value();
       if (o.resolver != "auto" && o.resolver != "tiles" && o.resolver != "pixels")
@@ -163,6 +163,7 @@ int main(int argc, char** argv) {
     if (!o.sampler.empty())
       scene.settings.sampler = o.sampler == "tiles"           ? mp::Sampler::Tiles
                                : o.sampler == "micropolygons" ? mp::Sampler::Micropolygons
+                               : o.sampler == "bins"          ? mp::Sampler::Bins
                                                               : mp::Sampler::Auto;
     if (!o.resolver.empty())
       scene.settings.resolver = o.resolver == "tiles"    ? mp::Resolver::Tiles

@@ -69,6 +69,7 @@ py::dict stats_dict(const RenderStats& s) {
   py::dict d, t;
   d["device"] = s.device;
   d["resolver"] = s.resolver;
+  d["sampler"] = s.sampler;
   d["width"] = s.width;
   d["height"] = s.height;
   d["spp"] = s.spp;
@@ -179,7 +180,8 @@ PYBIND11_MODULE(_native, m) {
   py::enum_<Sampler>(m, "Sampler")
       .value("AUTO", Sampler::Auto)
       .value("TILES", Sampler::Tiles)
-      .value("MICROPOLYGONS", Sampler::Micropolygons);
+      .value("MICROPOLYGONS", Sampler::Micropolygons)
+      .value("BINS", Sampler::Bins);
   py::enum_<Resolver>(m, "Resolver")
       .value("AUTO", Resolver::Auto)
       .value("TILES", Resolver::Tiles)

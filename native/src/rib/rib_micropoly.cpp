@@ -89,7 +89,7 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   s.holdout_covers = flag != 0;
   auto positive = [](float v) { return v > 0.0f && std::isfinite(v); };
   s.sampler = string_choice(args, params, "sampler", {{"auto", Sampler::Auto}, {"tiles", Sampler::Tiles},
-                                                       {"micropolygons", Sampler::Micropolygons}},
+                                                       {"micropolygons", Sampler::Micropolygons}, {"bins", Sampler::Bins}},
                             s.sampler);
   params.get_int("boundsplitchain", 1, 1024, &s.bound_split_chain);
   params.get_int("boundsplitsteps", 0, 1024, &s.bound_split_steps);

@@ -255,7 +255,9 @@ void write_options(std::string& o, const RenderSettings& s, const Camera& c) {
   if (differs(s.texture_filter_width, def.texture_filter_width))
     param(o, "float texturefilterwidth", s.texture_filter_width);
   if (s.sampler != def.sampler)
-    param(o, "string sampler", s.sampler == Sampler::Tiles ? "tiles" : "micropolygons");
+    param(o, "string sampler", s.sampler == Sampler::Tiles  ? "tiles"
+                               : s.sampler == Sampler::Bins ? "bins"
+                                                            : "micropolygons");
   if (s.bound_split_chain != def.bound_split_chain)
     param(o, "integer boundsplitchain", static_cast<long long>(s.bound_split_chain));
   if (s.bound_split_steps != def.bound_split_steps)

@@ -34,7 +34,8 @@ bool render_camera_bucket(MicropolygonPass& pass, const CameraStages& stages, co
   SampleStage& sample = stages.sample;
   const FrameParams fb = bucket_frame(frame.params, bucket);
   std::optional<DeviceSession::Activity> activity(std::in_place, s, "sample");
-  sample.begin_frame(fb, timer, scene.shutter_curve);
+  sample.begin_frame(fb, timer, scene.shutter_curve, frame.bin_sampler);
+  st.sampler = sample.sampler_name();
   if (progress.asked()) {
     s.queue().finish();  // clearing a large sample buffer takes a while: look again
     progress(0.0f);

@@ -13,6 +13,9 @@ struct FrameSetup {
   int full_width = 0, full_height = 0;  // whole image; params.width/height is the crop
   int crop_x0 = 0, crop_y0 = 0;         // crop origin in the whole image (top-left)
   glm::mat3 camera_to_world{1.0f};
+  // The camera's samples go through the binned sampler where a bin's keys
+  // fit the device's local memory (SampleStage::begin_frame).
+  bool bin_sampler = false;
 };
 
 // Screen window, raster mapping (RenderMan's conventions: the shorter side of

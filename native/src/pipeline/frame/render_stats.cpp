@@ -43,6 +43,7 @@ std::string RenderStats::to_json() const {
   std::string j = "{\n";
   j += "  \"device\": " + json_string(device) + ",\n";
   j += "  \"resolver\": " + json_string(resolver) + ",\n";
+  j += "  \"sampler\": " + json_string(sampler) + ",\n";
   j += "  \"width\": " + std::to_string(width) + ",\n";
   j += "  \"height\": " + std::to_string(height) + ",\n";
   j += "  \"spp\": " + std::to_string(spp) + ",\n";

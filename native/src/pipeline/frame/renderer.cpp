@@ -326,6 +326,10 @@ FrameSetup Renderer::Impl::setup_frame(const Scene& scene, const DeviceInfo& dev
   frame.params.planar_colors = (scene.settings.sampler == Sampler::Tiles ||
                                 (scene.settings.sampler == Sampler::Auto && device.type == "cpu")) &&
                                !mp_blur_on(frame.params) && tile_sampler;
+  // The binned sampler: pinhole frames, where the setting asks for it (on
+  // the H200 it lost to the per-micropolygon sampler: docs/performance.md).
+  frame.bin_sampler = !frame.params.planar_colors && !mp_blur_on(frame.params) &&
+                      scene.settings.sampler == Sampler::Bins;
   frame.params.holdout_covers = scene.settings.holdout_covers ? 1 : 0;
   // Whether any material can hold out (mp_closures.h's mp_add_holdout in its
   // program): only then does the resolve read samples' held-out shares.

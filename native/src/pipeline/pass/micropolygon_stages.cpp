@@ -147,7 +147,12 @@ SampleStage::SampleStage(DeviceSession& session)
       clear_(session.program(), "clear_samples"),
       project_(session.tile_sampler() ? cl::Kernel(session.program(), "project_grids") : cl::Kernel()),
       bound_runs_(session.tile_sampler() ? cl::Kernel(session.program(), "bound_runs") : cl::Kernel()),
-      tile_kernel_(session.tile_sampler() ? SceneKernel(session.program(), "sample_tiles") : SceneKernel()) {
+      tile_kernel_(session.tile_sampler() ? SceneKernel(session.program(), "sample_tiles") : SceneKernel()),
+      bin_runs_(session.program(), "bin_runs"),
+      bin_offsets_(session.program(), "bin_offsets"),
+      bin_scatter_(session.program(), "bin_scatter"),
+      bins_kernel_(session.program(), "sample_bins"),
+      local_bytes_(session.device().getInfo<CL_DEVICE_LOCAL_MEM_SIZE>()) {
   totals_ = session.allocate(5 * sizeof(cl_ulong), "sample totals");
 }
 
@@ -210,10 +215,26 @@ void SampleStage::mark_occlusion_cells(const cl::Buffer& dirty, const OcclusionP
   occlusion_ = params;
 }
 
-void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer, const std::vector<float>& shutter_curve) {
+void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer, const std::vector<float>& shutter_curve,
+                              bool bins) {
   mark_occlusion_cells(cl::Buffer(), OcclusionParams{});
   tiles_ = f.planar_colors != 0;
   const int spp = f.spp_x * f.spp_y;
+  bins_ready_ = false;
+  bin_side_ = bins && !tiles_ && !mp_blur_on(f) ? bin_side(spp, local_bytes_) : 0;
+  if (bin_side_ > 0) {
+    bins_x_ = cl_uint((f.width + bin_side_ - 1) / bin_side_);
+    bins_y_ = cl_uint((f.height + bin_side_ - 1) / bin_side_);
+    const size_t bins = size_t(bins_x_) * bins_y_;
+    session_.reserve(bin_counts_, bin_count_bytes_, std::max(bins * sizeof(cl_uint), bin_count_bytes_), "bin counts");
+    session_.reserve(bin_starts_, bin_start_bytes_, std::max((bins + 1) * sizeof(cl_uint), bin_start_bytes_),
+                     "bin list starts");
+    session_.reserve(bin_cursors_, bin_cursor_bytes_, std::max(bins * sizeof(cl_uint), bin_cursor_bytes_),
+                     "bin list cursors");
+    // bin_offsets clears the counts it reads; cleared here too, so that a
+    // batch stopped between the two leaves no count behind.
+    session_.queue().enqueueFillBuffer(bin_counts_, cl_uint(0), 0, bins * sizeof(cl_uint));
+  }
   size_t samples = static_cast<size_t>(f.width) * static_cast<size_t>(f.height) * static_cast<size_t>(spp);
   // The buffers only grow: the viewport alternates a small preview with the
   // full view, and reallocating (and first touching) the full view's buffers
@@ -283,7 +304,7 @@ void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer, const std
 
 void SampleStage::sample_micropolygons(const cl::Buffer& diceable, cl_uint first, cl_uint count,
                                        const SceneBuffers& scene, const FrameParams& f, GridBuffers& grids,
-                                       StageTimer& timer, cl_uint pass) {
+                                       StageTimer& timer, cl_uint pass, bool wide_runs) {
   // The run's micropolygons, numbered within the batch by its layout.
   const cl_uint base = grids.micropolygon_offsets_host[first];
   const cl_uint total = grids.micropolygon_offsets_host[first + count] - base;
@@ -293,7 +314,8 @@ void SampleStage::sample_micropolygons(const cl::Buffer& diceable, cl_uint first
   cl::Kernel& k = sampler.bind(scene, diceable, first, count, grids.micropolygon_offsets, base, total, f, grids.p,
                                grids.c, grids.n, offsets_, pass, keys_, colors_, normals_, totals_, occlusion_dirty_,
                                occlusion_, blur_, grids.motion_p() ? grids.motion_p : grids.p,
-                               cl_ulong(grids.slot_space()), grids.visible);
+                               cl_ulong(grids.slot_space()), grids.visible, wide_runs ? bin_rects_ : cl::Buffer(),
+                               wide_runs ? bin_runs_per_grid_ : cl_uint(0));
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(k, cl::NullRange, round_up_range(total), cl::NDRange(64), nullptr, &e);
   timer.add(Stage::Sample, e);
@@ -301,7 +323,7 @@ void SampleStage::sample_micropolygons(const cl::Buffer& diceable, cl_uint first
 
 size_t SampleStage::visibility(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene,
                                const FrameParams& f, GridBuffers& grids, StageTimer& timer) {
-  binned_ = false;
+  binned_ = bins_ready_ = false;
   if (count == 0) return timer.cursor();
   const cl_uchar unmarked = 0;
   session_.queue().enqueueFillBuffer(grids.visible, unmarked, 0, count);
@@ -313,6 +335,12 @@ size_t SampleStage::visibility(const cl::Buffer& diceable, cl_uint count, const 
       sample_binned(diceable, scene, f, grids, timer, MP_SAMPLE_OPAQUE_DEPTH, {});
       sample_binned(diceable, scene, f, grids, timer, MP_SAMPLE_MARK, {});
     }
+  } else if (bins()) {
+    bin_on_device(diceable, 0, count, f, grids, timer);
+    bins_ready_ = true;
+    passes = timer.cursor();
+    sample_bins(diceable, scene, f, grids, timer, MP_SAMPLE_OPAQUE_DEPTH);
+    sample_bins(diceable, scene, f, grids, timer, MP_SAMPLE_MARK);
   } else {
     sample_micropolygons(diceable, 0, count, scene, f, grids, timer, MP_SAMPLE_OPAQUE_DEPTH);
     sample_micropolygons(diceable, 0, count, scene, f, grids, timer, MP_SAMPLE_MARK);
@@ -335,6 +363,13 @@ void SampleStage::run(const cl::Buffer& diceable, cl_uint first, cl_uint count, 
     binned_ = false;
     if (binned || (!after_visibility && bin_tiles(diceable, first, count, f, grids, timer)))
       sample_binned(diceable, scene, f, grids, timer, MP_SAMPLE_ATTRIBUTES | after, keep_going);
+    return;
+  }
+  if (bins()) {
+    // The lists visibility() made for this batch serve again.
+    if (!(after_visibility && bins_ready_)) bin_on_device(diceable, first, count, f, grids, timer);
+    bins_ready_ = false;
+    sample_bins(diceable, scene, f, grids, timer, MP_SAMPLE_ATTRIBUTES | after);
     return;
   }
   // The first pass finds each sample's nearest key; the second lets its owner write.

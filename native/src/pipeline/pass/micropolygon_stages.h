@@ -132,10 +132,21 @@ class SampleStage {
   // Makes the sample buffers (key, color, normal per sample) fit the frame,
   // reusing them when the size is unchanged, and clears them. A frame with
   // planar sample colors (FrameParams.planar_colors, set by the renderer) is
-  // sampled by screen tiles (sample_tiles.cl), else one work-item per
-  // micropolygon (sample.cl).
-  void begin_frame(const FrameParams& f, StageTimer& timer, const std::vector<float>& shutter_curve = {});
+  // sampled by screen tiles (sample_tiles.cl); else, where `bins` asks and
+  // a bin's keys fit local memory (bin_side), by bins (sample_bins.cl);
+  // else one work-item per micropolygon (sample.cl).
+  void begin_frame(const FrameParams& f, StageTimer& timer, const std::vector<float>& shutter_curve = {},
+                   bool bins = false);
   bool tiles() const { return tiles_; }
+  bool bins() const { return bin_side_ > 0; }
+  // The sampler begin_frame chose: "tiles", "bins" or "micropolygons".
+  const char* sampler_name() const { return tiles_ ? "tiles" : bin_side_ > 0 ? "bins" : "micropolygons"; }
+  // Pixels per side of the binned sampler's bins at `spp` samples per
+  // pixel on a device with `local_bytes` of local memory per work-group:
+  // the largest of 32, 16 and 8 whose keys (8 bytes a sample) fit
+  // kBinKeyBytes and the device; 0 where none does.
+  static int bin_side(int spp, size_t local_bytes);
+  static constexpr size_t kBinKeyBytes = 32 * 1024;
   // Visibility first, before a batch's grids are shaded: the nearest keys
   // of its grids whose material is opaque whatever its shading, then a mark
   // (grids.visible) on each of those that owns a sample; the others cannot
@@ -187,9 +198,20 @@ class SampleStage {
   // Samples the binned tiles in one pass (pass: MP_SAMPLE_* of mp_raster.h).
   void sample_binned(const cl::Buffer& diceable, const SceneBuffers& scene, const FrameParams& f, GridBuffers& grids,
                      StageTimer& timer, cl_uint pass, const std::function<bool()>& keep_going);
-  // One pass of the per-micropolygon sampler over [first, first + count).
+  // One pass of the per-micropolygon sampler over [first, first + count);
+  // with `wide_runs`, only the runs that bin_on_device left out.
   void sample_micropolygons(const cl::Buffer& diceable, cl_uint first, cl_uint count, const SceneBuffers& scene,
-                            const FrameParams& f, GridBuffers& grids, StageTimer& timer, cl_uint pass);
+                            const FrameParams& f, GridBuffers& grids, StageTimer& timer, cl_uint pass,
+                            bool wide_runs = false);
+  // The binned sampler (sample_bins.cpp): bounds the runs of grids [first,
+  // first + count) in bins and writes the bins' lists, all on the device.
+  void bin_on_device(const cl::Buffer& diceable, cl_uint first, cl_uint count, const FrameParams& f,
+                     GridBuffers& grids, StageTimer& timer);
+  // Samples the binned batch through `pass` (MP_SAMPLE_ATTRIBUTES,
+  // _OPAQUE_DEPTH or _MARK, with MP_SAMPLE_AFTER_MARK): the runs left out
+  // by the per-micropolygon sampler, then every bin.
+  void sample_bins(const cl::Buffer& diceable, const SceneBuffers& scene, const FrameParams& f, GridBuffers& grids,
+                   StageTimer& timer, cl_uint pass);
   SceneKernel kernel_, blur_kernel_;  // pinhole samples; samples with times and lens positions
   SceneKernel count_unshaded_;
   cl::Kernel clear_;
@@ -204,6 +226,17 @@ class SampleStage {
   size_t projected_bytes_ = 0, rect_bytes_ = 0, tile_bytes_ = 0, start_bytes_ = 0, entry_bytes_ = 0;
   std::vector<cl_int> rects_host_;
   std::vector<cl_uint> tile_counts_, tile_ids_host_, tile_starts_host_, tile_entries_host_;
+  // The binned sampler's kernels, lists and the batch they hold
+  // (bin_first_, bin_count_; bins_ready_ while visibility() binned it).
+  cl::Kernel bin_runs_, bin_offsets_, bin_scatter_;
+  SceneKernel bins_kernel_;
+  size_t local_bytes_ = 0;
+  int bin_side_ = 0;
+  cl_uint bins_x_ = 0, bins_y_ = 0, bin_runs_per_grid_ = 0, bin_first_ = 0, bin_count_ = 0;
+  bool bins_ready_ = false;
+  cl::Buffer bin_rects_, bin_counts_, bin_starts_, bin_cursors_, bin_entries_;
+  size_t bin_rect_bytes_ = 0, bin_count_bytes_ = 0, bin_start_bytes_ = 0, bin_cursor_bytes_ = 0,
+         bin_entry_bytes_ = 0;
   cl::Buffer occlusion_dirty_;
   OcclusionParams occlusion_{};
   cl::Buffer keys_, colors_, normals_, offsets_, blur_, totals_;
