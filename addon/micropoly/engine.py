@@ -183,7 +183,11 @@ class MicropolyRenderEngine(bpy.types.RenderEngine):
                 cancel.set()
             self.update_progress(progress["value"])
         if "error" in outcome:
-            self.report({"ERROR"}, f"Micropoly: {outcome['error']}")
+            error = outcome["error"]
+            if isinstance(error, MemoryError):  # a host allocation outside the renderer's own phases
+                error = "the computer ran out of memory while rendering: close other programs, or lower the " \
+                        "resolution or the samples"
+            self.report({"ERROR"}, f"Micropoly: {error}")
             _final_renderers.forget()
             return
         result = outcome["result"]

@@ -249,6 +249,11 @@ def export_scene(depsgraph, view=None, meshes=None, motion=None):
                         motion.apply_to_mesh(native_scene, obj.name)
             except RuntimeError as e:  # numpy/native rejections of the data
                 raise ExportError(f"object '{obj.name}': {e}") from e
+            except MemoryError:
+                raise ExportError(
+                    f"the computer ran out of memory exporting object '{obj.name}' after {out.objects} mesh "
+                    "objects: every instance is exported as a copy of its mesh, so render fewer copies of heavy "
+                    "objects, or lower their subdivision levels") from None
         elif obj.type == "LIGHT":
             export_lights.export_light(native_scene, obj, inst.matrix_world, out.warnings)
     try:

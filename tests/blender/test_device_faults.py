@@ -2,7 +2,9 @@
 failure when the add-on opens its renderer (native/src/cl/device_faults.h).
 F12 must stop with the error reported in Blender (RenderEngine.report, which
 bpy.ops.render.render raises as RuntimeError in background mode), and the
-next F12 must render. The Rendered viewport's session, which keeps one
+next F12 must render. Host memory running out (a planted std::bad_alloc,
+and a MemoryError in the export) must be a message that says where and what
+would help. The Rendered viewport's session, which keeps one
 renderer across renders, must report the failure and render the next request."""
 
 import os
@@ -55,6 +57,42 @@ def main():
     failed += check(covered > 200.0, "the next F12 renders the cube", f"{covered:.0f} px covered")
     failed += check(np.array_equal(first["rgba"], second["rgba"]), "and again the same image")
 
+    # Host memory running out while the scene is uploaded: the message names
+    # the phase and what would help, not a bare "std::bad_alloc".
+    os.environ["MICROPOLY_CL_FAULT"] = "alloc:1:host@upload"
+    engine._final_renderers.drop()
+    try:
+        ru.render_passes(scene, "MICROPOLY", 64, 48, samples=4)
+        message = None
+    except RuntimeError as e:
+        message = str(e)
+    finally:
+        del os.environ["MICROPOLY_CL_FAULT"]
+    failed += check(message is not None and "(upload)" in message and "ran out of host memory" in message
+                    and "subdivision levels" in message and "bad_alloc" not in message,
+                    "F12 reports host memory running out", message)
+
+    # And while the add-on exports a mesh: the object and what would help.
+    from micropoly import export_mesh
+
+    export_object = export_mesh.export_object
+
+    def out_of_memory(*args, **kwargs):
+        raise MemoryError()
+
+    export_mesh.export_object = out_of_memory
+    try:
+        ru.render_passes(scene, "MICROPOLY", 64, 48, samples=4)
+        message = None
+    except RuntimeError as e:
+        message = str(e)
+    finally:
+        export_mesh.export_object = export_object
+    failed += check(message is not None and "ran out of memory exporting object 'Cube'" in message,
+                    "F12 reports memory running out in the export", message)
+    again = ru.render_passes(scene, "MICROPOLY", 64, 48, samples=4)
+    failed += check(np.array_equal(again["rgba"], first["rgba"]), "and the next F12 renders the same image")
+
     # The Rendered viewport: one renderer for the session's life.
     from micropoly import export, viewport
 
@@ -77,7 +115,7 @@ def main():
     finally:
         os.environ.pop("MICROPOLY_CL_FAULT", None)
         session.close()
-    print(f"{5 - failed} passed, {failed} failed")
+    print(f"{8 - failed} passed, {failed} failed")
     return 0 if failed == 0 else 1
 
 

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <new>
 #include <string>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -49,7 +50,7 @@ bool contains(const std::string& text, const std::string& part) { return text.fi
 struct Fault {
   const char* plan;
   const char* phase;   // failed_activity path the message carries
-  const char* code;    // the OpenCL error's name
+  const char* code;    // the OpenCL error's name, or what ran out
   const char* advice;  // the hint that follows it
 };
 
@@ -123,6 +124,15 @@ TEST(DeviceFaultPlan, ParsesKindCountCodeAndPhase) {
   EXPECT_EQ(p.op, DeviceOp::Alloc);
   EXPECT_TRUE(p.lost);
   EXPECT_EQ(p.activity, "dice");
+  p = parse_fault_plan("alloc:3:host@upload");
+  EXPECT_TRUE(p.host);
+  EXPECT_FALSE(p.lost);
+  EXPECT_EQ(p.nth, 3);
+  FaultInjector f;
+  f.arm(p);
+  EXPECT_NO_THROW(f.hit(DeviceOp::Alloc, "clCreateBuffer", "upload"));
+  EXPECT_NO_THROW(f.hit(DeviceOp::Alloc, "clCreateBuffer", "upload"));
+  EXPECT_THROW(f.hit(DeviceOp::Alloc, "clCreateBuffer", "upload"), std::bad_alloc);
   for (const char* bad : {"", "launch", "launch:1", "jump:1:CL_OUT_OF_RESOURCES", "launch:0:CL_OUT_OF_RESOURCES",
                           "launch:x:CL_OUT_OF_RESOURCES", "launch:1:CL_NOT_AN_ERROR", "launch:1:5",
                           "launch:1:CL_OUT_OF_RESOURCES:gone", "launch:1:CL_OUT_OF_RESOURCES:lost:x"}) {
@@ -186,6 +196,21 @@ TEST_F(DeviceFaultTest, OutOfResourcesInEachPhaseEndsTheFrameAndTheNextFrameIsCl
 // takes depends on the device: CPUs take the first roots in small waves
 // for occlusion culling, GPUs in one batch here, so the positions below are
 // ones every device reaches.)
+// Host memory (std::bad_alloc) in each phase: the message names the phase
+// and what would help there, never a bare "std::bad_alloc"; the next frame
+// is clean.
+TEST_F(DeviceFaultTest, OutOfHostMemoryInEachPhaseIsAMessageAndTheNextFrameIsClean) {
+  const char* const host = "the computer ran out of host memory";
+  const Fault faults[] = {
+      {"alloc:1:host@upload", "upload", host, "subdivision levels"},
+      {"launch:1:host@shadows", "shadows", host, "shadow memory budget"},
+      {"launch:2:host@sample", "bound_split/sample", host, "bound & split memory"},
+      {"launch:1:host@resolve", "resolve", host, "lower the resolution"},
+      {"read:1:host@readback", "readback", host, "Depth and Normal passes"},
+  };
+  for (const Fault& f : faults) fails_then_recovers(f);
+}
+
 TEST_F(DeviceFaultTest, OutOfResourcesInsideTheCamerasBatchesEndsTheFrame) {
   const Fault faults[] = {
       {"launch:1:CL_OUT_OF_RESOURCES@dice", "bound_split/dice", "CL_OUT_OF_RESOURCES", kOutOfMemory},

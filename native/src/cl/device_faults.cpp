@@ -1,6 +1,7 @@
 #include "cl/device_faults.h"
 
 #include <cstdlib>
+#include <new>
 
 #include "micropoly/error.h"
 
@@ -55,7 +56,8 @@ FaultPlan parse_fault_plan(const std::string& text) {
   plan.nth = std::strtol(fields[1].c_str(), &end, 10);
   if (fields[1].empty() || !end || *end != '\0' || plan.nth < 1)
     throw Error("device fault plan '" + text + "': N must be a positive count");
-  plan.code = parse_code(fields[2], text);
+  plan.host = fields[2] == "host";
+  plan.code = plan.host ? CL_OUT_OF_HOST_MEMORY : parse_code(fields[2], text);
   if (count == 4) {
     if (fields[3] != "lost") throw Error("device fault plan '" + text + "': the fourth field can only be 'lost'");
     plan.lost = true;
@@ -79,6 +81,7 @@ void FaultInjector::hit(DeviceOp op, const char* call, const char* activity) {
   fired_ = true;
   dead_ = plan_->lost;
   armed_ = dead_;  // a spent one-shot plan costs nothing any more
+  if (plan_->host) throw std::bad_alloc();
   throw cl::Error(plan_->code, call);
 }
 

@@ -21,7 +21,8 @@ enum class DeviceOp { Alloc, Launch, Read, Write, Finish };
 // read, write, finish), counted from when the plan is armed and only while
 // the innermost activity (DeviceSession::Activity) is ACTIVITY when one is
 // given, fails with CODE (an OpenCL error name such as CL_OUT_OF_RESOURCES,
-// or its number). Device-lost codes (cl_error_means_device_lost), and any
+// or its number), or with CODE "host" throws std::bad_alloc, as the host's
+// allocator does when the computer runs out of memory there. Device-lost codes (cl_error_means_device_lost), and any
 // code marked `lost`, also make every later operation of that session fail
 // with the same code, as a context whose device fell off the bus does.
 struct FaultPlan {
@@ -29,6 +30,7 @@ struct FaultPlan {
   long nth = 1;
   cl_int code = CL_OUT_OF_RESOURCES;
   bool lost = false;
+  bool host = false;     // std::bad_alloc rather than an OpenCL error
   std::string activity;  // empty: any
 };
 

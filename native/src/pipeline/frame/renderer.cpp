@@ -33,6 +33,22 @@ namespace {
 // Sub-patches per dice batch: grid buffers hold this many (max_grid+1)^2 grids.
 constexpr cl_uint kDiceBatch = 8192;
 
+// What would help a frame whose phase (DeviceSession::failed_activity) ran
+// out of host memory.
+std::string host_memory_advice(const std::string& phase) {
+  const std::string first = phase.substr(0, phase.find('/'));
+  if (first == "upload")
+    return "the scene's surfaces did not fit as their patches were built (each patch of every placed copy takes "
+           "about 700 bytes here and again on the device): render fewer copies of heavy objects, or lower their "
+           "subdivision levels or their image textures' sizes";
+  if (first == "shadows")
+    return "the lights' views did not fit: lower the shadow memory budget, or shadow fewer lights";
+  if (first == "readback")
+    return "the image did not come back: lower the resolution, or leave out the Depth and Normal passes";
+  return "the frame's work did not fit: close other programs, or lower the resolution, the samples or the "
+         "sample and bound & split memory budgets";
+}
+
 // The frame's statistics of every pass' bound & split.
 class FrameStatsObserver : public PassObserver {
  public:
@@ -238,10 +254,17 @@ void Renderer::Impl::guarded(const std::function<void()>& frame) {
     const std::string where = phase.empty() ? "" : " (" + phase + ")";
     throw Error("rendering on '" + info.name + "' failed" + where + ": " + describe_cl_error(e) +
                 (lost ? "; the next render reopens the device" : "; the frame's device memory was freed"));
+  } catch (const std::bad_alloc&) {
+    // Host memory: the frame's stages go as for any other failure below,
+    // and the message says which phase did not fit and what would help.
+    recover(SessionHealth::Good);
+    const std::string phase = session ? session->failed_activity() : std::string();
+    throw Error("rendering on '" + info.name + "' failed" + (phase.empty() ? "" : " (" + phase + ")") +
+                ": the computer ran out of host memory; " + host_memory_advice(phase));
   } catch (...) {
-    // Any other failure (a buffer larger than the device allows, host
-    // memory, a progress callback that raised) may also leave stages half
-    // set up: the next frame builds them anew on the same session.
+    // Any other failure (a buffer larger than the device allows, a
+    // progress callback that raised) may also leave stages half set up:
+    // the next frame builds them anew on the same session.
     recover(SessionHealth::Good);
     throw;
   }
