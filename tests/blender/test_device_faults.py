@@ -23,6 +23,23 @@ def check(ok, what, detail=""):
     return 0 if ok else 1
 
 
+def f12_error(scene, plan=None):
+    """The message F12 stops with (None if it rendered); with `plan`, a new
+    renderer opens the device with that fault planted."""
+    from micropoly import engine
+
+    if plan:
+        os.environ["MICROPOLY_CL_FAULT"] = plan
+        engine._final_renderers.drop()
+    try:
+        ru.render_passes(scene, "MICROPOLY", 64, 48, samples=4)
+        return None
+    except RuntimeError as e:
+        return str(e)
+    finally:
+        os.environ.pop("MICROPOLY_CL_FAULT", None)
+
+
 def main():
     scene = ru.reset_scene()
     bpy.ops.mesh.primitive_cube_add()
@@ -35,18 +52,10 @@ def main():
     # and the frame fails while shading. The renderer the add-on's kernel
     # warm-up built when it registered (and keeps for the first F12) was
     # opened without the plan: it is dropped once the warm-up has ended.
-    from micropoly import engine, warm_up
+    from micropoly import warm_up
 
     warm_up.wait()
-    os.environ["MICROPOLY_CL_FAULT"] = "launch:1:CL_OUT_OF_RESOURCES@shade"
-    engine._final_renderers.drop()
-    try:
-        ru.render_passes(scene, "MICROPOLY", 64, 48, samples=4)
-        message = None
-    except RuntimeError as e:
-        message = str(e)
-    finally:
-        del os.environ["MICROPOLY_CL_FAULT"]
+    message = f12_error(scene, "launch:1:CL_OUT_OF_RESOURCES@shade")
     failed += check(message is not None and "(bound_split/shade)" in message and "CL_OUT_OF_RESOURCES" in message
                     and "ran out of memory" in message, "F12 reports the device fault", message)
 
@@ -59,15 +68,7 @@ def main():
 
     # Host memory running out while the scene is uploaded: the message names
     # the phase and what would help, not a bare "std::bad_alloc".
-    os.environ["MICROPOLY_CL_FAULT"] = "alloc:1:host@upload"
-    engine._final_renderers.drop()
-    try:
-        ru.render_passes(scene, "MICROPOLY", 64, 48, samples=4)
-        message = None
-    except RuntimeError as e:
-        message = str(e)
-    finally:
-        del os.environ["MICROPOLY_CL_FAULT"]
+    message = f12_error(scene, "alloc:1:host@upload")
     failed += check(message is not None and "(upload)" in message and "ran out of host memory" in message
                     and "subdivision levels" in message and "bad_alloc" not in message,
                     "F12 reports host memory running out", message)
@@ -82,10 +83,7 @@ def main():
 
     export_mesh.export_object = out_of_memory
     try:
-        ru.render_passes(scene, "MICROPOLY", 64, 48, samples=4)
-        message = None
-    except RuntimeError as e:
-        message = str(e)
+        message = f12_error(scene)
     finally:
         export_mesh.export_object = export_object
     failed += check(message is not None and "ran out of memory exporting object 'Cube'" in message,
