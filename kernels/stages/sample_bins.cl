@@ -1,6 +1,7 @@
-/* Sample by bins (RenderSettings::sampler "bins"): a sort-middle rasteriser (Laine & Karras 2011,
- * "High-performance software rasterization on GPUs") whose bins are small
- * enough that their samples' keys fit a work-group's local memory. Per
+/* Sample by bins (RenderSettings::sampler "bins"): a sort-middle
+ * rasteriser (Laine & Karras 2011, "High-performance software rasterization
+ * on GPUs") whose bins are small enough that their samples' keys fit a
+ * work-group's local memory. Per
  * batch, with no host round trip:
  *  - bin_runs bounds each run of MP_TILE_RUN micropolygons of a grid in
  *    bins and counts the runs per bin;
