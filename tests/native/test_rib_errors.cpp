@@ -216,7 +216,7 @@ TEST(RibErrors, VisibilityValues) {
 
 TEST(RibErrors, SamplerAndSampleMemory) {
   expect_error("Option \"micropoly\" \"string sampler\" \"fast\"\n", 1,
-               "\"sampler\" must be \"auto\", \"tiles\" or \"micropolygons\"");
+               "\"sampler\" must be \"auto\", \"tiles\", \"micropolygons\" or \"bins\"");
   expect_error("Option \"micropoly\" \"string visibilityfirst\" \"later\"\n", 1,
                "\"visibilityfirst\" must be \"auto\", \"on\" or \"off\"");
   expect_error("Option \"micropoly\"\n\"float samplememory\" [0]\n", 2, "\"samplememory\" must be");
