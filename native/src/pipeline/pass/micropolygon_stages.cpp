@@ -226,11 +226,9 @@ void SampleStage::begin_frame(const FrameParams& f, StageTimer& timer, const std
     bins_x_ = cl_uint((f.width + bin_side_ - 1) / bin_side_);
     bins_y_ = cl_uint((f.height + bin_side_ - 1) / bin_side_);
     const size_t bins = size_t(bins_x_) * bins_y_;
-    session_.reserve(bin_counts_, bin_count_bytes_, std::max(bins * sizeof(cl_uint), bin_count_bytes_), "bin counts");
-    session_.reserve(bin_starts_, bin_start_bytes_, std::max((bins + 1) * sizeof(cl_uint), bin_start_bytes_),
-                     "bin list starts");
-    session_.reserve(bin_cursors_, bin_cursor_bytes_, std::max(bins * sizeof(cl_uint), bin_cursor_bytes_),
-                     "bin list cursors");
+    session_.reserve(bin_counts_, bin_count_bytes_, bins * sizeof(cl_uint), "bin counts");
+    session_.reserve(bin_starts_, bin_start_bytes_, (bins + 1) * sizeof(cl_uint), "bin list starts");
+    session_.reserve(bin_cursors_, bin_cursor_bytes_, bins * sizeof(cl_uint), "bin list cursors");
     // bin_offsets clears the counts it reads; cleared here too, so that a
     // batch stopped between the two leaves no count behind.
     session_.queue().enqueueFillBuffer(bin_counts_, cl_uint(0), 0, bins * sizeof(cl_uint));

@@ -35,9 +35,8 @@ void SampleStage::bin_on_device(const cl::Buffer& diceable, cl_uint first, cl_ui
   // Room for the largest batch, so the lists are sized once.
   const size_t most_runs = size_t(grids.capacity) * bin_runs_per_grid_;
   const cl_uint runs = count * bin_runs_per_grid_;
-  session_.reserve(bin_rects_, bin_rect_bytes_, std::max(most_runs * sizeof(cl_int4), bin_rect_bytes_), "bin bounds");
-  session_.reserve(bin_entries_, bin_entry_bytes_,
-                   std::max(most_runs * MP_BIN_RUN_TILES * sizeof(cl_uint), bin_entry_bytes_), "bin lists");
+  session_.reserve(bin_rects_, bin_rect_bytes_, most_runs * sizeof(cl_int4), "bin bounds");
+  session_.reserve(bin_entries_, bin_entry_bytes_, most_runs * MP_BIN_RUN_TILES * sizeof(cl_uint), "bin lists");
   const cl_uint bins = bins_x_ * bins_y_;
   bind_args(bin_runs_, diceable, first, count, f, grids.p, bin_runs_per_grid_, cl_int(bin_side_), bins_x_,
             bin_rects_, bin_counts_);
