@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _native, camera_view, export_lights, export_materials, export_mesh, export_motion
+from . import _native, camera_view, export_instances, export_lights, export_materials, export_mesh, export_motion
 
 
 class ExportError(Exception):
@@ -237,25 +237,33 @@ def export_scene(depsgraph, view=None, meshes=None, motion=None):
         if inst.object.type == "MESH":
             for slot in inst.object.material_slots:
                 materials.get(slot.material)
+    instances = export_instances.InstanceTable()
     for inst in depsgraph.object_instances:
         obj = inst.object
         if obj.type == "MESH":
             try:
-                if export_mesh.export_object(native_scene, materials, meshes, obj, _matrix(inst.matrix_world),
-                                             out.warnings, is_instance=inst.is_instance, depsgraph=depsgraph,
-                                             random_id=inst.random_id if inst.is_instance else None):
+                if inst.is_instance:
+                    # Instances share one prototype per mesh they place.
+                    if instances.add(native_scene, materials, meshes, inst, _matrix(inst.matrix_world),
+                                     out.warnings, depsgraph):
+                        out.objects += 1
+                elif export_mesh.export_object(native_scene, materials, meshes, obj, _matrix(inst.matrix_world),
+                                               out.warnings, depsgraph=depsgraph):
                     out.objects += 1
-                    if motion is not None and not inst.is_instance:
+                    if motion is not None:
                         motion.apply_to_mesh(native_scene, obj.name)
             except RuntimeError as e:  # numpy/native rejections of the data
                 raise ExportError(f"object '{obj.name}': {e}") from e
             except MemoryError:
                 raise ExportError(
                     f"the computer ran out of memory exporting object '{obj.name}' after {out.objects} mesh "
-                    "objects: every instance is exported as a copy of its mesh, so render fewer copies of heavy "
-                    "objects, or lower their subdivision levels") from None
+                    "objects: render fewer or lighter objects, or lower their subdivision levels") from None
         elif obj.type == "LIGHT":
             export_lights.export_light(native_scene, obj, inst.matrix_world, out.warnings)
+    try:
+        instances.flush(native_scene)
+    except RuntimeError as e:
+        raise ExportError(f"instances: {e}") from e
     try:
         native_scene.validate()
     except RuntimeError as e:

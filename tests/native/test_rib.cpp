@@ -542,7 +542,8 @@ TEST(RibVisibility, InstancesTakeTheVisibilityWhereTheyAreInstanced) {
       "ObjectInstance \"thing\"\n"
       "AttributeBegin\nAttribute \"visibility\" \"int transmission\" [0]\nObjectInstance \"thing\"\nAttributeEnd\n"
       "AttributeBegin\nAttribute \"visibility\" \"int camera\" [0]\nObjectInstance \"thing\"\nAttributeEnd\n");
-  const mp::Scene& s = r.scene;
+  ASSERT_EQ(r.scene.instances.size(), 3u);
+  const mp::Scene s = mp::with_instances_made_real(r.scene);
   ASSERT_EQ(s.meshes.size(), 3u);
   EXPECT_TRUE(s.meshes[0].visible_camera);
   EXPECT_TRUE(s.meshes[0].cast_shadows);
@@ -651,7 +652,8 @@ TEST(RibAllRequests, EveryRequestLandsInTheScene) {
   EXPECT_EQ(s.bezier_patches[0].name, "patches");
   EXPECT_EQ(s.bezier_patches[0].control_points.size(), 4u * 16u);
 
-  const mp::Mesh* inst = find_mesh(s, "instance");
+  const mp::Scene real = mp::with_instances_made_real(s);
+  const mp::Mesh* inst = find_mesh(real, "instance");
   ASSERT_NE(inst, nullptr);
   expect_near(apply(inst->object_to_world, {0, 0, 0}), {10, 0, 1});
 
@@ -854,7 +856,9 @@ TEST(RibObjects, InstancesUseTheInstanceTransformAndAttributes) {
       "ObjectEnd\n"
       "AttributeBegin\nTranslate 10 0 0\nColor [1 0 0]\nSides 1\nObjectInstance \"thing\"\nAttributeEnd\n"
       "AttributeBegin\nRotate 90 0 0 1\nObjectInstance \"thing\"\nAttributeEnd\n");
-  const mp::Scene& s = r.scene;
+  ASSERT_EQ(r.scene.prototypes.size(), 1u);  // one definition, placed twice
+  ASSERT_EQ(r.scene.instances.size(), 2u);
+  const mp::Scene s = mp::with_instances_made_real(r.scene);
   ASSERT_EQ(s.meshes.size(), 4u);
   expect_near(apply(s.meshes[0].object_to_world, {1, 0, 0}), {12, 0, 0});
   expect_near(apply(s.meshes[1].object_to_world, {0, 0, 0}), {10, 0, 2});

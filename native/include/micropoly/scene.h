@@ -83,6 +83,41 @@ struct BezierPatches {
   ObjectInfo info;
 };
 
+// Instancing (RenderMan's ObjectBegin/ObjectInstance; Blender's instances):
+// a prototype is a set of surfaces, each placed in the prototype's own space
+// by its object_to_world, rendered only where instances place it. Its
+// patches are built once however many instances place it.
+struct Prototype {
+  std::string name;
+  std::vector<Mesh> meshes;
+  std::vector<BezierPatches> bezier_patches;
+};
+
+// One placement of a prototype. Its surfaces keep their geometry, UVs,
+// materials per face and texture space; the instance brings where they are
+// (object_to_world: prototype space -> world, composed with each surface's
+// own), what Object Info reads (info), and the RIB attributes current at
+// ObjectInstance: a material that replaces each surface's `material`
+// (-1: their own; face_materials still apply), sidedness (-1: their own,
+// 0 one-sided, 1 double-sided), ray visibility (combined with the surfaces'
+// own: a surface is seen where both say so) and RenderMan's
+// ReverseOrientation (front and back swapped).
+struct Instance {
+  std::string name;  // for messages; made real, its copies' names
+  int prototype = 0;
+  glm::mat4 object_to_world{1.0f};
+  ObjectInfo info;
+  int material = -1;
+  int double_sided = -1;
+  bool visible_camera = true;
+  bool cast_shadows = true;
+  bool reverse_orientation = false;
+  // Motion blur (Scene::motion_steps): the transform at each step, or empty
+  // where it does not move. Prototypes' meshes do not deform over the
+  // shutter (their motion_points stay empty): their instances move whole.
+  std::vector<glm::mat4> motion_object_to_world;
+};
+
 // Materials. Constant, Matte and Plastic follow RenderMan's shaders (Cs,
 // Ka, Kd, Ks, roughness, specularcolor; no 1/pi in the diffuse term).
 // Principled follows Blender's Principled BSDF in physical units: a
@@ -370,6 +405,8 @@ struct Scene {
   World world;
   std::vector<Mesh> meshes;
   std::vector<BezierPatches> bezier_patches;
+  std::vector<Prototype> prototypes;
+  std::vector<Instance> instances;
   // Motion blur: 0 (none), or the number (2 to kMaxMotionSteps) of times,
   // evenly spread over the shutter from its opening (0) to its closing (1),
   // at which the camera, meshes and their transforms give their positions
@@ -387,5 +424,13 @@ constexpr size_t kMaxShutterCurve = 4096;
 
 // Checks indices, counts and finite values; throws mp::Error naming the object.
 void validate_scene(const Scene& scene);
+
+// The scene with every instance made real: each instance's prototype
+// surfaces appended to meshes and bezier_patches as objects of their own,
+// placed and attributed as the instance says (named as the instance, or
+// "<prototype>/<surface>#<index>" where it has no name); prototypes and
+// instances emptied.
+// What an instanced scene must render like.
+Scene with_instances_made_real(const Scene& scene);
 
 }  // namespace mp

@@ -503,7 +503,81 @@ PYBIND11_MODULE(_native, m) {
           py::arg("program_params") = std::vector<float>{},
           "Sets the world (scene.h, World): a world program's index (add_material_program) baked to a map "
           "bake_width wide, or an equirectangular radiance map (height, width, 4), rows bottom to top.")
+      .def(
+          "mesh_to_prototype",
+          [](Scene& s, int index, const std::string& name) {
+            const int n = int(s.meshes.size());
+            if (index < -n || index >= n) throw Error("mesh_to_prototype: no mesh " + std::to_string(index));
+            const auto at = s.meshes.begin() + (index < 0 ? index + n : index);
+            Prototype p;
+            p.name = name.empty() ? at->name : name;
+            p.meshes.push_back(std::move(*at));
+            s.meshes.erase(at);
+            s.prototypes.push_back(std::move(p));
+            return s.prototypes.size() - 1;
+          },
+          py::arg("index") = -1, py::arg("name") = "",
+          "Moves mesh `index` (negative: from the end) out of the scene into a new prototype (scene.h), rendered "
+          "only where instances place it; returns the prototype's index. Its object_to_world places it in the "
+          "prototype's own space.")
+      .def(
+          "add_instances",
+          [](Scene& s, int prototype, const Array<float>& object_to_world, const Array<float>& random,
+             const Array<float>& object_color, const Array<float>& pass_index, bool visible_camera, bool cast_shadows,
+             const Array<float>& motion_object_to_world) {
+            if (prototype < 0 || size_t(prototype) >= s.prototypes.size())
+              throw Error("add_instances: no prototype " + std::to_string(prototype));
+            const std::vector<glm::mat4> placed = to_matrices(object_to_world, "object_to_world");
+            const size_t n = placed.size();
+            auto per_instance = [&](const Array<float>& a, size_t width, const char* what) {
+              if (a.size() != 0 && size_t(a.size()) != n * width)
+                throw Error(std::string("add_instances: ") + what + " needs " + std::to_string(width) +
+                            " value(s) per instance");
+              return a.size() != 0;
+            };
+            const bool has_random = per_instance(random, 1, "random");
+            const bool has_color = per_instance(object_color, 4, "object_color");
+            const bool has_pass = per_instance(pass_index, 1, "pass_index");
+            size_t steps = 0;
+            if (motion_object_to_world.size() != 0) {
+              if (motion_object_to_world.ndim() != 4 || size_t(motion_object_to_world.shape(0)) != n ||
+                  motion_object_to_world.shape(2) != 4 || motion_object_to_world.shape(3) != 4)
+                throw Error("add_instances: motion_object_to_world must be an (instances, steps, 4, 4) array");
+              steps = size_t(motion_object_to_world.shape(1));
+            }
+            s.instances.reserve(s.instances.size() + n);
+            for (size_t i = 0; i < n; ++i) {
+              Instance inst;
+              inst.prototype = prototype;
+              inst.object_to_world = placed[i];
+              if (has_random) inst.info.random = random.data()[i];
+              if (has_color) {
+                const float* c = object_color.data() + 4 * i;
+                inst.info.color = glm::vec4(c[0], c[1], c[2], c[3]);
+              }
+              if (has_pass) inst.info.pass_index = pass_index.data()[i];
+              inst.visible_camera = visible_camera;
+              inst.cast_shadows = cast_shadows;
+              for (size_t k = 0; k < steps; ++k) {
+                const float* f = motion_object_to_world.data() + (i * steps + k) * 16;
+                glm::mat4 m;
+                for (int row = 0; row < 4; ++row)
+                  for (int col = 0; col < 4; ++col) m[col][row] = f[4 * row + col];
+                inst.motion_object_to_world.push_back(m);
+              }
+              s.instances.push_back(std::move(inst));
+            }
+          },
+          py::arg("prototype"), py::arg("object_to_world"), py::arg("random") = Array<float>(),
+          py::arg("object_color") = Array<float>(), py::arg("pass_index") = Array<float>(),
+          py::arg("visible_camera") = true, py::arg("cast_shadows") = true,
+          py::arg("motion_object_to_world") = Array<float>(),
+          "Places `prototype` once per row-major matrix of object_to_world (instances, 4, 4); per instance, "
+          "optionally: Object Info's random (instances,), object_color (instances, 4), pass_index (instances,), "
+          "and motion_object_to_world (instances, steps, 4, 4).")
       .def("validate", [](const Scene& s) { validate_scene(s); })
+      .def_property_readonly("prototype_count", [](const Scene& s) { return s.prototypes.size(); })
+      .def_property_readonly("instance_count", [](const Scene& s) { return s.instances.size(); })
       .def_property_readonly("mesh_count", [](const Scene& s) { return s.meshes.size(); })
       .def_property_readonly("patch_set_count", [](const Scene& s) { return s.bezier_patches.size(); })
       .def_property_readonly("material_count", [](const Scene& s) { return s.materials.size(); })

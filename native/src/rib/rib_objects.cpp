@@ -15,23 +15,10 @@
 #include <algorithm>
 
 #include "rib/rib_parser.h"
+#include "scene/orientation.h"
 
 namespace mp::rib {
 namespace {
-
-void reverse_faces(Mesh& mesh, size_t first_face, size_t first_index) {
-  size_t offset = first_index;
-  for (size_t f = first_face; f < mesh.face_vertex_counts.size(); ++f) {
-    const size_t n = static_cast<size_t>(mesh.face_vertex_counts[f]);
-    const auto flip = [&](auto& corners) {
-      std::reverse(corners.begin() + static_cast<long>(offset), corners.begin() + static_cast<long>(offset + n));
-    };
-    flip(mesh.face_vertex_indices);
-    for (auto& layer : mesh.uv_layers) flip(layer);  // UVs belong to their corners
-    if (!mesh.corner_normals.empty()) flip(mesh.corner_normals);
-    offset += n;
-  }
-}
 
 // Appends `src`'s UV layers for its corners to `dst`, which had `dst_corners`
 // corners; a layer one side lacks reads zeros there, as a missing layer does.
@@ -44,15 +31,6 @@ void append_uv_layers(Mesh& dst, size_t dst_corners, const Mesh& src) {
     else
       dst.uv_layers[k].resize(dst_corners + src.face_vertex_indices.size(), glm::vec2(0.0f));
   }
-}
-
-// Mirrors each 4x4 net in u, which negates dPdu and so the normal.
-void mirror_patches_u(std::vector<glm::vec3>& cps, size_t first) {
-  for (size_t p = first; p + 16 <= cps.size(); p += 16)
-    for (size_t j = 0; j < 4; ++j) {
-      std::swap(cps[p + 4 * j + 0], cps[p + 4 * j + 3]);
-      std::swap(cps[p + 4 * j + 1], cps[p + 4 * j + 2]);
-    }
 }
 
 // Appends `src`'s corner normals; when only one side has them, the other's
@@ -111,11 +89,9 @@ void Parser::account_lights(const Attributes& attrs) {
   }
 }
 
-void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const Attributes& attrs,
-                          int line) {
-  charge(prim.elements(), line);
-  const glm::mat4 object_to_world = xform * prim.local;
-  const int material = material_index(attrs);
+// What every primitive and instance does to the parser's accounts: the
+// lights it is lit by, and the one shading rate.
+void Parser::note_primitive(const Attributes& attrs, int line) {
   account_lights(attrs);
   ++prims_emitted_;
   // ShadingRate is an attribute in RenderMan but one global setting here.
@@ -127,6 +103,14 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
     warn_once("shading-rate", line,
               "ShadingRate differs between primitives; one rate (the last one set) is used");
   }
+}
+
+void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const Attributes& attrs,
+                          int line) {
+  charge(prim.elements(), line);
+  const glm::mat4 object_to_world = xform * prim.local;
+  const int material = material_index(attrs);
+  note_primitive(attrs, line);
   const bool flip = attrs.inside_out;
   const std::string name = attrs.has_identifier ? attrs.identifier : prim.origin;
   Scene& scene = result_.scene;
@@ -244,10 +228,53 @@ void Parser::req_object_instance(ArgReader& args) {
     return;
   }
   if (!in_world_) args.fail("ObjectInstance outside WorldBegin/WorldEnd");
-  // Instances take the attributes (material, sides, orientation, visibility)
-  // current here, as the RI specification has it; attributes set inside the
-  // definition do not apply to it.
-  for (const Primitive& p : prims) add_to_scene(p, attrs_.ctm, attrs_, line);
+  add_instance(it->second, key, line);
+}
+
+// An object's prototype is made at its first instance (definitions never
+// placed cost nothing); every instance is then one Scene Instance. Instances
+// take the attributes (material, sides, orientation, visibility) current
+// here, as the RI specification has it; attributes set inside the
+// definition do not apply to it.
+void Parser::add_instance(ObjectDef& def, const std::string& key, int line) {
+  Scene& scene = result_.scene;
+  if (def.prototype < 0) {
+    Prototype proto;
+    proto.name = key;
+    for (const Primitive& p : def.prims) {
+      if (p.kind == Primitive::Kind::Mesh) {
+        Mesh mesh = p.mesh;
+        mesh.name = p.origin;
+        mesh.object_to_world = p.local;
+        proto.meshes.push_back(std::move(mesh));
+      } else {
+        BezierPatches set;
+        set.name = p.origin;
+        set.control_points = p.patch_points;
+        set.object_to_world = p.local;
+        proto.bezier_patches.push_back(std::move(set));
+      }
+    }
+    def.prototype = int(scene.prototypes.size());
+    scene.prototypes.push_back(std::move(proto));
+  }
+  charge(1, line);
+  note_primitive(attrs_, line);
+  Instance inst;
+  inst.name = attrs_.has_identifier ? attrs_.identifier : key;
+  inst.prototype = def.prototype;
+  inst.object_to_world = attrs_.ctm;
+  inst.material = material_index(attrs_);
+  inst.double_sided = attrs_.double_sided ? 1 : 0;
+  inst.visible_camera = attrs_.visible_camera;
+  inst.cast_shadows = attrs_.cast_shadows;
+  inst.info = attrs_.object_info;
+  inst.reverse_orientation = attrs_.inside_out;
+  inst.motion_object_to_world = attrs_.motion_ctm;
+  if (!inst.motion_object_to_world.empty() && !scene.prototypes[size_t(def.prototype)].bezier_patches.empty())
+    warn_once("motion-patches", line, "patches (Patch, PatchMesh) do not move: they render at the shutter's centre");
+  scene.instances.push_back(std::move(inst));
+  has_merge_target_ = false;
 }
 
 }  // namespace mp::rib

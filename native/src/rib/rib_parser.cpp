@@ -727,7 +727,9 @@ RibResult Parser::finish(const std::string& file) {
   const bool moves = !scene.camera.motion_world_to_camera.empty() ||
                      std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const Mesh& m) {
                        return !m.motion_points.empty() || !m.motion_object_to_world.empty();
-                     });
+                     }) ||
+                     std::any_of(scene.instances.begin(), scene.instances.end(),
+                                 [](const Instance& i) { return !i.motion_object_to_world.empty(); });
   if (!moves) scene.motion_steps = 0;
   number_programs_by_use(scene);
   bool partial = false;

@@ -127,6 +127,7 @@ class Parser {
   };
   struct ObjectDef {
     std::vector<Primitive> prims;
+    int prototype = -1;  // its Scene prototype, once an instance placed it
   };
   struct MergeTarget {
     Primitive::Kind kind;
@@ -148,6 +149,8 @@ class Parser {
   [[noreturn]] void fail(int line, const std::string& reason) const;
   std::string where(int line) const;
   void charge(size_t elements, int line);
+  void note_primitive(const Attributes& attrs, int line);
+  void add_instance(ObjectDef& def, const std::string& key, int line);
   void push_block(Block::Kind kind, int line);
   void pop_block(Block::Kind kind, ArgReader& args);
   static const char* block_name(Block::Kind kind);

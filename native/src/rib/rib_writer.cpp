@@ -485,6 +485,16 @@ void write_visibility(std::string& o, bool visible_camera, bool cast_shadows) {
 
 // Name, placement, sides, visibility and material: what a mesh and a patch
 // set share.
+void write_object_info(std::string& o, const ObjectInfo& info) {
+  if (info == ObjectInfo{}) return;
+  o += "  Attribute \"micropoly\"";
+  param(o, "color objectcolor", glm::vec3(info.color));
+  param(o, "float objectalpha", info.color.w);
+  param(o, "float objectindex", info.pass_index);
+  param(o, "float objectrandom", info.random);
+  o += '\n';
+}
+
 template <typename Object>
 void write_object_state(std::string& o, const Object& object, const std::vector<Material>& materials,
                         const std::vector<MaterialProgram>& programs) {
@@ -494,14 +504,7 @@ void write_object_state(std::string& o, const Object& object, const std::vector<
   write_transform(o, object.object_to_world, motion_transforms(object), "  ");
   o += object.double_sided ? "  Sides 2\n" : "  Sides 1\n";
   write_visibility(o, object.visible_camera, object.cast_shadows);
-  if (!(object.info == ObjectInfo{})) {
-    o += "  Attribute \"micropoly\"";
-    param(o, "color objectcolor", glm::vec3(object.info.color));
-    param(o, "float objectalpha", object.info.color.w);
-    param(o, "float objectindex", object.info.pass_index);
-    param(o, "float objectrandom", object.info.random);
-    o += '\n';
-  }
+  write_object_info(o, object.info);
   const int material = object.material;
   write_material(o, materials[static_cast<size_t>(material)], material, "  ", programs);
 }
@@ -615,6 +618,92 @@ void write_patches(std::string& o, const BezierPatches& b, const std::vector<Mat
   o += "AttributeEnd\n";
 }
 
+// A prototype as RenderMan retained geometry (ObjectBegin/ObjectEnd), or
+// nothing where RIB cannot say it: a definition holds geometry only, and its
+// instances bring the material, sidedness and visibility, so its surfaces
+// must agree on those (meshes say their own material per face).
+struct WrittenPrototype {
+  bool as_object = false;
+  int material = 0;  // what its instances take unless they choose one
+  bool double_sided = true, visible_camera = true, cast_shadows = true;
+};
+
+WrittenPrototype prototype_state(const Prototype& p) {
+  WrittenPrototype w;
+  bool first = true, agree = true;
+  auto take = [&](const auto& s) {
+    if (first) {
+      w.double_sided = s.double_sided, w.visible_camera = s.visible_camera, w.cast_shadows = s.cast_shadows;
+      first = false;
+    }
+    agree = agree && s.double_sided == w.double_sided && s.visible_camera == w.visible_camera &&
+            s.cast_shadows == w.cast_shadows;
+  };
+  for (const Mesh& m : p.meshes) take(m);
+  for (const BezierPatches& b : p.bezier_patches) {
+    take(b);
+    agree = agree && b.material == p.bezier_patches.front().material;
+  }
+  w.material = !p.bezier_patches.empty() ? p.bezier_patches.front().material
+               : !p.meshes.empty()       ? p.meshes.front().material
+                                         : 0;
+  w.as_object = agree && !first;
+  return w;
+}
+
+// ObjectBegin <handle> ... ObjectEnd: each surface in its own transform,
+// meshes' materials per face (their own `material` spelt out where it is
+// not the one instances take).
+void write_prototype(std::string& o, const Prototype& p, const WrittenPrototype& w, int handle) {
+  o += "ObjectBegin ";
+  put_int(o, handle);
+  o += '\n';
+  for (const Mesh& m : p.meshes) {
+    o += "AttributeBegin\n  ConcatTransform ";
+    put_matrix(o, m.object_to_world);
+    o += '\n';
+    if (m.face_materials.empty() && m.material != w.material) {
+      Mesh spelt = m;
+      spelt.face_materials.assign(m.face_vertex_counts.size(), m.material);
+      write_mesh_geometry(o, spelt, spelt.points);
+    } else {
+      write_mesh_geometry(o, m, m.points);
+    }
+    o += "AttributeEnd\n";
+  }
+  for (const BezierPatches& b : p.bezier_patches) {
+    o += "AttributeBegin\n  ConcatTransform ";
+    put_matrix(o, b.object_to_world);
+    o += "\n  Basis \"bezier\" 3 \"bezier\" 3\n";
+    for (size_t k = 0; k + 16 <= b.control_points.size(); k += 16) {
+      o += "  Patch \"bicubic\" \"P\" ";
+      put_points(o, std::vector<glm::vec3>(b.control_points.begin() + static_cast<long>(k),
+                                           b.control_points.begin() + static_cast<long>(k + 16)));
+      o += '\n';
+    }
+    o += "AttributeEnd\n";
+  }
+  o += "ObjectEnd\n";
+}
+
+// One ObjectInstance with the instance's transform (over the shutter when it
+// moves) and the attributes it brings.
+void write_instance(std::string& o, const Instance& inst, const WrittenPrototype& w, int handle,
+                    const std::vector<Material>& materials, const std::vector<MaterialProgram>& programs) {
+  o += "AttributeBegin\n";
+  write_transform(o, inst.object_to_world, inst.motion_object_to_world, "  ");
+  const bool double_sided = inst.double_sided >= 0 ? inst.double_sided == 1 : w.double_sided;
+  o += double_sided ? "  Sides 2\n" : "  Sides 1\n";
+  if (inst.reverse_orientation) o += "  ReverseOrientation\n";
+  write_visibility(o, inst.visible_camera && w.visible_camera, inst.cast_shadows && w.cast_shadows);
+  write_object_info(o, inst.info);
+  const int material = inst.material >= 0 ? inst.material : w.material;
+  write_material(o, materials[static_cast<size_t>(material)], material, "  ", programs);
+  o += "  ObjectInstance ";
+  put_int(o, handle);
+  o += "\nAttributeEnd\n";
+}
+
 void flush(std::ostream& out, std::string& text) {
   out.write(text.data(), static_cast<std::streamsize>(text.size()));
   text.clear();
@@ -676,6 +765,41 @@ void write_world(std::string& o, const Scene& scene, const std::string& folder, 
   o += '\n';
 }
 
+// Prototypes RIB can hold as retained objects, with their instances; the
+// instances of any other are written as the copies they render like.
+void write_instances(std::string& o, std::ostream& out, const Scene& scene, const std::vector<Material>& materials) {
+  std::vector<WrittenPrototype> written;
+  Scene rest;  // instances of prototypes RIB cannot hold
+  for (size_t p = 0; p < scene.prototypes.size(); ++p) {
+    written.push_back(prototype_state(scene.prototypes[p]));
+    rest.prototypes.push_back(written.back().as_object ? Prototype{} : scene.prototypes[p]);
+  }
+  std::vector<bool> defined(scene.prototypes.size(), false);
+  for (const Instance& inst : scene.instances) {
+    const size_t p = size_t(inst.prototype);
+    if (!written[p].as_object) {
+      rest.instances.push_back(inst);
+      continue;
+    }
+    const int handle = int(p) + 1;
+    if (!defined[p]) {
+      write_prototype(o, scene.prototypes[p], written[p], handle);
+      defined[p] = true;
+    }
+    write_instance(o, inst, written[p], handle, materials, scene.material_programs);
+    flush(out, o);
+  }
+  const Scene copies = with_instances_made_real(rest);
+  for (const Mesh& m : copies.meshes) {
+    write_mesh(o, m, materials, scene.material_programs);
+    flush(out, o);
+  }
+  for (const BezierPatches& b : copies.bezier_patches) {
+    write_patches(o, b, materials, scene.material_programs);
+    flush(out, o);
+  }
+}
+
 // write_rib() after validation.
 void write_valid_scene(const Scene& scene, std::ostream& out, const std::string& display_name,
                        const std::string& image_folder, const std::string& image_reference) {
@@ -715,6 +839,7 @@ void write_valid_scene(const Scene& scene, std::ostream& out, const std::string&
     write_patches(o, b, materials, scene.material_programs);
     flush(out, o);
   }
+  write_instances(o, out, scene, materials);
   o += "WorldEnd\nFrameEnd\n";
   flush(out, o);
   out.flush();

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <cstdint>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "micropoly/error.h"
 #include "micropoly/scene.h"
@@ -197,6 +199,70 @@ void validate_mesh(const Mesh& m, size_t materials) {
 
 }  // namespace
 
+void validate_patches(const BezierPatches& b, size_t materials) {
+  if (b.control_points.size() % 16 != 0) fail("patch set", b.name, "needs 16 control points per bicubic patch");
+  for (const glm::vec3& p : b.control_points)
+    if (!finite(p)) fail("patch set", b.name, "has a NaN or infinite control point");
+  if (!finite(b.object_to_world)) fail("patch set", b.name, "transform contains NaN or infinite values");
+  check_extent(b.control_points, b.object_to_world, "patch set", b.name);
+  check_material_index(b.material, materials, "patch set", b.name);
+}
+
+// Prototypes are checked once, in their own space; each instance by its
+// transforms and the prototype's box carried through them, so a million
+// instances cost a million boxes, not a million meshes.
+void validate_instances(const Scene& scene) {
+  std::vector<std::pair<glm::vec3, glm::vec3>> boxes;
+  for (const Prototype& proto : scene.prototypes) {
+    glm::vec3 lo(0.0f), hi(0.0f);
+    bool any = false;
+    auto grow = [&](const std::vector<glm::vec3>& points, const glm::mat4& m) {
+      for (const glm::vec3& p : points) {
+        const glm::vec3 q(m * glm::vec4(p, 1.0f));
+        lo = any ? glm::min(lo, q) : q, hi = any ? glm::max(hi, q) : q, any = true;
+      }
+    };
+    for (const Mesh& m : proto.meshes) {
+      validate_mesh(m, scene.materials.size());
+      if (!m.motion_points.empty() || !m.motion_object_to_world.empty())
+        fail("prototype", proto.name, "mesh '" + m.name + "' moves on its own; instances move, their prototypes do not");
+      grow(m.points, m.object_to_world);
+    }
+    for (const BezierPatches& b : proto.bezier_patches) {
+      validate_patches(b, scene.materials.size());
+      grow(b.control_points, b.object_to_world);
+    }
+    boxes.emplace_back(lo, hi);
+  }
+  const size_t steps = size_t(scene.motion_steps);
+  for (size_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& inst = scene.instances[i];
+    const std::string name = std::to_string(i);
+    if (inst.prototype < 0 || size_t(inst.prototype) >= scene.prototypes.size())
+      fail("instance", name, "places prototype " + std::to_string(inst.prototype) + " of " +
+                                 std::to_string(scene.prototypes.size()));
+    if (inst.material != -1) check_material_index(inst.material, scene.materials.size(), "instance", name);
+    if (inst.double_sided < -1 || inst.double_sided > 1)
+      fail("instance", name, "double_sided must be -1 (the surfaces' own), 0 or 1");
+    if (!finite(inst.info.color) || !std::isfinite(inst.info.pass_index) || !std::isfinite(inst.info.random))
+      fail("instance", name, "has NaN or infinite Object Info values");
+    if (!inst.motion_object_to_world.empty() && inst.motion_object_to_world.size() != steps)
+      fail("instance", name, "has " + std::to_string(inst.motion_object_to_world.size()) +
+                                 " motion transforms for " + std::to_string(steps) + " motion steps");
+    const auto& box = boxes[size_t(inst.prototype)];
+    std::vector<glm::vec3> corners;
+    for (int c = 0; c < 8; ++c)
+      corners.emplace_back(c & 1 ? box.second.x : box.first.x, c & 2 ? box.second.y : box.first.y,
+                           c & 4 ? box.second.z : box.first.z);
+    if (!finite(inst.object_to_world)) fail("instance", name, "transform contains NaN or infinite values");
+    check_extent(corners, inst.object_to_world, "instance", name);
+    for (const glm::mat4& t : inst.motion_object_to_world) {
+      if (!finite(t)) fail("instance", name, "has a motion transform with NaN or infinite values");
+      check_extent(corners, t, "instance", name);
+    }
+  }
+}
+
 void validate_scene(const Scene& scene) {
   const RenderSettings& s = scene.settings;
   if (s.width < 1 || s.height < 1 || s.width > 65536 || s.height > 65536)
@@ -329,14 +395,8 @@ void validate_scene(const Scene& scene) {
     for (const glm::vec4& p : im.pixels)
       if (!finite(p)) fail("image", im.name, "has NaN or infinite pixels");
   }
-  for (const BezierPatches& b : scene.bezier_patches) {
-    if (b.control_points.size() % 16 != 0) fail("patch set", b.name, "needs 16 control points per bicubic patch");
-    for (const glm::vec3& p : b.control_points)
-      if (!finite(p)) fail("patch set", b.name, "has a NaN or infinite control point");
-    if (!finite(b.object_to_world)) fail("patch set", b.name, "transform contains NaN or infinite values");
-    check_extent(b.control_points, b.object_to_world, "patch set", b.name);
-    check_material_index(b.material, scene.materials.size(), "patch set", b.name);
-  }
+  for (const BezierPatches& b : scene.bezier_patches) validate_patches(b, scene.materials.size());
+  validate_instances(scene);
 }
 
 }  // namespace mp

@@ -227,7 +227,13 @@ void Renderer::Impl::render(const Scene& scene, RenderResult& out, const Progres
   validate_scene(scene);
   guarded([&] {
     ready_session();
-    render_frame(scene, out, progress, overlapped);
+    if (scene.instances.empty() && scene.prototypes.empty()) {
+      render_frame(scene, out, progress, overlapped);
+    } else {
+      // Instances are placed as copies of their prototypes' surfaces
+      // (docs/pipeline.md, "Instances": the device does not place them yet).
+      render_frame(with_instances_made_real(scene), out, progress, overlapped);
+    }
   });
 }
 

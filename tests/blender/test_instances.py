@@ -1,0 +1,211 @@
+"""Instances in Blender (run by blender -b, or a Python with the bpy module):
+Geometry Nodes' Instance on Points, a particle system of objects, and a
+collection instanced by empties whose collection holds another collection
+instance (nested), each exported as prototypes and instances (one
+prototype per instanced mesh, one instance per copy: the exported scene's
+own counts), and each rendering like the same scene with its instances made
+real in Blender (Realize Instances, Make Instances Real): PSNR >= 60 dB,
+alpha identical. Exits non-zero on failure."""
+
+import math
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+import render_utils as ru  # noqa: E402
+
+RESULTS = []
+W, H = 160, 120
+
+
+def check(name, condition, detail=""):
+    RESULTS.append(bool(condition))
+    print(f"{'ok  ' if condition else 'FAIL'} {name}" + (f": {detail}" if detail else ""))
+
+
+def exported_counts(scene):
+    from micropoly import export
+
+    exported = export.export_scene(bpy.context.evaluated_depsgraph_get())
+    return exported.scene.prototype_count, exported.scene.instance_count, exported.scene.mesh_count
+
+
+def base_scene():
+    scene = ru.reset_scene()
+    ru.add_camera(scene, (7.0, -9.0, 7.0), (0.0, 0.0, 0.0))
+    ru.add_sun(scene, (math.radians(35), 0.0, math.radians(25)))
+    bpy.ops.mesh.primitive_plane_add(size=12.0, location=(0.0, 0.0, -0.6))
+    bpy.context.object.name = "Floor"
+    bpy.context.object.data.materials.append(ru.diffuse_material("Floor", (0.6, 0.6, 0.6)))
+    return scene
+
+
+def rock(name, color, location=(0.0, 0.0, -20.0)):
+    """A flat-shaded ico sphere, away from the camera: only its instances show."""
+    bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=2, radius=0.5, location=location)
+    obj = bpy.context.object
+    obj.name = name
+    obj.data.materials.append(ru.diffuse_material(name, color))
+    return obj
+
+
+def compare(name, scene, make_real, prototypes, instances):
+    got = exported_counts(scene)
+    check(f"{name}: exported as prototypes and instances", got[0] == prototypes and got[1] == instances,
+          f"{got[0]} prototypes, {got[1]} instances (expected {prototypes}, {instances})")
+    a = ru.render_passes(scene, "MICROPOLY", W, H, samples=4)["rgba"]
+    make_real()
+    real = exported_counts(scene)
+    check(f"{name}: made real, no instances are left", real[1] == 0, f"{real[1]} instances")
+    b = ru.render_passes(scene, "MICROPOLY", W, H, samples=4)["rgba"]
+    p = ru.psnr(a[..., :3], b[..., :3], peak=1.0)
+    alpha_same = bool(np.array_equal(a[..., 3], b[..., 3]))
+    covered = float((a[..., 3] > 0.5).mean())
+    check(f"{name}: renders like its instances made real", p >= 60.0 and alpha_same and covered > 0.2,
+          f"{p:.1f} dB, alpha identical {alpha_same}, covered {covered:.2f}")
+
+
+def geometry_nodes_scene():
+    """Instance on Points: a rock on each vertex of a 4 x 4 grid, rotated and
+    scaled per point."""
+    scene = base_scene()
+    stone = rock("Stone", (0.8, 0.4, 0.2))
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=3, y_subdivisions=3, size=8.0)
+    grid = bpy.context.object
+    grid.name = "Scatter"
+    mod = grid.modifiers.new("Scatter", "NODES")
+    tree = bpy.data.node_groups.new("Scatter", "GeometryNodeTree")
+    mod.node_group = tree
+    nodes, links = tree.nodes, tree.links
+    if hasattr(tree, "interface"):  # Blender 4.0 and later
+        tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+        tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    else:
+        tree.inputs.new("NodeSocketGeometry", "Geometry")
+        tree.outputs.new("NodeSocketGeometry", "Geometry")
+    group_in = nodes.new("NodeGroupInput")
+    group_out = nodes.new("NodeGroupOutput")
+    info = nodes.new("GeometryNodeObjectInfo")
+    info.inputs["Object"].default_value = stone
+    info.transform_space = "ORIGINAL"
+    if "As Instance" in info.inputs:
+        info.inputs["As Instance"].default_value = True
+    on_points = nodes.new("GeometryNodeInstanceOnPoints")
+    rotation = nodes.new("FunctionNodeRandomValue")
+    rotation.data_type = "FLOAT_VECTOR"
+    rotation.inputs["Max"].default_value = (0.0, 0.0, 6.0)
+    scale = nodes.new("FunctionNodeRandomValue")
+    scale.data_type = "FLOAT"
+    scale.inputs[2].default_value = 0.6  # Min (float)
+    scale.inputs[3].default_value = 1.3  # Max (float)
+    links.new(group_in.outputs[0], on_points.inputs["Points"])
+    links.new(info.outputs["Geometry"], on_points.inputs["Instance"])
+    links.new(rotation.outputs[0], on_points.inputs["Rotation"])
+    links.new(scale.outputs[1], on_points.inputs["Scale"])
+    links.new(on_points.outputs["Instances"], group_out.inputs[0])
+
+    def realize():
+        real = nodes.new("GeometryNodeRealizeInstances")
+        links.new(on_points.outputs["Instances"], real.inputs["Geometry"])
+        links.new(real.outputs["Geometry"], group_out.inputs[0])
+
+    return scene, realize
+
+
+def particle_scene():
+    """A particle system on an emitter that renders a rock per particle."""
+    scene = base_scene()
+    stone = rock("Pebble", (0.3, 0.5, 0.8))
+    bpy.ops.mesh.primitive_plane_add(size=8.0, location=(0.0, 0.0, 0.0))
+    emitter = bpy.context.object
+    emitter.name = "Emitter"
+    emitter.show_instancer_for_render = False
+    emitter.modifiers.new("Particles", "PARTICLE_SYSTEM")
+    settings = emitter.particle_systems[0].settings
+    settings.count = 24
+    settings.frame_start = settings.frame_end = 1
+    settings.physics_type = "NO"
+    settings.render_type = "OBJECT"
+    settings.instance_object = stone
+    settings.particle_size = 0.8
+    settings.use_rotations = True
+    settings.rotation_factor_random = 1.0
+
+    def make_real():
+        bpy.ops.object.select_all(action="DESELECT")
+        emitter.select_set(True)
+        bpy.context.view_layer.objects.active = emitter
+        bpy.ops.object.duplicates_make_real()
+        emitter.modifiers.clear()
+
+    return scene, make_real
+
+
+def nested_collection_scene():
+    """Empties instancing a collection whose own objects include an empty
+    instancing a second collection: two levels flatten to prototype and
+    transform."""
+    scene = base_scene()
+    inner = bpy.data.collections.new("Inner")
+    scene.collection.children.link(inner)
+    pebble = rock("Inner Rock", (0.2, 0.7, 0.3), location=(0.0, 0.0, 0.0))
+    for c in pebble.users_collection:
+        c.objects.unlink(pebble)
+    inner.objects.link(pebble)
+    outer = bpy.data.collections.new("Outer")
+    scene.collection.children.link(outer)
+    big = rock("Outer Rock", (0.7, 0.2, 0.5), location=(0.0, 0.0, 0.0))
+    for c in big.users_collection:
+        c.objects.unlink(big)
+    outer.objects.link(big)
+    nested = bpy.data.objects.new("Nested", None)
+    nested.instance_type = "COLLECTION"
+    nested.instance_collection = inner
+    nested.location = (0.9, 0.0, 0.3)
+    nested.scale = (0.6, 0.6, 0.6)
+    outer.objects.link(nested)
+    # The collections themselves stay out of the render; only their instances show.
+    scene.view_layers[0].layer_collection.children["Inner"].exclude = True
+    scene.view_layers[0].layer_collection.children["Outer"].exclude = True
+    empties = []
+    for k, (x, y, angle) in enumerate(((-3.0, -1.0, 0.3), (0.0, 2.0, 1.2), (3.0, -0.5, 2.0))):
+        e = bpy.data.objects.new(f"Place{k}", None)
+        e.instance_type = "COLLECTION"
+        e.instance_collection = outer
+        e.location = (x, y, 0.0)
+        e.rotation_euler = (0.0, 0.0, angle)
+        scene.collection.objects.link(e)
+        empties.append(e)
+
+    def make_real():
+        bpy.ops.object.select_all(action="DESELECT")
+        for e in empties:
+            e.select_set(True)
+        bpy.context.view_layer.objects.active = empties[0]
+        bpy.ops.object.duplicates_make_real(use_base_parent=False, use_hierarchy=False)
+        # Made real, the nested empties instance the inner collection still.
+        for obj in list(bpy.context.view_layer.objects):
+            if obj.type == "EMPTY" and obj.instance_type == "COLLECTION" and obj.name.startswith("Nested"):
+                bpy.ops.object.select_all(action="DESELECT")
+                obj.select_set(True)
+                bpy.context.view_layer.objects.active = obj
+                bpy.ops.object.duplicates_make_real()
+
+    return scene, make_real
+
+
+def main():
+    scene, realize = geometry_nodes_scene()
+    compare("Geometry Nodes Instance on Points", scene, realize, prototypes=1, instances=16)
+    scene, make_real = particle_scene()
+    compare("particle system of objects", scene, make_real, prototypes=1, instances=24)
+    scene, make_real = nested_collection_scene()
+    compare("nested collection instances", scene, make_real, prototypes=2, instances=6)
+    return 0 if all(RESULTS) else 1
+
+
+ru.run_test(main)
