@@ -150,18 +150,18 @@ def nested_collection_scene():
     instancing a second collection: two levels flatten to prototype and
     transform."""
     scene = base_scene()
-    inner = bpy.data.collections.new("Inner")
-    scene.collection.children.link(inner)
-    pebble = rock("Inner Rock", (0.2, 0.7, 0.3), location=(0.0, 0.0, 0.0))
-    for c in pebble.users_collection:
-        c.objects.unlink(pebble)
-    inner.objects.link(pebble)
-    outer = bpy.data.collections.new("Outer")
-    scene.collection.children.link(outer)
-    big = rock("Outer Rock", (0.7, 0.2, 0.5), location=(0.0, 0.0, 0.0))
-    for c in big.users_collection:
-        c.objects.unlink(big)
-    outer.objects.link(big)
+
+    def collection_of_rock(name, color):
+        collection = bpy.data.collections.new(name)
+        scene.collection.children.link(collection)
+        obj = rock(f"{name} Rock", color, location=(0.0, 0.0, 0.0))
+        for c in obj.users_collection:
+            c.objects.unlink(obj)
+        collection.objects.link(obj)
+        return collection
+
+    inner = collection_of_rock("Inner", (0.2, 0.7, 0.3))
+    outer = collection_of_rock("Outer", (0.7, 0.2, 0.5))
     nested = bpy.data.objects.new("Nested", None)
     nested.instance_type = "COLLECTION"
     nested.instance_collection = inner

@@ -602,19 +602,23 @@ void write_mesh(std::string& o, const Mesh& m, const std::vector<Material>& mate
   o += "AttributeEnd\n";
 }
 
-void write_patches(std::string& o, const BezierPatches& b, const std::vector<Material>& materials,
-                   const std::vector<MaterialProgram>& programs) {
-  // One Patch request per 4x4 net in the default Bezier basis (step 3); the
-  // reader joins consecutive patches of one attribute block into one set.
-  o += "AttributeBegin\n";
-  write_object_state(o, b, materials, programs);
+// One Patch request per 4x4 net in the default Bezier basis (step 3).
+void write_patch_requests(std::string& o, const std::vector<glm::vec3>& control_points) {
   o += "  Basis \"bezier\" 3 \"bezier\" 3\n";
-  for (size_t p = 0; p + 16 <= b.control_points.size(); p += 16) {
+  for (size_t p = 0; p + 16 <= control_points.size(); p += 16) {
     o += "  Patch \"bicubic\" \"P\" ";
-    put_points(o, std::vector<glm::vec3>(b.control_points.begin() + static_cast<long>(p),
-                                         b.control_points.begin() + static_cast<long>(p + 16)));
+    put_points(o, std::vector<glm::vec3>(control_points.begin() + static_cast<long>(p),
+                                         control_points.begin() + static_cast<long>(p + 16)));
     o += '\n';
   }
+}
+
+void write_patches(std::string& o, const BezierPatches& b, const std::vector<Material>& materials,
+                   const std::vector<MaterialProgram>& programs) {
+  // The reader joins consecutive patches of one attribute block into one set.
+  o += "AttributeBegin\n";
+  write_object_state(o, b, materials, programs);
+  write_patch_requests(o, b.control_points);
   o += "AttributeEnd\n";
 }
 
@@ -674,13 +678,8 @@ void write_prototype(std::string& o, const Prototype& p, const WrittenPrototype&
   for (const BezierPatches& b : p.bezier_patches) {
     o += "AttributeBegin\n  ConcatTransform ";
     put_matrix(o, b.object_to_world);
-    o += "\n  Basis \"bezier\" 3 \"bezier\" 3\n";
-    for (size_t k = 0; k + 16 <= b.control_points.size(); k += 16) {
-      o += "  Patch \"bicubic\" \"P\" ";
-      put_points(o, std::vector<glm::vec3>(b.control_points.begin() + static_cast<long>(k),
-                                           b.control_points.begin() + static_cast<long>(k + 16)));
-      o += '\n';
-    }
+    o += '\n';
+    write_patch_requests(o, b.control_points);
     o += "AttributeEnd\n";
   }
   o += "ObjectEnd\n";
