@@ -240,6 +240,10 @@ def export_scene(depsgraph, view=None, meshes=None, motion=None):
     instances = export_instances.InstanceTable()
     for inst in depsgraph.object_instances:
         obj = inst.object
+        # An instancer whose own geometry is hidden (a particle emitter with
+        # Show Emitter off for renders; Cycles reads the same flag).
+        if obj.type == "MESH" and not getattr(inst, "show_self", True):
+            continue
         if obj.type == "MESH":
             try:
                 if inst.is_instance:

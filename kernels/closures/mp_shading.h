@@ -6,6 +6,8 @@
 #ifndef MP_SHADING_H
 #define MP_SHADING_H
 
+#include "geometry/mp_instance.h"
+
 #include "core/mp_compat.h"
 #include "geometry/mp_patch.h"
 #include "core/mp_types.h"
@@ -253,10 +255,10 @@ MP_INLINE float mp_bump_shadowing_v4(float3 ns, float3 n, float3 l, int correcti
  * does, as Cycles flips a smooth normal with the geometric one on back
  * faces; zero when the patch has none. */
 MP_INLINE float3 mp_face_shading_normal(const MP_GLOBAL float4* normals, uint patch, float u, float v, float3 ng,
-                                        float3 p, int ortho) {
+                                        float3 p, int ortho, const MpPlacement* place) {
   const MP_GLOBAL float4* c = normals + (ulong)patch * MP_PATCH_NORMALS;
-  float3 n = (1.0f - u) * (1.0f - v) * MP_XYZ(c[0]) + u * (1.0f - v) * MP_XYZ(c[1]) + u * v * MP_XYZ(c[2]) +
-             (1.0f - u) * v * MP_XYZ(c[3]);
+  float3 n = mp_place_normal(place, (1.0f - u) * (1.0f - v) * MP_XYZ(c[0]) + u * (1.0f - v) * MP_XYZ(c[1]) +
+                                        u * v * MP_XYZ(c[2]) + (1.0f - u) * v * MP_XYZ(c[3]));
   float len = length(n);
   if (!(len > 0.0f) || !isfinite(len)) return MP_F3(0.0f, 0.0f, 0.0f);
   n = n / len;

@@ -30,6 +30,9 @@
   BUFFER(const float4, world_glossy)       /* the world's glossy maps (closures/mp_world.h), or one zero texel */ \
   BUFFER(const float4, motion_points)      /* points at each motion step, or one float4 without motion */         \
   BUFFER(const float4, motion_curves)      /* edge curves at each motion step, likewise */                        \
+  BUFFER(const DeviceInstance, instances)  /* prototype surfaces placed by instances (geometry/mp_instance.h) */ \
+  BUFFER(const uint, instance_roots)       /* instance_count + 1: the first root of each (exclusive prefix) */    \
+  BUFFER(const float4, instance_motion)    /* 3 rows per instance at each motion step, or one float4 */           \
   BUFFER(const uint, refract_roots)        /* refraction proxies (geometry/mp_refract_trace.h) */                 \
   BUFFER(const float4, refract_nodes)                                                                              \
   BUFFER(const float4, refract_tris)                                                                               \
@@ -37,7 +40,9 @@
   VALUE(uint, motion_steps)                                                                                        \
   VALUE(uint, point_count)                 /* float4s of one motion step in motion_points */                      \
   VALUE(uint, curve_count)                 /* float4s of one motion step in motion_curves */                      \
-  VALUE(uint, patch_count)                                                                                         \
+  VALUE(uint, patch_count)                 /* patches placed on their own (instances' roots follow them) */       \
+  VALUE(uint, root_count)                  /* patch_count + every instance's patches: roots of one view */        \
+  VALUE(uint, instance_count)                                                                                      \
   VALUE(uint, light_count)                                                                                         \
   VALUE(uint, uv_layers)                                                                                           \
   VALUE(uint, image_count)

@@ -19,7 +19,10 @@ typedef struct {
   uint patch;
   uint info;
   uint rates;
+  uint instance; /* the DeviceInstance placing `patch`, or MP_NO_INSTANCE (mp_instance.h) */
 } SubPatch;
+
+#define MP_NO_INSTANCE 0xffffffffu
 
 #define MP_EDGE_CODE(rates, e) (((rates) >> (8u * (uint)(e))) & 0xffu)
 #define MP_CODE_RATE(code) (1u << ((code) - 1u))
@@ -168,6 +171,30 @@ typedef struct {
   float color[4];       /* Object Info: the object's colour (RGBA) */
   float info[4];        /* Object Info: pass index, random number, 0, 0 */
 } DeviceObject;
+
+/* One surface of a prototype placed by one instance (scene.h Instance;
+ * geometry/mp_instance.h): patches [first_patch, first_patch + patch_count)
+ * hold the surface in its own space, once for all its instances; this
+ * record carries them to camera space at the shutter's centre (rows of a
+ * 3x4 matrix, and the inverse transpose of its linear part for normals).
+ * box: the placed surface's camera-space box over the whole shutter,
+ * displacement included; reach: how far (camera axes) its points move away
+ * from the centre's during the shutter; scale: the longest a unit vector of
+ * its space becomes (its patches' displacement bounds, in its units, times
+ * this); flags: MP_PATCH_FLIP_ORIENTATION (a mirroring transform),
+ * MP_PATCH_NO_CAMERA and MP_PATCH_NO_SHADOW (the instance's visibility),
+ * added to its patches' own; object: its DeviceObject. */
+typedef struct {
+  float to_camera[12];
+  float normal_to_camera[12];
+  float box_lo[4];
+  float box_hi[4];
+  float reach[4]; /* xyz; w: scale */
+  uint first_patch;
+  uint patch_count;
+  uint object;
+  uint flags;
+} DeviceInstance;
 
 /* A texture image (scene.h Image): its texels are width * height float4
  * (RGBA, rows bottom to top) from `offset` in the texel buffer; srgb = 1

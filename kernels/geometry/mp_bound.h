@@ -325,7 +325,7 @@ MP_INLINE float mp_polyline_screen_length(float3* p, int count, FrameParams f) {
  * on the patch boundary, else from the lexicographically smaller end. */
 MP_INLINE float mp_edge_screen_length(const MP_GLOBAL float4* points, const MP_GLOBAL uint* patch_info,
                                       const MP_GLOBAL uint* edges, const MP_GLOBAL float4* curves, uint patch,
-                                      float2 a, float2 b, FrameParams f) {
+                                      float2 a, float2 b, FrameParams f, const MpPlacement* place) {
   float3 p[MP_EDGE_SEGMENTS + 1];
   int e = a.y == 0.0f && b.y == 0.0f ? 0 : a.x == 1.0f && b.x == 1.0f ? 1 : a.y == 1.0f && b.y == 1.0f ? 2
         : a.x == 0.0f && b.x == 0.0f ? 3 : -1;
@@ -357,6 +357,7 @@ MP_INLINE float mp_edge_screen_length(const MP_GLOBAL float4* points, const MP_G
       mp_eval_patch(cp, type, uv.x, uv.y, &p[k], &du, &dv);
     }
   }
+  for (int k = 0; k <= MP_EDGE_SEGMENTS; ++k) p[k] = mp_place_point(place, p[k]);
   return mp_polyline_screen_length(p, MP_EDGE_SEGMENTS + 1, f);
 }
 
@@ -380,7 +381,7 @@ MP_INLINE uint mp_edge_rate_code(float len, FrameParams f) {
  * collapsed edges). *chord is the line's end minus its start on screen. Only
  * this sub-patch uses it, so it needs no canonical order. */
 MP_INLINE float mp_mid_screen_length(const MP_GLOBAL float4* cp, uint type, const SubPatch* sp, int dir, FrameParams f,
-                                     float2* chord) {
+                                     float2* chord, const MpPlacement* place) {
   float2 c0 = mp_corner(sp, 0), c1 = mp_corner(sp, 1), c2 = mp_corner(sp, 2), c3 = mp_corner(sp, 3);
   float2 a = dir == 0 ? 0.5f * (c3 + c0) : 0.5f * (c0 + c1);
   float2 b = dir == 0 ? 0.5f * (c1 + c2) : 0.5f * (c2 + c3);
@@ -389,6 +390,7 @@ MP_INLINE float mp_mid_screen_length(const MP_GLOBAL float4* cp, uint type, cons
     float2 uv = a + (b - a) * ((float)k / (float)MP_EDGE_SEGMENTS);
     float3 du, dv;
     mp_eval_patch(cp, type, uv.x, uv.y, &p[k], &du, &dv);
+    p[k] = mp_place_point(place, p[k]);
   }
   float len = mp_polyline_screen_length(p, MP_EDGE_SEGMENTS + 1, f);
   *chord = len >= 0.0f ? mp_project_view_unplaced(p[MP_EDGE_SEGMENTS], f) - mp_project_view_unplaced(p[0], f)
@@ -509,32 +511,68 @@ MP_INLINE int mp_bound_culled(MpBound b, const float3* lo, const float3* hi, int
  * camera's view) shows hidden by what is already sampled (MP_CULL_OCCLUDED).
  * The view is f's (the camera or a shadow map); shadow views also cull what
  * lies under none of their rendered pages (page_masks). */
+/* The box test of mp_classify for a camera-space box: cull, occluded, or 0. */
+MP_INLINE uint mp_classify_box(float3 blo, float3 bhi, FrameParams f, const MP_GLOBAL uchar* page_masks,
+                               const MP_GLOBAL uint* occlusion, OcclusionParams occ, int can_split) {
+  mp_boxes_to_view(&blo, &bhi, 1, f);
+  MpBound bb = mp_bound_boxes(&blo, &bhi, 1, f);
+  if (mp_bound_culled(bb, &blo, &bhi, 1, f, page_masks, can_split)) return MP_CULL;
+  if (occ.levels > 0 &&
+      mp_occluded(occlusion, occ, f, bb.xmin, bb.ymin, bb.xmax, bb.ymax, bb.dmin, MP_CULLING_PLANE(&blo, &bhi, 1, f)))
+    return MP_CULL_OCCLUDED;
+  return 0u;
+}
+
+/* Grows camera-space boxes by an instance's motion reach (mp_types.h). */
+MP_INLINE void mp_grow_boxes(float3* lo, float3* hi, int count, float3 grow) {
+  if (grow.x > 0.0f || grow.y > 0.0f || grow.z > 0.0f)
+    for (int k = 0; k < count; ++k) {
+      lo[k] -= grow;
+      hi[k] += grow;
+    }
+}
+
 MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint* patch_info,
                            const MP_GLOBAL uint* edges, const MP_GLOBAL float4* curves,
-                           const MP_GLOBAL float4* patch_bounds, SubPatch* sp, FrameParams f,
-                           const MP_GLOBAL uchar* page_masks, const MP_GLOBAL uint* occlusion, OcclusionParams occ) {
+                           const MP_GLOBAL float4* patch_bounds, const MP_GLOBAL DeviceInstance* instances,
+                           SubPatch* sp, FrameParams f, const MP_GLOBAL uchar* page_masks,
+                           const MP_GLOBAL uint* occlusion, OcclusionParams occ) {
   const MP_GLOBAL float4* cp = points + (ulong)sp->patch * MP_PATCH_POINTS;
   uint type = patch_info[4 * (ulong)sp->patch];
   /* Ray visibility: objects hidden from the camera still cast shadows, and
    * objects that cast none stay out of the lights' views. */
-  uint flags = patch_info[4 * (ulong)sp->patch + 2];
+  uint flags = mp_placed_flags(patch_info, instances, sp->patch, sp->instance);
   if (flags & (f.view_kind == MP_VIEW_SHADOW ? MP_PATCH_NO_SHADOW : MP_PATCH_NO_CAMERA)) return MP_CULL;
   uint depth = MP_INFO_DEPTH(sp->info);
   int can_split = (int)depth < f.max_depth;
+  MpPlacement place = mp_instance_placement(instances, sp->instance);
+  float3 reach = MP_F3(0.0f, 0.0f, 0.0f);
+  if (sp->instance != MP_NO_INSTANCE) {
+    reach = MP_F3(instances[sp->instance].reach[0], instances[sp->instance].reach[1], instances[sp->instance].reach[2]);
+    /* An instance's roots meet the view through the whole instance's box
+     * first, before their patch is read. */
+    if (depth == 0u) {
+      const MP_GLOBAL DeviceInstance* in = instances + sp->instance;
+      uint d = mp_classify_box(MP_F3(in->box_lo[0], in->box_lo[1], in->box_lo[2]),
+                               MP_F3(in->box_hi[0], in->box_hi[1], in->box_hi[2]), f, page_masks, occlusion, occ,
+                               can_split);
+      if (d) return d;
+    }
+  }
   /* Whole patches meet the view through their box first: a pass over many
    * views (shadow maps) sees most patches outside most views, and a box is
    * far cheaper to bound than the net. */
   if (depth == 0u && patch_bounds) {
     float3 blo = MP_XYZ(patch_bounds[2 * (ulong)sp->patch]), bhi = MP_XYZ(patch_bounds[2 * (ulong)sp->patch + 1]);
-    mp_boxes_to_view(&blo, &bhi, 1, f);
-    MpBound bb = mp_bound_boxes(&blo, &bhi, 1, f);
-    if (mp_bound_culled(bb, &blo, &bhi, 1, f, page_masks, can_split)) return MP_CULL;
-    if (occ.levels > 0 && mp_occluded(occlusion, occ, f, bb.xmin, bb.ymin, bb.xmax, bb.ymax, bb.dmin,
-                                      MP_CULLING_PLANE(&blo, &bhi, 1, f)))
-      return MP_CULL_OCCLUDED;
+    mp_place_boxes(&place, &blo, &bhi, 1);
+    mp_grow_boxes(&blo, &bhi, 1, reach);
+    uint d = mp_classify_box(blo, bhi, f, page_masks, occlusion, occ, can_split);
+    if (d) return d;
   }
   float3 lo[16], hi[16];
   mp_subpatch_hull(cp, type, sp, lo, hi);
+  mp_place_boxes(&place, lo, hi, 16);
+  mp_grow_boxes(lo, hi, 16, reach);
   mp_boxes_to_view(lo, hi, 16, f);
   MpBound b = mp_bound_boxes(lo, hi, 16, f);
   if (mp_bound_culled(b, lo, hi, 16, f, page_masks, can_split)) return MP_CULL;
@@ -551,7 +589,8 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
     uint code = MP_EDGE_CODE(sp->rates, e);
     float len = 0.0f;
     if (code == 0u) {
-      len = mp_edge_screen_length(points, patch_info, edges, curves, sp->patch, mp_corner(sp, e), mp_corner(sp, e + 1), f);
+      len = mp_edge_screen_length(points, patch_info, edges, curves, sp->patch, mp_corner(sp, e), mp_corner(sp, e + 1), f,
+                                  &place);
       code = mp_edge_rate_code(len, f);
       sp->rates |= code << (8u * (uint)e);
     }
@@ -560,8 +599,8 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
     any_long |= code == 0u;
   }
   float2 chord_u, chord_v;
-  float mid_u = mp_mid_screen_length(cp, type, sp, 0, f, &chord_u);
-  float mid_v = mp_mid_screen_length(cp, type, sp, 1, f, &chord_v);
+  float mid_u = mp_mid_screen_length(cp, type, sp, 0, f, &chord_u, &place);
+  float mid_v = mp_mid_screen_length(cp, type, sp, 1, f, &chord_v, &place);
   if (straddles) mid_u = mid_v = MP_UNMEASURABLE;
   float limit = 1.41421356f * (float)f.max_grid * f.micropoly_edge;
   int long_u = mid_u > limit, long_v = mid_v > limit;
@@ -610,6 +649,7 @@ MP_INLINE void mp_split(const SubPatch* sp, uint action, SubPatch* a, SubPatch* 
   uint ra[4] = {x_first, 0u, y_second, r[3]}, rb[4] = {x_second, r[1], y_first, 0u};
   uint info = MP_MAKE_INFO(MP_INFO_DEPTH(sp->info) + 1u, 0u, 0u) | (sp->info & MP_INFO_VIEW_BITS);
   a->patch = b->patch = sp->patch;
+  a->instance = b->instance = sp->instance;
   a->info = b->info = info;
   a->rates = b->rates = 0u;
   for (int k = 0; k < 4; ++k) {

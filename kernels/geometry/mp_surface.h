@@ -13,6 +13,8 @@
 #ifndef MP_SURFACE_H
 #define MP_SURFACE_H
 
+#include "geometry/mp_instance.h"
+
 /* Bernstein evaluation of curve `ref` at t along the referring edge: its
  * position (which = 0) or its normal cubic (which = 1, not normalised). */
 MP_INLINE float3 mp_curve_eval(const MP_GLOBAL float4* curves, uint ref, float t, uint which) {
@@ -49,11 +51,11 @@ MP_INLINE int mp_boundary_edge(float u, float v, float* t) {
   return -1;
 }
 
-/* Position and derivatives at (u, v) of patch `patch`; on the boundary the
- * position comes from the shared edge curve. */
+/* Position and derivatives at (u, v) of patch `patch`, placed (camera
+ * space); on the boundary the position comes from the shared edge curve. */
 MP_INLINE void mp_surface_point(const MP_GLOBAL float4* points, const MP_GLOBAL uint* patch_info,
                                 const MP_GLOBAL uint* edges, const MP_GLOBAL float4* curves, uint patch, float u,
-                                float v, float3* P, float3* dPdu, float3* dPdv) {
+                                float v, const MpPlacement* place, float3* P, float3* dPdu, float3* dPdv) {
   const MP_GLOBAL float4* cp = points + (ulong)patch * MP_PATCH_POINTS;
   mp_eval_patch(cp, patch_info[4 * (ulong)patch], u, v, P, dPdu, dPdv);
   float t;
@@ -62,18 +64,24 @@ MP_INLINE void mp_surface_point(const MP_GLOBAL float4* points, const MP_GLOBAL 
     uint ref = mp_edge_curve(edges, patch, (uint)e, &t);
     *P = mp_curve_point(curves, ref, t);
   }
+  *P = mp_place_point(place, *P);
+  *dPdu = mp_place_vector(place, *dPdu);
+  *dPdv = mp_place_vector(place, *dPdv);
 }
 
 /* Unit normal of the patch at (u, v) from its derivatives. Where they are
  * parallel or vanish (collapsed corners, poles) the normal is taken a little
  * way towards the patch centre, which is its limit along that direction. */
-MP_INLINE float3 mp_patch_normal(const MP_GLOBAL float4* cp, uint type, float u, float v, float3 dpdu, float3 dpdv) {
+MP_INLINE float3 mp_patch_normal(const MP_GLOBAL float4* cp, uint type, float u, float v, float3 dpdu, float3 dpdv,
+                                 const MpPlacement* place) {
   float3 n = cross(dpdu, dpdv);
   float scale = length(dpdu) * length(dpdv);
   for (int k = 0; k < 3 && !(length(n) > 1e-7f * scale && length(n) > 0.0f); ++k) {
     float t = k == 0 ? 1e-4f : k == 1 ? 1e-3f : 1e-2f;
     float3 p;
     mp_eval_patch(cp, type, u + (0.5f - u) * t, v + (0.5f - v) * t, &p, &dpdu, &dpdv);
+    dpdu = mp_place_vector(place, dpdu);
+    dpdv = mp_place_vector(place, dpdv);
     n = cross(dpdu, dpdv);
     scale = length(dpdu) * length(dpdv);
   }
@@ -81,19 +89,19 @@ MP_INLINE float3 mp_patch_normal(const MP_GLOBAL float4* cp, uint type, float u,
   return len > 0.0f ? n / len : MP_F3(0.0f, 0.0f, 1.0f);
 }
 
-/* Unit normal for dicing (before the object's orientation flip). On the
- * patch boundary it comes from the edge's shared normal cubic, oriented like
+/* Unit normal for dicing (before the object's orientation flip), from
+ * placed derivatives. On the patch boundary it comes from the edge's shared normal cubic, oriented like
  * this patch, so both sides displace a shared vertex identically. */
 MP_INLINE float3 mp_surface_normal(const MP_GLOBAL float4* points, const MP_GLOBAL uint* patch_info,
                                    const MP_GLOBAL uint* edges, const MP_GLOBAL float4* curves, uint patch, float u,
-                                   float v, float3 dPdu, float3 dPdv) {
+                                   float v, float3 dPdu, float3 dPdv, const MpPlacement* place) {
   const MP_GLOBAL float4* cp = points + (ulong)patch * MP_PATCH_POINTS;
-  float3 n = mp_patch_normal(cp, patch_info[4 * (ulong)patch], u, v, dPdu, dPdv);
+  float3 n = mp_patch_normal(cp, patch_info[4 * (ulong)patch], u, v, dPdu, dPdv, place);
   float t;
   int e = mp_boundary_edge(u, v, &t);
   if (e >= 0) {
     uint ref = mp_edge_curve(edges, patch, (uint)e, &t);
-    float3 c = mp_curve_eval(curves, ref, t, 1u);
+    float3 c = mp_place_normal(place, mp_curve_eval(curves, ref, t, 1u));
     float len = length(c);
     if (len > 0.0f) n = dot(c, n) < 0.0f ? -(c / len) : c / len;
   }

@@ -156,11 +156,12 @@ inline float3 mp_object_normal_to_camera(__global const DeviceObject* o, float3 
  * with its (u, v) on the patch. */
 inline int mp_program_vertex(uint gid, uint count, __global const uint* vertex_offsets, FrameParams f,
                              __global const SubPatch* diceable, __global const uint* patch_info,
-                             __global const DeviceMaterial* materials, int program, SubPatch* sp, uint* material,
-                             uint* object, float2* uv, uint* i, uint* j, ulong* index) {
+                             __global const DeviceInstance* instances, __global const DeviceMaterial* materials,
+                             int program, SubPatch* sp, uint* material, uint* object, float2* uv, uint* i, uint* j,
+                             ulong* index) {
   if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, sp, i, j, uv, index)) return 0;
   *material = patch_info[4 * (ulong)sp->patch + 1];
-  *object = MP_PATCH_OBJECT(patch_info[4 * (ulong)sp->patch + 2]);
+  *object = MP_PATCH_OBJECT(mp_placed_flags(patch_info, instances, sp->patch, sp->instance));
   return (int)materials[*material].program[0] == program;
 }
 /* What node programs read of the scene (mp_node_lib.h), from MP_SCENE_PARAMS. */
@@ -178,7 +179,7 @@ __kernel void displace_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, 
   SubPatch sp;
   float2 uv;
   ulong index;
-  if (!mp_program_vertex(gid, count, vertex_offsets, f, diceable, patch_info, materials, program, &sp, &material,
+  if (!mp_program_vertex(gid, count, vertex_offsets, f, diceable, patch_info, instances, materials, program, &sp, &material,
                          &object, &uv, &i, &j, &index))
     return;
   if (!(materials[material].program[1] > 0.0f)) return;
@@ -213,7 +214,7 @@ __kernel void shade_program_grids(MP_SCENE_PARAMS __global const SubPatch* dicea
    * program reads no other. */
   const uint k = gid - (uint)get_global_offset(0);
   if (!alpha_only) mp_record_skip(records, record_stride, k);
-  if (!mp_program_vertex(gid, count, vertex_offsets, f, diceable, patch_info, materials, program, &sp, &material,
+  if (!mp_program_vertex(gid, count, vertex_offsets, f, diceable, patch_info, instances, materials, program, &sp, &material,
                          &object, &uv, &i, &j, &index))
     return;
   if (mp_grid_unseen(visible, index, f.max_grid, materials, patch_info, sp.patch)) return;

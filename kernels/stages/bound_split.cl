@@ -17,22 +17,35 @@
 #include "geometry/mp_bound.h"
 #include "core/mp_scene_data.h"
 
-/* Root r of a pass over patch_count patches in one or more views: the whole
- * domain of patch r % patch_count in view r / patch_count, no edge rated yet.
- * With an order (occlusion culling), the patches are taken in it, near to
- * far, and a pass over several views (one light's shadow maps) takes each
- * patch in all its views before the next, so every view's pyramid fills
- * with the nearest surfaces first. */
-inline SubPatch mp_root_subpatch(uint r, uint patch_count, uint view_count, __global const uint* order) {
+/* Root r of a pass over root_count roots (mp_instance.h) in one or more
+ * views: the whole domain of root r % root_count in view r / root_count, no
+ * edge rated yet. With an order of the patch_count patches placed on their
+ * own (occlusion culling), those are taken in it, near to far, and then the
+ * instances' roots (the host sorts instances near to far); a pass over
+ * several views (one light's shadow maps) takes each root in all its views
+ * before the next, so every view's pyramid fills with the nearest surfaces
+ * first. */
+#define MP_ROOT_SUBPATCH(r, view_count, order) \
+  mp_root_subpatch((r), patch_count, root_count, instance_roots, instance_count, instances, (view_count), (order))
+
+inline SubPatch mp_root_subpatch(uint r, uint patch_count, uint root_count, __global const uint* instance_roots,
+                                 uint instance_count, __global const DeviceInstance* instances, uint view_count,
+                                 __global const uint* order) {
   uint views = max(view_count, 1u);
-  uint p = order ? order[r / views] : r % patch_count;
-  uint view = order ? r % views : r / patch_count;
+  uint q, view;
+  if (!order) {
+    q = r % root_count, view = r / root_count;
+  } else if (r < patch_count * views) {
+    q = order[r / views], view = r % views;
+  } else {
+    q = patch_count + (r - patch_count * views) / views, view = r % views;
+  }
   SubPatch sp;
+  mp_root_patch(q, patch_count, instance_roots, instance_count, instances, &sp.patch, &sp.instance);
   sp.corner[0] = 0.0f; sp.corner[1] = 0.0f;
   sp.corner[2] = 1.0f; sp.corner[3] = 0.0f;
   sp.corner[4] = 1.0f; sp.corner[5] = 1.0f;
   sp.corner[6] = 0.0f; sp.corner[7] = 1.0f;
-  sp.patch = p;
   sp.info = view << 24;
   sp.rates = 0u;
   return sp;
@@ -52,7 +65,7 @@ __kernel void bs_init_queue(MP_SCENE_PARAMS __global SubPatch* queue, uint n, ui
                             __global const uint* order) {
   uint i = get_global_id(0);
   if (i >= n) return;
-  queue[i] = mp_root_subpatch(i, patch_count, view_count, order);
+  queue[i] = MP_ROOT_SUBPATCH(i, view_count, order);
 }
 
 __kernel void bs_breadth_classify(MP_SCENE_PARAMS __global SubPatch* queue, uint n, FrameParams f,
@@ -68,7 +81,7 @@ __kernel void bs_breadth_classify(MP_SCENE_PARAMS __global SubPatch* queue, uint
     return;
   }
   SubPatch sp = queue[i];
-  uint d = mp_classify(points, patch_info, patch_edges, edge_curves, patch_bounds, &sp,
+  uint d = mp_classify(points, patch_info, patch_edges, edge_curves, patch_bounds, instances, &sp,
                        mp_subpatch_view(&sp, f, views, view_count), page_masks, occlusion, occ);
   uint action = MP_DECISION_ACTION(d);
   if (d == MP_CULL_OCCLUDED) atomic_inc(occluded);
@@ -147,11 +160,11 @@ __kernel void bs_bounded_step(MP_SCENE_PARAMS __global const uint* root_order, F
       } else {
         uint r = atomic_inc(&counters[BS_NEXT_ROOT]);
         if (r >= root_limit) break; /* the roots taken so far (occlusion culling takes them in waves) */
-        stack[size++] = mp_root_subpatch(r, patch_count, view_count, root_order);
+        stack[size++] = MP_ROOT_SUBPATCH(r, view_count, root_order);
       }
     }
     SubPatch sp = stack[--size];
-    uint d = mp_classify(points, patch_info, patch_edges, edge_curves, patch_bounds, &sp,
+    uint d = mp_classify(points, patch_info, patch_edges, edge_curves, patch_bounds, instances, &sp,
                          mp_subpatch_view(&sp, f, views, view_count), page_masks, occlusion, occ);
     uint action = MP_DECISION_ACTION(d);
     if (d == MP_CULL_OCCLUDED) atomic_inc(&counters[BS_OCCLUDED]);

@@ -18,15 +18,17 @@ __kernel void dice_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, uint
   ulong index;
   if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
   float3 p, dpdu, dpdv;
-  mp_surface_point(points, patch_info, patch_edges, edge_curves, sp.patch, uv.x, uv.y, &p, &dpdu, &dpdv);
-  uint flags = patch_info[4 * (ulong)sp.patch + 2];
+  MpPlacement place = mp_instance_placement(instances, sp.instance);
+  mp_surface_point(points, patch_info, patch_edges, edge_curves, sp.patch, uv.x, uv.y, &place, &p, &dpdu, &dpdv);
+  uint flags = mp_placed_flags(patch_info, instances, sp.patch, sp.instance);
   /* Displaced materials move shared edge vertices along the edge's own normal
    * (watertight); others shade with the patch's normal, which keeps polygon
    * faces flat. */
   float3 n = materials[patch_info[4 * (ulong)sp.patch + 1]].program[1] > 0.0f
-                 ? mp_surface_normal(points, patch_info, patch_edges, edge_curves, sp.patch, uv.x, uv.y, dpdu, dpdv)
+                 ? mp_surface_normal(points, patch_info, patch_edges, edge_curves, sp.patch, uv.x, uv.y, dpdu, dpdv,
+                                     &place)
                  : mp_patch_normal(points + (ulong)sp.patch * MP_PATCH_POINTS, patch_info[4 * (ulong)sp.patch], uv.x,
-                                   uv.y, dpdu, dpdv);
+                                   uv.y, dpdu, dpdv, &place);
   if (flags & MP_PATCH_FLIP_ORIENTATION) n = -n;
   grid_p[index] = (float4)(p, 1.0f);
   grid_n[index] = (float4)(n, 0.0f);
@@ -75,7 +77,8 @@ __kernel void displaced_normals(MP_SCENE_PARAMS __global const SubPatch* diceabl
 
 /* Motion blur: the positions of the same grid vertices at one motion step,
  * from that step's control points and edge curves (the same patches, moved,
- * in motion_points and motion_curves) into grid_p + out_offset.
+ * in motion_points and motion_curves), or an instance's prototype through
+ * its transform at that step, into grid_p + out_offset.
  * The same (u, v) and the same edge rates as the shutter centre's grid, so
  * shared edges stay shared at every step. */
 __kernel void dice_motion_positions(MP_SCENE_PARAMS __global const SubPatch* diceable, uint count, uint step,
@@ -87,8 +90,13 @@ __kernel void dice_motion_positions(MP_SCENE_PARAMS __global const SubPatch* dic
   ulong index;
   if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
   float3 p, dpdu, dpdv;
-  mp_surface_point(motion_points + (ulong)step * point_count, patch_info, patch_edges,
-                   motion_curves + (ulong)step * curve_count, sp.patch, uv.x, uv.y, &p, &dpdu, &dpdv);
+  /* An instance's prototype does not move: its step is the instance's transform at that step. */
+  MpPlacement place = mp_instance_placement_at_step(instances, instance_motion, instance_count, sp.instance, step);
+  if (sp.instance == MP_NO_INSTANCE)
+    mp_surface_point(motion_points + (ulong)step * point_count, patch_info, patch_edges,
+                     motion_curves + (ulong)step * curve_count, sp.patch, uv.x, uv.y, &place, &p, &dpdu, &dpdv);
+  else
+    mp_surface_point(points, patch_info, patch_edges, edge_curves, sp.patch, uv.x, uv.y, &place, &p, &dpdu, &dpdv);
   grid_p[out_offset + index] = (float4)(p, 1.0f);
 }
 

@@ -438,7 +438,8 @@ typedef struct {
  * cells under it; a tile's pass (keys.tile) only in the tile that holds the
  * first pixel of its bound, so each micropolygon is counted once. `blur` (a
  * constant where inlined) picks the stochastic path. */
-inline MpSampled mp_sample_micropolygon(__global const uint* patch_info, __global const DeviceMaterial* materials,
+inline MpSampled mp_sample_micropolygon(__global const uint* patch_info, __global const DeviceInstance* instances,
+                                        __global const DeviceMaterial* materials,
                                         __global const SubPatch* diceable, uint slot, uint m, FrameParams f,
                                         __global const float4* grid_p, __global const float4* grid_c,
                                         __global const float4* grid_n, __global const ushort* sample_offsets,
@@ -477,7 +478,7 @@ inline MpSampled mp_sample_micropolygon(__global const uint* patch_info, __globa
   }
   if (!ok) return r;
   long area2 = 0;
-  uint keep = mp_quad_facing(v[0].p, v[1].p, v[2].p, v[3].p, patch_info[4 * (ulong)sp.patch + 2], f, &area2);
+  uint keep = mp_quad_facing(v[0].p, v[1].p, v[2].p, v[3].p, mp_placed_flags(patch_info, instances, sp.patch, sp.instance), f, &area2);
   if (finds_depth && keys.tile) {
     long hx = clamp(min(min(v[0].p.x, v[1].p.x), min(v[2].p.x, v[3].p.x)) >> MP_SUBPIXEL_BITS, (long)0, (long)f.width - 1);
     long hy = clamp(min(min(v[0].p.y, v[1].p.y), min(v[2].p.y, v[3].p.y)) >> MP_SUBPIXEL_BITS, (long)0, (long)f.height - 1);
@@ -487,7 +488,7 @@ inline MpSampled mp_sample_micropolygon(__global const uint* patch_info, __globa
   if (!keep) return r;
   uint mp_id = mp_micropolygon_id(mp_grid_id(&sp), m);
   MpCover cover = {mp_quad_opacity(vc[0].w, vc[1].w, vc[2].w, vc[3].w),
-                   mp_quad_opacity(vn[0].w, vn[1].w, vn[2].w, vn[3].w), mp_opacity_surface(sp.patch),
+                   mp_quad_opacity(vn[0].w, vn[1].w, vn[2].w, vn[3].w), mp_opacity_surface(mp_placed_patch_id(sp.patch, sp.instance)),
                    mp_material_cut(materials, patch_info, sp.patch) || mp_quad_cut(vc[0].w, vc[1].w, vc[2].w, vc[3].w)};
   /* Before shading, the grid's colours are not yet its own: opaque. */
   if (kind >= MP_SAMPLE_OPAQUE_DEPTH) cover.opacity = 1.0f, cover.holdout = 0.0f, cover.cut = 0;

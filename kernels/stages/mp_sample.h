@@ -119,7 +119,7 @@ inline uint mp_quad_facing(MpFixed2 p0, MpFixed2 p1, MpFixed2 p2, MpFixed2 p3, u
 /* A micropolygon's id in sample keys: its grid's (from the patch and the
  * corners) combined with its number m in the grid. */
 inline uint mp_grid_id(const SubPatch* sp) {
-  uint grid_id = mp_hash32(sp->patch);
+  uint grid_id = mp_hash32(mp_placed_patch_id(sp->patch, sp->instance));
   for (int k = 0; k < 8; ++k) grid_id = mp_hash_combine(grid_id, as_uint(sp->corner[k]));
   return grid_id;
 }

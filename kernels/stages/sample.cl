@@ -26,7 +26,8 @@
  * layout, GridLayoutStage), `base` is the first of these grids' and `total`
  * their number. A work-item finds its grid by binary search, so no
  * work-item idles on an unused grid slot. */
-inline void mp_sample(__global const uint* patch_info, __global const DeviceMaterial* materials, MP_SAMPLE_ARGS,
+inline void mp_sample(__global const uint* patch_info, __global const DeviceInstance* instances,
+                      __global const DeviceMaterial* materials, MP_SAMPLE_ARGS,
                       __local ulong* area_sum, __local uint* count_sum, __local uint* test_sum, const int blur) {
   uint gid = get_global_id(0);
   MpSampled r = {0, 0u};
@@ -35,7 +36,7 @@ inline void mp_sample(__global const uint* patch_info, __global const DeviceMate
     uint m = base + gid - offsets[slot];
     /* Beside the binned sampler (sample_bins.cl): only the runs it left out. */
     if (!bin_runs || bin_rects[(ulong)(slot - first) * bin_runs + m / MP_TILE_RUN].x < 0)
-      r = mp_sample_micropolygon(patch_info, materials, diceable, slot, m, f, grid_p, grid_c, grid_n, sample_offsets,
+      r = mp_sample_micropolygon(patch_info, instances, materials, diceable, slot, m, f, grid_p, grid_c, grid_n, sample_offsets,
                                  sample_table, grid_pm, motion_stride, pass, mp_frame_keys(keys, f), colors, normals,
                                  occlusion_dirty, occ, visible, blur);
   }
@@ -49,7 +50,7 @@ inline void mp_sample(__global const uint* patch_info, __global const DeviceMate
 __kernel __attribute__((reqd_work_group_size(64, 1, 1))) void sample_micropolygons(MP_SCENE_PARAMS MP_SAMPLE_ARGS) {
   __local ulong area_sum[64];
   __local uint count_sum[64], test_sum[64];
-  mp_sample(patch_info, materials, MP_SAMPLE_PASS, area_sum, count_sum, test_sum, 0);
+  mp_sample(patch_info, instances, materials, MP_SAMPLE_PASS, area_sum, count_sum, test_sum, 0);
 }
 
 /* Samples with times and lens positions (mp_blur.h). */
@@ -57,7 +58,7 @@ __kernel __attribute__((reqd_work_group_size(64, 1, 1)))
 void sample_micropolygons_blur(MP_SCENE_PARAMS MP_SAMPLE_ARGS) {
   __local ulong area_sum[64];
   __local uint count_sum[64], test_sum[64];
-  mp_sample(patch_info, materials, MP_SAMPLE_PASS, area_sum, count_sum, test_sum, 1);
+  mp_sample(patch_info, instances, materials, MP_SAMPLE_PASS, area_sum, count_sum, test_sum, 1);
 }
 
 /* Visibility first's count, after its mark pass: one work-item per grid of

@@ -110,7 +110,8 @@ typedef struct {
 
 /* One phase of sample_bins: every micropolygon of the bin's runs through
  * pass `pass`, the work-group's items taking them in turn. */
-inline MpBinCounts mp_bin_phase(__global const uint* patch_info, __global const DeviceMaterial* materials,
+inline MpBinCounts mp_bin_phase(__global const uint* patch_info, __global const DeviceInstance* instances,
+                                __global const DeviceMaterial* materials,
                                 __global const SubPatch* diceable, uint first, FrameParams f,
                                 __global const float4* grid_p, __global const float4* grid_c,
                                 __global const float4* grid_n, __global const ushort* sample_offsets,
@@ -122,7 +123,7 @@ inline MpBinCounts mp_bin_phase(__global const uint* patch_info, __global const 
     uint e = entries[start + i / MP_TILE_RUN];
     uint slot = first + e / runs_per_grid, m = (e % runs_per_grid) * MP_TILE_RUN + i % MP_TILE_RUN;
     /* Pinhole frames only: no motion steps, no lens table. */
-    MpSampled r = mp_sample_micropolygon(patch_info, materials, diceable, slot, m, f, grid_p, grid_c, grid_n,
+    MpSampled r = mp_sample_micropolygon(patch_info, instances, materials, diceable, slot, m, f, grid_p, grid_c, grid_n,
                                          sample_offsets, grid_p, grid_p, 0ul, pass, keys, colors, normals,
                                          occlusion_dirty, occ, visible, 0);
     c.area2 += (ulong)r.area2;
@@ -171,7 +172,7 @@ __kernel __attribute__((reqd_work_group_size(MP_BIN_GROUP, 1, 1))) void sample_b
   uint phase0 = kind == MP_SAMPLE_MARK ? 1u : 0u, phase1 = kind == MP_SAMPLE_OPAQUE_DEPTH ? 0u : 1u;
   for (uint phase = phase0; phase <= phase1; ++phase) {
     uint p = phase == 1u ? pass : (kind == MP_SAMPLE_ATTRIBUTES ? MP_SAMPLE_DEPTH : kind) | after;
-    MpBinCounts pc = mp_bin_phase(patch_info, materials, diceable, first, f, grid_p, grid_c, grid_n, sample_offsets,
+    MpBinCounts pc = mp_bin_phase(patch_info, instances, materials, diceable, first, f, grid_p, grid_c, grid_n, sample_offsets,
                                   entries, start, n, runs_per_grid, p, k, colors, normals, occlusion_dirty, occ, visible);
     if (phase == 0u) c = pc;
     barrier(CLK_LOCAL_MEM_FENCE);

@@ -358,7 +358,7 @@ __kernel void sample_tiles(MP_SCENE_PARAMS __global const SubPatch* diceable, Fr
     int finds_depth = kind == MP_SAMPLE_OPAQUE_DEPTH || (kind == MP_SAMPLE_ATTRIBUTES && !owned);
     int marked = 0;
     MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
-    uint flags = patch_info[4 * (ulong)sp.patch + 2];
+    uint flags = mp_placed_flags(patch_info, instances, sp.patch, sp.instance);
     uint grid_id = mp_grid_id(&sp);
     ulong base = (ulong)slot * stride * stride;
     uint nm = min(mp_grid_micropolygons(&g), (run + 1u) * MP_TILE_RUN);
@@ -392,7 +392,7 @@ __kernel void sample_tiles(MP_SCENE_PARAMS __global const SubPatch* diceable, Fr
                                        grid_c[base + q[3]].w),
                        mp_quad_opacity(grid_n[base + q[0]].w, grid_n[base + q[1]].w, grid_n[base + q[2]].w,
                                        grid_n[base + q[3]].w),
-                       mp_opacity_surface(sp.patch),
+                       mp_opacity_surface(mp_placed_patch_id(sp.patch, sp.instance)),
                        mp_material_cut(materials, patch_info, sp.patch) ||
                            mp_quad_cut(grid_c[base + q[0]].w, grid_c[base + q[1]].w, grid_c[base + q[2]].w,
                                        grid_c[base + q[3]].w)};

@@ -30,8 +30,9 @@ __kernel void shade_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, uin
   /* The surface itself faces away from the viewer. */
   int away = dot(n, f.ortho ? (float3)(0.0f, 0.0f, 1.0f) : -p) < 0.0f;
   int smooth = (patch_info[4 * (ulong)sp.patch + 2] & MP_PATCH_SMOOTH_NORMALS) && !(m.program[1] > 0.0f);
+  MpPlacement place = mp_instance_placement(instances, sp.instance);
   if (smooth) {
-    float3 ns = mp_face_shading_normal(patch_normals, sp.patch, uv.x, uv.y, n, p, f.ortho);
+    float3 ns = mp_face_shading_normal(patch_normals, sp.patch, uv.x, uv.y, n, p, f.ortho, &place);
     if (dot(ns, ns) > 0.0f) {
       /* w, for node programs: 1 faced, 2 faced and the surface itself faces
        * away (Backfacing). They replace it by the held-out share the sampler
@@ -63,14 +64,14 @@ __kernel void shade_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, uin
     float2 uvx = uv, uvy = uv;
     mp_slot_uv(&sp, &shape, sx % stride, sx / stride, &uvx);
     mp_slot_uv(&sp, &shape, sy % stride, sy / stride, &uvy);
-    nx = mp_face_shading_normal(patch_normals, sp.patch, uvx.x, uvx.y, shadow.normal, grid_p[gx].xyz, f.ortho);
-    ny = mp_face_shading_normal(patch_normals, sp.patch, uvy.x, uvy.y, shadow.normal, grid_p[gy].xyz, f.ortho);
+    nx = mp_face_shading_normal(patch_normals, sp.patch, uvx.x, uvx.y, shadow.normal, grid_p[gx].xyz, f.ortho, &place);
+    ny = mp_face_shading_normal(patch_normals, sp.patch, uvy.x, uvy.y, shadow.normal, grid_p[gy].xyz, f.ortho, &place);
     if (!(dot(nx, nx) > 0.0f)) nx = n; /* a patch without smooth normals there */
     if (!(dot(ny, ny) > 0.0f)) ny = n;
   }
   float spread2 = mp_normal_spread2(n, nx, ny);
   MpRefractScene refract = {refract_nodes, refract_tris,
-                            refract_roots[MP_PATCH_OBJECT(patch_info[4 * (ulong)sp.patch + 2])]};
+                            refract_roots[MP_PATCH_OBJECT(mp_placed_flags(patch_info, instances, sp.patch, sp.instance))]};
   float3 c = mp_shade_material(p, n, faced, f.ortho, &m, lights, light_count, world_glossy, use_shadows ? &shadow : 0,
                                spread2, refract.root != MP_REFRACT_NONE ? &refract : 0);
   grid_c[index] = (float4)(c, m.opacity[3]);

@@ -593,7 +593,7 @@ void shadow_sample(MP_SCENE_PARAMS __global const SubPatch* diceable, uint first
    * camera's samples): a hard alpha cut casts a crisp-edged shadow. */
   float to[2][3] = {{o[0], tris[0].swapped ? o[2] : o[1], tris[0].swapped ? o[1] : o[2]},
                     {o[0], tris[1].swapped ? o[3] : o[2], tris[1].swapped ? o[2] : o[3]}};
-  uint surface = opacity < 1.0f ? mp_opacity_surface(sp.patch) : 0u;
+  uint surface = opacity < 1.0f ? mp_opacity_surface(mp_placed_patch_id(sp.patch, sp.instance)) : 0u;
   int cut = mat->program[3] > 1.5f || mp_quad_cut(o[0], o[1], o[2], o[3]);
   int side = v.page_side;
   /* Most micropolygons lie within one page: one table lookup for all. */

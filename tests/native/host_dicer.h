@@ -38,13 +38,15 @@ inline void host_dice(const Scene& scene,
   const PatchBuffer& pb = data.patches;
   const uint* info = reinterpret_cast<const uint*>(pb.info.data());
   std::vector<SubPatch> stack;
-  for (uint p = 0; p < pb.size(); ++p) stack.push_back(SubPatch{{0, 0, 1, 0, 1, 1, 0, 1}, p, 0, 0});
+  // The patches placed on their own (this dicer places no instances).
+  for (uint p = 0; p < data.own_patches; ++p) stack.push_back(SubPatch{{0, 0, 1, 0, 1, 1, 0, 1}, p, 0, 0, MP_NO_INSTANCE});
+  const MpPlacement none = mp_placement_none();
   DicedGrid g;
   while (!stack.empty()) {
     SubPatch sp = stack.back();
     stack.pop_back();
-    const uint d = mp_classify(pb.points.data(), info, pb.edges.data(), pb.curves.data(), nullptr, &sp, f, nullptr, nullptr,
-                               OcclusionParams{});
+    const uint d = mp_classify(pb.points.data(), info, pb.edges.data(), pb.curves.data(), nullptr, nullptr, &sp, f,
+                               nullptr, nullptr, OcclusionParams{});
     const uint action = MP_DECISION_ACTION(d);
     if (action >= MP_SPLIT_U) {
       SubPatch a, b;
@@ -66,7 +68,8 @@ inline void host_dice(const Scene& scene,
         glm::vec2 uv;
         if (!mp_slot_uv(&g.sp, &g.shape, i, j, &uv)) continue;
         float3 P, du, dv;
-        mp_surface_point(pb.points.data(), info, pb.edges.data(), pb.curves.data(), sp.patch, uv.x, uv.y, &P, &du, &dv);
+        mp_surface_point(pb.points.data(), info, pb.edges.data(), pb.curves.data(), sp.patch, uv.x, uv.y, &none, &P, &du,
+                         &dv);
         g.p.push_back(P);
         g.uv.push_back(uv);
         g.slot_p[mp_slot(&g.shape, i, j)] = P;

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <string>
 
@@ -14,6 +15,7 @@
 
 #include "micropoly/error.h"
 #include "micropoly/renderer.h"
+#include "pipeline/device_scene/scene_buffers.h"
 #include "renderer_fixture.h"
 #include "rib/rib_reader.h"
 #include "rib/rib_writer.h"
@@ -137,7 +139,9 @@ double psnr(const std::vector<float>& a, const std::vector<float>& b) {
 // Same image (>= 60 dB), the same alpha to the bit, and something drawn.
 void expect_same_image(const RenderResult& a, const RenderResult& b, const std::string& what) {
   ASSERT_EQ(a.rgba.size(), b.rgba.size()) << what;
-  EXPECT_GE(psnr(a.rgba, b.rgba), 60.0) << what;
+  const double db = psnr(a.rgba, b.rgba);
+  std::printf("%s: %.1f dB\n", what.c_str(), db);
+  EXPECT_GE(db, 60.0) << what;
   size_t alpha_diff = 0, covered = 0;
   for (size_t i = 3; i < a.rgba.size(); i += 4) {
     alpha_diff += a.rgba[i] != b.rgba[i];
@@ -184,6 +188,88 @@ TEST_F(InstancesTest, MadeRealMatchesTheRendering) {
     EXPECT_TRUE(real.meshes[i].info == hand.meshes[i].info);
   }
   EXPECT_TRUE(real.prototypes.empty() && real.instances.empty());
+}
+
+TEST_F(InstancesTest, EveryPathOfThePipelineRendersThemLikeCopies) {
+  // Bound & split breadth-first, the per-micropolygon sampler, buckets (a
+  // sample budget too small for the frame), and no shadows.
+  const Scene base = instanced_scene();
+  for (int c = 0; c < 4; ++c) {
+    Scene s = base;
+    if (c == 0) s.settings.bound_split = BoundSplitMethod::Breadth;
+    if (c == 1) s.settings.sampler = Sampler::Micropolygons;
+    if (c == 2) {  // 11 MiB of samples in buckets of 2
+      s.settings.width = 200, s.settings.height = 150;
+      set_samples_per_pixel(s.settings, 16);
+      s.settings.sample_memory_mib = 2.0f;
+    }
+    if (c == 3) s.settings.shadows = false;
+    expect_same_image(renderer_->render(s), renderer_->render(copies_by_hand(s)), "path " + std::to_string(c));
+  }
+}
+
+// A field of n x n instances of a subdivided sphere-like cube behind a wall
+// (the camera sees the wall and, over it, the last rows).
+Scene field_behind_wall(int n) {
+  Scene s = base_scene(96, 72, 4);
+  s.camera = look_at({0.0f, -12.0f, 2.0f}, {0.0f, 0.0f, 0.0f}, 50.0f);
+  Prototype rock;
+  rock.name = "rock";
+  rock.meshes.push_back(cube_mesh(SubdivScheme::CatmullClark));
+  s.prototypes.push_back(rock);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      Instance inst;
+      inst.object_to_world = glm::scale(glm::translate(glm::mat4(1.0f), {-6.0f + 12.0f * i / (n - 1), 1.0f + 8.0f * j / (n - 1), 0.0f}),
+                                        glm::vec3(0.35f));
+      s.instances.push_back(inst);
+    }
+  Mesh wall = grid_mesh(2, 1.0f, SubdivScheme::None);
+  wall.object_to_world = glm::scale(glm::rotate(glm::translate(glm::mat4(1.0f), {0.0f, -2.0f, 0.0f}), 1.5708f, {1, 0, 0}),
+                                    {9.0f, 1.6f, 1.0f});
+  s.meshes.push_back(wall);
+  return s;
+}
+
+TEST_F(InstancesTest, PatchesAreUploadedOncePerPrototype) {
+  const Scene s = field_behind_wall(12);
+  const HostSceneData data = prepare_scene_data(s);
+  Scene one = s;
+  one.instances.resize(1);
+  const size_t proto_patches = prepare_scene_data(one).patches.size() - prepare_scene_data(one).own_patches;
+  EXPECT_GT(proto_patches, 0u);
+  EXPECT_EQ(data.patches.size(), data.own_patches + proto_patches);  // not once per instance
+  EXPECT_EQ(data.instances.size(), s.instances.size());
+  EXPECT_EQ(data.root_count, data.own_patches + s.instances.size() * proto_patches);
+  ASSERT_EQ(data.instance_roots.size(), s.instances.size() + 1);
+  EXPECT_EQ(data.instance_roots.back(), s.instances.size() * proto_patches);
+  // Nearest the camera first.
+  for (size_t i = 1; i < data.instances.size(); ++i)
+    EXPECT_GE(data.instances[i - 1].box_hi[2], data.instances[i].box_hi[2]);
+}
+
+TEST_F(InstancesTest, InstancesBehindAWallAreCulledWholeAndTheImageStays) {
+  Scene s = field_behind_wall(12);
+  const RenderResult on = renderer_->render(s);
+  s.settings.occlusion_culling = false;
+  const RenderResult off = renderer_->render(s);
+  expect_same_image(on, off, "occlusion culling");
+  // Most instances hide behind the wall: culled at their roots' first test.
+  EXPECT_GT(on.stats.subpatches_occluded, on.stats.patches / 2) << on.stats.patches << " roots";
+  EXPECT_LT(on.stats.subpatches_diced * 4, off.stats.subpatches_diced);
+  expect_same_image(on, renderer_->render(copies_by_hand(field_behind_wall(12))), "copies");
+}
+
+TEST_F(InstancesTest, MovingOneInstanceRendersItsShadowAnew) {
+  // A renderer keeps shadow pages between frames where nothing changed;
+  // an instance that moved must cast its shadow from where it is now.
+  Scene s = instanced_scene();
+  Renderer kept;
+  kept.render(s);
+  s.instances[1].object_to_world = glm::translate(s.instances[1].object_to_world, {0.0f, 1.5f, 0.6f});
+  const RenderResult again = kept.render(s);
+  Renderer fresh;
+  expect_same_image(again, fresh.render(s), "moved instance");
 }
 
 // --- RIB ------------------------------------------------------------------------------

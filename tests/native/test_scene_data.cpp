@@ -76,8 +76,8 @@ TEST(SceneData, EveryKernelThatReadsTheSceneTakesTheWholeListFirst) {
   EXPECT_GE(readers, 12);
 }
 
-// bs_init_queue reads patch_count from the list: root r of two views is
-// patch r % patch_count in view r / patch_count.
+// bs_init_queue reads root_count from the list: without instances, root r
+// of two views is patch r % root_count in view r / root_count.
 std::vector<SubPatch> roots(DeviceSession& session, SceneKernel& kernel, const SceneBuffers& scene, cl_uint n) {
   cl::Buffer queue = session.allocate(n * sizeof(SubPatch), "roots");
   cl::Kernel& k = kernel.bind(scene, queue, n, cl_uint(2), cl::Buffer());
@@ -91,15 +91,15 @@ TEST(SceneData, AKernelBindsTheSceneAgainOnlyWhenItsBuffersChange) {
   DeviceSession session("");
   SceneKernel init(session.program(), "bs_init_queue");
   SceneBuffers a;
-  a.patch_count = 3;
+  a.patch_count = a.root_count = 3;  // no instances: a root per patch
   a.version = session.next_data_version();
   std::vector<SubPatch> r = roots(session, init, a, 6);
   EXPECT_EQ(r[3].patch, 0u);
-  EXPECT_EQ(r[3].info >> 24, 1u);  // view 1 starts at patch_count
+  EXPECT_EQ(r[3].info >> 24, 1u);  // view 1 starts at root_count
 
   // Another upload: bound again.
   SceneBuffers b;
-  b.patch_count = 2;
+  b.patch_count = b.root_count = 2;
   b.version = session.next_data_version();
   r = roots(session, init, b, 6);
   EXPECT_EQ(r[2].patch, 0u);
@@ -107,7 +107,7 @@ TEST(SceneData, AKernelBindsTheSceneAgainOnlyWhenItsBuffersChange) {
 
   // The same upload: what the kernel holds stays (a change that does not
   // take a new version is not seen, which is why every replacement takes one).
-  b.patch_count = 5;
+  b.patch_count = b.root_count = 5;
   r = roots(session, init, b, 6);
   EXPECT_EQ(r[2].info >> 24, 1u);
 

@@ -294,7 +294,8 @@ void share_patch_edges(PatchBuffer& buffer, size_t first) {
     const glm::vec4* cp = pts + p * MP_PATCH_POINTS;
     float3 P, du, dv;
     mp_eval_patch(cp, info[4 * p], u, v, &P, &du, &dv);
-    return glm::vec3(mp_patch_normal(cp, info[4 * p], u, v, du, dv));
+    const MpPlacement none = mp_placement_none();
+    return glm::vec3(mp_patch_normal(cp, info[4 * p], u, v, du, dv, &none));
   };
   std::unordered_map<uint32_t, glm::vec3> corner_normal;
   for (size_t p = first; p < buffer.size(); ++p)

@@ -9,6 +9,8 @@
 
 #include "cl/kernel_args.h"
 #include "geometry/mp_patch.h"
+#include "pipeline/device_scene/instance_placement.h"
+#include "pipeline/device_scene/shape_placement.h"
 #include "pipeline/pass/stage_timer.h"
 #include "textures/mp_tex_image.h"
 #include "closures/mp_world.h"
@@ -52,103 +54,6 @@ uint32_t append_params(const std::vector<float>& values, const std::string& owne
   const uint32_t at = uint32_t(params.size());
   params.insert(params.end(), values.begin(), values.end());
   return at;
-}
-
-// Camera <-> object transforms and texture space of one surface.
-DeviceObject to_device_object(const glm::mat4& to_camera, const glm::mat4& to_world, glm::vec3 texspace_location,
-                              glm::vec3 texspace_size, const std::vector<glm::vec3>& points, const ObjectInfo& info) {
-  if (texspace_size == glm::vec3(0.0f) && !points.empty()) {
-    glm::vec3 lo(3e38f), hi(-3e38f);
-    for (const glm::vec3& p : points) lo = glm::min(lo, p), hi = glm::max(hi, p);
-    texspace_location = 0.5f * (lo + hi);
-    texspace_size = 0.5f * (hi - lo);
-  }
-  DeviceObject o{};
-  const glm::mat4 to_object = glm::inverse(to_camera);
-  const glm::mat4 from_world = glm::inverse(to_world);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c) {
-      o.to_object[4 * r + c] = to_object[c][r];  // glm is column-major
-      o.to_camera[4 * r + c] = to_camera[c][r];
-      o.to_world[4 * r + c] = to_world[c][r];
-      o.from_world[4 * r + c] = from_world[c][r];
-    }
-  put(o.texspace_location, texspace_location, 0.0f);
-  put(o.texspace_size, texspace_size, 0.0f);
-  for (int k = 0; k < 4; ++k) o.color[k] = info.color[k];
-  o.info[0] = info.pass_index;
-  o.info[1] = info.random;
-  return o;
-}
-
-// Longest a unit object-space vector can become in camera space.
-float max_scale(const glm::mat4& m) {
-  return std::max({glm::length(glm::vec3(m[0])), glm::length(glm::vec3(m[1])), glm::length(glm::vec3(m[2]))});
-}
-
-// Appends an object-space shape's control points and edge curves carried to
-// camera space: points by `to_camera`, the curves' normal halves by its
-// inverse transpose (the kernels normalise them and orient them like the
-// patch, so their scale and sign do not matter).
-void place_positions(const PatchBuffer& shape, const glm::mat4& to_camera, std::vector<glm::vec4>& points,
-                     std::vector<glm::vec4>& curves) {
-  const glm::dmat4 m(to_camera);
-  const glm::dmat3 normal_map = glm::transpose(glm::inverse(glm::dmat3(m)));
-  auto point = [&](const glm::vec4& p) {
-    const glm::dvec4 q = m * glm::dvec4(glm::dvec3(p), 1.0);
-    return glm::vec4(float(q.x), float(q.y), float(q.z), 0.0f);
-  };
-  for (const glm::vec4& p : shape.points) points.push_back(point(p));
-  for (size_t c = 0; c < shape.curves.size(); c += MP_CURVE_FLOAT4S) {
-    for (int k = 0; k < 4; ++k) curves.push_back(point(shape.curves[c + size_t(k)]));
-    for (int k = 4; k < MP_CURVE_FLOAT4S; ++k) {
-      const glm::dvec3 n = normal_map * glm::dvec3(glm::vec3(shape.curves[c + size_t(k)]));
-      curves.emplace_back(float(n.x), float(n.y), float(n.z), 0.0f);
-    }
-  }
-}
-
-// Appends an object-space shape (patch_cache.h) as object `object`: control
-// points and edge curves carried to camera space, edge-curve references
-// rebased, and the object's materials (per face through the patch's
-// primitive id), sidedness and displacement bound filled in.
-void place_shape(const PatchBuffer& shape, const glm::mat4& to_camera, const Mesh* mesh, const BezierPatches* set,
-                 uint32_t object, const Scene& scene, PatchBuffer& out) {
-  const glm::dmat4 m(to_camera);
-  // Shading normals map by the inverse transpose.
-  const glm::dmat3 normal_map = glm::transpose(glm::inverse(glm::dmat3(m)));
-  unsigned flags = object << 8;
-  if (mesh ? mesh->double_sided : set->double_sided) flags |= MP_PATCH_DOUBLE_SIDED;
-  if (!(mesh ? mesh->cast_shadows : set->cast_shadows)) flags |= MP_PATCH_NO_SHADOW;
-  if (!(mesh ? mesh->visible_camera : set->visible_camera)) flags |= MP_PATCH_NO_CAMERA;
-  const int set_material = set ? set->material : 0;
-  // A mirroring transform turns counter-clockwise faces clockwise; the
-  // pipeline flips the geometric normal instead of reordering control points.
-  if (glm::determinant(glm::dmat3(m)) < 0.0) flags |= MP_PATCH_FLIP_ORIENTATION;
-  const float bound_scale = max_scale(to_camera);
-  const size_t first = out.size();
-  const uint32_t curve_base = uint32_t(out.curves.size() / MP_CURVE_FLOAT4S);
-  place_positions(shape, to_camera, out.points, out.curves);
-  for (size_t p = 0; p < shape.size(); ++p) {
-    glm::uvec4 info = shape.info[p];
-    const int material = mesh ? (mesh->face_materials.empty() ? mesh->material : mesh->face_materials[info.w])
-                              : set_material;
-    info.y = unsigned(material);
-    info.z = flags | (info.z & MP_PATCH_SMOOTH_NORMALS);
-    out.info.push_back(info);
-    if (size_t(material) < scene.materials.size()) {
-      const Material& mat = scene.materials[size_t(material)];
-      if (mat.program >= 0 && mat.program_displaces)
-        out.points[(first + p) * MP_PATCH_POINTS].w =
-            mat.displacement_bound * (mat.displacement_bound_world ? 1.0f : bound_scale);  // camera = world units
-    }
-  }
-  for (uint32_t ref : shape.edges) out.edges.push_back(ref == MP_NO_CURVE ? ref : ref + (curve_base << 1));
-  out.uvs.insert(out.uvs.end(), shape.uvs.begin(), shape.uvs.end());
-  for (const glm::vec4& n : shape.normals) {
-    const glm::dvec3 m = normal_map * glm::dvec3(glm::vec3(n));
-    out.normals.emplace_back(float(m.x), float(m.y), float(m.z), 0.0f);
-  }
 }
 
 // Motion blur: every surface's control points and edge curves in camera
@@ -336,13 +241,24 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
   const glm::mat4& w2c = scene.camera.world_to_camera;
   for (const Mesh& mesh : scene.meshes)
     out.patches.uv_layers = std::max(out.patches.uv_layers, int(mesh.uv_layers.size()));
+  for (const Prototype& proto : scene.prototypes)
+    for (const Mesh& mesh : proto.meshes)
+      out.patches.uv_layers = std::max(out.patches.uv_layers, int(mesh.uv_layers.size()));
   // Each surface's patches share their edges' curves (patch_edges.h), so
   // neighbouring patches dice watertight; separate surfaces do not.
   std::vector<PatchCache::Surface> surfaces;
   for (const Mesh& mesh : scene.meshes) surfaces.push_back({&mesh, nullptr});
   for (const BezierPatches& set : scene.bezier_patches) surfaces.push_back({nullptr, &set});
+  // The prototypes' surfaces are built in the same call (the cache keeps
+  // what its last two calls used).
+  const PrototypeVariants variants = prototype_variants(scene);
+  std::vector<PatchCache::Surface> all = surfaces;
+  all.insert(all.end(), variants.surfaces.begin(), variants.surfaces.end());
   PatchCache local;
-  const auto shapes = (cache ? cache : &local)->shapes(surfaces, out.patches.uv_layers);
+  auto shapes = (cache ? cache : &local)->shapes(all, out.patches.uv_layers);
+  const std::vector<std::shared_ptr<const PatchBuffer>> prototype_shapes(shapes.begin() + long(surfaces.size()),
+                                                                         shapes.end());
+  shapes.resize(surfaces.size());
   // Reserved once for all surfaces: growing per surface to its exact size
   // would copy everything placed so far for every object (quadratic in the
   // object count; thousands of instances took minutes).
@@ -366,6 +282,8 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
                                                   set->control_points, set->info));
   }
   if (scene.motion_steps >= 2) place_motion(scene, surfaces, cache ? cache : &local, out);
+  out.own_patches = out.root_count = out.patches.size();
+  place_instances(scene, variants, prototype_shapes, out);
   if (scene.materials.empty()) out.materials.push_back(to_device(Material{}));
   for (const Material& m : scene.materials) {
     DeviceMaterial d = to_device(m);
@@ -446,8 +364,13 @@ SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data
     b.lights = upload(session, data.lights);
     b.patch_uvs = upload(session, data.patches.uvs);
     b.patch_normals = upload(session, data.patches.normals);
-    b.host_patch_bounds = patch_bounds(data.patches);  // lives until the queue finishes below
-    b.patch_bounds = upload(session, b.host_patch_bounds);
+    // Every patch's box (the prototypes' in their own space) lives until the
+    // queue finishes below; the host keeps those of the patches placed on
+    // their own, which its root orders sort.
+    const std::vector<glm::vec4> bounds = patch_bounds(data.patches);
+    b.patch_bounds = upload(session, bounds);
+    b.instances = upload(session, data.instances);
+    b.instance_roots = upload(session, data.instance_roots);
     b.images = upload(session, data.images);
     b.texels = upload_images(session, data);
     b.node_params = upload(session, data.params);
@@ -455,6 +378,7 @@ SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data
     b.world_glossy = upload(session, no_world_glossy);
     b.motion_points = upload(session, data.motion_points);
     b.motion_curves = upload(session, data.motion_curves);
+    b.instance_motion = upload(session, data.instance_motion);
     b.refract_roots = upload(session, data.refraction.roots);
     b.refract_nodes = upload(session, data.refraction.nodes);
     b.refract_tris = upload(session, data.refraction.tris);
@@ -463,10 +387,13 @@ SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data
     b.curve_count = static_cast<cl_uint>(data.patches.curves.size());
     b.uv_layers = static_cast<cl_uint>(data.patches.uv_layers);
     b.image_count = static_cast<cl_uint>(data.images.size());
-    b.patch_count = static_cast<cl_uint>(data.patches.size());
+    b.patch_count = static_cast<cl_uint>(data.own_patches);
+    b.root_count = static_cast<cl_uint>(data.root_count);
+    b.instance_count = static_cast<cl_uint>(data.instances.size());
     b.light_count = static_cast<cl_uint>(data.lights.size());
     b.version = session.next_data_version();
     session.queue().finish();
+    b.host_patch_bounds.assign(bounds.begin(), bounds.begin() + long(2 * data.own_patches));
   });
   return b;
 }

@@ -19,7 +19,18 @@ class DeviceSession;
 // Host side: every surface as device patches in camera space, plus materials
 // and lights in their device layout. Pure CPU work; no OpenCL involved.
 struct HostSceneData {
+  // The patches placed on their own (camera space) first, own_patches of
+  // them, then the prototypes' (each in its own space, instance_placement.h).
   PatchBuffer patches;
+  size_t own_patches = 0;
+  // Instances (kernels/geometry/mp_instance.h): one record per prototype
+  // surface each instance places, nearest the camera first; where each one's
+  // roots start (an exclusive prefix, instances.size() + 1 entries); and,
+  // with motion blur, their rows at each step.
+  std::vector<DeviceInstance> instances;
+  std::vector<uint32_t> instance_roots;
+  std::vector<glm::vec4> instance_motion;
+  size_t root_count = 0;  // own_patches + every instance's patches
   std::vector<DeviceMaterial> materials;
   std::vector<DeviceLight> lights;
   std::vector<DeviceObject> objects;  // one per surface, in patch order (MP_PATCH_OBJECT)

@@ -87,36 +87,58 @@ bool program_in_shadows(const Material& m) { return m.program >= 0 && (m.program
 
 // Surfaces, materials and images, as the camera's view reads them
 // (scene_fingerprint).
-void hash_surfaces(Hasher& h, const Scene& scene) {
-  h.value(scene.meshes.size());
-  for (const Mesh& m : scene.meshes) {
-    h.text(m.name), h.value(m.visible_camera);
-    hash_mesh_shape(h, m);
-    h.value(m.material);
-    h.values(m.face_materials);
-    h.value(m.object_to_world);
-    h.value(m.double_sided);
-    h.value(m.texspace_location);
-    h.value(m.texspace_size);
-    h.value(m.cast_shadows);
-    h.value(m.info.color), h.value(m.info.pass_index), h.value(m.info.random);
-    h.value(m.motion_points.size());
-    for (const std::vector<glm::vec3>& step : m.motion_points) h.values(step);
-    h.values(m.motion_object_to_world);
+void hash_mesh(Hasher& h, const Mesh& m) {
+  h.text(m.name), h.value(m.visible_camera);
+  hash_mesh_shape(h, m);
+  h.value(m.material);
+  h.values(m.face_materials);
+  h.value(m.object_to_world);
+  h.value(m.double_sided);
+  h.value(m.texspace_location);
+  h.value(m.texspace_size);
+  h.value(m.cast_shadows);
+  h.value(m.info.color), h.value(m.info.pass_index), h.value(m.info.random);
+  h.value(m.motion_points.size());
+  for (const std::vector<glm::vec3>& step : m.motion_points) h.values(step);
+  h.values(m.motion_object_to_world);
+}
+
+void hash_patch_set(Hasher& h, const BezierPatches& b) {
+  h.values(b.control_points);
+  h.value(b.material);
+  h.value(b.object_to_world);
+  h.value(b.double_sided);
+  h.value(b.visible_camera);
+  h.value(b.cast_shadows);
+  h.value(b.info.color), h.value(b.info.pass_index), h.value(b.info.random);
+}
+
+void hash_instances(Hasher& h, const Scene& scene) {
+  h.value(scene.prototypes.size());
+  for (const Prototype& p : scene.prototypes) {
+    h.value(p.meshes.size());
+    for (const Mesh& m : p.meshes) hash_mesh(h, m);
+    h.value(p.bezier_patches.size());
+    for (const BezierPatches& b : p.bezier_patches) hash_patch_set(h, b);
   }
+  h.value(scene.instances.size());
+  for (const Instance& i : scene.instances) {
+    h.value(i.prototype), h.value(i.object_to_world), h.values(i.motion_object_to_world);
+    h.value(i.info.color), h.value(i.info.pass_index), h.value(i.info.random);
+    h.value(i.material), h.value(i.double_sided), h.value(i.visible_camera), h.value(i.cast_shadows);
+    h.value(i.reverse_orientation);
+  }
+}
+
+void hash_surfaces(Hasher& h, const Scene& scene) {
+  hash_instances(h, scene);
+  h.value(scene.meshes.size());
+  for (const Mesh& m : scene.meshes) hash_mesh(h, m);
   h.value(scene.motion_steps);
   h.values(scene.shutter_curve);
   h.values(scene.camera.motion_world_to_camera);
   h.value(scene.bezier_patches.size());
-  for (const BezierPatches& b : scene.bezier_patches) {
-    h.values(b.control_points);
-    h.value(b.material);
-    h.value(b.object_to_world);
-    h.value(b.double_sided);
-    h.value(b.visible_camera);
-    h.value(b.cast_shadows);
-    h.value(b.info.color), h.value(b.info.pass_index), h.value(b.info.random);
-  }
+  for (const BezierPatches& b : scene.bezier_patches) hash_patch_set(h, b);
   h.value(scene.materials.size());
   for (const Material& m : scene.materials) {
     h.value(m.opacity);
@@ -205,37 +227,67 @@ ShadowGeometryKeys shadow_geometry_keys(const Scene& scene) {
     programs_anywhere = programs_anywhere || program_in_shadows(m);
   }
   // Object info and the texture space enter only where the surface's own
-  // materials run a program in the shadow views.
-  out.meshes.reserve(scene.meshes.size());
-  for (const Mesh& m : scene.meshes) {
+  // materials run a program in the shadow views. `programs` tells whether
+  // they do.
+  auto mesh_key = [&](const Mesh& m, bool* programs) {
     Hasher h;
     h.value(uint32_t(1));
     hash_mesh_shape(h, m);
     h.values(m.face_materials);
-    const bool programs = hash_used_materials(h, scene, materials, m.material, m.face_materials);
+    *programs = hash_used_materials(h, scene, materials, m.material, m.face_materials);
     h.value(m.object_to_world);
     h.value(m.double_sided);
     h.value(m.cast_shadows);
-    if (programs) {
+    if (*programs) {
       h.value(m.texspace_location), h.value(m.texspace_size);
       h.value(m.info.color), h.value(m.info.pass_index), h.value(m.info.random);
     }
     h.value(m.motion_points.size());
     for (const std::vector<glm::vec3>& step : m.motion_points) h.values(step);
     h.values(m.motion_object_to_world);
-    out.meshes.push_back(h.result());
-  }
-  out.patch_sets.reserve(scene.bezier_patches.size());
-  for (const BezierPatches& b : scene.bezier_patches) {
+    return h.result();
+  };
+  auto patch_set_key = [&](const BezierPatches& b, bool* programs) {
     Hasher h;
     h.value(uint32_t(2));
     h.values(b.control_points);
-    const bool programs = hash_used_materials(h, scene, materials, b.material, {});
+    *programs = hash_used_materials(h, scene, materials, b.material, {});
     h.value(b.object_to_world);
     h.value(b.double_sided);
     h.value(b.cast_shadows);
-    if (programs) h.value(b.info.color), h.value(b.info.pass_index), h.value(b.info.random);
-    out.patch_sets.push_back(h.result());
+    if (*programs) h.value(b.info.color), h.value(b.info.pass_index), h.value(b.info.random);
+    return h.result();
+  };
+  bool programs = false;
+  out.meshes.reserve(scene.meshes.size());
+  for (const Mesh& m : scene.meshes) out.meshes.push_back(mesh_key(m, &programs));
+  out.patch_sets.reserve(scene.bezier_patches.size());
+  for (const BezierPatches& b : scene.bezier_patches) out.patch_sets.push_back(patch_set_key(b, &programs));
+  // Instances: their prototype's surfaces (keyed once per prototype) and
+  // their own placement and attributes.
+  std::vector<uint64_t> prototype_keys;
+  std::vector<bool> prototype_programs;
+  for (const Prototype& p : scene.prototypes) {
+    Hasher h;
+    bool any = false;
+    for (const Mesh& m : p.meshes) h.value(mesh_key(m, &programs)), any = any || programs;
+    h.value(uint32_t(0));
+    for (const BezierPatches& b : p.bezier_patches) h.value(patch_set_key(b, &programs)), any = any || programs;
+    prototype_keys.push_back(h.result());
+    prototype_programs.push_back(any);
+  }
+  out.instances.reserve(scene.instances.size());
+  for (const Instance& inst : scene.instances) {
+    Hasher h;
+    h.value(uint32_t(3));
+    h.value(prototype_keys[size_t(inst.prototype)]);
+    const bool own = inst.material >= 0 && hash_used_materials(h, scene, materials, inst.material, {});
+    h.value(inst.material), h.value(inst.double_sided), h.value(inst.cast_shadows), h.value(inst.reverse_orientation);
+    h.value(inst.object_to_world);
+    h.values(inst.motion_object_to_world);
+    if (own || prototype_programs[size_t(inst.prototype)])
+      h.value(inst.info.color), h.value(inst.info.pass_index), h.value(inst.info.random);
+    out.instances.push_back(h.result());
   }
   Hasher g;
   g.value(scene.motion_steps);
@@ -259,6 +311,7 @@ uint64_t geometry_fingerprint(const ShadowGeometryKeys& keys) {
   h.value(keys.global);
   h.values(keys.meshes);
   h.values(keys.patch_sets);
+  h.values(keys.instances);
   return h.result();
 }
 

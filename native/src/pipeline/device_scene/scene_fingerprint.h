@@ -29,6 +29,7 @@ uint64_t world_fingerprint(const Scene& scene);
 struct ShadowGeometryKeys {
   uint64_t global = 0;
   std::vector<uint64_t> meshes, patch_sets;
+  std::vector<uint64_t> instances;  // each instance with its prototype's surfaces
 };
 ShadowGeometryKeys shadow_geometry_keys(const Scene& scene);
 // All of them in one.

@@ -227,13 +227,7 @@ void Renderer::Impl::render(const Scene& scene, RenderResult& out, const Progres
   validate_scene(scene);
   guarded([&] {
     ready_session();
-    if (scene.instances.empty() && scene.prototypes.empty()) {
-      render_frame(scene, out, progress, overlapped);
-    } else {
-      // Instances are placed as copies of their prototypes' surfaces
-      // (docs/pipeline.md, "Instances": the device does not place them yet).
-      render_frame(with_instances_made_real(scene), out, progress, overlapped);
-    }
+    render_frame(scene, out, progress, overlapped);
   });
 }
 
@@ -415,7 +409,7 @@ std::vector<Light> Renderer::Impl::upload(const Scene& scene, RenderStats& st) {
   }
   if (fresh) d.scene_key = key;
   st.timings_ms.upload = ms_since(started);
-  st.patches = d.scene_buffers->patch_count;
+  st.patches = d.scene_buffers->root_count;
   return lights;
 }
 

@@ -52,8 +52,9 @@ void tessellate(const PatchBuffer& pb, const std::vector<uint32_t>& patches, int
       for (int i = 0; i <= steps; ++i) {
         const float u = float(i) / float(steps), v = float(j) / float(steps);
         float3 P, du, dv;
-        mp_surface_point(pb.points.data(), info, pb.edges.data(), pb.curves.data(), patch, u, v, &P, &du, &dv);
-        const float3 nn = mp_patch_normal(cp, pb.info[patch].x, u, v, du, dv);
+        const MpPlacement none = mp_placement_none();
+        mp_surface_point(pb.points.data(), info, pb.edges.data(), pb.curves.data(), patch, u, v, &none, &P, &du, &dv);
+        const float3 nn = mp_patch_normal(cp, pb.info[patch].x, u, v, du, dv, &none);
         p[size_t(j) * stride + i] = P;
         n[size_t(j) * stride + i] = flip ? -nn : nn;
       }

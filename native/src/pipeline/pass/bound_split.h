@@ -4,10 +4,13 @@
 #pragma once
 
 #include <algorithm>
+#include <cstdint>
+#include <string>
 #include <functional>
 #include <utility>
 
 #include "cl/device_session.h"
+#include "micropoly/error.h"
 #include "micropoly/renderer.h"
 #include "pipeline/device_scene/scene_buffers.h"
 #include "pipeline/device_scene/scene_kernel.h"
@@ -108,7 +111,14 @@ struct BoundSplitContext {
   const PassViews& views;
   const PassOcclusion& occlusion;
   // Roots: every patch in every view.
-  cl_uint root_count() const { return scene.patch_count * std::max<cl_uint>(views.count, 1); }
+  // Every view's roots (mp_instance.h); a pass whose count exceeds 2^32 is refused.
+  cl_uint root_count() const {
+    const uint64_t n = uint64_t(scene.root_count) * std::max<cl_uint>(views.count, 1);
+    if (n > UINT32_MAX)
+      throw Error(std::to_string(scene.root_count) + " patches in " + std::to_string(views.count) +
+                  " views exceed the 2^32 roots of one pass: use fewer instances, simpler prototypes or fewer lights");
+    return cl_uint(n);
+  }
 };
 
 // Device buffers of the bounded method, kept between frames so a renderer

@@ -8,7 +8,7 @@ namespace mp {
 BoundSplitResult MicropolygonPass::run(const PassView& view, const ViewTarget& target) {
   BoundSplitResult result;
   result.cancelled = progress_.cancelled();
-  if (scene_.patch_count == 0 || result.cancelled) return result;
+  if (scene_.root_count == 0 || result.cancelled) return result;
   const FrameParams& f = view.frame;
   GridBuffers& grids = stages_.grids;
   // Dicing is the same for every view; the target makes the difference.

@@ -17,6 +17,12 @@ ShadowCasters shadow_casters(const Scene& scene, const ShadowGeometryKeys& keys)
     const BezierPatches& b = scene.bezier_patches[i];
     if (b.cast_shadows) out.surfaces.push_back({keys.patch_sets[i], surface_bounds(scene, b), false});
   }
+  const std::vector<WorldBounds> boxes = instance_bounds(scene);
+  for (size_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& inst = scene.instances[i];
+    if (inst.cast_shadows)
+      out.surfaces.push_back({keys.instances[i], boxes[i], !inst.motion_object_to_world.empty()});
+  }
   std::sort(out.surfaces.begin(), out.surfaces.end(),
             [](const ShadowCaster& a, const ShadowCaster& b) { return a.key < b.key; });
   return out;

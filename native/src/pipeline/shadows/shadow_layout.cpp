@@ -102,7 +102,72 @@ WorldBounds world_bounds(const Scene& scene) {
     grow(b, m.points, m.object_to_world, displacement_reach(scene, m.material, m.face_materials, m.object_to_world));
   for (const BezierPatches& p : scene.bezier_patches)
     grow(b, p.control_points, p.object_to_world, displacement_reach(scene, p.material, {}, p.object_to_world));
+  for (const WorldBounds& i : instance_bounds(scene))
+    if (!i.empty()) b.lo = glm::min(b.lo, i.lo), b.hi = glm::max(b.hi, i.hi);
   return b;
+}
+
+namespace {
+
+// A prototype surface's box in its own space and the displacement bounds
+// of its per-face materials (object and world units).
+struct SurfaceBox {
+  glm::vec3 lo{1e30f}, hi{-1e30f};
+  glm::mat4 to_prototype{1.0f};
+  int material = 0;
+  float object_reach = 0.0f, world_reach = 0.0f;
+};
+
+void add_reach(const Scene& scene, int material, float& object_reach, float& world_reach) {
+  if (material < 0 || size_t(material) >= scene.materials.size()) return;
+  const Material& m = scene.materials[size_t(material)];
+  if (m.program < 0 || !m.program_displaces) return;
+  (m.displacement_bound_world ? world_reach : object_reach) =
+      std::max(m.displacement_bound_world ? world_reach : object_reach, m.displacement_bound);
+}
+
+template <typename Surface>
+SurfaceBox surface_box(const Scene& scene, const Surface& s, const std::vector<glm::vec3>& points,
+                       const std::vector<int>& face_materials) {
+  SurfaceBox b;
+  for (const glm::vec3& p : points) b.lo = glm::min(b.lo, p), b.hi = glm::max(b.hi, p);
+  b.to_prototype = s.object_to_world;
+  b.material = s.material;
+  for (int m : face_materials) add_reach(scene, m, b.object_reach, b.world_reach);
+  return b;
+}
+
+}  // namespace
+
+std::vector<WorldBounds> instance_bounds(const Scene& scene) {
+  std::vector<std::vector<SurfaceBox>> boxes(scene.prototypes.size());
+  for (size_t p = 0; p < scene.prototypes.size(); ++p) {
+    for (const Mesh& m : scene.prototypes[p].meshes) boxes[p].push_back(surface_box(scene, m, m.points, m.face_materials));
+    for (const BezierPatches& b : scene.prototypes[p].bezier_patches)
+      boxes[p].push_back(surface_box(scene, b, b.control_points, {}));
+  }
+  std::vector<WorldBounds> out(scene.instances.size());
+  for (size_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& inst = scene.instances[i];
+    auto place = [&](const glm::mat4& to_world) {
+      for (const SurfaceBox& s : boxes[size_t(inst.prototype)]) {
+        if (!(s.lo.x <= s.hi.x)) continue;
+        float object_reach = s.object_reach, world_reach = s.world_reach;
+        add_reach(scene, inst.material >= 0 ? inst.material : s.material, object_reach, world_reach);
+        const glm::mat4 m = to_world * s.to_prototype;
+        const float pad = std::max(object_reach * max_scale(m), world_reach);
+        for (int k = 0; k < 8; ++k) {
+          const glm::vec3 c((k & 1) ? s.hi.x : s.lo.x, (k & 2) ? s.hi.y : s.lo.y, (k & 4) ? s.hi.z : s.lo.z);
+          const glm::vec3 w(m * glm::vec4(c, 1.0f));
+          out[i].lo = glm::min(out[i].lo, w - glm::vec3(pad));
+          out[i].hi = glm::max(out[i].hi, w + glm::vec3(pad));
+        }
+      }
+    };
+    place(inst.object_to_world);
+    for (const glm::mat4& t : inst.motion_object_to_world) place(t);
+  }
+  return out;
 }
 
 WorldBounds surface_bounds(const Scene& scene, const Mesh& mesh) {

@@ -23,6 +23,10 @@ WorldBounds world_bounds(const Scene& scene);
 // One surface's box, displacement and deformation motion included.
 WorldBounds surface_bounds(const Scene& scene, const Mesh& mesh);
 WorldBounds surface_bounds(const Scene& scene, const BezierPatches& set);
+// Each instance's box over the shutter (its motion transforms), displacement
+// included: its prototype's surfaces' boxes, found once per prototype,
+// carried through the instance's transforms.
+std::vector<WorldBounds> instance_bounds(const Scene& scene);
 
 // Levels (or mips) coarser than the pixel footprint asks for, that marking
 // falls back to when the shadow memory budget is short; suns keep clipmap

@@ -497,7 +497,7 @@ bool ShadowMaps::render_maps(const Scene& scene, const std::vector<Light>& light
   const RenderSettings& settings = scene.settings;
   stats.budget_bytes = size_t(double(settings.shadow_memory_mib) * 1048576.0);
   inputs_.enabled = false;
-  if (!settings.shadows || buffers.patch_count == 0) return true;
+  if (!settings.shadows || buffers.root_count == 0) return true;
   const ShadowGeometryKeys geometry = shadow_geometry_keys(scene);
   scene_key_ = geometry_fingerprint(geometry);
   ShadowLayout layout = make_shadow_layout(scene, lights, frame, world_bounds(scene), geometry.global);
