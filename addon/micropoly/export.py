@@ -233,10 +233,17 @@ def export_scene(depsgraph, view=None, meshes=None, motion=None):
     out.background = export_lights.export_world(native_scene, scene.world, materials, out.warnings,
                                                 film_transparent=scene.render.film_transparent)
     # Materials first: their node programs decide which UV maps meshes export.
+    # Meanwhile, objects that share their mesh with others (linked
+    # duplicates) are counted: without motion blur they become instances.
+    shared = {}
     for inst in depsgraph.object_instances:
         if inst.object.type == "MESH":
             for slot in inst.object.material_slots:
                 materials.get(slot.material)
+            if motion is None and not inst.is_instance:
+                key = export_instances.InstanceTable.key(inst.object, shared_data=True)
+                if key is not None:
+                    shared[key] = shared.get(key, 0) + 1
     instances = export_instances.InstanceTable()
     for inst in depsgraph.object_instances:
         obj = inst.object
@@ -246,10 +253,12 @@ def export_scene(depsgraph, view=None, meshes=None, motion=None):
             continue
         if obj.type == "MESH":
             try:
-                if inst.is_instance:
-                    # Instances share one prototype per mesh they place.
+                key = None if inst.is_instance or motion is not None else \
+                    export_instances.InstanceTable.key(obj, shared_data=True)
+                if inst.is_instance or shared.get(key, 0) > 1:
+                    # Instances, and objects that share their mesh, place one prototype per mesh.
                     if instances.add(native_scene, materials, meshes, inst, _matrix(inst.matrix_world),
-                                     out.warnings, depsgraph):
+                                     out.warnings, depsgraph, key=key):
                         out.objects += 1
                 elif export_mesh.export_object(native_scene, materials, meshes, obj, _matrix(inst.matrix_world),
                                                out.warnings, depsgraph=depsgraph):

@@ -1,14 +1,16 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Depsgraph instances (Geometry Nodes' Instance on Points, particle systems,
-collection instances, instancing by vertices or faces) -> Scene prototypes
-and instances (scene.h).
+collection instances, instancing by vertices or faces) and linked duplicates
+(objects that share one mesh) -> Scene prototypes and instances (scene.h).
 
-Each distinct instanced mesh becomes one prototype, exported once; every
-instance then costs only its matrix and Object Info values, gathered in
-numpy arrays and handed over in one call per prototype. Two instances share
-a prototype when they place the same evaluated mesh data with the same
-material slots (Cycles keys its geometry the same way: by the data, not by
-the instancing object).
+Each distinct mesh becomes one prototype, exported once; every instance then
+costs only its matrix and Object Info values, gathered in numpy arrays and
+handed over in one call per prototype. Two placements share a prototype when
+they render the same mesh with the same material slots and ray visibility:
+the same evaluated mesh data, or, for objects rendered as the limit surface
+of their cage (a Subdivision Surface modifier alone), the same cage with the
+same boundary and crease settings (Cycles keys its geometry by the data too,
+not by the object that places it).
 """
 
 import numpy as np
@@ -22,15 +24,29 @@ class InstanceTable:
         self._placed = {}      # prototype index -> ([matrices], [random], [colour], [pass index], visibility)
 
     @staticmethod
-    def _key(obj):
+    def key(obj, shared_data=False):
+        """What a placement of `obj` shares its prototype by, or None where
+        the object is exported on its own (shared_data: only where it
+        renders a cage or an evaluated mesh other objects may share: not a
+        mesh its own modifiers or shape keys made)."""
         slots = tuple(slot.material.name_full if slot.material else "" for slot in obj.material_slots)
-        return obj.data.as_pointer(), obj.original.name_full, slots, export_mesh.ray_visibility(obj)
+        subsurf, only = export_mesh.subdivision_modifier(obj)
+        if subsurf is not None and only:
+            if obj.original.data.shape_keys is not None:
+                return None if shared_data else (obj.data.as_pointer(), obj.original.name_full, slots)
+            data = ("cage", obj.original.data.name_full, subsurf.boundary_smooth, subsurf.use_creases)
+        elif shared_data and any(m.show_render for m in obj.original.modifiers):
+            return None
+        else:
+            data = obj.data.as_pointer()
+        return data, slots, export_mesh.ray_visibility(obj)
 
-    def add(self, native_scene, materials, meshes, inst, matrix, warnings, depsgraph):
-        """Places `inst` (a depsgraph instance of a mesh); returns False when
-        its mesh has nothing to render."""
+    def add(self, native_scene, materials, meshes, inst, matrix, warnings, depsgraph, key=None):
+        """Places `inst` (a depsgraph instance of a mesh, or an object that
+        shares its mesh: `key`); returns False when its mesh has nothing to
+        render."""
         obj = inst.object
-        key = self._key(obj)
+        key = key if key is not None else self.key(obj)
         if key not in self._prototypes:
             identity = np.identity(4, dtype=np.float32)
             made = export_mesh.export_object(native_scene, materials, meshes, obj, identity, warnings,
@@ -39,9 +55,9 @@ class InstanceTable:
         proto = self._prototypes[key]
         if proto is None:
             return False
-        placed = self._placed.setdefault(proto, ([], [], [], [], key[3]))
+        placed = self._placed.setdefault(proto, ([], [], [], [], key[-1]))
         placed[0].append(matrix)
-        placed[1].append(export_mesh.object_random(obj.name, inst.random_id))
+        placed[1].append(export_mesh.object_random(obj.name, inst.random_id if inst.is_instance else None))
         placed[2].append(tuple(obj.color))
         placed[3].append(float(obj.pass_index))
         return True

@@ -1,12 +1,13 @@
 """Instances in Blender (run by blender -b, or a Python with the bpy module):
 Geometry Nodes' Instance on Points, a particle system of objects, a
 collection instanced by empties whose collection holds another collection
-instance (nested), and Instance on Points of a subdivided, displaced rock,
-each exported as prototypes and instances (one prototype per instanced
+instance (nested), objects sharing one mesh (linked duplicates), and
+Instance on Points of a subdivided, displaced rock, each exported as prototypes and instances (one prototype per instanced
 mesh, one instance per copy: the exported scene's own counts), each against
 Cycles' direct light (PSNR >= 30 dB over pixels both cover, silhouettes
 IoU >= 0.98), and each rendering like the same scene with its instances made
-real in Blender (Realize Instances, Make Instances Real): PSNR >= 60 dB,
+real in Blender (Realize Instances, Make Instances Real, a mesh of its own
+for each duplicate): PSNR >= 60 dB,
 alpha identical. Exits non-zero on failure."""
 
 import math
@@ -66,6 +67,14 @@ def against_cycles(name, scene):
     p = ru.psnr(a, b, peak=float(a.max())) if both.sum() else 0.0
     check(f"{name}: against Cycles' direct light", p >= 30.0 and iou >= 0.98 and both.sum() > 2000,
           f"{p:.1f} dB, IoU {iou:.4f}, {int(both.sum())} pixels")
+
+
+def single_users(scene):
+    """Each mesh object its own mesh: objects made real share their mesh,
+    which would make them instances again (linked duplicates)."""
+    for obj in scene.objects:
+        if obj.type == "MESH" and obj.data.users > 1:
+            obj.data = obj.data.copy()
 
 
 def compare(name, scene, make_real, prototypes, instances):
@@ -172,6 +181,7 @@ def particle_scene():
         bpy.ops.object.duplicates_make_real()
         emitter.modifiers.clear()
         emitter.hide_render = True  # as its particle system hid it
+        single_users(scene)
 
     return scene, make_real
 
@@ -225,8 +235,31 @@ def nested_collection_scene():
                 obj.select_set(True)
                 bpy.context.view_layer.objects.active = obj
                 bpy.ops.object.duplicates_make_real()
+        single_users(scene)
 
     return scene, make_real
+
+
+def linked_duplicates_scene():
+    """Three objects sharing one subdivided, displaced mesh (linked
+    duplicates, Alt+D), placed and sized apart."""
+    scene = base_scene()
+    first = displaced_rock("Shared", (0.4, 0.6, 0.7))
+    objects = [first]
+    for k in range(1, 3):
+        dup = first.copy()  # a new object, the same mesh
+        scene.collection.objects.link(dup)
+        objects.append(dup)
+    for k, obj in enumerate(objects):
+        obj.location = (-2.5 + 2.5 * k, 0.5 * k, 0.0)
+        obj.scale = (1.0 + 0.3 * k,) * 3
+        obj.rotation_euler = (0.2 * k, 0.0, 0.7 * k)
+
+    def make_single():
+        for obj in objects[1:]:
+            obj.data = obj.data.copy()
+
+    return scene, make_single
 
 
 def main():
@@ -236,6 +269,8 @@ def main():
     compare("particle system of objects", scene, make_real, prototypes=1, instances=24)
     scene, make_real = nested_collection_scene()
     compare("nested collection instances", scene, make_real, prototypes=2, instances=6)
+    scene, make_single = linked_duplicates_scene()
+    compare("linked duplicates", scene, make_single, prototypes=1, instances=3)
     # Made real by Realize Instances, the rocks would be the modifier's
     # polygons: compared with Cycles only.
     scene, _ = geometry_nodes_scene(displaced=True)
