@@ -62,7 +62,9 @@ struct RenderStats {
   std::string resolver;  // the resolve's kernel: "tiles" or "pixels" (RenderSettings::resolver)
   std::string sampler;   // the camera's sampler: "tiles", "bins" or "micropolygons" (RenderSettings::sampler)
   int width = 0, height = 0, spp = 0;
-  size_t patches = 0;
+  size_t patches = 0;        // roots of one view: patches placed on their own and every instance's
+  size_t instances = 0;      // instances' placed surfaces (scene.h Instance)
+  size_t scene_bytes = 0;    // device memory of the scene's patches, objects and instances
   size_t subpatches_diced = 0;
   size_t micropolygons = 0;
   // Dicing density: micropolygons that reached the rasteriser and their total

@@ -89,6 +89,8 @@ py::dict stats_dict(const RenderStats& s) {
   d["micropolygons_per_covered_pixel"] =
       s.covered_pixels ? double(s.micropolygons_sampled) / double(s.covered_pixels) : 0.0;
   d["bound_split_peak_bytes"] = s.bound_split_peak_bytes;
+  d["instances"] = s.instances;
+  d["scene_bytes"] = s.scene_bytes;
   d["bound_split_launches"] = s.bound_split_launches;
   d["batches"] = s.batches;
   auto by_phase = [](const std::vector<std::pair<std::string, size_t>>& counts) {

@@ -394,6 +394,15 @@ SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data
     b.version = session.next_data_version();
     session.queue().finish();
     b.host_patch_bounds.assign(bounds.begin(), bounds.begin() + long(2 * data.own_patches));
+    for (const DeviceInstance& in : data.instances) {
+      b.host_instance_bounds.emplace_back(in.box_lo[0], in.box_lo[1], in.box_lo[2], 0.0f);
+      b.host_instance_bounds.emplace_back(in.box_hi[0], in.box_hi[1], in.box_hi[2], 0.0f);
+    }
+    auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
+    b.bytes = bytes(data.patches.points) + bytes(data.patches.info) + bytes(data.patches.edges) +
+              bytes(data.patches.curves) + bytes(data.patches.uvs) + bytes(data.patches.normals) + bytes(bounds) +
+              bytes(data.objects) + bytes(data.instances) + bytes(data.instance_roots) + bytes(data.instance_motion) +
+              bytes(data.motion_points) + bytes(data.motion_curves);
   });
   return b;
 }

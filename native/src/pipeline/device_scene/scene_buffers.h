@@ -67,6 +67,8 @@ std::vector<DeviceLight> device_lights(const std::vector<Light>& lights, const g
 struct SceneBuffers {
   MP_SCENE_DATA(MP_HOST_SCENE_BUFFER, MP_HOST_SCENE_VALUE)
   std::vector<glm::vec4> host_patch_bounds;  // patch_bounds on the host (occlusion culling's root order)
+  std::vector<glm::vec4> host_instance_bounds;  // 2 per instance: camera-space boxes (the roots' overlap)
+  size_t bytes = 0;  // device memory of the scene's geometry and objects (not images or lights)
   // Which upload these buffers are (DeviceSession::next_data_version); every
   // replacement of a buffer takes a new one, so kernels bound to the old
   // buffers bind again (scene_kernel.h).

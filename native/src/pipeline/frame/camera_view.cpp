@@ -51,7 +51,7 @@ bool render_camera_bucket(MicropolygonPass& pass, const CameraStages& stages, co
     occ.begin_frame(fb, timer);
     view.occlusion.pyramid = occ.pyramid();
     view.occlusion.params = occ.params();
-    view.occlusion.root_order = occ.root_order(buffers.host_patch_bounds, scene_key, fb);
+    view.occlusion.root_order = occ.root_order(buffers.host_patch_bounds, buffers.host_instance_bounds, scene_key, fb);
     if (roots.seen > 0) view.occlusion.root_order = roots.order, view.occlusion.first_wave = roots.seen;
     st.root_overlap = occ.root_overlap();
     view.occlusion.waves = camera_takes_waves(scene.settings, s.info(), st.root_overlap);

@@ -66,6 +66,8 @@ std::string RenderStats::to_json() const {
   j += "  \"micropolygons_per_covered_pixel\": " +
        num(covered_pixels ? double(micropolygons_sampled) / double(covered_pixels) : 0.0) + ",\n";
   j += "  \"bound_split_peak_bytes\": " + std::to_string(bound_split_peak_bytes) + ",\n";
+  j += "  \"instances\": " + std::to_string(instances) + ",\n";
+  j += "  \"scene_bytes\": " + std::to_string(scene_bytes) + ",\n";
   j += "  \"surface_record_bytes\": " + std::to_string(surface_record_bytes) + ",\n";
   j += "  \"bound_split_launches\": " + std::to_string(bound_split_launches) + ",\n";
   j += "  \"batches\": " + std::to_string(batches) + ",\n";

@@ -297,7 +297,7 @@ void Renderer::Impl::render_frame(const Scene& scene, RenderResult& out, const P
   // not under motion blur or depth of field (camera_view.cpp).
   cl::Buffer camera_order;
   if (scene.settings.shadows && scene.settings.occlusion_culling && !mp_blur_on(frame.params))
-    camera_order = d.occlusion.root_order(buffers.host_patch_bounds, d.scene_key, frame.params);
+    camera_order = d.occlusion.root_order(buffers.host_patch_bounds, buffers.host_instance_bounds, d.scene_key, frame.params);
   bool going = d.shadow_maps.render(scene, lights, frame, pass, camera_order, st.shadows);
   activity.reset();
   st.timings_ms.shadows_wall = ms_since(shadows_started);
@@ -410,6 +410,8 @@ std::vector<Light> Renderer::Impl::upload(const Scene& scene, RenderStats& st) {
   if (fresh) d.scene_key = key;
   st.timings_ms.upload = ms_since(started);
   st.patches = d.scene_buffers->root_count;
+  st.instances = d.scene_buffers->instance_count;
+  st.scene_bytes = d.scene_buffers->bytes;
   return lights;
 }
 

@@ -90,13 +90,14 @@ size_t OcclusionCulling::covered_pixels(const cl::Buffer& keys, const FrameParam
   return n;
 }
 
-const cl::Buffer& OcclusionCulling::root_order(const std::vector<glm::vec4>& boxes, uint64_t scene_key,
+const cl::Buffer& OcclusionCulling::root_order(const std::vector<glm::vec4>& boxes,
+                                               const std::vector<glm::vec4>& instances, uint64_t scene_key,
                                                const FrameParams& f) {
   uint64_t key = scene_key;
   for (const float v : {f.ax, f.bx, f.ay, f.by, f.clip_near, f.clip_far, float(f.width), float(f.height)})
     key = (key ^ uint64_t(as_uint(v))) * 0x100000001b3ull;
   if (order_() && key == order_key_) return order_;
-  const std::vector<cl_uint> order = near_to_far_order(boxes, f, &overlap_);
+  const std::vector<cl_uint> order = near_to_far_order(boxes, f, &overlap_, instances);
   order_ = cl::Buffer();
   order_ = session_.allocate(std::max<size_t>(order.size(), 1) * sizeof(cl_uint), "occlusion patch order",
                              CL_MEM_READ_ONLY);
@@ -106,7 +107,8 @@ const cl::Buffer& OcclusionCulling::root_order(const std::vector<glm::vec4>& box
   return order_;
 }
 
-std::vector<cl_uint> near_to_far_order(const std::vector<glm::vec4>& boxes, const FrameParams& f, double* overlap) {
+std::vector<cl_uint> near_to_far_order(const std::vector<glm::vec4>& boxes, const FrameParams& f, double* overlap,
+                                       const std::vector<glm::vec4>& instances) {
   // The distance from the eye (camera space's origin) to box p: not its
   // depth, which would put the sides of every shell around the camera
   // (boxes that reach behind the eye) before the nearest one's front. Boxes
@@ -117,22 +119,25 @@ std::vector<cl_uint> near_to_far_order(const std::vector<glm::vec4>& boxes, cons
   constexpr int kGrid = 64;
   std::vector<uint32_t> count(kGrid * kGrid, 0);
   const float sx = float(kGrid) / float(std::max(f.width, 1)), sy = float(kGrid) / float(std::max(f.height, 1));
-  for (size_t p = 0; p < patch_count; ++p) {
-    glm::vec3 lo(boxes[2 * p]), hi(boxes[2 * p + 1]);
-    near[p] = glm::length(glm::clamp(glm::vec3(0.0f), lo, hi));
+  // Counts a box over the grid (weight times); false where the view culls it.
+  auto counted = [&](glm::vec3 lo, glm::vec3 hi, uint32_t weight) {
     const MpBound b = mp_bound_boxes(&lo, &hi, 1, f);
-    if (mp_bound_culled(b, &lo, &hi, 1, f, nullptr, 1)) {
-      near[p] = std::numeric_limits<float>::infinity();
-      continue;
-    }
+    if (mp_bound_culled(b, &lo, &hi, 1, f, nullptr, 1)) return false;
     int x0 = 0, x1 = kGrid - 1, y0 = 0, y1 = kGrid - 1;  // reaching behind the eye: may cover the frame
     if (f.ortho || b.dmin > f.eye_epsilon) {
       x0 = std::clamp(int(b.xmin * sx), 0, kGrid - 1), x1 = std::clamp(int(b.xmax * sx), 0, kGrid - 1);
       y0 = std::clamp(int(b.ymin * sy), 0, kGrid - 1), y1 = std::clamp(int(b.ymax * sy), 0, kGrid - 1);
     }
     for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) ++count[y * kGrid + x];
+      for (int x = x0; x <= x1; ++x) count[y * kGrid + x] += weight;
+    return true;
+  };
+  for (size_t p = 0; p < patch_count; ++p) {
+    const glm::vec3 lo(boxes[2 * p]), hi(boxes[2 * p + 1]);
+    near[p] = counted(lo, hi, 1) ? glm::length(glm::clamp(glm::vec3(0.0f), lo, hi))
+                                 : std::numeric_limits<float>::infinity();
   }
+  for (size_t i = 0; i + 1 < instances.size(); i += 2) counted(glm::vec3(instances[i]), glm::vec3(instances[i + 1]), 2);
   size_t sum = 0, covered = 0;
   for (uint32_t c : count) sum += c, covered += c > 0;
   if (overlap) *overlap = covered ? double(sum) / double(covered) : 0.0;

@@ -34,7 +34,10 @@ class OcclusionCulling {
   const OcclusionParams& params() const { return params_; }
   // The patches near to far for this scene and view (near_to_far_order),
   // kept while neither changes.
-  const cl::Buffer& root_order(const std::vector<glm::vec4>& boxes, uint64_t scene_key, const FrameParams& f);
+  // `instances`: the instances' boxes (2 per instance), which count in the
+  // overlap but are not ordered (their roots follow the patches').
+  const cl::Buffer& root_order(const std::vector<glm::vec4>& boxes, const std::vector<glm::vec4>& instances,
+                               uint64_t scene_key, const FrameParams& f);
   // The overlap of the roots' boxes that root_order found.
   double root_overlap() const { return overlap_; }
 
@@ -62,9 +65,11 @@ OcclusionParams occlusion_layout(const FrameParams& f, int cell_shift);
 // `overlap` receives how many boxes cover a point of the frame that any
 // covers, on average over a coarse grid (boxes reaching behind the eye
 // count as covering all): an estimate, from above, of the depth complexity
-// bound & split will meet.
+// bound & split will meet. Each of `instances`' boxes counts twice there
+// (a closed prototype covers what it covers with a front and a back) but
+// takes no place in the order.
 std::vector<cl_uint> near_to_far_order(const std::vector<glm::vec4>& boxes, const FrameParams& f,
-                                       double* overlap = nullptr);
+                                       double* overlap = nullptr, const std::vector<glm::vec4>& instances = {});
 
 // Patch indices ordered by their camera-space boxes' nearness to view v's
 // eye: the distance from it (perspective views: a point light's cube faces
