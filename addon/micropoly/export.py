@@ -236,10 +236,15 @@ def export_scene(depsgraph, view=None, meshes=None, motion=None):
     # Meanwhile, objects that share their mesh with others (linked
     # duplicates) are counted: without motion blur they become instances.
     shared = {}
+    seen = set()
     for inst in depsgraph.object_instances:
-        if inst.object.type == "MESH":
-            for slot in inst.object.material_slots:
-                materials.get(slot.material)
+        obj = inst.object
+        if obj.type == "MESH":
+            pointers = (obj.as_pointer(), obj.data.as_pointer())
+            if pointers not in seen:  # thousands of instances of one object: its materials once
+                seen.add(pointers)
+                for slot in obj.material_slots:
+                    materials.get(slot.material)
             if motion is None and not inst.is_instance:
                 key = export_instances.InstanceTable.key(inst.object, shared_data=True)
                 if key is not None:
@@ -257,8 +262,7 @@ def export_scene(depsgraph, view=None, meshes=None, motion=None):
                     export_instances.InstanceTable.key(obj, shared_data=True)
                 if inst.is_instance or shared.get(key, 0) > 1:
                     # Instances, and objects that share their mesh, place one prototype per mesh.
-                    if instances.add(native_scene, materials, meshes, inst, _matrix(inst.matrix_world),
-                                     out.warnings, depsgraph, key=key):
+                    if instances.add(native_scene, materials, meshes, inst, out.warnings, depsgraph, key=key):
                         out.objects += 1
                 elif export_mesh.export_object(native_scene, materials, meshes, obj, _matrix(inst.matrix_world),
                                                out.warnings, depsgraph=depsgraph):

@@ -19,9 +19,16 @@ from . import export_mesh
 
 
 class InstanceTable:
+    """Prototypes by what they share, and each prototype's placements as
+    lists that become numpy arrays in flush(). Per placement only its
+    matrix and random id are read; what an object brings (its prototype,
+    colour, pass index) is looked up once per object and mesh data (the
+    depsgraph may hand one temporary object several meshes)."""
+
     def __init__(self):
         self._prototypes = {}  # key -> prototype index, or None (nothing to render)
-        self._placed = {}      # prototype index -> ([matrices], [random], [colour], [pass index], visibility)
+        self._objects = {}     # (object, data) pointers -> (prototype, colour, pass index, name's random id, visibility)
+        self._placed = {}      # prototype -> ([matrix rows], [random ids], [colours], [pass indices], visibility)
 
     @staticmethod
     def key(obj, shared_data=False):
@@ -41,32 +48,42 @@ class InstanceTable:
             data = obj.data.as_pointer()
         return data, slots, export_mesh.ray_visibility(obj)
 
-    def add(self, native_scene, materials, meshes, inst, matrix, warnings, depsgraph, key=None):
+    def add(self, native_scene, materials, meshes, inst, warnings, depsgraph, key=None):
         """Places `inst` (a depsgraph instance of a mesh, or an object that
         shares its mesh: `key`); returns False when its mesh has nothing to
         render."""
         obj = inst.object
-        key = key if key is not None else self.key(obj)
-        if key not in self._prototypes:
-            identity = np.identity(4, dtype=np.float32)
-            made = export_mesh.export_object(native_scene, materials, meshes, obj, identity, warnings,
-                                             is_instance=True, depsgraph=depsgraph)
-            self._prototypes[key] = native_scene.mesh_to_prototype(-1, obj.name) if made else None
-        proto = self._prototypes[key]
+        pointers = (obj.as_pointer(), obj.data.as_pointer())
+        entry = self._objects.get(pointers)
+        if entry is None:
+            key = key if key is not None else self.key(obj)
+            if key not in self._prototypes:
+                identity = np.identity(4, dtype=np.float32)
+                made = export_mesh.export_object(native_scene, materials, meshes, obj, identity, warnings,
+                                                 is_instance=True, depsgraph=depsgraph)
+                self._prototypes[key] = native_scene.mesh_to_prototype(-1, obj.name) if made else None
+            entry = (self._prototypes[key], tuple(obj.color), float(obj.pass_index),
+                     export_mesh.name_random_id(obj.name), key[-1])
+            self._objects[pointers] = entry
+        proto = entry[0]
         if proto is None:
             return False
-        placed = self._placed.setdefault(proto, ([], [], [], [], key[-1]))
-        placed[0].append(matrix)
-        placed[1].append(export_mesh.object_random(obj.name, inst.random_id if inst.is_instance else None))
-        placed[2].append(tuple(obj.color))
-        placed[3].append(float(obj.pass_index))
+        placed = self._placed.get(proto)
+        if placed is None:
+            placed = self._placed[proto] = ([], [], [], [], entry[4])
+        m = inst.matrix_world
+        placed[0].append((*m[0], *m[1], *m[2], *m[3]))
+        placed[1].append(inst.random_id if inst.is_instance else entry[3])
+        placed[2].append(entry[1])
+        placed[3].append(entry[2])
         return True
 
     def flush(self, native_scene):
         """Hands every prototype's instances to the scene."""
-        for proto, (matrices, random, colours, passes, (camera, shadows)) in self._placed.items():
+        for proto, (matrices, ids, colours, passes, (camera, shadows)) in self._placed.items():
             native_scene.add_instances(
                 proto, np.asarray(matrices, dtype=np.float32).reshape(-1, 4, 4),
-                random=np.asarray(random, dtype=np.float32), object_color=np.asarray(colours, dtype=np.float32),
+                random=export_mesh.random_from_ids(np.asarray(ids, dtype=np.int64)),
+                object_color=np.asarray(colours, dtype=np.float32),
                 pass_index=np.asarray(passes, dtype=np.float32), visible_camera=camera, cast_shadows=shadows)
         self._placed.clear()

@@ -315,11 +315,21 @@ def _hash_uint2(kx, ky):
     return (c - rot(b, 24)) & m
 
 
+def name_random_id(name):
+    """The random id Cycles gives an object of its own: the hash of its name."""
+    return _hash_uint2(_hash_string(name), 0)
+
+
 def object_random(name, random_id=None):
     """Object Info's Random as Cycles gives it: an instance's random id, or
     for an object of its own the hash of its name, over 0xFFFFFFFF (float)."""
-    rid = (random_id & 0xFFFFFFFF) if random_id is not None else _hash_uint2(_hash_string(name), 0)
+    rid = (random_id & 0xFFFFFFFF) if random_id is not None else name_random_id(name)
     return float(np.float32(rid) * np.float32(1.0 / 0xFFFFFFFF))
+
+
+def random_from_ids(ids):
+    """object_random of many random ids (an integer array) at once."""
+    return (ids & 0xFFFFFFFF).astype(np.float32) * np.float32(1.0 / 0xFFFFFFFF)
 
 
 def export_object(native_scene, materials, cache, obj, matrix, warnings, is_instance=False, depsgraph=None,

@@ -1,0 +1,79 @@
+"""Export time of Geometry Nodes instances: a grid of points, a subdivided
+rock instanced on each (Instance on Points, random rotation and scale),
+exported by the add-on (export.export_scene) as F12 does; the time of the
+export alone, its prototypes and instances, and per million instances.
+
+  MICROPOLY_ADDON_DIR=build/addons build/bpy-4.5.15/bin/python3 bench/instance_export_bench.py [--instances 100000] [--rounds 3]
+"""
+
+import os
+import statistics
+import sys
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "blender"))
+
+import bpy  # noqa: E402
+
+import render_utils as ru  # noqa: E402
+
+args = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
+COUNT = int(args[args.index("--instances") + 1]) if "--instances" in args else 100000
+ROUNDS = int(args[args.index("--rounds") + 1]) if "--rounds" in args else 3
+
+
+def scene(count):
+    scene = ru.reset_scene()
+    ru.add_camera(scene, (0.0, -60.0, 30.0), (0.0, 0.0, 0.0))
+    ru.add_sun(scene, (0.8, 0.0, 0.5))
+    bpy.ops.mesh.primitive_ico_sphere_add(subdivisions=2, radius=0.3, location=(0.0, 0.0, -50.0))
+    rock = bpy.context.object
+    rock.modifiers.new("Subdivision", "SUBSURF").render_levels = 2
+    side = max(2, int(round(count ** 0.5)))
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=side - 1, y_subdivisions=side - 1, size=100.0)
+    grid = bpy.context.object
+    mod = grid.modifiers.new("Scatter", "NODES")
+    tree = bpy.data.node_groups.new("Scatter", "GeometryNodeTree")
+    mod.node_group = tree
+    if hasattr(tree, "interface"):
+        tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+        tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    else:
+        tree.inputs.new("NodeSocketGeometry", "Geometry")
+        tree.outputs.new("NodeSocketGeometry", "Geometry")
+    nodes, links = tree.nodes, tree.links
+    group_in, group_out = nodes.new("NodeGroupInput"), nodes.new("NodeGroupOutput")
+    info = nodes.new("GeometryNodeObjectInfo")
+    info.inputs["Object"].default_value = rock
+    if "As Instance" in info.inputs:
+        info.inputs["As Instance"].default_value = True
+    on_points = nodes.new("GeometryNodeInstanceOnPoints")
+    rotation = nodes.new("FunctionNodeRandomValue")
+    rotation.data_type = "FLOAT_VECTOR"
+    rotation.inputs["Max"].default_value = (0.0, 0.0, 6.0)
+    links.new(group_in.outputs[0], on_points.inputs["Points"])
+    links.new(info.outputs["Geometry"], on_points.inputs["Instance"])
+    links.new(rotation.outputs[0], on_points.inputs["Rotation"])
+    links.new(on_points.outputs["Instances"], group_out.inputs[0])
+    return scene, side * side
+
+
+def main():
+    built, count = scene(COUNT)
+    from micropoly import export
+
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    times = []
+    for _ in range(ROUNDS):
+        start = time.perf_counter()
+        exported = export.export_scene(depsgraph)
+        times.append(time.perf_counter() - start)
+    s = exported.scene
+    median = statistics.median(times)
+    print(f"Blender {bpy.app.version_string}: {count:,} instances, {s.prototype_count} prototypes, "
+          f"{s.instance_count:,} placed; export {median:.2f} s (median of {ROUNDS}: "
+          f"{', '.join(f'{t:.2f}' for t in times)}), {median * 1e6 / count:.1f} s per million")
+    return 0
+
+
+ru.run_test(main)
