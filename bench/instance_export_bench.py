@@ -32,29 +32,7 @@ def scene(count):
     side = max(2, int(round(count ** 0.5)))
     bpy.ops.mesh.primitive_grid_add(x_subdivisions=side - 1, y_subdivisions=side - 1, size=100.0)
     grid = bpy.context.object
-    mod = grid.modifiers.new("Scatter", "NODES")
-    tree = bpy.data.node_groups.new("Scatter", "GeometryNodeTree")
-    mod.node_group = tree
-    if hasattr(tree, "interface"):
-        tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
-        tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
-    else:
-        tree.inputs.new("NodeSocketGeometry", "Geometry")
-        tree.outputs.new("NodeSocketGeometry", "Geometry")
-    nodes, links = tree.nodes, tree.links
-    group_in, group_out = nodes.new("NodeGroupInput"), nodes.new("NodeGroupOutput")
-    info = nodes.new("GeometryNodeObjectInfo")
-    info.inputs["Object"].default_value = rock
-    if "As Instance" in info.inputs:
-        info.inputs["As Instance"].default_value = True
-    on_points = nodes.new("GeometryNodeInstanceOnPoints")
-    rotation = nodes.new("FunctionNodeRandomValue")
-    rotation.data_type = "FLOAT_VECTOR"
-    rotation.inputs["Max"].default_value = (0.0, 0.0, 6.0)
-    links.new(group_in.outputs[0], on_points.inputs["Points"])
-    links.new(info.outputs["Geometry"], on_points.inputs["Instance"])
-    links.new(rotation.outputs[0], on_points.inputs["Rotation"])
-    links.new(on_points.outputs["Instances"], group_out.inputs[0])
+    ru.scatter_instances(grid, rock)
     return scene, side * side
 
 

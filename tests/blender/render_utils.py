@@ -529,3 +529,40 @@ def write_bench_rib(scene, name):
     path = os.path.abspath(os.path.join(folder, name + ".rib"))
     operators.export_rib(bpy.context.evaluated_depsgraph_get(), path)
     print(f"wrote {path}")
+
+
+def scatter_instances(grid, obj, scale_range=None):
+    """A Geometry Nodes modifier on `grid` placing `obj` (as an instance) on
+    each of its vertices, turned about Z by a random angle and, with
+    scale_range (min, max), scaled at random. Returns the node tree, its
+    Instance on Points node and its group output."""
+    mod = grid.modifiers.new("Scatter", "NODES")
+    tree = bpy.data.node_groups.new("Scatter", "GeometryNodeTree")
+    mod.node_group = tree
+    nodes, links = tree.nodes, tree.links
+    if hasattr(tree, "interface"):  # Blender 4.0 and later
+        tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+        tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    else:
+        tree.inputs.new("NodeSocketGeometry", "Geometry")
+        tree.outputs.new("NodeSocketGeometry", "Geometry")
+    group_in, group_out = nodes.new("NodeGroupInput"), nodes.new("NodeGroupOutput")
+    info = nodes.new("GeometryNodeObjectInfo")
+    info.inputs["Object"].default_value = obj
+    info.transform_space = "ORIGINAL"
+    if "As Instance" in info.inputs:
+        info.inputs["As Instance"].default_value = True
+    on_points = nodes.new("GeometryNodeInstanceOnPoints")
+    rotation = nodes.new("FunctionNodeRandomValue")
+    rotation.data_type = "FLOAT_VECTOR"
+    rotation.inputs["Max"].default_value = (0.0, 0.0, 6.0)
+    links.new(group_in.outputs[0], on_points.inputs["Points"])
+    links.new(info.outputs["Geometry"], on_points.inputs["Instance"])
+    links.new(rotation.outputs[0], on_points.inputs["Rotation"])
+    if scale_range is not None:
+        scale = nodes.new("FunctionNodeRandomValue")
+        scale.data_type = "FLOAT"
+        scale.inputs[2].default_value, scale.inputs[3].default_value = scale_range  # Min, Max (float)
+        links.new(scale.outputs[1], on_points.inputs["Scale"])
+    links.new(on_points.outputs["Instances"], group_out.inputs[0])
+    return tree, on_points, group_out

@@ -116,36 +116,8 @@ def geometry_nodes_scene(displaced=False):
     bpy.ops.mesh.primitive_grid_add(x_subdivisions=3, y_subdivisions=3, size=8.0)
     grid = bpy.context.object
     grid.name = "Scatter"
-    mod = grid.modifiers.new("Scatter", "NODES")
-    tree = bpy.data.node_groups.new("Scatter", "GeometryNodeTree")
-    mod.node_group = tree
+    tree, on_points, group_out = ru.scatter_instances(grid, stone, scale_range=(0.6, 1.3))
     nodes, links = tree.nodes, tree.links
-    if hasattr(tree, "interface"):  # Blender 4.0 and later
-        tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
-        tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
-    else:
-        tree.inputs.new("NodeSocketGeometry", "Geometry")
-        tree.outputs.new("NodeSocketGeometry", "Geometry")
-    group_in = nodes.new("NodeGroupInput")
-    group_out = nodes.new("NodeGroupOutput")
-    info = nodes.new("GeometryNodeObjectInfo")
-    info.inputs["Object"].default_value = stone
-    info.transform_space = "ORIGINAL"
-    if "As Instance" in info.inputs:
-        info.inputs["As Instance"].default_value = True
-    on_points = nodes.new("GeometryNodeInstanceOnPoints")
-    rotation = nodes.new("FunctionNodeRandomValue")
-    rotation.data_type = "FLOAT_VECTOR"
-    rotation.inputs["Max"].default_value = (0.0, 0.0, 6.0)
-    scale = nodes.new("FunctionNodeRandomValue")
-    scale.data_type = "FLOAT"
-    scale.inputs[2].default_value = 0.6  # Min (float)
-    scale.inputs[3].default_value = 1.3  # Max (float)
-    links.new(group_in.outputs[0], on_points.inputs["Points"])
-    links.new(info.outputs["Geometry"], on_points.inputs["Instance"])
-    links.new(rotation.outputs[0], on_points.inputs["Rotation"])
-    links.new(scale.outputs[1], on_points.inputs["Scale"])
-    links.new(on_points.outputs["Instances"], group_out.inputs[0])
 
     def realize():
         real = nodes.new("GeometryNodeRealizeInstances")

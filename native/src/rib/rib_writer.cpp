@@ -764,6 +764,19 @@ void write_world(std::string& o, const Scene& scene, const std::string& folder, 
   o += '\n';
 }
 
+// The scene's meshes and patch sets, each flushed to `out` once written.
+void write_surfaces(std::string& o, std::ostream& out, const Scene& scene, const std::vector<Material>& materials,
+                    const std::vector<MaterialProgram>& programs) {
+  for (const Mesh& m : scene.meshes) {
+    write_mesh(o, m, materials, programs);
+    flush(out, o);
+  }
+  for (const BezierPatches& b : scene.bezier_patches) {
+    write_patches(o, b, materials, programs);
+    flush(out, o);
+  }
+}
+
 // Prototypes RIB can hold as retained objects, with their instances; the
 // instances of any other are written as the copies they render like.
 void write_instances(std::string& o, std::ostream& out, const Scene& scene, const std::vector<Material>& materials) {
@@ -788,15 +801,7 @@ void write_instances(std::string& o, std::ostream& out, const Scene& scene, cons
     write_instance(o, inst, written[p], handle, materials, scene.material_programs);
     flush(out, o);
   }
-  const Scene copies = with_instances_made_real(rest);
-  for (const Mesh& m : copies.meshes) {
-    write_mesh(o, m, materials, scene.material_programs);
-    flush(out, o);
-  }
-  for (const BezierPatches& b : copies.bezier_patches) {
-    write_patches(o, b, materials, scene.material_programs);
-    flush(out, o);
-  }
+  write_surfaces(o, out, with_instances_made_real(rest), materials, scene.material_programs);
 }
 
 // write_rib() after validation.
@@ -830,14 +835,7 @@ void write_valid_scene(const Scene& scene, std::ostream& out, const std::string&
     o += "AttributeEnd\n";
   }
   flush(out, o);
-  for (const Mesh& m : scene.meshes) {
-    write_mesh(o, m, materials, scene.material_programs);
-    flush(out, o);
-  }
-  for (const BezierPatches& b : scene.bezier_patches) {
-    write_patches(o, b, materials, scene.material_programs);
-    flush(out, o);
-  }
+  write_surfaces(o, out, scene, materials, scene.material_programs);
   write_instances(o, out, scene, materials);
   o += "WorldEnd\nFrameEnd\n";
   flush(out, o);
