@@ -8,7 +8,9 @@ Cycles' direct light (PSNR >= 30 dB over pixels both cover, silhouettes
 IoU >= 0.98), and each rendering like the same scene with its instances made
 real in Blender (Realize Instances, Make Instances Real, a mesh of its own
 for each duplicate): PSNR >= 60 dB,
-alpha identical. Exits non-zero on failure."""
+alpha identical. The Geometry Nodes scene, written as RIB (ObjectBegin,
+ObjectInstance) and rendered by the CLI, matches its F12. Exits non-zero on
+failure."""
 
 import math
 import os
@@ -236,6 +238,12 @@ def linked_duplicates_scene():
 
 def main():
     scene, realize = geometry_nodes_scene()
+    # Exported as RIB (ObjectBegin, ObjectInstance), rendered by the CLI:
+    # the image F12 makes.
+    diff = ru.rib_against_f12(scene, W, H, 4, ["ObjectBegin", "ObjectInstance"], transparent=True)
+    if diff is not None:
+        check("Geometry Nodes Instance on Points: the RIB renders like F12", diff <= 1.0 / 255.0 + 1e-6,
+              f"largest difference {diff * 255:.1f} / 255")
     compare("Geometry Nodes Instance on Points", scene, realize, prototypes=1, instances=16)
     scene, make_real = particle_scene()
     compare("particle system of objects", scene, make_real, prototypes=1, instances=24)
