@@ -179,9 +179,9 @@ typedef struct {
  * 3x4 matrix, and the inverse transpose of its linear part for normals).
  * box: the placed surface's camera-space box over the whole shutter,
  * displacement included; reach: how far (camera axes) its points move away
- * from the centre's during the shutter; scale: the longest a unit vector of
- * its space becomes (its patches' displacement bounds, in its units, times
- * this); flags: MP_PATCH_FLIP_ORIENTATION (a mirroring transform),
+ * from the centre's during the shutter (its patches' displacement bounds,
+ * in their own units, grow their boxes before the transform carries them);
+ * flags: MP_PATCH_FLIP_ORIENTATION (a mirroring transform),
  * MP_PATCH_NO_CAMERA and MP_PATCH_NO_SHADOW (the instance's visibility),
  * added to its patches' own; object: its DeviceObject. */
 typedef struct {
@@ -189,7 +189,7 @@ typedef struct {
   float normal_to_camera[12];
   float box_lo[4];
   float box_hi[4];
-  float reach[4]; /* xyz; w: scale */
+  float reach[4]; /* xyz; w unused */
   uint first_patch;
   uint patch_count;
   uint object;

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <numeric>
 #include <string>
 #include <tuple>
 
@@ -177,7 +176,6 @@ void place_instances(const Scene& scene, const PrototypeVariants& pv,
         }
       }
       for (int a = 0; a < 3; ++a) r.box_lo[a] = lo[a], r.box_hi[a] = hi[a], r.reach[a] = reach[a];
-      r.reach[3] = max_scale(p.to_camera);
       placed.push_back(std::move(p));
     }
   }
