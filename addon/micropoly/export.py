@@ -174,6 +174,7 @@ def export_settings(native_scene, scene, width, height):
     settings.bound_split = getattr(_native.BoundSplitMethod, mp.bound_split_method)
     settings.bound_split_memory_mib = mp.bound_split_memory
     settings.occlusion_culling = mp.use_occlusion_culling
+    settings.sample_culling = mp.use_sample_culling
     # An opaque film lays the world behind by alpha: held-out samples count
     # as covered so it shows nowhere through a Holdout, as in Cycles.
     settings.holdout_covers = not r.film_transparent
@@ -234,7 +235,9 @@ def export_scene(depsgraph, view=None, meshes=None, motion=None):
                                                 film_transparent=scene.render.film_transparent)
     # Materials first: their node programs decide which UV maps meshes export.
     # Meanwhile, objects that share their mesh with others (linked
-    # duplicates) are counted: without motion blur they become instances.
+    # duplicates) are counted: without motion blur they become instances
+    # (with it, each renders as an object of its own, deforming or not;
+    # depsgraph instances stay instances and move by their transforms).
     shared = {}
     seen = set()
     for inst in depsgraph.object_instances:
@@ -249,7 +252,7 @@ def export_scene(depsgraph, view=None, meshes=None, motion=None):
                 key = export_instances.InstanceTable.key(inst.object, shared_data=True)
                 if key is not None:
                     shared[key] = shared.get(key, 0) + 1
-    instances = export_instances.InstanceTable()
+    instances = export_instances.InstanceTable(motion)
     for inst in depsgraph.object_instances:
         obj = inst.object
         # An instancer whose own geometry is hidden (a particle emitter with

@@ -15,7 +15,7 @@ not by the object that places it).
 
 import numpy as np
 
-from . import export_mesh
+from . import export_mesh, export_motion
 
 
 class InstanceTable:
@@ -25,10 +25,13 @@ class InstanceTable:
     colour, pass index) is looked up once per object and mesh data (the
     depsgraph may hand one temporary object several meshes)."""
 
-    def __init__(self):
+    def __init__(self, motion=None):
         self._prototypes = {}  # key -> prototype index, or None (nothing to render)
         self._objects = {}     # (object, data) pointers -> (prototype, colour, pass index, name's random id, visibility)
-        self._placed = {}      # prototype -> ([matrix rows], [random ids], [colours], [pass indices], visibility)
+        # prototype -> ([matrix rows], [random ids], [colours], [pass indices], visibility, [motion or None])
+        self._placed = {}
+        # Depsgraph instances that move over the shutter (export_motion.Motion.instances).
+        self._moving = motion.instances if motion is not None else {}
 
     @staticmethod
     def key(obj, shared_data=False):
@@ -70,20 +73,37 @@ class InstanceTable:
             return False
         placed = self._placed.get(proto)
         if placed is None:
-            placed = self._placed[proto] = ([], [], [], [], entry[4])
+            placed = self._placed[proto] = ([], [], [], [], entry[4], [])
         m = inst.matrix_world
         placed[0].append((*m[0], *m[1], *m[2], *m[3]))
         placed[1].append(inst.random_id if inst.is_instance else entry[3])
         placed[2].append(entry[1])
         placed[3].append(entry[2])
+        if self._moving and inst.is_instance:
+            placed[5].append(self._moving.get(export_motion.instance_key(inst)))
         return True
 
     def flush(self, native_scene):
         """Hands every prototype's instances to the scene."""
-        for proto, (matrices, ids, colours, passes, (camera, shadows)) in self._placed.items():
+        for proto, (matrices, ids, colours, passes, (camera, shadows), moving) in self._placed.items():
+            placed = np.asarray(matrices, dtype=np.float32).reshape(-1, 4, 4)
             native_scene.add_instances(
-                proto, np.asarray(matrices, dtype=np.float32).reshape(-1, 4, 4),
-                random=export_mesh.random_from_ids(np.asarray(ids, dtype=np.int64)),
+                proto, placed, random=export_mesh.random_from_ids(np.asarray(ids, dtype=np.int64)),
                 object_color=np.asarray(colours, dtype=np.float32),
-                pass_index=np.asarray(passes, dtype=np.float32), visible_camera=camera, cast_shadows=shadows)
+                pass_index=np.asarray(passes, dtype=np.float32), visible_camera=camera, cast_shadows=shadows,
+                motion_object_to_world=self._motion(placed, moving))
         self._placed.clear()
+
+    @staticmethod
+    def _motion(placed, moving):
+        """(instances, steps, 4, 4) matrices over the shutter where any
+        instance of the prototype moves (the others hold still at their
+        own), else an empty array."""
+        steps = next((m.shape[0] for m in moving if m is not None), 0)
+        if steps == 0:
+            return np.zeros(0, dtype=np.float32)
+        out = np.repeat(placed[:, None], steps, axis=1)
+        for i, m in enumerate(moving):
+            if m is not None:
+                out[i] = m
+        return out

@@ -81,15 +81,32 @@ def _points(obj, depsgraph):
     return points.reshape(-1, 3)
 
 
+def instance_key(inst):
+    """What names a depsgraph instance from one motion step to the next:
+    its instancer, its persistent id (the instance's path through nested
+    instancers) and the object it places."""
+    parent = inst.parent
+    return (parent.name if parent is not None else "", tuple(inst.persistent_id), inst.object.name)
+
+
+def _rows(m):
+    """A matrix as a tuple of its rows, flat (far cheaper than numpy.array
+    of a Matrix, which matters per instance)."""
+    return (*m[0], *m[1], *m[2], *m[3])
+
+
 @dataclass
 class Motion:
     """What moves during the shutter: per step the camera's world-to-camera
-    matrix, and per object name its matrices and (deforming) points."""
+    matrix, per object name its matrices and (deforming) points, and per
+    depsgraph instance (instance_key) its matrices, as (steps, 4, 4) arrays
+    of rows."""
     times: list
     camera: np.ndarray = None
     curve: np.ndarray = None
     matrices: dict = field(default_factory=dict)
     points: dict = field(default_factory=dict)
+    instances: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
 
     def apply(self, native_scene):
@@ -110,20 +127,26 @@ class Motion:
 def sample(setter, depsgraph, times):
     """Evaluates the scene at each time (leaving it at the last) and returns
     its Motion; what does not move is left out."""
-    camera, matrices, points = [], {}, {}
+    camera, matrices, points, instances = [], {}, {}, {}
     for time in times:
         frame_set(setter, time)
         scene = depsgraph.scene
         camera.append(camera_view.view_matrix(scene.camera.evaluated_get(depsgraph)))
         for inst in depsgraph.object_instances:
             obj = inst.object
-            if inst.is_instance or obj.type != "MESH" or not _object_blurs(obj):
+            if obj.type != "MESH" or not _object_blurs(obj):
+                continue
+            if inst.is_instance:  # its transform only: a prototype does not deform
+                instances.setdefault(instance_key(inst), []).append(_rows(inst.matrix_world))
                 continue
             matrices.setdefault(obj.name, []).append(np.array(inst.matrix_world, dtype=np.float32))
             points.setdefault(obj.name, []).append(_points(obj, depsgraph))
     motion = Motion(times=times, curve=shutter_curve(depsgraph.scene))
     camera = np.stack(camera)
     motion.camera = camera if not np.all(camera == camera[0]) else None
+    for key, steps in instances.items():
+        if len(steps) == len(times) and any(s != steps[0] for s in steps):  # else: rendered still
+            motion.instances[key] = np.asarray(steps, dtype=np.float32).reshape(-1, 4, 4)
     for name, steps in matrices.items():
         if len(steps) != len(times):
             continue  # not in every step: rendered still

@@ -40,6 +40,10 @@ class MicropolySceneSettings(bpy.types.PropertyGroup):
     use_occlusion_culling: BoolProperty(name="Occlusion Culling", description="Skip surfaces hidden behind "
                                         "what is already rendered before dicing them (the image is the same; "
                                         "off for comparison)", default=True)
+    use_sample_culling: BoolProperty(name="Sample Culling", description="Skip surfaces a pixel or two across "
+                                     "that fall between the samples before dicing them: distant instances cost "
+                                     "the samples they cover (the image is the same; off for comparison)",
+                                     default=True)
     filter_type: EnumProperty(name="Pixel Filter", items=FILTERS, default="BLACKMAN_HARRIS")
     filter_width: FloatProperty(name="Filter Width", description="Pixel filter width in pixels, as Cycles "
                                 "reads it (Blackman-Harris reaches this far on each side of a pixel's centre)",

@@ -109,6 +109,7 @@ class MICROPOLY_PT_bound_split(MicropolyPanel, bpy.types.Panel):
         row.enabled = settings.bound_split_method == "BOUNDED"
         row.prop(settings, "bound_split_memory")
         layout.prop(settings, "use_occlusion_culling")
+        layout.prop(settings, "use_sample_culling")
         layout.prop(settings, "sample_memory")
 
 

@@ -31,7 +31,7 @@
   BUFFER(const float4, motion_points)      /* points at each motion step, or one float4 without motion */         \
   BUFFER(const float4, motion_curves)      /* edge curves at each motion step, likewise */                        \
   BUFFER(const DeviceInstance, instances)  /* prototype surfaces placed by instances (geometry/mp_instance.h) */ \
-  BUFFER(const uint, instance_roots)       /* instance_count + 1: the first root of each (exclusive prefix) */    \
+  BUFFER(const DevicePatchNode, patch_nodes) /* prototype surfaces' trees of patches (mp_types.h) */            \
   BUFFER(const float4, instance_motion)    /* 3 rows per instance at each motion step, or one float4 */           \
   BUFFER(const uint, refract_roots)        /* refraction proxies (geometry/mp_refract_trace.h) */                 \
   BUFFER(const float4, refract_nodes)                                                                              \
@@ -41,7 +41,7 @@
   VALUE(uint, point_count)                 /* float4s of one motion step in motion_points */                      \
   VALUE(uint, curve_count)                 /* float4s of one motion step in motion_curves */                      \
   VALUE(uint, patch_count)                 /* patches placed on their own (instances' roots follow them) */       \
-  VALUE(uint, root_count)                  /* patch_count + every instance's patches: roots of one view */        \
+  VALUE(uint, root_count)                  /* patch_count + instance_count: roots of one view */                  \
   VALUE(uint, instance_count)                                                                                      \
   VALUE(uint, light_count)                                                                                         \
   VALUE(uint, uv_layers)                                                                                           \

@@ -16,7 +16,7 @@
  * 1 + log2 of the number of micropolygon edges along it (see mp_bound.h). */
 typedef struct {
   float corner[8];
-  uint patch;
+  uint patch; /* or, while bound & split opens an instance, a node of its tree (MP_NODE_REF; mp_instance.h) */
   uint info;
   uint rates;
   uint instance; /* the DeviceInstance placing `patch`, or MP_NO_INSTANCE (mp_instance.h) */
@@ -123,7 +123,16 @@ typedef struct {
   /* Image lookups filter over this many micropolygon footprints
    * (RenderSettings::texture_filter_width; mp_tex_image.h). */
   float texture_filter;
+  /* Where the view's samples lie, so that bound & split may cull a small
+   * bound that holds none (mp_bound.h, mp_bound_misses_samples): the
+   * camera's pattern (MP_SAMPLES_PATTERN, mp_raster.h), texel centres
+   * (MP_SAMPLES_CENTRES: shadow maps), or not known (0: views whose grids
+   * serve more than samples, as the shadow markings' do). */
+  int samples;
 } FrameParams;
+#define MP_SAMPLES_UNKNOWN 0
+#define MP_SAMPLES_PATTERN 1
+#define MP_SAMPLES_CENTRES 2
 
 /* The camera view's occlusion pyramid (mp_occlusion.h): level 0 has a cell
  * per 2^cell_shift x 2^cell_shift pixels holding the farthest depth of the
@@ -174,9 +183,10 @@ typedef struct {
 
 /* One surface of a prototype placed by one instance (scene.h Instance;
  * geometry/mp_instance.h): patches [first_patch, first_patch + patch_count)
- * hold the surface in its own space, once for all its instances; this
- * record carries them to camera space at the shutter's centre (rows of a
- * 3x4 matrix, and the inverse transpose of its linear part for normals).
+ * hold the surface in its own space, once for all its instances, under a
+ * tree of boxes whose root is `root` (DevicePatchNode); this record carries
+ * them to camera space at the shutter's centre (rows of a 3x4 matrix, and
+ * the inverse transpose of its linear part for normals).
  * box: the placed surface's camera-space box over the whole shutter,
  * displacement included; reach: how far (camera axes) its points move away
  * from the centre's during the shutter (its patches' displacement bounds,
@@ -191,10 +201,27 @@ typedef struct {
   float box_hi[4];
   float reach[4]; /* xyz; w unused */
   uint first_patch;
-  uint patch_count;
+  uint root; /* MP_NODE_REF(node), or its one patch */
   uint object;
   uint flags;
 } DeviceInstance;
+
+/* A node of a prototype surface's tree of patches (geometry/mp_instance.h):
+ * the box (its own space, displacement included) around the patches below
+ * it, and its two children, each a node (MP_NODE_REF) or a patch. Bound &
+ * split opens an instance down this tree, so what a view cannot see is
+ * culled a subtree at a time, the whole instance first. */
+typedef struct {
+  float lo[4]; /* xyz; w unused */
+  float hi[4];
+  uint child[2];
+  uint unused[2];
+} DevicePatchNode;
+
+#define MP_NODE_BIT 0x80000000u
+#define MP_NODE_REF(node) ((uint)(node) | MP_NODE_BIT)
+#define MP_IS_NODE(ref) (((ref) & MP_NODE_BIT) != 0u)
+#define MP_NODE_INDEX(ref) ((ref) & ~MP_NODE_BIT)
 
 /* A texture image (scene.h Image): its texels are width * height float4
  * (RGBA, rows bottom to top) from `offset` in the texel buffer; srgb = 1

@@ -20,11 +20,13 @@
 #include "geometry/mp_grid.h" /* mp_corner */
 #include "stages/mp_occlusion.h"
 #include "stages/mp_blur.h"
+#include "stages/mp_raster.h" /* the camera's sample pattern */
 
 #define MP_CULL 0u
 #define MP_DICE 1u
 #define MP_SPLIT_U 2u
 #define MP_SPLIT_V 3u
+#define MP_SPLIT_NODE 4u /* a node of an instance's tree of patches opens into its children (mp_instance.h) */
 
 /* Decision word: action in bits 0-7, grid size nu, nv in bits 8-15, 16-23;
  * a cull for occlusion has bit 8 set (counted apart). */
@@ -486,6 +488,43 @@ MP_INLINE int mp_boxes_beside_frustum(const float3* lo, const float3* hi, int co
          mp_boxes_plane_max(lo, hi, count, -f.ay, (float)f.height + r - f.by) + sy < 0.0f;
 }
 
+/* Bounds at most this many pixels across are tested against the view's
+ * samples: few enough to enumerate, and what a distant instance's subtree
+ * or a sub-pixel patch shrinks to. */
+#define MP_SAMPLE_TEST_SPAN 2.0f
+
+/* Whether the raster rectangle holds none of the view's samples
+ * (FrameParams.samples), so that nothing inside it can be sampled: a tree
+ * of patches far smaller than a pixel (a distant instance) is then dropped
+ * where it falls between samples, not diced a patch at a time. The
+ * rectangle is widened by a few sub-pixel steps for the rounding between
+ * this bound and the sampler's fixed-point vertices; a wider rectangle, or
+ * a view whose grids serve more than its samples, is never culled here. The
+ * samples are the camera's pattern (mp_sample_offset_packed, the table
+ * the samplers read) or texel centres (shadow maps, shadow_sample). */
+MP_INLINE int mp_bound_misses_samples(float xmin, float ymin, float xmax, float ymax, FrameParams f) {
+  if (f.samples == MP_SAMPLES_UNKNOWN || !(xmax - xmin <= MP_SAMPLE_TEST_SPAN) ||
+      !(ymax - ymin <= MP_SAMPLE_TEST_SPAN))
+    return 0;
+  const float one = (float)MP_SUBPIXEL_ONE, margin = 4.0f;
+  float lx = floor(xmin * one) - margin, hx = ceil(xmax * one) + margin;
+  float ly = floor(ymin * one) - margin, hy = ceil(ymax * one) + margin;
+  int px0 = (int)floor(lx / one), px1 = (int)floor(hx / one);
+  int py0 = (int)floor(ly / one), py1 = (int)floor(hy / one);
+  int spp = f.samples == MP_SAMPLES_CENTRES ? 1 : f.spp_x * f.spp_y;
+  for (int py = py0; py <= py1; ++py)
+    for (int px = px0; px <= px1; ++px)
+      for (int s = 0; s < spp; ++s) {
+        uint o = f.samples == MP_SAMPLES_CENTRES
+                     ? (uint)(MP_SUBPIXEL_ONE / 2) * 0x101u
+                     : mp_sample_offset_packed((px + f.crop_x0) & (MP_SAMPLE_TILE - 1),
+                                               (py + f.crop_y0) & (MP_SAMPLE_TILE - 1), s, f);
+        float x = (float)px * one + (float)(o & 0xffu), y = (float)py * one + (float)(o >> 8);
+        if (x >= lx && x <= hx && y >= ly && y <= hy) return 0;
+      }
+  return 1;
+}
+
 /* Whether view-space boxes with bound b lie outside the view: beyond its
  * clipping planes, beside its frustum, outside its frame (plus the ribbon),
  * or (shadow views) outside every page it renders; boxes that reach the eye
@@ -498,6 +537,8 @@ MP_INLINE int mp_bound_culled(MpBound b, const float3* lo, const float3* hi, int
   /* Seen through a lens, a point may land anywhere in its circle of confusion. */
   float rx = f.ribbon + mp_lens_slack_x(f, b.dmin, b.dmax), ry = f.ribbon + mp_lens_slack_y(f, b.dmin, b.dmax);
   if (b.xmax < -rx || b.ymax < -ry || b.xmin > (float)f.width + rx || b.ymin > (float)f.height + ry) return 1;
+  float sx = rx - f.ribbon, sy = ry - f.ribbon; /* the lens's reach */
+  if (mp_bound_misses_samples(b.xmin - sx, b.ymin - sy, b.xmax + sx, b.ymax + sy, f)) return 1;
   return f.view_kind == MP_VIEW_SHADOW && page_masks &&
          !mp_page_mask_overlaps(page_masks + f.page_mask, f.page_side, b.xmin - f.ribbon, b.ymin - f.ribbon,
                                 b.xmax + f.ribbon, b.ymax + f.ribbon);
@@ -532,11 +573,41 @@ MP_INLINE void mp_grow_boxes(float3* lo, float3* hi, int count, float3 grow) {
     }
 }
 
+/* A sub-patch that is a node of an instance's tree (mp_instance.h): culled
+ * when its box, carried into the view by the instance (and grown by its
+ * motion), is; else opened (MP_SPLIT_NODE), its children stored in *sp for
+ * mp_split. The tree's root is met through the instance's own box, which
+ * follows its motion step by step. Ray visibility is the instance's: a
+ * prototype's patches may still differ below. */
+MP_INLINE uint mp_classify_node(const MP_GLOBAL DevicePatchNode* nodes, const MP_GLOBAL DeviceInstance* instances,
+                                SubPatch* sp, FrameParams f, const MP_GLOBAL uchar* page_masks,
+                                const MP_GLOBAL uint* occlusion, OcclusionParams occ) {
+  const MP_GLOBAL DeviceInstance* in = instances + sp->instance;
+  if (in->flags & (f.view_kind == MP_VIEW_SHADOW ? MP_PATCH_NO_SHADOW : MP_PATCH_NO_CAMERA)) return MP_CULL;
+  const MP_GLOBAL DevicePatchNode* node = nodes + MP_NODE_INDEX(sp->patch);
+  float3 lo, hi;
+  if (sp->patch == in->root) {
+    lo = MP_F3(in->box_lo[0], in->box_lo[1], in->box_lo[2]);
+    hi = MP_F3(in->box_hi[0], in->box_hi[1], in->box_hi[2]);
+  } else {
+    MpPlacement place = mp_instance_placement(instances, sp->instance);
+    lo = MP_F3(node->lo[0], node->lo[1], node->lo[2]);
+    hi = MP_F3(node->hi[0], node->hi[1], node->hi[2]);
+    mp_place_boxes(&place, &lo, &hi, 1);
+    mp_grow_boxes(&lo, &hi, 1, MP_F3(in->reach[0], in->reach[1], in->reach[2]));
+  }
+  uint d = mp_classify_box(lo, hi, f, page_masks, occlusion, occ, 1);
+  if (d) return d;
+  mp_node_store_children(sp, node);
+  return MP_SPLIT_NODE;
+}
+
 MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint* patch_info,
                            const MP_GLOBAL uint* edges, const MP_GLOBAL float4* curves,
                            const MP_GLOBAL float4* patch_bounds, const MP_GLOBAL DeviceInstance* instances,
-                           SubPatch* sp, FrameParams f, const MP_GLOBAL uchar* page_masks,
-                           const MP_GLOBAL uint* occlusion, OcclusionParams occ) {
+                           const MP_GLOBAL DevicePatchNode* nodes, SubPatch* sp, FrameParams f,
+                           const MP_GLOBAL uchar* page_masks, const MP_GLOBAL uint* occlusion, OcclusionParams occ) {
+  if (MP_IS_NODE(sp->patch)) return mp_classify_node(nodes, instances, sp, f, page_masks, occlusion, occ);
   const MP_GLOBAL float4* cp = points + (ulong)sp->patch * MP_PATCH_POINTS;
   uint type = patch_info[4 * (ulong)sp->patch];
   /* Ray visibility: objects hidden from the camera still cast shadows, and
@@ -547,18 +618,8 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
   int can_split = (int)depth < f.max_depth;
   MpPlacement place = mp_instance_placement(instances, sp->instance);
   float3 reach = MP_F3(0.0f, 0.0f, 0.0f);
-  if (sp->instance != MP_NO_INSTANCE) {
+  if (sp->instance != MP_NO_INSTANCE)
     reach = MP_F3(instances[sp->instance].reach[0], instances[sp->instance].reach[1], instances[sp->instance].reach[2]);
-    /* An instance's roots meet the view through the whole instance's box
-     * first, before their patch is read. */
-    if (depth == 0u) {
-      const MP_GLOBAL DeviceInstance* in = instances + sp->instance;
-      uint d = mp_classify_box(MP_F3(in->box_lo[0], in->box_lo[1], in->box_lo[2]),
-                               MP_F3(in->box_hi[0], in->box_hi[1], in->box_hi[2]), f, page_masks, occlusion, occ,
-                               can_split);
-      if (d) return d;
-    }
-  }
   /* Whole patches meet the view through their box first: a pass over many
    * views (shadow maps) sees most patches outside most views, and a box is
    * far cheaper to bound than the net. */
@@ -632,6 +693,11 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
 /* Splits across edges 0 and 2 (MP_SPLIT_U) or 1 and 3 (MP_SPLIT_V; done as
  * the same cut on the corners rotated by one, which keeps the orientation). */
 MP_INLINE void mp_split(const SubPatch* sp, uint action, SubPatch* a, SubPatch* b) {
+  if (action == MP_SPLIT_NODE) { /* its children, whole and unrated, as roots are */
+    mp_whole_subpatch(mp_node_child(sp, 0), sp->instance, sp->info & MP_INFO_VIEW_BITS, a);
+    mp_whole_subpatch(mp_node_child(sp, 1), sp->instance, sp->info & MP_INFO_VIEW_BITS, b);
+    return;
+  }
   int rot = action == MP_SPLIT_V ? 1 : 0;
   float2 c[4];
   uint r[4];

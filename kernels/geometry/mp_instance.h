@@ -12,8 +12,13 @@
  * same curve through the same transform, so its grids stay watertight.
  *
  * Roots: a view's roots are the patches placed on their own
- * [0, patch_count), then every instance's patches, instance after instance
- * (instance_roots holds where each starts), never listed one by one.
+ * [0, patch_count), then one per instance: the root of its surface's tree
+ * of patches (DevicePatchNode). Bound & split opens a node whose box the
+ * instance carries into the view (not culled by the frustum, the shadow
+ * pages or the occlusion pyramid) into its two children, down to patches,
+ * which go on as any patch does; (instance, patch) pairs are never listed,
+ * and what a view cannot see is dropped a subtree at a time, the whole
+ * instance first. Nodes never reach the dicer.
  *
  * Compiles as OpenCL C and C++. */
 #ifndef MP_INSTANCE_H
@@ -118,25 +123,41 @@ MP_INLINE uint mp_placed_flags(const MP_GLOBAL uint* patch_info, const MP_GLOBAL
          (instances[instance].object << 8);
 }
 
-/* Root q of a view (q < root_count): its patch and instance. */
-MP_INLINE void mp_root_patch(uint q, uint patch_count, const MP_GLOBAL uint* instance_roots, uint instance_count,
-                             const MP_GLOBAL DeviceInstance* instances, uint* patch, uint* instance) {
+/* Root q of a view (q < root_count): its patch, or its instance's tree's
+ * root node, and its instance. */
+MP_INLINE void mp_root_patch(uint q, uint patch_count, const MP_GLOBAL DeviceInstance* instances, uint* patch,
+                             uint* instance) {
   if (q < patch_count) {
     *patch = q;
     *instance = MP_NO_INSTANCE;
     return;
   }
-  uint k = q - patch_count, lo = 0u, hi = instance_count - 1u;
-  while (lo < hi) { /* the last instance that starts at or before k */
-    uint mid = lo + (hi - lo + 1u) / 2u;
-    if (instance_roots[mid] <= k)
-      lo = mid;
-    else
-      hi = mid - 1u;
-  }
-  *instance = lo;
-  *patch = instances[lo].first_patch + (k - instance_roots[lo]);
+  *instance = q - patch_count;
+  *patch = instances[q - patch_count].root;
 }
+
+/* The whole domain of a patch (or a node) as a sub-patch of `instance`,
+ * split nowhere and no edge rated yet: a root, or a node's child. */
+MP_INLINE void mp_whole_subpatch(uint patch, uint instance, uint info, SubPatch* sp) {
+  sp->corner[0] = 0.0f, sp->corner[1] = 0.0f;
+  sp->corner[2] = 1.0f, sp->corner[3] = 0.0f;
+  sp->corner[4] = 1.0f, sp->corner[5] = 1.0f;
+  sp->corner[6] = 0.0f, sp->corner[7] = 1.0f;
+  sp->patch = patch;
+  sp->instance = instance;
+  sp->info = info;
+  sp->rates = 0u;
+}
+
+/* A node's children as its sub-patch carries them from its classification
+ * to its split (mp_bound.h): a node has no parametric domain, so its first
+ * two corners hold them. */
+MP_INLINE void mp_node_store_children(SubPatch* sp, const MP_GLOBAL DevicePatchNode* node) {
+  sp->corner[0] = as_float(node->child[0]);
+  sp->corner[1] = as_float(node->child[1]);
+}
+
+MP_INLINE uint mp_node_child(const SubPatch* sp, int k) { return as_uint(sp->corner[k]); }
 
 /* An id for hashes that tell surfaces apart (sample keys, stochastic
  * opacity): the patch's, combined with its instance's. */

@@ -26,11 +26,10 @@
  * before the next, so every view's pyramid fills with the nearest surfaces
  * first. */
 #define MP_ROOT_SUBPATCH(r, view_count, order) \
-  mp_root_subpatch((r), patch_count, root_count, instance_roots, instance_count, instances, (view_count), (order))
+  mp_root_subpatch((r), patch_count, root_count, instances, (view_count), (order))
 
-inline SubPatch mp_root_subpatch(uint r, uint patch_count, uint root_count, __global const uint* instance_roots,
-                                 uint instance_count, __global const DeviceInstance* instances, uint view_count,
-                                 __global const uint* order) {
+inline SubPatch mp_root_subpatch(uint r, uint patch_count, uint root_count, __global const DeviceInstance* instances,
+                                 uint view_count, __global const uint* order) {
   uint views = max(view_count, 1u);
   uint q, view;
   if (!order) {
@@ -41,13 +40,9 @@ inline SubPatch mp_root_subpatch(uint r, uint patch_count, uint root_count, __gl
     q = patch_count + (r - patch_count * views) / views, view = r % views;
   }
   SubPatch sp;
-  mp_root_patch(q, patch_count, instance_roots, instance_count, instances, &sp.patch, &sp.instance);
-  sp.corner[0] = 0.0f; sp.corner[1] = 0.0f;
-  sp.corner[2] = 1.0f; sp.corner[3] = 0.0f;
-  sp.corner[4] = 1.0f; sp.corner[5] = 1.0f;
-  sp.corner[6] = 0.0f; sp.corner[7] = 1.0f;
-  sp.info = view << 24;
-  sp.rates = 0u;
+  uint patch, instance;
+  mp_root_patch(q, patch_count, instances, &patch, &instance);
+  mp_whole_subpatch(patch, instance, view << 24, &sp);
   return sp;
 }
 
@@ -81,7 +76,7 @@ __kernel void bs_breadth_classify(MP_SCENE_PARAMS __global SubPatch* queue, uint
     return;
   }
   SubPatch sp = queue[i];
-  uint d = mp_classify(points, patch_info, patch_edges, edge_curves, patch_bounds, instances, &sp,
+  uint d = mp_classify(points, patch_info, patch_edges, edge_curves, patch_bounds, instances, patch_nodes, &sp,
                        mp_subpatch_view(&sp, f, views, view_count), page_masks, occlusion, occ);
   uint action = MP_DECISION_ACTION(d);
   if (d == MP_CULL_OCCLUDED) atomic_inc(occluded);
@@ -164,7 +159,7 @@ __kernel void bs_bounded_step(MP_SCENE_PARAMS __global const uint* root_order, F
       }
     }
     SubPatch sp = stack[--size];
-    uint d = mp_classify(points, patch_info, patch_edges, edge_curves, patch_bounds, instances, &sp,
+    uint d = mp_classify(points, patch_info, patch_edges, edge_curves, patch_bounds, instances, patch_nodes, &sp,
                          mp_subpatch_view(&sp, f, views, view_count), page_masks, occlusion, occ);
     uint action = MP_DECISION_ACTION(d);
     if (d == MP_CULL_OCCLUDED) atomic_inc(&counters[BS_OCCLUDED]);

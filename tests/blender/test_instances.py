@@ -1,6 +1,7 @@
 """Instances in Blender (run by blender -b, or a Python with the bpy module):
-Geometry Nodes' Instance on Points, a particle system of objects, a
-collection instanced by empties whose collection holds another collection
+Geometry Nodes' Instance on Points (still, and moving over the shutter
+with Render > Motion Blur), a particle system of objects and one of a
+collection, a collection instanced by empties whose collection holds another collection
 instance (nested), objects sharing one mesh (linked duplicates), and
 Instance on Points of a subdivided, displaced rock, each exported as prototypes and instances (one prototype per instanced
 mesh, one instance per copy: the exported scene's own counts), each against
@@ -129,10 +130,20 @@ def geometry_nodes_scene(displaced=False):
     return scene, realize
 
 
-def particle_scene():
-    """A particle system on an emitter that renders a rock per particle."""
+def particle_scene(collection=False):
+    """A particle system on an emitter that renders a rock per particle, or
+    (collection) one of a collection's two rocks per particle."""
     scene = base_scene()
-    stone = rock("Pebble", (0.3, 0.5, 0.8))
+    if collection:
+        pebbles = bpy.data.collections.new("Pebbles")
+        scene.collection.children.link(pebbles)
+        for name, color in (("PebbleA", (0.3, 0.5, 0.8)), ("PebbleB", (0.8, 0.7, 0.2))):
+            stone = rock(name, color)
+            pebbles.objects.link(stone)
+            scene.collection.objects.unlink(stone)
+        pebbles.instance_offset = (0.0, 0.0, -20.0)  # where the rocks lie, out of view
+    else:
+        stone = rock("Pebble", (0.3, 0.5, 0.8))
     bpy.ops.mesh.primitive_plane_add(size=8.0, location=(0.0, 0.0, 0.0))
     emitter = bpy.context.object
     emitter.name = "Emitter"
@@ -142,8 +153,12 @@ def particle_scene():
     settings.count = 24
     settings.frame_start = settings.frame_end = 1
     settings.physics_type = "NO"
-    settings.render_type = "OBJECT"
-    settings.instance_object = stone
+    if collection:
+        settings.render_type = "COLLECTION"
+        settings.instance_collection = pebbles
+    else:
+        settings.render_type = "OBJECT"
+        settings.instance_object = stone
     settings.particle_size = 0.8
     settings.use_rotations = True
     settings.rotation_factor_random = 1.0
@@ -158,6 +173,28 @@ def particle_scene():
         single_users(scene)
 
     return scene, make_real
+
+
+def moving_instances_scene():
+    """Instance on Points whose instancer slides over the shutter (Render >
+    Motion Blur): every instance moves by its own transform at each step."""
+    scene, realize = geometry_nodes_scene()
+    grid = bpy.data.objects["Scatter"]
+    edit = bpy.context.preferences.edit
+    interpolation = edit.keyframe_new_interpolation_type
+    edit.keyframe_new_interpolation_type = "LINEAR"
+    grid.location.x = -0.6
+    grid.keyframe_insert("location", frame=1)
+    grid.location.x = 0.6
+    grid.keyframe_insert("location", frame=3)
+    edit.keyframe_new_interpolation_type = interpolation
+    r = scene.render
+    r.use_motion_blur = True
+    r.motion_blur_shutter = 1.0
+    owner = r if hasattr(r, "motion_blur_position") else scene.cycles
+    owner.motion_blur_position = "CENTER"
+    scene.frame_set(2)
+    return scene, realize
 
 
 def nested_collection_scene():
@@ -247,6 +284,16 @@ def main():
     compare("Geometry Nodes Instance on Points", scene, realize, prototypes=1, instances=16)
     scene, make_real = particle_scene()
     compare("particle system of objects", scene, make_real, prototypes=1, instances=24)
+    scene, make_real = particle_scene(collection=True)
+    compare("particle system of a collection", scene, make_real, prototypes=2, instances=24)
+    scene, realize = moving_instances_scene()
+    blurred = ru.render_passes(scene, "MICROPOLY", W, H, samples=4)["rgba"]
+    scene.render.use_motion_blur = False
+    still = ru.render_passes(scene, "MICROPOLY", W, H, samples=4)["rgba"]
+    scene.render.use_motion_blur = True
+    p = ru.psnr(blurred[..., :3], still[..., :3], peak=1.0)
+    check("moving instances: the shutter blurs them", p < 35.0, f"{p:.1f} dB against the still frame")
+    compare("moving instances (motion blur)", scene, realize, prototypes=1, instances=16)
     scene, make_real = nested_collection_scene()
     compare("nested collection instances", scene, make_real, prototypes=2, instances=6)
     scene, make_single = linked_duplicates_scene()

@@ -33,7 +33,8 @@ struct DicedGrid {
 // frame and the scene's device patches.
 inline void host_dice(const Scene& scene,
                       const std::function<void(const DicedGrid&, const FrameParams&, const PatchBuffer&)>& visit) {
-  const FrameParams f = make_frame_setup(scene).params;
+  FrameParams f = make_frame_setup(scene).params;
+  f.samples = MP_SAMPLES_UNKNOWN;  // every grid, sampled or not
   HostSceneData data = prepare_scene_data(scene);
   const PatchBuffer& pb = data.patches;
   const uint* info = reinterpret_cast<const uint*>(pb.info.data());
@@ -45,7 +46,7 @@ inline void host_dice(const Scene& scene,
   while (!stack.empty()) {
     SubPatch sp = stack.back();
     stack.pop_back();
-    const uint d = mp_classify(pb.points.data(), info, pb.edges.data(), pb.curves.data(), nullptr, nullptr, &sp, f,
+    const uint d = mp_classify(pb.points.data(), info, pb.edges.data(), pb.curves.data(), nullptr, nullptr, nullptr, &sp, f,
                                nullptr, nullptr, OcclusionParams{});
     const uint action = MP_DECISION_ACTION(d);
     if (action >= MP_SPLIT_U) {

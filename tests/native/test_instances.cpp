@@ -240,9 +240,11 @@ TEST_F(InstancesTest, PatchesAreUploadedOncePerPrototype) {
   EXPECT_GT(proto_patches, 0u);
   EXPECT_EQ(data.patches.size(), data.own_patches + proto_patches);  // not once per instance
   EXPECT_EQ(data.instances.size(), s.instances.size());
-  EXPECT_EQ(data.root_count, data.own_patches + s.instances.size() * proto_patches);
-  ASSERT_EQ(data.instance_roots.size(), s.instances.size() + 1);
-  EXPECT_EQ(data.instance_roots.back(), s.instances.size() * proto_patches);
+  // One root per instance (its prototype's tree), not one per placed patch.
+  EXPECT_EQ(data.root_count, data.own_patches + s.instances.size());
+  EXPECT_EQ(data.placed_patches, s.instances.size() * proto_patches);
+  EXPECT_EQ(data.patch_nodes.size(), proto_patches - 1);  // a binary tree over the prototype's patches
+  for (const DeviceInstance& in : data.instances) EXPECT_EQ(in.root, data.instances[0].root);
   // Nearest the camera first.
   for (size_t i = 1; i < data.instances.size(); ++i)
     EXPECT_GE(data.instances[i - 1].box_hi[2], data.instances[i].box_hi[2]);
@@ -257,10 +259,62 @@ TEST_F(InstancesTest, InstancesBehindAWallAreCulledWholeAndTheImageStays) {
   s.settings.occlusion_culling = false;
   const RenderResult off = renderer_->render(s);
   expect_same_image(on, off, "occlusion culling");
-  // Most instances hide behind the wall: culled at their roots' first test.
-  EXPECT_GT(on.stats.subpatches_occluded, on.stats.patches / 2) << on.stats.patches << " roots";
+  // Most instances hide behind the wall: culled whole, at their tree's
+  // root, never patch by patch.
+  EXPECT_GT(on.stats.subpatches_occluded, on.stats.instances / 2) << on.stats.instances << " instances";
+  EXPECT_LT(on.stats.subpatches_occluded, on.stats.patches / 20) << on.stats.patches << " patches";
   EXPECT_LT(on.stats.subpatches_diced * 4, off.stats.subpatches_diced);
   expect_same_image(on, renderer_->render(copies_by_hand(field_behind_wall(12))), "copies");
+}
+
+// A far field of instances a pixel or less across, on a ground under a
+// sun: bound & split drops the subtrees that fall between samples
+// (RenderSettings::sample_culling) in the camera's view and the sun's
+// shadow maps, so the instances cost the samples they cover, not their
+// patches, and the image stays the same, still, moving and out of focus.
+TEST_F(InstancesTest, DistantInstancesCostTheSamplesTheyCover) {
+  Scene base = instanced_scene();
+  base.camera = look_at({0.0f, -30.0f, 3.0f}, {0.0f, 40.0f, 0.0f}, 50.0f);
+  const Instance proto_cube = base.instances[0];
+  base.instances.clear();
+  for (int j = 0; j < 24; ++j)
+    for (int i = 0; i < 24; ++i) {
+      Instance inst = proto_cube;
+      const float x = -30.0f + 60.0f * (float(i) + 0.37f * float(j % 3)) / 24.0f, y = 20.0f + 4.0f * float(j);
+      inst.object_to_world = glm::scale(glm::translate(glm::mat4(1.0f), {x, y, 0.4f}), glm::vec3(0.5f));
+      inst.info.random = float((i * 7 + j * 13) % 24) / 24.0f;
+      base.instances.push_back(inst);
+    }
+  Mesh ground = grid_mesh(2, 1.0f, SubdivScheme::None);
+  ground.object_to_world = glm::scale(glm::translate(glm::mat4(1.0f), {0.0f, 60.0f, 0.0f}), {80.0f, 90.0f, 1.0f});
+  base.meshes.push_back(ground);
+  for (int c = 0; c < 3; ++c) {
+    Scene s = base;
+    const char* what = c == 0 ? "still" : c == 1 ? "moving" : "out of focus";
+    if (c == 1) {
+      s.motion_steps = 2;
+      for (Instance& inst : s.instances)
+        inst.motion_object_to_world = {glm::translate(glm::mat4(1.0f), {-0.3f, 0.0f, 0.0f}) * inst.object_to_world,
+                                       glm::translate(glm::mat4(1.0f), {0.3f, 0.0f, 0.2f}) * inst.object_to_world};
+    }
+    if (c == 2) {
+      s.camera.focus_distance = 25.0f;
+      s.camera.lens_radius = 0.05f;
+    }
+    s.settings.keep_shadow_pages = false;  // both render the sun's maps
+    const RenderResult on = renderer_->render(s);
+    s.settings.sample_culling = false;
+    const RenderResult off = renderer_->render(s);
+    expect_same_image(on, off, what);
+    // Still, most of the field falls between samples; moving or blurred,
+    // its bounds grow over the shutter or the lens and fewer do.
+    const size_t factor = c == 0 ? 4 : 1, slack = c == 0 ? 1 : 5;
+    EXPECT_LT(on.stats.subpatches_diced * factor * slack, off.stats.subpatches_diced * (slack - (c != 0))) << what;
+    EXPECT_LT(on.stats.shadows.micropolygons * (c == 0 ? 2 : 1), off.stats.shadows.micropolygons) << what;
+    std::printf("%s: %zu against %zu sub-patches diced, %zu against %zu in shadow maps' micropolygons\n", what,
+                size_t(on.stats.subpatches_diced), size_t(off.stats.subpatches_diced),
+                size_t(on.stats.shadows.micropolygons), size_t(off.stats.shadows.micropolygons));
+  }
 }
 
 TEST_F(InstancesTest, MovingOneInstanceRendersItsShadowAnew) {

@@ -73,6 +73,7 @@ void expect_same_settings(const RenderSettings& a, const RenderSettings& b) {
   EXPECT_EQ(a.shadow_memory_mib, b.shadow_memory_mib);
   EXPECT_EQ(a.shadow_shading_rate, b.shadow_shading_rate);
   EXPECT_EQ(a.occlusion_culling, b.occlusion_culling);
+  EXPECT_EQ(a.sample_culling, b.sample_culling);
   EXPECT_EQ(a.holdout_covers, b.holdout_covers);
   EXPECT_EQ(a.visibility_first, b.visibility_first);
   EXPECT_EQ(a.resolver, b.resolver);
@@ -312,6 +313,7 @@ Scene full_scene() {
   st.shadow_memory_mib = 100.3f;  // shadows stay on, so that the render tests see them
   st.shadow_shading_rate = 2.7f;
   st.occlusion_culling = false;
+  st.sample_culling = false;
   st.holdout_covers = true;
   st.visibility_first = VisibilityFirst::Off;
   st.resolver = Resolver::Tiles;

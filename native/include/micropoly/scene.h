@@ -369,6 +369,11 @@ struct RenderSettings {
   // Bound & split drops sub-patches hidden behind what earlier dice batches
   // sampled (kernels/stages/mp_occlusion.h); the image is the same either way.
   bool occlusion_culling = true;
+  // Bound & split drops bounds of a pixel or two that hold none of the
+  // view's samples (mp_bound.h, mp_bound_misses_samples), so distant
+  // instances cost the samples they cover, not their patches; the image is
+  // the same either way.
+  bool sample_culling = true;
   // The world's light is shadowed through this many probe directions
   // (world_lighting.h), each a soft-shadowed distant light.
   int world_probes = 16;

@@ -21,7 +21,8 @@ const char* kUsage =
     "                        [--bound-split-memory MIB] [--bound-split-chain N]\n"
     "                        [--bound-split-steps N] [--shadows on|off]\n"
     "                        [--shadow-memory MIB]\n"
-    "                        [--fresh-shadows] [--occlusion-culling on|off] [--stats FILE.json]\n"
+    "                        [--fresh-shadows] [--occlusion-culling on|off] [--sample-culling on|off]\n"
+    "                        [--stats FILE.json]\n"
     "                        [--sampler auto|tiles|micropolygons|bins] [--sample-memory MIB]\n"
     "                        [--visibility-first auto|on|off] [--resolver auto|tiles|pixels]\n"
     "                        [--occlusion-waves auto|on|off]\n"
@@ -35,7 +36,8 @@ const char* kUsage =
     "both rules (docs/rib.md, \"Untrusted scene files\").\n";
 
 struct Options {
-  std::string scene, output, device, stats, bound_split, shadows, occlusion, sampler, visibility_first, resolver;
+  std::string scene, output, device, stats, bound_split, shadows, occlusion, sample_culling, sampler, visibility_first,
+      resolver;
   std::string occlusion_waves;
   std::string readback;  // float (default), half, none (no image written: benchmarks)
   int spp = 0, repeat = 1, bound_split_chain = 0, bound_split_steps = -1;
@@ -85,7 +87,10 @@ Options parse(int argc, char** argv) {
       if (o.shadows != "on" && o.shadows != "off") usage_error("--shadows is on or off");
     } else if (a == "--shadow-memory") o.shadow_memory_mib = static_cast<float>(parse_number(a, value(), 1, 1 << 20));
     else if (a == "--fresh-shadows") o.fresh_shadows = true;
-    else if (a == "--occlusion-culling") {
+    else if (a == "--sample-culling") {
+      o.sample_culling = value();
+      if (o.sample_culling != "on" && o.sample_culling != "off") usage_error("--sample-culling is on or off");
+    } else if (a == "--occlusion-culling") {
       o.occlusion = value();
       if (o.occlusion != "on" && o.occlusion != "off") usage_error("--occlusion-culling is on or off");
     }
@@ -160,6 +165,7 @@ int main(int argc, char** argv) {
     if (o.shadow_memory_mib > 0) scene.settings.shadow_memory_mib = o.shadow_memory_mib;
     if (o.fresh_shadows) scene.settings.keep_shadow_pages = false;
     if (!o.occlusion.empty()) scene.settings.occlusion_culling = o.occlusion == "on";
+    if (!o.sample_culling.empty()) scene.settings.sample_culling = o.sample_culling == "on";
     if (!o.sampler.empty())
       scene.settings.sampler = o.sampler == "tiles"           ? mp::Sampler::Tiles
                                : o.sampler == "micropolygons" ? mp::Sampler::Micropolygons

@@ -231,6 +231,7 @@ PYBIND11_MODULE(_native, m) {
       .def_readwrite("keep_shadow_pages", &RenderSettings::keep_shadow_pages)
       .def_readwrite("soft_shadow_pages", &RenderSettings::soft_shadow_pages)
       .def_readwrite("occlusion_culling", &RenderSettings::occlusion_culling)
+      .def_readwrite("sample_culling", &RenderSettings::sample_culling)
       .def_readwrite("holdout_covers", &RenderSettings::holdout_covers)
       .def_readwrite("world_probes", &RenderSettings::world_probes)
       .def_readwrite("texture_filter_width", &RenderSettings::texture_filter_width)

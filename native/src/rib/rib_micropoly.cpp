@@ -84,6 +84,9 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   flag = s.occlusion_culling ? 1 : 0;
   params.get_int("occlusionculling", 0, 1, &flag);
   s.occlusion_culling = flag != 0;
+  flag = s.sample_culling ? 1 : 0;
+  params.get_int("sampleculling", 0, 1, &flag);
+  s.sample_culling = flag != 0;
   flag = s.holdout_covers ? 1 : 0;
   params.get_int("holdoutcovers", 0, 1, &flag);
   s.holdout_covers = flag != 0;
@@ -130,7 +133,8 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   const int line = args.request().line;
   warn_unknown(params,
                {"boundsplit", "boundsplitmemory", "maxgridsize", "maxsplitdepth", "backfaceculling",
-                "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate", "occlusionculling", "holdoutcovers",
+                "depthandnormal", "shadows", "shadowmemory", "shadowshadingrate", "occlusionculling", "sampleculling",
+                "holdoutcovers",
                 "worldshadowdirections", "texturefilterwidth", "apertureblades", "aperturerotation", "apertureratio",
                 "focusfactor", "shuttercurve", "sampler", "samplememory", "visibilityfirst", "resolver", "boundsplitchain", "occlusionwaves",
                 "boundsplitsteps"},

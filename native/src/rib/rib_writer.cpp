@@ -247,6 +247,8 @@ void write_options(std::string& o, const RenderSettings& s, const Camera& c) {
     param(o, "float shadowshadingrate", s.shadow_shading_rate);
   if (s.occlusion_culling != def.occlusion_culling)
     param(o, "integer occlusionculling", static_cast<long long>(s.occlusion_culling ? 1 : 0));
+  if (s.sample_culling != def.sample_culling)
+    param(o, "integer sampleculling", static_cast<long long>(s.sample_culling ? 1 : 0));
   if (s.holdout_covers != def.holdout_covers)
     param(o, "integer holdoutcovers", static_cast<long long>(s.holdout_covers ? 1 : 0));
   if (s.world_probes != def.world_probes)

@@ -8,6 +8,7 @@
 
 #include "micropoly/error.h"
 #include "geometry/mp_patch.h"
+#include "pipeline/device_scene/patch_tree.h"
 #include "pipeline/device_scene/scene_buffers.h"
 #include "pipeline/device_scene/shape_placement.h"
 #include "scene/orientation.h"
@@ -22,6 +23,7 @@ constexpr uint32_t kNoObject = 0xffffffu;
 // A variant's patches and what its instances read of them.
 struct Variant {
   uint32_t first = 0, count = 0;
+  PatchTree tree;
   glm::vec3 lo{3e38f}, hi{-3e38f};  // its patches' box, displacement included (its own space)
   glm::vec3 texspace_location{0.0f}, texspace_size{0.0f};
   glm::mat4 to_prototype{1.0f};
@@ -109,15 +111,23 @@ void place_instances(const Scene& scene, const PrototypeVariants& pv,
     var.first = uint32_t(out.patches.size());
     place_shape(*shapes[v], glm::mat4(1.0f), mesh, set, kNoObject, scene, out.patches);
     var.count = uint32_t(out.patches.size() - var.first);
+    std::vector<glm::vec3> boxes(2 * size_t(var.count));
     for (uint32_t p = var.first; p < var.first + var.count; ++p) {
       glm::vec4* cp = &out.patches.points[size_t(p) * MP_PATCH_POINTS];
       const uint32_t material = out.patches.info[p].y;
       if (material < scene.materials.size() && scene.materials[material].displacement_bound_world)
         cp[0].w *= var.world_fix;  // the bound in the least-scaled placement's units
+      glm::vec3 lo(3e38f), hi(-3e38f);
       for (int k = 0; k < MP_PATCH_POINTS; ++k) {
-        var.lo = glm::min(var.lo, glm::vec3(cp[k]) - glm::vec3(cp[0].w));
-        var.hi = glm::max(var.hi, glm::vec3(cp[k]) + glm::vec3(cp[0].w));
+        lo = glm::min(lo, glm::vec3(cp[k]) - glm::vec3(cp[0].w));
+        hi = glm::max(hi, glm::vec3(cp[k]) + glm::vec3(cp[0].w));
       }
+      boxes[2 * (p - var.first)] = lo, boxes[2 * (p - var.first) + 1] = hi;
+      var.lo = glm::min(var.lo, lo), var.hi = glm::max(var.hi, hi);
+    }
+    if (var.count > 0) {
+      var.tree = build_patch_tree(boxes, var.first, out.patch_nodes);
+      out.tree_depth = std::max(out.tree_depth, var.tree.depth);
     }
     const std::vector<glm::vec3>& points = mesh ? mesh->points : set->control_points;
     if (mesh) var.texspace_location = mesh->texspace_location, var.texspace_size = mesh->texspace_size;
@@ -154,7 +164,7 @@ void place_instances(const Scene& scene, const PrototypeVariants& pv,
         for (int c = 0; c < 3; ++c) r.normal_to_camera[4 * row + c] = float(normal[c][row]);
       r.flags = (glm::determinant(glm::dmat3(m)) < 0.0 ? MP_PATCH_FLIP_ORIENTATION : 0u) |
                 (inst.visible_camera ? 0u : MP_PATCH_NO_CAMERA) | (inst.cast_shadows ? 0u : MP_PATCH_NO_SHADOW);
-      r.first_patch = var.first, r.patch_count = var.count;
+      r.first_patch = var.first, r.root = var.tree.root;
       glm::vec3 lo(3e38f), hi(-3e38f), reach(0.0f);
       for (int k = 0; k < 8; ++k) {
         const glm::vec3 c = apply(m, corner(var, k));
@@ -183,22 +193,18 @@ void place_instances(const Scene& scene, const PrototypeVariants& pv,
   // fill the occlusion pyramid front to back.
   std::stable_sort(placed.begin(), placed.end(),
                    [](const Placed& a, const Placed& b) { return a.record.box_hi[2] > b.record.box_hi[2]; });
-  uint64_t roots = 0;
-  out.instance_roots.reserve(placed.size() + 1);
+  if (out.own_patches + placed.size() > UINT32_MAX)
+    throw Error("the scene places " + std::to_string(placed.size()) +
+                " instances' surfaces, more than 2^32 in all: use fewer instances");
   for (Placed& p : placed) {
     const Variant& var = variants[p.variant];
     p.record.object = uint32_t(out.objects.size());
     out.objects.push_back(to_device_object(p.to_camera, p.to_world, var.texspace_location, var.texspace_size, {},
                                            scene.instances[p.instance].info));
-    out.instance_roots.push_back(uint32_t(roots));
-    roots += p.record.patch_count;
-    if (out.own_patches + roots > UINT32_MAX)
-      throw Error("the scene's instances place " + std::to_string(roots) +
-                  " patches, more than 2^32 in all: use fewer instances or simpler prototypes");
+    out.placed_patches += var.count;
     out.instances.push_back(p.record);
   }
-  out.instance_roots.push_back(uint32_t(roots));
-  out.root_count = out.own_patches + size_t(roots);
+  out.root_count = out.own_patches + out.instances.size();
   if (out.objects.size() > kNoObject)
     throw Error("the scene has " + std::to_string(out.objects.size()) + " objects and instances' surfaces, more than " +
                 std::to_string(kNoObject));

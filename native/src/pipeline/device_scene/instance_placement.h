@@ -27,8 +27,9 @@ struct PrototypeVariants {
 PrototypeVariants prototype_variants(const Scene& scene);
 
 // Appends the variants' patches (shapes: PatchCache's, one per variant) after
-// the patches placed on their own, and the instances' records, objects,
-// roots and motion rows. Throws mp::Error where the roots exceed 2^32.
+// the patches placed on their own, with each variant's tree of patches, and
+// the instances' records, objects and motion rows. Throws mp::Error where
+// the roots exceed 2^32.
 void place_instances(const Scene& scene, const PrototypeVariants& variants,
                      const std::vector<std::shared_ptr<const PatchBuffer>>& shapes, HostSceneData& out);
 

@@ -370,7 +370,9 @@ SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data
     const std::vector<glm::vec4> bounds = patch_bounds(data.patches);
     b.patch_bounds = upload(session, bounds);
     b.instances = upload(session, data.instances);
-    b.instance_roots = upload(session, data.instance_roots);
+    b.patch_nodes = upload(session, data.patch_nodes);
+    b.tree_depth = data.tree_depth;
+    b.placed_patches = data.own_patches + data.placed_patches;
     b.images = upload(session, data.images);
     b.texels = upload_images(session, data);
     b.node_params = upload(session, data.params);
@@ -401,7 +403,7 @@ SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data
     auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
     b.bytes = bytes(data.patches.points) + bytes(data.patches.info) + bytes(data.patches.edges) +
               bytes(data.patches.curves) + bytes(data.patches.uvs) + bytes(data.patches.normals) + bytes(bounds) +
-              bytes(data.objects) + bytes(data.instances) + bytes(data.instance_roots) + bytes(data.instance_motion) +
+              bytes(data.objects) + bytes(data.instances) + bytes(data.patch_nodes) + bytes(data.instance_motion) +
               bytes(data.motion_points) + bytes(data.motion_curves);
   });
   return b;

@@ -24,13 +24,15 @@ struct HostSceneData {
   PatchBuffer patches;
   size_t own_patches = 0;
   // Instances (kernels/geometry/mp_instance.h): one record per prototype
-  // surface each instance places, nearest the camera first; where each one's
-  // roots start (an exclusive prefix, instances.size() + 1 entries); and,
-  // with motion blur, their rows at each step.
+  // surface each instance places, nearest the camera first; the surfaces'
+  // trees of patches (patch_tree.h) and the deepest's depth; with motion
+  // blur, the records' rows at each step.
   std::vector<DeviceInstance> instances;
-  std::vector<uint32_t> instance_roots;
+  std::vector<DevicePatchNode> patch_nodes;
+  int tree_depth = 0;
   std::vector<glm::vec4> instance_motion;
-  size_t root_count = 0;  // own_patches + every instance's patches
+  size_t root_count = 0;       // own_patches + instances.size(): the roots of one view
+  uint64_t placed_patches = 0;  // the patches the instances place, all told
   std::vector<DeviceMaterial> materials;
   std::vector<DeviceLight> lights;
   std::vector<DeviceObject> objects;  // one per surface, in patch order (MP_PATCH_OBJECT)
@@ -69,6 +71,8 @@ struct SceneBuffers {
   std::vector<glm::vec4> host_patch_bounds;  // patch_bounds on the host (occlusion culling's root order)
   std::vector<glm::vec4> host_instance_bounds;  // 2 per instance: camera-space boxes (the roots' overlap)
   size_t bytes = 0;  // device memory of the scene's geometry and objects (not images or lights)
+  int tree_depth = 0;  // HostSceneData's: bound & split's stacks hold a path down it
+  uint64_t placed_patches = 0;  // own patches and those the instances place
   // Which upload these buffers are (DeviceSession::next_data_version); every
   // replacement of a buffer takes a new one, so kernels bound to the old
   // buffers bind again (scene_kernel.h).

@@ -49,6 +49,7 @@ FrameSetup make_frame_setup(const Scene& scene) {
   f.clip_far = cam.clip_far;
   f.micropoly_edge = std::sqrt(std::max(s.shading_rate, 1e-3f));
   f.texture_filter = s.texture_filter_width;
+  f.samples = s.sample_culling ? MP_SAMPLES_PATTERN : MP_SAMPLES_UNKNOWN;
   // Edge rates are powers of two (mp_bound.h), so the grid limit is one too.
   f.max_grid = 1;
   while (f.max_grid * 2 <= std::clamp(s.max_grid_size, 1, MP_MAX_GRID)) f.max_grid *= 2;

@@ -409,7 +409,7 @@ std::vector<Light> Renderer::Impl::upload(const Scene& scene, RenderStats& st) {
   }
   if (fresh) d.scene_key = key;
   st.timings_ms.upload = ms_since(started);
-  st.patches = d.scene_buffers->root_count;
+  st.patches = d.scene_buffers->placed_patches;
   st.instances = d.scene_buffers->instance_count;
   st.scene_bytes = d.scene_buffers->bytes;
   return lights;

@@ -110,13 +110,12 @@ struct BoundSplitContext {
   const ProgressCallback& progress;
   const PassViews& views;
   const PassOcclusion& occlusion;
-  // Roots: every patch in every view.
   // Every view's roots (mp_instance.h); a pass whose count exceeds 2^32 is refused.
   cl_uint root_count() const {
     const uint64_t n = uint64_t(scene.root_count) * std::max<cl_uint>(views.count, 1);
     if (n > UINT32_MAX)
-      throw Error(std::to_string(scene.root_count) + " patches in " + std::to_string(views.count) +
-                  " views exceed the 2^32 roots of one pass: use fewer instances, simpler prototypes or fewer lights");
+      throw Error(std::to_string(scene.root_count) + " patches and instances in " + std::to_string(views.count) +
+                  " views exceed the 2^32 roots of one pass: use fewer instances or fewer lights");
     return cl_uint(n);
   }
 };

@@ -90,7 +90,9 @@ BoundSplitResult bound_split_bounded(BoundSplitContext& ctx, size_t budget_bytes
   DeviceSession& s = ctx.session;
   DeviceQueue& queue = s.queue();
   const size_t rec = sizeof(SubPatch);
-  const cl_uint stack_depth = static_cast<cl_uint>(ctx.frame.max_depth) + 2;
+  // A path down the deepest instance's tree of patches (mp_instance.h),
+  // then the splits of one patch.
+  const cl_uint stack_depth = static_cast<cl_uint>(ctx.frame.max_depth + ctx.scene.tree_depth) + 2;
   const size_t fixed = static_cast<size_t>(dice_capacity) * rec + kCounters * sizeof(cl_uint);
   // Per worker: its stack, its stack size and one ring slot.
   const size_t per_worker = stack_depth * rec + sizeof(cl_uint) + rec;

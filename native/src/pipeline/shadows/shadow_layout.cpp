@@ -83,6 +83,7 @@ FrameParams shadow_view_base(const FrameParams& camera, const RenderSettings& s)
   FrameParams v = camera;
   v.has_view = 1;
   v.view_kind = MP_VIEW_SHADOW;
+  v.samples = s.sample_culling ? MP_SAMPLES_CENTRES : MP_SAMPLES_UNKNOWN;
   v.micropoly_edge = std::sqrt(std::max(s.shadow_shading_rate, 1e-3f));
   v.ribbon = 1.0f;
   v.backface_culling = 0;

@@ -39,6 +39,8 @@ cl_uint list_capacity(cl_uint table_entries) { return std::max<cl_uint>(4096, ta
 FrameParams marking_view(const FrameSetup& frame) {
   FrameParams coarse = frame.params;
   coarse.micropoly_edge *= kMarkCoarsening;
+  // Its grids' vertices mark pages wherever they lie, sample or not.
+  coarse.samples = MP_SAMPLES_UNKNOWN;
   return coarse;
 }
 
