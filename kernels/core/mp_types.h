@@ -182,9 +182,9 @@ typedef struct {
 } DeviceObject;
 
 /* One surface of a prototype placed by one instance (scene.h Instance;
- * geometry/mp_instance.h): patches [first_patch, first_patch + patch_count)
- * hold the surface in its own space, once for all its instances, under a
- * tree of boxes whose root is `root` (DevicePatchNode); this record carries
+ * geometry/mp_instance.h): the surface's patches, in its own space, once
+ * for all its instances, lie under a tree of boxes whose root is `root`
+ * (DevicePatchNode); this record carries
  * them to camera space at the shutter's centre (rows of a 3x4 matrix, and
  * the inverse transpose of its linear part for normals).
  * box: the placed surface's camera-space box over the whole shutter,
@@ -200,7 +200,6 @@ typedef struct {
   float box_lo[4];
   float box_hi[4];
   float reach[4]; /* xyz; w unused */
-  uint first_patch;
   uint root; /* MP_NODE_REF(node), or its one patch */
   uint object;
   uint flags;

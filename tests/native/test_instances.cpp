@@ -242,7 +242,7 @@ TEST_F(InstancesTest, PatchesAreUploadedOncePerPrototype) {
   EXPECT_EQ(data.instances.size(), s.instances.size());
   // One root per instance (its prototype's tree), not one per placed patch.
   EXPECT_EQ(data.root_count, data.own_patches + s.instances.size());
-  EXPECT_EQ(data.placed_patches, s.instances.size() * proto_patches);
+  EXPECT_EQ(data.instanced_patches, s.instances.size() * proto_patches);
   EXPECT_EQ(data.patch_nodes.size(), proto_patches - 1);  // a binary tree over the prototype's patches
   for (const DeviceInstance& in : data.instances) EXPECT_EQ(in.root, data.instances[0].root);
   // Nearest the camera first.

@@ -164,7 +164,7 @@ void place_instances(const Scene& scene, const PrototypeVariants& pv,
         for (int c = 0; c < 3; ++c) r.normal_to_camera[4 * row + c] = float(normal[c][row]);
       r.flags = (glm::determinant(glm::dmat3(m)) < 0.0 ? MP_PATCH_FLIP_ORIENTATION : 0u) |
                 (inst.visible_camera ? 0u : MP_PATCH_NO_CAMERA) | (inst.cast_shadows ? 0u : MP_PATCH_NO_SHADOW);
-      r.first_patch = var.first, r.root = var.tree.root;
+      r.root = var.tree.root;
       glm::vec3 lo(3e38f), hi(-3e38f), reach(0.0f);
       for (int k = 0; k < 8; ++k) {
         const glm::vec3 c = apply(m, corner(var, k));
@@ -201,7 +201,7 @@ void place_instances(const Scene& scene, const PrototypeVariants& pv,
     p.record.object = uint32_t(out.objects.size());
     out.objects.push_back(to_device_object(p.to_camera, p.to_world, var.texspace_location, var.texspace_size, {},
                                            scene.instances[p.instance].info));
-    out.placed_patches += var.count;
+    out.instanced_patches += var.count;
     out.instances.push_back(p.record);
   }
   out.root_count = out.own_patches + out.instances.size();

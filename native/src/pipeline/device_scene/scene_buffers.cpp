@@ -372,7 +372,7 @@ SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data
     b.instances = upload(session, data.instances);
     b.patch_nodes = upload(session, data.patch_nodes);
     b.tree_depth = data.tree_depth;
-    b.placed_patches = data.own_patches + data.placed_patches;
+    b.placed_patches = data.own_patches + data.instanced_patches;
     b.images = upload(session, data.images);
     b.texels = upload_images(session, data);
     b.node_params = upload(session, data.params);

@@ -32,7 +32,7 @@ struct HostSceneData {
   int tree_depth = 0;
   std::vector<glm::vec4> instance_motion;
   size_t root_count = 0;       // own_patches + instances.size(): the roots of one view
-  uint64_t placed_patches = 0;  // the patches the instances place, all told
+  uint64_t instanced_patches = 0;  // the patches the instances place, all told
   std::vector<DeviceMaterial> materials;
   std::vector<DeviceLight> lights;
   std::vector<DeviceObject> objects;  // one per surface, in patch order (MP_PATCH_OBJECT)
