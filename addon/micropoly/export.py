@@ -14,7 +14,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _native, camera_view, export_instances, export_lights, export_materials, export_mesh, export_motion
+from . import (_native, camera_view, export_attributes, export_instances, export_lights, export_materials,
+               export_mesh, export_motion)
 
 
 class ExportError(Exception):
@@ -252,7 +253,8 @@ def export_scene(depsgraph, view=None, meshes=None, motion=None):
                 key = export_instances.InstanceTable.key(inst.object, shared_data=True)
                 if key is not None:
                     shared[key] = shared.get(key, 0) + 1
-    instances = export_instances.InstanceTable(motion)
+    instances = export_instances.InstanceTable(
+        motion, export_attributes.InstanceAttributes(materials.object_attributes, out.warnings))
     for inst in depsgraph.object_instances:
         obj = inst.object
         # An instancer whose own geometry is hidden (a particle emitter with

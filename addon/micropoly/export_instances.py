@@ -15,7 +15,7 @@ not by the object that places it).
 
 import numpy as np
 
-from . import export_mesh, export_motion
+from . import export_attributes, export_mesh, export_motion
 
 
 class InstanceTable:
@@ -25,11 +25,14 @@ class InstanceTable:
     colour, pass index) is looked up once per object and mesh data (the
     depsgraph may hand one temporary object several meshes)."""
 
-    def __init__(self, motion=None):
+    def __init__(self, motion=None, attributes=None):
         self._prototypes = {}  # key -> prototype index, or None (nothing to render)
         self._objects = {}     # (object, data) pointers -> (prototype, colour, pass index, name's random id, visibility)
-        # prototype -> ([matrix rows], [random ids], [colours], [pass indices], visibility, [motion or None])
+        # prototype -> ([matrix rows], [random ids], [colours], [pass indices], visibility, [motion or None],
+        # [Attribute nodes' values: (slots, 4) or None])
         self._placed = {}
+        # Attribute nodes of type Object and Instancer (export_attributes.InstanceAttributes), or None.
+        self._attributes = attributes
         # Depsgraph instances that move over the shutter (export_motion.Motion.instances).
         self._moving = motion.instances if motion is not None else {}
 
@@ -73,7 +76,7 @@ class InstanceTable:
             return False
         placed = self._placed.get(proto)
         if placed is None:
-            placed = self._placed[proto] = ([], [], [], [], entry[4], [])
+            placed = self._placed[proto] = ([], [], [], [], entry[4], [], [])
         m = inst.matrix_world
         placed[0].append((*m[0], *m[1], *m[2], *m[3]))
         placed[1].append(inst.random_id if inst.is_instance else entry[3])
@@ -81,17 +84,20 @@ class InstanceTable:
         placed[3].append(entry[2])
         if self._moving and inst.is_instance:
             placed[5].append(self._moving.get(export_motion.instance_key(inst)))
+        if self._attributes is not None and self._attributes.slots:
+            placed[6].append(self._attributes.values(inst))
         return True
 
     def flush(self, native_scene):
         """Hands every prototype's instances to the scene."""
-        for proto, (matrices, ids, colours, passes, (camera, shadows), moving) in self._placed.items():
+        for proto, (matrices, ids, colours, passes, (camera, shadows), moving, attributes) in self._placed.items():
             placed = np.asarray(matrices, dtype=np.float32).reshape(-1, 4, 4)
             native_scene.add_instances(
                 proto, placed, random=export_mesh.random_from_ids(np.asarray(ids, dtype=np.int64)),
                 object_color=np.asarray(colours, dtype=np.float32),
                 pass_index=np.asarray(passes, dtype=np.float32), visible_camera=camera, cast_shadows=shadows,
-                motion_object_to_world=self._motion(placed, moving))
+                motion_object_to_world=self._motion(placed, moving),
+                attributes=np.asarray(attributes, dtype=np.float32) if attributes else np.zeros(0, np.float32))
         self._placed.clear()
 
     @staticmethod

@@ -100,6 +100,9 @@ class MaterialTable:
         # UV maps the programs read, by name ("" = each mesh's active render
         # UV map); meshes export these layers in this order.
         self.uv_names = []
+        # Attribute nodes of type Object or Instancer: (name, instancer) per
+        # slot (export_attributes.py).
+        self.object_attributes = []
         self.images = export_images.ImageTable(native_scene)
         native_scene.add_material(name="default", **material_parameters(None))
 
@@ -131,6 +134,15 @@ class MaterialTable:
                                  f"'{name or 'the active color attribute'}' reads zero")
             return -1, -1
         return tuple(self.uv_layer(("attribute", name, k)) for k in (0, 1))
+
+    def object_attribute(self, name, instancer):
+        """The slot of Attribute node value `name` (type Instancer when
+        `instancer`, else Object) that every object carries
+        (export_attributes.py)."""
+        key = (name, instancer)
+        if key not in self.object_attributes:
+            self.object_attributes.append(key)
+        return self.object_attributes.index(key)
 
     def image(self, image, warn):
         return self.images.get(image, warn)

@@ -8,6 +8,8 @@ creases are passed on. Everything else renders as flat polygons."""
 
 import numpy as np
 
+from . import export_attributes
+
 # Blender's crease values in [0, 1] become OpenSubdiv sharpness as Blender's
 # own OpenSubdiv integration maps them (docs/blender.md).
 CREASE_SHARPNESS_SCALE = 10.0
@@ -389,7 +391,9 @@ def export_object(native_scene, materials, cache, obj, matrix, warnings, is_inst
         boundary=boundary, double_sided=double_sided, uv_layers=arrays.get("uv_layers", empty_f),
         corner_normals=arrays.get("corner_normals", empty_f), visible_camera=visible_camera,
         cast_shadows=cast_shadows, object_color=list(obj.color), pass_index=float(obj.pass_index),
-        random=object_random(obj.name, random_id if is_instance else None), **_texture_space(obj.original.data))
+        random=object_random(obj.name, random_id if is_instance else None),
+        attributes=export_attributes.object_values(materials.object_attributes, obj),
+        **_texture_space(obj.original.data))
     return True
 
 

@@ -76,6 +76,9 @@ class NoResources:
     def attribute_layers(self, name):
         return -1, -1
 
+    def object_attribute(self, name, instancer):
+        return -1
+
     def image(self, image, warn):
         return -1, None
 

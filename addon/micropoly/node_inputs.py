@@ -84,18 +84,24 @@ def emit_layer_weight(c, node):
 def emit_attribute(c, node):
     """Attribute (Geometry type) and Color Attribute: a mesh attribute's
     value per face corner, interpolated over the surface as UVs are
-    (two layers: RG and BA)."""
-    if node.type == "VERTEX_COLOR":
-        name = node.layer_name
-    else:
-        if getattr(node, "attribute_type", "GEOMETRY") != "GEOMETRY":
-            c.warn(node, f"{node.attribute_type.title()} attributes are not supported; it gives zero")
+    (two layers: RG and BA); Attribute of type Object or Instancer: the
+    object's or instance's value (export_attributes.py)."""
+    kind = getattr(node, "attribute_type", "GEOMETRY") if node.type == "ATTRIBUTE" else "GEOMETRY"
+    if kind in ("OBJECT", "INSTANCER"):
+        # One value per object or instance (export_attributes.py).
+        slot = c.resources.object_attribute(node.attribute_name, kind == "INSTANCER")
+        if slot < 0:
             return {}
-        name = node.attribute_name
-    ka, kb = c.resources.attribute_layers(name)
-    if ka < 0:
+        rgba = c.fn.temp("float4", f"mp_object_attribute(g, {slot}u)")[0]
+    elif kind != "GEOMETRY":
+        c.warn(node, f"{kind.replace('_', ' ').title()} attributes are not supported; it gives zero")
         return {}
-    rgba = c.fn.temp("float4", f"(float4)(g->uv[{ka}].x, g->uv[{ka}].y, g->uv[{kb}].x, g->uv[{kb}].y)")[0]
+    else:
+        name = node.layer_name if node.type == "VERTEX_COLOR" else node.attribute_name
+        ka, kb = c.resources.attribute_layers(name)
+        if ka < 0:
+            return {}
+        rgba = c.fn.temp("float4", f"(float4)(g->uv[{ka}].x, g->uv[{ka}].y, g->uv[{kb}].x, g->uv[{kb}].y)")[0]
     color = (f"{rgba}.xyz", VEC, None)
     # Fac: a float attribute's value, a colour's or vector's average (Cycles).
     return {"Color": color, "Vector": color, "Fac": (f"dot({rgba}.xyz, (float3)(1.0f / 3.0f))", FLOAT, None),

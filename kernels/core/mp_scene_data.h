@@ -20,6 +20,7 @@
   BUFFER(const float4, edge_curves)        /* MP_CURVE_FLOAT4S per shared edge curve */                            \
   BUFFER(const DeviceMaterial, materials)                                                                          \
   BUFFER(const DeviceObject, objects)                                                                              \
+  BUFFER(const float4, object_attributes)  /* object_attribute_count per object (Attribute nodes' Object type) */ \
   BUFFER(const DeviceLight, lights)        /* the scene's and its world's, camera space */                        \
   BUFFER(const float4, patch_uvs)          /* 2 per patch and UV layer */                                          \
   BUFFER(const float4, patch_normals)      /* 4 per patch: smooth shading normals at its corners */               \
@@ -44,6 +45,7 @@
   VALUE(uint, root_count)                  /* patch_count + instance_count: roots of one view */                  \
   VALUE(uint, instance_count)                                                                                      \
   VALUE(uint, light_count)                                                                                         \
+  VALUE(uint, object_attribute_count)                                                                              \
   VALUE(uint, uv_layers)                                                                                           \
   VALUE(uint, image_count)
 

@@ -52,6 +52,9 @@ typedef struct {
   uint image_count;
   __global const float4* texels;
   __global const float* params; /* the node values of the material (or world) being evaluated */
+  __global const DeviceObject* objects;
+  __global const float4* object_attributes; /* object_attribute_count per object (mp_scene_data.h) */
+  uint object_attribute_count;
 } MpProgramInputs;
 
 inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, float3 n, const MpProgramInputs* in,
@@ -71,6 +74,8 @@ inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, f
   g.P = (float3)(mp_row3(o->to_object, 0, p, 1.0f), mp_row3(o->to_object, 1, p, 1.0f), mp_row3(o->to_object, 2, p, 1.0f));
   g.N = mp_camera_normal_to_object(o, n);
   g.object = o;
+  g.attributes = in->object_attributes + (ulong)(o - in->objects) * in->object_attribute_count;
+  g.attribute_count = in->object_attribute_count;
   g.Nw = mp_object_normal_to_world(&g, g.N);
   g.camera = (float3)(p.x, p.y, -p.z);
   float d = ortho ? 1.0f : -p.z;
@@ -165,7 +170,9 @@ inline int mp_program_vertex(uint gid, uint count, __global const uint* vertex_o
   return (int)materials[*material].program[0] == program;
 }
 /* What node programs read of the scene (mp_node_lib.h), from MP_SCENE_PARAMS. */
-#define MP_PROGRAM_INPUTS {patch_edges, patch_uvs, uv_layers, images, image_count, texels, node_params}
+#define MP_PROGRAM_INPUTS \
+  {patch_edges, patch_uvs, uv_layers, images, image_count, texels, node_params, objects, object_attributes, \
+   object_attribute_count}
 
 /* A tree builds either as a material's program (displace and shade) or as
  * the world's (its radiance baked and behind the frame): the host defines
@@ -305,6 +312,8 @@ float3 mp_world_radiance(float3 d, const MpProgramInputs* in, int camera_ray, fl
   g.window = window;
   for (uint k = 0; k < MP_MAX_UV_LAYERS; ++k) g.uv[k] = (float3)(0.0f);
   g.object = 0;
+  g.attributes = 0;
+  g.attribute_count = 0;
   g.images = in->images;
   g.image_count = in->image_count;
   g.texels = in->texels;

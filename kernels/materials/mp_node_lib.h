@@ -40,6 +40,10 @@ typedef struct MpNodeGlobals {
   int backfacing;   /* the surface faces away from the viewer (Geometry > Backfacing) */
   float3 uv[MP_MAX_UV_LAYERS];
   MP_GLOBAL const DeviceObject* object; /* object <-> world (world-space nodes), or null */
+  /* The object's values of the Attribute nodes of type Object or Instancer
+   * (the slots the add-on numbers, export_attributes.py), or null. */
+  MP_GLOBAL const float4* attributes;
+  uint attribute_count;
   MP_GLOBAL const DeviceImage* images;
   MP_GLOBAL const float4* texels;
   uint image_count;
@@ -191,6 +195,13 @@ MP_INLINE float mp_layer_weight(const MpNodeGlobals* g, float blend, float3 n, f
   }
   *facing = 1.0f - f;
   return fresnel;
+}
+
+/* Attribute node of type Object or Instancer: this object's value in
+ * `slot`; zero where it has none (Cycles' value for a name it finds
+ * nowhere). */
+MP_INLINE float4 mp_object_attribute(const MpNodeGlobals* g, uint slot) {
+  return g->attributes && slot < g->attribute_count ? g->attributes[slot] : (float4)(0.0f);
 }
 
 /* This point in world space (Geometry > Position). */

@@ -3,7 +3,8 @@ Geometry Nodes' Instance on Points (still, and moving over the shutter
 with Render > Motion Blur), a particle system of objects and one of a
 collection, a collection instanced by empties whose collection holds another collection
 instance (nested), objects sharing one mesh (linked duplicates), and
-Instance on Points of a subdivided, displaced rock, each exported as prototypes and instances (one prototype per instanced
+Instance on Points of a subdivided, displaced rock, and Attribute nodes of
+type Instancer and Object on instances, each exported as prototypes and instances (one prototype per instanced
 mesh, one instance per copy: the exported scene's own counts), each against
 Cycles' direct light (PSNR >= 30 dB over pixels both cover, silhouettes
 IoU >= 0.98), and each rendering like the same scene with its instances made
@@ -128,6 +129,54 @@ def geometry_nodes_scene(displaced=False):
         links.new(real.outputs["Geometry"], group_out.inputs[0])
 
     return scene, realize
+
+
+def instance_attributes_scene():
+    """Instance on Points whose rocks take their colour from Attribute
+    nodes: "tint" of type Instancer, a random colour per instance stored by
+    Geometry Nodes where Python can read it (Blender 4.3 and later), else
+    the instancer's custom property of that name (which Cycles reads where
+    the instance has no such attribute), times "shade" of type Object, the
+    rock's own custom property. Returns the scene and the node storing the
+    colours (None before 4.3)."""
+    scene, _ = geometry_nodes_scene()
+    grid, stone = bpy.data.objects["Scatter"], bpy.data.objects["Stone"]
+    grid["tint"] = (0.2, 0.7, 0.4)
+    stone["shade"] = 0.9
+    tree = grid.modifiers["Scatter"].node_group
+    nodes, links = tree.nodes, tree.links
+    on_points = next(n for n in nodes if n.type == "INSTANCE_ON_POINTS")
+    group_out = next(n for n in nodes if n.type == "GROUP_OUTPUT")
+    store = None
+    if hasattr(bpy.types, "GeometrySet"):
+        store = store_random_colours(nodes, links, on_points, group_out)
+    mat = stone.data.materials[0]
+    nt = mat.node_tree
+    bsdf = next(n for n in nt.nodes if n.type == "BSDF_DIFFUSE")
+    tint, shade = nt.nodes.new("ShaderNodeAttribute"), nt.nodes.new("ShaderNodeAttribute")
+    tint.attribute_type, tint.attribute_name = "INSTANCER", "tint"
+    shade.attribute_type, shade.attribute_name = "OBJECT", "shade"
+    times = nt.nodes.new("ShaderNodeVectorMath")
+    times.operation = "SCALE"
+    nt.links.new(tint.outputs["Color"], times.inputs[0])
+    nt.links.new(shade.outputs["Fac"], times.inputs["Scale"])
+    nt.links.new(times.outputs[0], bsdf.inputs["Color"])
+    return scene, store
+
+
+def store_random_colours(nodes, links, on_points, group_out):
+    """Stores "tint", a random colour per instance, after Instance on Points."""
+    store = nodes.new("GeometryNodeStoreNamedAttribute")
+    store.data_type, store.domain = "FLOAT_VECTOR", "INSTANCE"
+    store.inputs["Name"].default_value = "tint"
+    colour = nodes.new("FunctionNodeRandomValue")
+    colour.data_type = "FLOAT_VECTOR"
+    colour.inputs["Min"].default_value = (0.1, 0.1, 0.1)
+    colour.inputs["Max"].default_value = (1.0, 1.0, 1.0)
+    links.new(on_points.outputs["Instances"], store.inputs["Geometry"])
+    links.new(colour.outputs[0], next(i for i in store.inputs if i.name == "Value" and i.enabled))
+    links.new(store.outputs["Geometry"], group_out.inputs[0])
+    return store
 
 
 def particle_scene(collection=False):
@@ -298,6 +347,21 @@ def main():
     compare("nested collection instances", scene, make_real, prototypes=2, instances=6)
     scene, make_single = linked_duplicates_scene()
     compare("linked duplicates", scene, make_single, prototypes=1, instances=3)
+    # Attribute nodes of type Instancer and Object: against Cycles; and
+    # where Geometry Nodes store a colour per instance, the rocks' colours
+    # spread far wider than with the instancer's one colour.
+    scene, store = instance_attributes_scene()
+    against_cycles("instance attributes", scene)
+    if store is not None:
+        spreads = []
+        for mute in (False, True):
+            store.mute = mute
+            got = ru.render_passes(scene, "MICROPOLY", W, H, samples=4)["rgba"]
+            rocks = got[(got[..., 3] > 0.999) & (np.abs(got[..., 0] - got[..., 2]) > 0.02)][:, :3]
+            share = rocks[:, 0] / np.maximum(rocks.sum(axis=1), 1e-6)
+            spreads.append(float(np.std(share)) if len(rocks) > 500 else 0.0)
+        check("instance attributes: each instance its own colour", spreads[0] > 2.0 * spreads[1] > 0.0,
+              f"spread of red's share {spreads[0]:.3f}, with the instancer's one colour {spreads[1]:.3f}")
     # Made real by Realize Instances, the rocks would be the modifier's
     # polygons: compared with Cycles only.
     scene, _ = geometry_nodes_scene(displaced=True)

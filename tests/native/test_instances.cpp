@@ -29,14 +29,16 @@ namespace {
 Scene instanced_scene() {
   Scene s = base_scene(96, 72, 4);
   s.camera = look_at({0.0f, -9.0f, 5.0f}, {0.0f, 0.0f, 0.0f}, 50.0f);
-  // Material 1 colours by Object Info's random and displaces in object space.
+  // Material 1 colours by Object Info's random and by an Attribute node of
+  // type Instancer (slot 1), and displaces in object space.
   s.material_programs.push_back(
       {"bumpy",
        "float3 mp_node_displacement(const MpNodeGlobals* g) {\n"
        "  return g->N * (0.08f * sin(11.0f * g->P.x) * sin(9.0f * g->P.z));\n}\n"
        "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {\n"
        "  float r = g->object ? g->object->info[1] : 0.0f;\n"
-       "  mp_add_diffuse(s, (float3)(0.2f + 0.7f * r, 0.5f, 0.9f - 0.7f * r), 0, 0.0f);\n}\n"});
+       "  float4 a = mp_object_attribute(g, 1u);\n"
+       "  mp_add_diffuse(s, (float3)(0.2f + 0.7f * r, 0.2f + 0.7f * a.y, 0.9f - 0.7f * r), 0, 0.0f);\n}\n"});
   Material bumpy;
   bumpy.model = Material::Model::Principled;
   bumpy.program = 0;
@@ -78,6 +80,10 @@ Scene instanced_scene() {
     inst.object_to_world = glm::scale(glm::rotate(glm::translate(glm::mat4(1.0f), at), angle, glm::vec3(0, 0, 1)), scale);
     inst.info.random = float(s.instances.size()) / 6.0f;
     inst.info.pass_index = float(s.instances.size());
+    // Two attribute slots, the second read by material 1; the third
+    // instance carries only the first, and so reads zero in the second.
+    inst.info.attributes = {glm::vec4(0.5f, 0.25f, 0.0f, 1.0f), glm::vec4(0.0f, 1.0f - inst.info.random, 0.0f, 1.0f)};
+    if (s.instances.size() == 2) inst.info.attributes.pop_back();
     s.instances.push_back(inst);
     return &s.instances.back();
   };
@@ -156,6 +162,17 @@ class InstancesTest : public SharedRendererTest {};
 TEST_F(InstancesTest, RenderLikeTheirCopiesMadeByHand) {
   const Scene s = instanced_scene();
   expect_same_image(renderer_->render(s), renderer_->render(copies_by_hand(s)), "still");
+}
+
+TEST_F(InstancesTest, AttributesReachTheirInstancesMaterial) {
+  // Each instance's own attribute colours it: without them the image
+  // differs, far beyond the 60 dB within which images count as the same.
+  const Scene s = instanced_scene();
+  Scene none = s;
+  for (Instance& inst : none.instances) inst.info.attributes.clear();
+  const double db = psnr(renderer_->render(s).rgba, renderer_->render(none).rgba);
+  std::printf("attributes against none: %.1f dB\n", db);
+  EXPECT_LT(db, 45.0);
 }
 
 TEST_F(InstancesTest, MovingInstancesBlurLikeTheirCopies) {

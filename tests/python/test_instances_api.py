@@ -1,6 +1,7 @@
 """Scene.mesh_to_prototype and add_instances from Python: arrays of
 instances land in the scene, render like the same meshes placed one by one,
-and malformed arrays are refused with a message, never a crash."""
+and malformed arrays are refused with a message, never a crash; Attribute
+nodes' per-object values convert as Cycles converts them."""
 
 import numpy as np
 import pytest
@@ -77,3 +78,53 @@ def test_an_instance_of_nan_is_refused_at_validation():
     with pytest.raises(RuntimeError) as e:
         s.validate()
     assert "instance '0'" in str(e.value)
+
+
+def test_malformed_attributes_are_refused_with_a_message():
+    s = base()
+    with pytest.raises(RuntimeError, match="attributes"):
+        s.add_mesh("cube", POINTS, COUNTS, FACES, attributes=np.zeros(6, dtype=np.float32))
+    s.add_mesh("cube", POINTS, COUNTS, FACES, attributes=np.full((2, 4), np.nan, dtype=np.float32))
+    proto = s.mesh_to_prototype(-1, "cube")
+    with pytest.raises(RuntimeError, match="attributes"):
+        s.add_instances(proto, placements(3), attributes=np.zeros((2, 1, 4), dtype=np.float32))
+    with pytest.raises(RuntimeError, match="attributes"):
+        s.add_instances(proto, placements(3), attributes=np.zeros((3, 1, 3), dtype=np.float32))
+    s.add_instances(proto, placements(3), attributes=np.zeros((3, 2, 4), dtype=np.float32))
+    s.validate()  # NaN read as zero
+    assert s.instance_count == 3
+
+
+class Owner(dict):
+    """A custom-property holder with property paths, as an ID is."""
+
+    def __init__(self, props, paths):
+        super().__init__(props)
+        self.paths = paths
+
+    def path_resolve(self, name):
+        if name not in self.paths:
+            raise ValueError(name)
+        return self.paths[name]
+
+
+def test_attribute_values_convert_as_cycles_converts_them():
+    from micropoly import export_attributes as ea
+
+    o = Owner({"f": 0.25, "i": 3, "b": True, "v2": [1, 2], "c": (0.1, 0.2, 0.3, 0.4), "s": "12", "long": [1] * 5},
+              {"color": (0.5, 0.6, 0.7, 1.0), "f": 9.0})
+    assert ea.rgba(o, "f") == (0.25, 0.25, 0.25, 1.0)  # the custom property before the path
+    assert ea.rgba(o, "i") == (3.0, 3.0, 3.0, 1.0)
+    assert ea.rgba(o, "b") == (1.0, 1.0, 1.0, 1.0)
+    assert ea.rgba(o, "v2") == (1.0, 2.0, 0.0, 1.0)
+    assert ea.rgba(o, "c") == (0.1, 0.2, 0.3, 0.4)
+    assert ea.rgba(o, "color") == (0.5, 0.6, 0.7, 1.0)
+    assert ea.rgba(o, "s") is None and ea.rgba(o, "long") is None and ea.rgba(o, "missing") is None
+    assert ea.rgba(None, "f") is None
+
+    class Obj(Owner):
+        data = Owner({"m": 2.0}, {})
+
+    obj = Obj({"f": 0.5}, {})
+    values = ea.object_values([("f", False), ("m", True), ("none", False)], obj)
+    np.testing.assert_array_equal(values, [[0.5, 0.5, 0.5, 1.0], [2.0, 2.0, 2.0, 1.0], [0, 0, 0, 0]])

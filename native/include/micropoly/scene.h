@@ -14,13 +14,18 @@ enum class BoundaryInterpolation { None, EdgeOnly, EdgeAndCorner };
 
 // What Blender's Object Info node reads of an object: its Object Color
 // (RGBA), Pass Index and random number (Cycles': a hash of the object's
-// name, or the instance's random id, over 0xFFFFFFFF).
+// name, or the instance's random id, over 0xFFFFFFFF); and what Attribute
+// nodes of type Object or Instancer read (an object's custom properties,
+// Geometry Nodes' instance attributes): one RGBA per slot the scene's
+// material programs number (the add-on's export_attributes.py), slots
+// past the end reading zero.
 struct ObjectInfo {
   glm::vec4 color{1.0f};
   float pass_index = 0.0f;
   float random = 0.0f;
+  std::vector<glm::vec4> attributes;
   bool operator==(const ObjectInfo& o) const {
-    return color == o.color && pass_index == o.pass_index && random == o.random;
+    return color == o.color && pass_index == o.pass_index && random == o.random && attributes == o.attributes;
   }
 };
 

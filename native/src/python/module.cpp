@@ -5,6 +5,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <cstring>
 
 #include "micropoly/error.h"
@@ -29,6 +30,14 @@ std::vector<glm::vec3> to_points(const Array<float>& a, const char* what) {
   if (a.ndim() != 2 || a.shape(1) != 3) throw Error(std::string(what) + " must be an (N, 3) array");
   std::vector<glm::vec3> out(static_cast<size_t>(a.shape(0)));
   std::memcpy(out.data(), a.data(), out.size() * sizeof(glm::vec3));
+  return out;
+}
+
+// `count` RGBA values, non-finite ones read as zero (an Attribute node's
+// value where a custom property holds NaN).
+std::vector<glm::vec4> to_rgba(const float* v, size_t count) {
+  std::vector<glm::vec4> out(count);
+  for (size_t k = 0; k < 4 * count; ++k) out[k / 4][int(k % 4)] = std::isfinite(v[k]) ? v[k] : 0.0f;
   return out;
 }
 
@@ -411,12 +420,15 @@ PYBIND11_MODULE(_native, m) {
              const Array<int>& corner_vertices, const Array<float>& corner_sharpness, const Array<int>& hole_faces,
              const std::string& boundary, bool double_sided, std::vector<float> texspace_location,
              std::vector<float> texspace_size, const Array<float>& uv_layers, const Array<float>& corner_normals,
-             bool visible_camera, bool cast_shadows, std::vector<float> object_color, float pass_index, float random) {
+             bool visible_camera, bool cast_shadows, std::vector<float> object_color, float pass_index, float random,
+             const Array<float>& attributes) {
             Mesh mesh;
             if (object_color.size() != 4) throw Error("mesh '" + name + "': object_color must have 4 values (RGBA)");
             mesh.info.color = glm::vec4(object_color[0], object_color[1], object_color[2], object_color[3]);
             mesh.info.pass_index = pass_index;
             mesh.info.random = random;
+            if (attributes.size() % 4 != 0) throw Error("mesh '" + name + "': attributes must be RGBA per slot");
+            mesh.info.attributes = to_rgba(attributes.data(), size_t(attributes.size()) / 4);
             mesh.visible_camera = visible_camera;
             mesh.cast_shadows = cast_shadows;
             mesh.corner_normals = to_points(corner_normals, "corner_normals");
@@ -462,9 +474,10 @@ PYBIND11_MODULE(_native, m) {
           py::arg("texspace_size") = std::vector<float>{0, 0, 0}, py::arg("uv_layers") = Array<float>(),
           py::arg("corner_normals") = Array<float>(), py::arg("visible_camera") = true, py::arg("cast_shadows") = true,
           py::arg("object_color") = std::vector<float>{1, 1, 1, 1}, py::arg("pass_index") = 0.0f,
-          py::arg("random") = 0.0f,
+          py::arg("random") = 0.0f, py::arg("attributes") = Array<float>(),
           "Adds a mesh; uv_layers is (layers, face corners, 2): UV layer k is what material programs read as "
-          "UV layer k; corner_normals (face corners, 3), object space, shade a polygon mesh smooth.")
+          "UV layer k; corner_normals (face corners, 3), object space, shade a polygon mesh smooth; attributes "
+          "(slots, 4): the RGBA that Attribute nodes of type Object or Instancer read in each slot.")
       .def(
           "add_image",
           [](Scene& s, const std::string& name, const Array<float>& pixels, bool srgb) {
@@ -527,7 +540,7 @@ PYBIND11_MODULE(_native, m) {
           "add_instances",
           [](Scene& s, int prototype, const Array<float>& object_to_world, const Array<float>& random,
              const Array<float>& object_color, const Array<float>& pass_index, bool visible_camera, bool cast_shadows,
-             const Array<float>& motion_object_to_world) {
+             const Array<float>& motion_object_to_world, const Array<float>& attributes) {
             if (prototype < 0 || size_t(prototype) >= s.prototypes.size())
               throw Error("add_instances: no prototype " + std::to_string(prototype));
             const std::vector<glm::mat4> placed = to_matrices(object_to_world, "object_to_world");
@@ -541,6 +554,12 @@ PYBIND11_MODULE(_native, m) {
             const bool has_random = per_instance(random, 1, "random");
             const bool has_color = per_instance(object_color, 4, "object_color");
             const bool has_pass = per_instance(pass_index, 1, "pass_index");
+            size_t slots = 0;
+            if (attributes.size() != 0) {
+              if (attributes.ndim() != 3 || size_t(attributes.shape(0)) != n || attributes.shape(2) != 4)
+                throw Error("add_instances: attributes must be an (instances, slots, 4) array");
+              slots = size_t(attributes.shape(1));
+            }
             size_t steps = 0;
             if (motion_object_to_world.size() != 0) {
               if (motion_object_to_world.ndim() != 4 || size_t(motion_object_to_world.shape(0)) != n ||
@@ -559,6 +578,7 @@ PYBIND11_MODULE(_native, m) {
                 inst.info.color = glm::vec4(c[0], c[1], c[2], c[3]);
               }
               if (has_pass) inst.info.pass_index = pass_index.data()[i];
+              if (slots) inst.info.attributes = to_rgba(attributes.data() + i * slots * 4, slots);
               inst.visible_camera = visible_camera;
               inst.cast_shadows = cast_shadows;
               for (size_t k = 0; k < steps; ++k) {
@@ -574,10 +594,11 @@ PYBIND11_MODULE(_native, m) {
           py::arg("prototype"), py::arg("object_to_world"), py::arg("random") = Array<float>(),
           py::arg("object_color") = Array<float>(), py::arg("pass_index") = Array<float>(),
           py::arg("visible_camera") = true, py::arg("cast_shadows") = true,
-          py::arg("motion_object_to_world") = Array<float>(),
+          py::arg("motion_object_to_world") = Array<float>(), py::arg("attributes") = Array<float>(),
           "Places `prototype` once per row-major matrix of object_to_world (instances, 4, 4); per instance, "
           "optionally: Object Info's random (instances,), object_color (instances, 4), pass_index (instances,), "
-          "and motion_object_to_world (instances, steps, 4, 4).")
+          "motion_object_to_world (instances, steps, 4, 4) and the RGBA Attribute nodes of type Object or "
+          "Instancer read in each slot: attributes (instances, slots, 4).")
       .def("validate", [](const Scene& s) { validate_scene(s); })
       .def_property_readonly("prototype_count", [](const Scene& s) { return s.prototypes.size(); })
       .def_property_readonly("instance_count", [](const Scene& s) { return s.instances.size(); })

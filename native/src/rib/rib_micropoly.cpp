@@ -263,7 +263,7 @@ void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
   const int line = args.request().line;
   warn_unknown(params, {"material", "materialname", "program", "programparams", "programdisplaces", "programshades",
                         "programalpha", "displacementbound", "displacementworld", "objectcolor", "objectalpha",
-                        "objectindex", "objectrandom"}, [&](const std::string& name) {
+                        "objectindex", "objectrandom", "objectattributes"}, [&](const std::string& name) {
     warn_once("attribute-micropoly:" + name, line,
               "Attribute \"micropoly\": parameter \"" + name + "\" is ignored");
   });
@@ -276,6 +276,14 @@ void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
   info.pass_index = params.get_float_checked("objectindex", info.pass_index, finite, "a finite number");
   info.random = params.get_float_checked("objectrandom", info.random,
                                          [](float v) { return v >= 0.0f && v <= 1.0f; }, "a number in [0, 1]");
+  // Attribute nodes' per-object values (ObjectInfo::attributes): RGBA per slot.
+  if (params.find("objectattributes")) {
+    const std::vector<float> a = params.get_float_list("objectattributes");
+    if (a.size() % 4 != 0)
+      args.fail_at(line, "Attribute \"micropoly\": \"objectattributes\" needs four numbers (RGBA) per slot");
+    info.attributes.clear();
+    for (size_t k = 0; k + 3 < a.size(); k += 4) info.attributes.emplace_back(a[k], a[k + 1], a[k + 2], a[k + 3]);
+  }
   if (!params.find("material")) {
     if (params.find("materialname"))
       warn_once("attribute-micropoly:materialname", line,

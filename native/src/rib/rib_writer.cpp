@@ -494,6 +494,9 @@ void write_object_info(std::string& o, const ObjectInfo& info) {
   param(o, "float objectalpha", info.color.w);
   param(o, "float objectindex", info.pass_index);
   param(o, "float objectrandom", info.random);
+  std::vector<float> attributes;
+  for (const glm::vec4& a : info.attributes) attributes.insert(attributes.end(), {a.x, a.y, a.z, a.w});
+  param_list(o, "objectattributes", attributes);
   o += '\n';
 }
 

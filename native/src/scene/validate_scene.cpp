@@ -244,7 +244,9 @@ void validate_instances(const Scene& scene) {
     if (inst.material != -1) check_material_index(inst.material, scene.materials.size(), "instance", name);
     if (inst.double_sided < -1 || inst.double_sided > 1)
       fail("instance", name, "double_sided must be -1 (the surfaces' own), 0 or 1");
-    if (!finite(inst.info.color) || !std::isfinite(inst.info.pass_index) || !std::isfinite(inst.info.random))
+    if (!finite(inst.info.color) || !std::isfinite(inst.info.pass_index) || !std::isfinite(inst.info.random) ||
+        !std::all_of(inst.info.attributes.begin(), inst.info.attributes.end(),
+                     [&](const glm::vec4& a) { return finite(a); }))
       fail("instance", name, "has NaN or infinite Object Info values");
     if (!inst.motion_object_to_world.empty() && inst.motion_object_to_world.size() != steps)
       fail("instance", name, "has " + std::to_string(inst.motion_object_to_world.size()) +

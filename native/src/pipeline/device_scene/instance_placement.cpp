@@ -199,8 +199,9 @@ void place_instances(const Scene& scene, const PrototypeVariants& pv,
   for (Placed& p : placed) {
     const Variant& var = variants[p.variant];
     p.record.object = uint32_t(out.objects.size());
-    out.objects.push_back(to_device_object(p.to_camera, p.to_world, var.texspace_location, var.texspace_size, {},
-                                           scene.instances[p.instance].info));
+    out.add_object(to_device_object(p.to_camera, p.to_world, var.texspace_location, var.texspace_size, {},
+                                    scene.instances[p.instance].info),
+                   scene.instances[p.instance].info);
     out.instanced_patches += var.count;
     out.instances.push_back(p.record);
   }

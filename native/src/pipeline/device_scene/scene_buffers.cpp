@@ -239,6 +239,12 @@ std::vector<DeviceLight> device_lights(const std::vector<Light>& lights, const g
 HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
   HostSceneData out;
   const glm::mat4& w2c = scene.camera.world_to_camera;
+  auto attribute_slots = [&](const ObjectInfo& info) {
+    out.object_attribute_count = std::max(out.object_attribute_count, uint32_t(info.attributes.size()));
+  };
+  for (const Mesh& mesh : scene.meshes) attribute_slots(mesh.info);
+  for (const BezierPatches& set : scene.bezier_patches) attribute_slots(set.info);
+  for (const Instance& inst : scene.instances) attribute_slots(inst.info);
   for (const Mesh& mesh : scene.meshes)
     out.patches.uv_layers = std::max(out.patches.uv_layers, int(mesh.uv_layers.size()));
   for (const Prototype& proto : scene.prototypes)
@@ -276,10 +282,12 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
     const glm::mat4 to_camera = w2c * (mesh ? mesh->object_to_world : set->object_to_world);
     place_shape(*shapes[i], to_camera, mesh, set, uint32_t(out.objects.size()), scene, out.patches);
     const glm::mat4& to_world = mesh ? mesh->object_to_world : set->object_to_world;
-    out.objects.push_back(mesh ? to_device_object(to_camera, to_world, mesh->texspace_location, mesh->texspace_size,
-                                                  mesh->points, mesh->info)
-                               : to_device_object(to_camera, to_world, glm::vec3(0.0f), glm::vec3(0.0f),
-                                                  set->control_points, set->info));
+    const ObjectInfo& info = mesh ? mesh->info : set->info;
+    out.add_object(mesh ? to_device_object(to_camera, to_world, mesh->texspace_location, mesh->texspace_size,
+                                           mesh->points, info)
+                        : to_device_object(to_camera, to_world, glm::vec3(0.0f), glm::vec3(0.0f),
+                                           set->control_points, info),
+                   info);
   }
   if (scene.motion_steps >= 2) place_motion(scene, surfaces, cache ? cache : &local, out);
   out.own_patches = out.root_count = out.patches.size();
@@ -293,6 +301,7 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
   }
   out.world_params_at = append_params(scene.world.program_params, "the world", out.params);
   if (out.params.empty()) out.params.push_back(0.0f);  // a buffer of at least one value
+  if (out.object_attributes.empty()) out.object_attributes.emplace_back(0.0f);
   out.lights = device_lights(scene.lights, w2c);
   std::vector<bool> refracts(out.materials.size(), false);
   for (size_t k = 0; k < scene.materials.size(); ++k) {
@@ -361,6 +370,8 @@ SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data
     b.edge_curves = upload(session, data.patches.curves);
     b.materials = upload(session, data.materials);
     b.objects = upload(session, data.objects);
+    b.object_attributes = upload(session, data.object_attributes);
+    b.object_attribute_count = static_cast<cl_uint>(data.object_attribute_count);
     b.lights = upload(session, data.lights);
     b.patch_uvs = upload(session, data.patches.uvs);
     b.patch_normals = upload(session, data.patches.normals);
@@ -403,7 +414,7 @@ SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data
     auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
     b.bytes = bytes(data.patches.points) + bytes(data.patches.info) + bytes(data.patches.edges) +
               bytes(data.patches.curves) + bytes(data.patches.uvs) + bytes(data.patches.normals) + bytes(bounds) +
-              bytes(data.objects) + bytes(data.instances) + bytes(data.patch_nodes) + bytes(data.instance_motion) +
+              bytes(data.objects) + bytes(data.object_attributes) + bytes(data.instances) + bytes(data.patch_nodes) + bytes(data.instance_motion) +
               bytes(data.motion_points) + bytes(data.motion_curves);
   });
   return b;

@@ -36,6 +36,16 @@ struct HostSceneData {
   std::vector<DeviceMaterial> materials;
   std::vector<DeviceLight> lights;
   std::vector<DeviceObject> objects;  // one per surface, in patch order (MP_PATCH_OBJECT)
+  // Attribute nodes' per-object values (ObjectInfo::attributes): slots per
+  // object (the most any object has), then object after object, zero past
+  // an object's own; one zero float4 where no object has any.
+  uint32_t object_attribute_count = 0;
+  std::vector<glm::vec4> object_attributes;
+  void add_object(const DeviceObject& o, const ObjectInfo& info) {
+    objects.push_back(o);
+    for (uint32_t k = 0; k < object_attribute_count; ++k)
+      object_attributes.push_back(k < info.attributes.size() ? info.attributes[k] : glm::vec4(0.0f));
+  }
   // Images' offsets count every MIP level (mp_tex_image.h): the device's
   // texel buffer holds device_texels, each image's level 0 at its offset
   // and its other levels after it, built on the device at upload.

@@ -34,6 +34,10 @@ class Hasher {
     bytes(v.data(), v.size() * sizeof(T));
   }
   void text(const std::string& s) { bytes(s.data(), s.size()); }
+  void info(const ObjectInfo& i) {
+    value(i.color), value(i.pass_index), value(i.random);
+    values(i.attributes);
+  }
   uint64_t result() const { return h_; }
 
  private:
@@ -97,7 +101,7 @@ void hash_mesh(Hasher& h, const Mesh& m) {
   h.value(m.texspace_location);
   h.value(m.texspace_size);
   h.value(m.cast_shadows);
-  h.value(m.info.color), h.value(m.info.pass_index), h.value(m.info.random);
+  h.info(m.info);
   h.value(m.motion_points.size());
   for (const std::vector<glm::vec3>& step : m.motion_points) h.values(step);
   h.values(m.motion_object_to_world);
@@ -110,7 +114,7 @@ void hash_patch_set(Hasher& h, const BezierPatches& b) {
   h.value(b.double_sided);
   h.value(b.visible_camera);
   h.value(b.cast_shadows);
-  h.value(b.info.color), h.value(b.info.pass_index), h.value(b.info.random);
+  h.info(b.info);
 }
 
 void hash_instances(Hasher& h, const Scene& scene) {
@@ -124,7 +128,7 @@ void hash_instances(Hasher& h, const Scene& scene) {
   h.value(scene.instances.size());
   for (const Instance& i : scene.instances) {
     h.value(i.prototype), h.value(i.object_to_world), h.values(i.motion_object_to_world);
-    h.value(i.info.color), h.value(i.info.pass_index), h.value(i.info.random);
+    h.info(i.info);
     h.value(i.material), h.value(i.double_sided), h.value(i.visible_camera), h.value(i.cast_shadows);
     h.value(i.reverse_orientation);
   }
@@ -240,7 +244,7 @@ ShadowGeometryKeys shadow_geometry_keys(const Scene& scene) {
     h.value(m.cast_shadows);
     if (*programs) {
       h.value(m.texspace_location), h.value(m.texspace_size);
-      h.value(m.info.color), h.value(m.info.pass_index), h.value(m.info.random);
+      h.info(m.info);
     }
     h.value(m.motion_points.size());
     for (const std::vector<glm::vec3>& step : m.motion_points) h.values(step);
@@ -255,7 +259,7 @@ ShadowGeometryKeys shadow_geometry_keys(const Scene& scene) {
     h.value(b.object_to_world);
     h.value(b.double_sided);
     h.value(b.cast_shadows);
-    if (*programs) h.value(b.info.color), h.value(b.info.pass_index), h.value(b.info.random);
+    if (*programs) h.info(b.info);
     return h.result();
   };
   bool programs = false;
@@ -286,7 +290,7 @@ ShadowGeometryKeys shadow_geometry_keys(const Scene& scene) {
     h.value(inst.object_to_world);
     h.values(inst.motion_object_to_world);
     if (own || prototype_programs[size_t(inst.prototype)])
-      h.value(inst.info.color), h.value(inst.info.pass_index), h.value(inst.info.random);
+      h.info(inst.info);
     out.instances.push_back(h.result());
   }
   Hasher g;
