@@ -6,7 +6,9 @@ transform and Object Info random of its own per rock, scattered as the
 2,000 rocks are (bench/occlusion_bench.py: sizes 0.4 to 1.3, turned about Z)
 over a ground that grows with the count, so the rocks stay as dense.
 
-  python3 bench/scatter_instances_rib.py bench/out/field_2000.rib 100000 OUT.rib
+  python3 bench/scatter_instances_rib.py bench/out/field_2000.rib 100000 OUT.rib [--sun-only]
+
+--sun-only leaves the world's light out (the sun alone lights the field).
 
 Standard library only (the GPU machine has no packages)."""
 
@@ -19,6 +21,8 @@ import sys
 def main():
     source, count, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
     text = open(source).read()
+    if "--sun-only" in sys.argv[4:]:
+        text = re.sub(r'LightSource "micropoly_environmentlight"[^\n]*\n', "", text)
     first = text.index("AttributeBegin\n  Transform", text.index("ObjectEnd"))
     end = text.index("AttributeEnd\n", first) + len("AttributeEnd\n")
     block = text[first:end]
