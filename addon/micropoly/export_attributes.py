@@ -59,22 +59,24 @@ def object_values(slots, obj):
 
 
 class InstanceAttributes:
-    """Per depsgraph instance, the slots' values. What an instance shares
+    """The slots' values of depsgraph instances. What an instance shares
     with others of its instancer and object (their properties, its
-    particle settings') is looked up once per such triple; Geometry Nodes'
-    attributes are read as arrays once per instancer, and each instance
-    then only picks its row by its persistent id."""
+    particle settings') is looked up once per such combination; Geometry
+    Nodes' attributes are read as arrays once per instancer. Per instance,
+    entry() keeps only which combination and which row it takes (a few
+    dictionary lookups); values() builds the arrays with numpy."""
 
     def __init__(self, slots, warnings):
         self.slots = slots
         self.warnings = warnings
-        self._shared = {}     # (particle settings, instancer, object) -> (first, last) arrays and found masks
-        self._geometry = {}   # instancer pointer -> (id -> row, {name: (rows, 4) array}) or None
+        self._shared = {}     # (settings, instancer, object, data) pointers -> index into _bases
+        self._bases = []      # per combination: (slots, 4) values, and which slots the particle settings gave
+        self._geometry = {}   # instancer pointer -> index into _instancers, or -1 (no instance attributes)
+        self._instancers = []  # (id -> row or None, {name: (rows, 4) array})
 
-    def values(self, inst):
-        """(slots, 4) for depsgraph instance `inst`."""
-        if not self.slots:
-            return None
+    def entry(self, inst):
+        """What instance `inst` takes its values from: (combination,
+        instancer with attributes or -1, its row there or -1)."""
         obj = inst.object
         parent = inst.parent if inst.is_instance else None
         psys = inst.particle_system if inst.is_instance else None
@@ -83,18 +85,32 @@ class InstanceAttributes:
                obj.data.as_pointer())
         shared = self._shared.get(key)
         if shared is None:
-            shared = self._shared[key] = self._lookup(settings, parent, obj)
-        first, first_found, last = shared
-        geometry = self._geometry_attributes(parent) if parent is not None else None
-        if geometry is None:
-            return np.where(first_found[:, None], first, last)
-        rows, arrays = geometry
-        row = rows.get(inst.persistent_id[1]) if rows is not None else inst.persistent_id[1]
-        out = np.where(first_found[:, None], first, last)
-        for k, (name, dupli) in enumerate(self.slots):
-            a = arrays.get(name)
-            if dupli and a is not None and not first_found[k] and row is not None and 0 <= row < len(a):
-                out[k] = a[row]
+            shared = self._shared[key] = len(self._bases)
+            first, found, last = self._lookup(settings, parent, obj)
+            self._bases.append((np.where(found[:, None], first, last), found))
+        geometry = self._geometry_attributes(parent) if parent is not None else -1
+        if geometry < 0:
+            return shared, -1, -1
+        rows = self._instancers[geometry][0]
+        pid = inst.persistent_id[1]
+        row = rows.get(pid, -1) if rows is not None else pid
+        return shared, geometry, row
+
+    def values(self, entries):
+        """(instances, slots, 4) for entries from entry()."""
+        e = np.asarray(entries, dtype=np.int64).reshape(-1, 3)
+        bases = np.stack([b for b, _ in self._bases])
+        found = np.stack([f for _, f in self._bases])
+        out = bases[e[:, 0]]
+        for g, (_, arrays) in enumerate(self._instancers):
+            mine = e[:, 1] == g
+            for k, (name, dupli) in enumerate(self.slots):
+                a = arrays.get(name)
+                if not dupli or a is None:
+                    continue
+                # A value the particle settings give comes first.
+                take = mine & ~found[e[:, 0], k] & (e[:, 2] >= 0) & (e[:, 2] < len(a))
+                out[take, k] = a[e[take, 2]]
         return out
 
     def _lookup(self, settings, parent, obj):
@@ -118,37 +134,39 @@ class InstanceAttributes:
         return first, found, last
 
     def _geometry_attributes(self, parent):
-        """The instancer's Geometry Nodes instance attributes the slots name
-        (Instancer type), with the map from an instance's id (its persistent
-        id's second entry) to its row, or None where it has none."""
+        """Index into _instancers of the instancer's Geometry Nodes instance
+        attributes that the slots name (Instancer type), with the map from
+        an instance's id (its persistent id's second entry) to its row; -1
+        where it has none."""
         pointer = parent.as_pointer()
         if pointer in self._geometry:
             return self._geometry[pointer]
-        self._geometry[pointer] = None
+        self._geometry[pointer] = -1
         names = {name for name, dupli in self.slots if dupli}
         if not names or not any(m.type == "NODES" for m in getattr(parent, "modifiers", ())):
-            return None
+            return -1
         import bpy
         geometry_set = getattr(bpy.types, "GeometrySet", None)
         if geometry_set is None:
             self.warnings.append(f"'{parent.name}': Geometry Nodes instance attributes are read from Blender 4.3 "
                                  "on; Attribute nodes of type Instancer read its properties and the object's")
-            return None
+            return -1
         geometry = geometry_set.from_evaluated_object(parent)  # owns the point cloud read below
         points = geometry.instances_pointcloud()
         if points is None:
-            return None
+            return -1
         arrays = {}
         for name in names & set(points.attributes.keys()):
             arrays[name] = _attribute_rgba(points.attributes[name])
         if not arrays:
-            return None
+            return -1
         rows = None
         if "id" in points.attributes:
             ids = np.zeros(len(points.attributes["id"].data), dtype=np.int32)
             points.attributes["id"].data.foreach_get("value", ids)
             rows = dict(zip(ids.tolist(), range(len(ids))))
-        self._geometry[pointer] = (rows, arrays)
+        self._instancers.append((rows, arrays))
+        self._geometry[pointer] = len(self._instancers) - 1
         return self._geometry[pointer]
 
 

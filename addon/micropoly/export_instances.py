@@ -29,7 +29,7 @@ class InstanceTable:
         self._prototypes = {}  # key -> prototype index, or None (nothing to render)
         self._objects = {}     # (object, data) pointers -> (prototype, colour, pass index, name's random id, visibility)
         # prototype -> ([matrix rows], [random ids], [colours], [pass indices], visibility, [motion or None],
-        # [Attribute nodes' values: (slots, 4) or None])
+        # [where Attribute nodes' values come from: InstanceAttributes.entry])
         self._placed = {}
         # Attribute nodes of type Object and Instancer (export_attributes.InstanceAttributes), or None.
         self._attributes = attributes
@@ -85,7 +85,7 @@ class InstanceTable:
         if self._moving and inst.is_instance:
             placed[5].append(self._moving.get(export_motion.instance_key(inst)))
         if self._attributes is not None and self._attributes.slots:
-            placed[6].append(self._attributes.values(inst))
+            placed[6].append(self._attributes.entry(inst))
         return True
 
     def flush(self, native_scene):
@@ -97,7 +97,7 @@ class InstanceTable:
                 object_color=np.asarray(colours, dtype=np.float32),
                 pass_index=np.asarray(passes, dtype=np.float32), visible_camera=camera, cast_shadows=shadows,
                 motion_object_to_world=self._motion(placed, moving),
-                attributes=np.asarray(attributes, dtype=np.float32) if attributes else np.zeros(0, np.float32))
+                attributes=self._attributes.values(attributes) if attributes else np.zeros(0, np.float32))
         self._placed.clear()
 
     @staticmethod
