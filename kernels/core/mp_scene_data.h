@@ -20,7 +20,7 @@
   BUFFER(const float4, edge_curves)        /* MP_CURVE_FLOAT4S per shared edge curve */                            \
   BUFFER(const DeviceMaterial, materials)                                                                          \
   BUFFER(const DeviceObject, objects)                                                                              \
-  BUFFER(const float4, object_attributes)  /* object_attribute_count per object (Attribute nodes' Object type) */ \
+  BUFFER(const float4, object_attributes)  /* object_attribute_count per object (Attribute: Object, Instancer) */ \
   BUFFER(const DeviceLight, lights)        /* the scene's and its world's, camera space */                        \
   BUFFER(const float4, patch_uvs)          /* 2 per patch and UV layer */                                          \
   BUFFER(const float4, patch_normals)      /* 4 per patch: smooth shading normals at its corners */               \

@@ -414,7 +414,8 @@ SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data
     auto bytes = [](const auto& v) { return v.size() * sizeof(v[0]); };
     b.bytes = bytes(data.patches.points) + bytes(data.patches.info) + bytes(data.patches.edges) +
               bytes(data.patches.curves) + bytes(data.patches.uvs) + bytes(data.patches.normals) + bytes(bounds) +
-              bytes(data.objects) + bytes(data.object_attributes) + bytes(data.instances) + bytes(data.patch_nodes) + bytes(data.instance_motion) +
+              bytes(data.objects) + bytes(data.object_attributes) + bytes(data.instances) +
+              bytes(data.patch_nodes) + bytes(data.instance_motion) +
               bytes(data.motion_points) + bytes(data.motion_curves);
   });
   return b;
