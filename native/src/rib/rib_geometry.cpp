@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "rib/rib_parser.h"
+#include "rib/rib_quadrics.h"
 
 namespace mp::rib {
 namespace {
@@ -438,6 +439,40 @@ void Parser::req_patch_mesh(ArgReader& args) {
   patch_mesh_to_bezier(bicubic, nu, uper, nv, vper, attrs_.ubasis, attrs_.vbasis, points,
                        prim.patch_points);
   prim.mergeable = true;
+  place(std::move(prim), args);
+}
+
+// --- quadrics -------------------------------------------------------------------
+
+// RenderMan's quadrics become Bezier nets (rib_quadrics.h) and go on as a
+// Patch would: orientation, sides, visibility and instancing alike.
+void Parser::req_quadric(ArgReader& args) {
+  QuadricKind kind{};
+  quadric_kind(args.request().name, &kind);
+  // The numbers as scalars or one array; a Hyperboloid's points may also be
+  // arrays of 3 each ("Hyperboloid [x1 y1 z1] [x2 y2 z2] thetamax").
+  std::vector<double> numbers;
+  if (kind == QuadricKind::Hyperboloid && !args.at_end() && args.peek().is_array() && args.peek().size() == 3) {
+    numbers = args.numbers(3);
+    for (double v : args.numbers(3)) numbers.push_back(v);
+    numbers.push_back(args.number());
+  } else {
+    numbers = args.numbers(quadric_arg_count(kind));
+  }
+  ParamList params(args, decls_);
+  for (const Param& p : params.params())
+    warn_once("primvar:" + p.name, p.line, "primitive variable \"" + p.name + "\" is ignored");
+  Primitive prim = make_primitive(Primitive::Kind::Patches, args);
+  try {
+    prim.patch_points = quadric_patches(kind, numbers);
+  } catch (const Error& e) {
+    args.fail(e.what());
+  }
+  if (prim.patch_points.empty()) {
+    warn_once("quadric-empty:" + args.request().name, args.request().line,
+              args.request().name + " with no area (a zero radius, height or sweep) is skipped");
+    return;
+  }
   place(std::move(prim), args);
 }
 
