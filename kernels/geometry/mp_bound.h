@@ -558,7 +558,10 @@ MP_INLINE uint mp_classify_box(float3 blo, float3 bhi, FrameParams f, const MP_G
   mp_boxes_to_view(&blo, &bhi, 1, f);
   MpBound bb = mp_bound_boxes(&blo, &bhi, 1, f);
   if (mp_bound_culled(bb, &blo, &bhi, 1, f, page_masks, can_split)) return MP_CULL;
-  if (occ.levels > 0 &&
+  /* A box that straddles the eye plane has no raster rectangle (an empty
+   * one would read as hidden everywhere): only its sub-patches are tested. */
+  int straddles = !f.ortho && bb.dmin <= f.eye_epsilon;
+  if (!straddles && occ.levels > 0 &&
       mp_occluded(occlusion, occ, f, bb.xmin, bb.ymin, bb.xmax, bb.ymax, bb.dmin, MP_CULLING_PLANE(&blo, &bhi, 1, f)))
     return MP_CULL_OCCLUDED;
   return 0u;
