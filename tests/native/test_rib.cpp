@@ -685,10 +685,10 @@ TEST(RibAllRequests, EveryRequestLandsInTheScene) {
 
 TEST(RibStructure, UnsupportedRequestsWarnOncePerName) {
   const mp::RibResult r = parse_world(
-      "Sphere 1 -1 1 360\nSphere 2 -2 2 360\nCylinder 1 0 1 360\nSphere 1 -1 1 [360]\n"
+      "Atmosphere \"fog\"\nAtmosphere \"fog\" \"distance\" [2]\nExposure 1 2.2\nAtmosphere [\"fog\"]\n"
       "Hider \"hidden\"\nHider \"hidden\"\nPolygon \"P\" [0 0 0 1 0 0 0 1 0]\n");
-  EXPECT_EQ(count_warnings(r, "'Sphere'"), 1);
-  EXPECT_EQ(count_warnings(r, "'Cylinder'"), 1);
+  EXPECT_EQ(count_warnings(r, "'Atmosphere'"), 1);
+  EXPECT_EQ(count_warnings(r, "'Exposure'"), 1);
   EXPECT_EQ(count_warnings(r, "'Hider'"), 1);
   EXPECT_EQ(r.warnings.size(), 3u);
   EXPECT_EQ(r.scene.meshes.size(), 1u);  // arguments were skipped cleanly

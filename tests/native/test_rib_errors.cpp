@@ -335,7 +335,7 @@ TEST(RibJunk, RandomRequestSoup) {
       "ObjectEnd", "ObjectInstance", "Format", "Projection", "ScreenWindow", "Clipping",
       "PixelSamples", "PixelFilter", "ShadingRate", "Display", "Declare", "Option", "Attribute",
       "CoordinateSystem", "CoordSysTransform", "MotionBegin", "MotionEnd", "Sphere", "ReadArchive",
-      "CropWindow", "SolidBegin", "SolidEnd"};
+      "CropWindow", "SolidBegin", "SolidEnd", "Points", "Torus", "Paraboloid", "Hyperboloid", "Disk"};
   const std::vector<std::string> words = {
       "P", "Pw", "N", "Ka", "fov", "from", "to", "catmull-clark", "bicubic", "bilinear", "periodic",
       "nonperiodic", "crease", "corner", "hole", "interpolateboundary", "b-spline", "hermite",

@@ -12,6 +12,7 @@
 #include "micropoly/renderer.h"
 #include "micropoly/settings_util.h"
 #include "rib/rib_reader.h"
+#include "scene/points.h"
 
 namespace py = pybind11;
 using namespace mp;
@@ -599,6 +600,40 @@ PYBIND11_MODULE(_native, m) {
           "optionally: Object Info's random (instances,), object_color (instances, 4), pass_index (instances,), "
           "motion_object_to_world (instances, steps, 4, 4) and the RGBA Attribute nodes of type Object or "
           "Instancer read in each slot: attributes (instances, slots, 4).")
+      .def(
+          "add_points",
+          [](Scene& s, const std::string& name, const Array<float>& positions, const Array<float>& radii,
+             const Array<float>& object_to_world, int material, bool visible_camera, bool cast_shadows,
+             std::vector<float> object_color, float pass_index, float random, const Array<float>& attributes) {
+            PointCloud cloud;
+            cloud.name = name;
+            cloud.positions = to_points(positions, "positions");
+            if (radii.ndim() != 1) throw Error("point cloud '" + name + "': radii must be a (points,) array");
+            cloud.radii.assign(radii.data(), radii.data() + radii.size());
+            cloud.object_to_world = to_matrix(object_to_world, "object_to_world");
+            cloud.material = material;
+            cloud.visible_camera = visible_camera;
+            cloud.cast_shadows = cast_shadows;
+            if (object_color.size() != 4)
+              throw Error("point cloud '" + name + "': object_color must have 4 values (RGBA)");
+            cloud.info.color = glm::vec4(object_color[0], object_color[1], object_color[2], object_color[3]);
+            cloud.info.pass_index = pass_index;
+            cloud.info.random = random;
+            if (attributes.size() != 0) {
+              if (attributes.ndim() != 2 || attributes.shape(1) != 4)
+                throw Error("point cloud '" + name + "': attributes must be a (slots, 4) array");
+              cloud.info.attributes = to_rgba(attributes.data(), size_t(attributes.shape(0)));
+            }
+            return add_point_cloud(s, cloud);
+          },
+          py::arg("name"), py::arg("positions"), py::arg("radii"), py::arg("object_to_world") = Array<float>(),
+          py::arg("material") = 0, py::arg("visible_camera") = true, py::arg("cast_shadows") = true,
+          py::arg("object_color") = std::vector<float>{1, 1, 1, 1}, py::arg("pass_index") = 0.0f,
+          py::arg("random") = 0.0f, py::arg("attributes") = Array<float>(),
+          "Adds a point cloud (positions (points, 3) and radii (points,), object space) as spheres, Cycles' "
+          "shape for points: one instance of a shared unit sphere per point (scene/points.h), each reading the "
+          "cloud's Object Info and attributes (slots, 4). Returns how many points were skipped (a position or "
+          "radius not finite, a radius not positive).")
       .def("validate", [](const Scene& s) { validate_scene(s); })
       .def_property_readonly("prototype_count", [](const Scene& s) { return s.prototypes.size(); })
       .def_property_readonly("instance_count", [](const Scene& s) { return s.instances.size(); })

@@ -7,7 +7,8 @@
 #include <cmath>
 
 #include "rib/rib_parser.h"
-#include "rib/rib_quadrics.h"
+#include "scene/points.h"
+#include "scene/quadrics.h"
 
 namespace mp::rib {
 namespace {
@@ -474,6 +475,60 @@ void Parser::req_quadric(ArgReader& args) {
     return;
   }
   place(std::move(prim), args);
+}
+
+// --- points ---------------------------------------------------------------------
+
+// RenderMan's Points: discs of diameter "width" (per point) or
+// "constantwidth" (one for all; 1 by default) facing the camera, each an
+// instance of one unit disc (scene/points.h).
+void Parser::req_points(ArgReader& args) {
+  ParamList params(args, decls_);
+  const int line = args.request().line;
+  for (const Param& p : params.params())
+    if (p.name != "P" && p.name != "width" && p.name != "constantwidth")
+      warn_once("primvar:" + p.name, p.line, "primitive variable \"" + p.name + "\" is ignored");
+  const Param* P = params.find("P");
+  if (!P) args.fail("missing \"P\" (point positions)");
+  if (P->decl.is_string() || P->decl.components() != 3) args.fail_at(P->line, "\"P\" must hold points (3 values each)");
+  PointCloud cloud;
+  cloud.shape = PointShape::Disc;
+  const std::vector<double>& v = P->value->numbers;
+  cloud.positions.reserve(v.size() / 3);
+  for (size_t i = 0; i + 2 < v.size(); i += 3) cloud.positions.emplace_back(v[i], v[i + 1], v[i + 2]);
+  const size_t n = cloud.positions.size();
+  const std::vector<float> widths = params.get_float_list("width");
+  if (!widths.empty()) {
+    if (widths.size() != n)
+      args.fail("\"width\" has " + std::to_string(widths.size()) + " values for " + std::to_string(n) + " points");
+    for (float w : widths) cloud.radii.push_back(0.5f * w);
+  } else {
+    cloud.radii.assign(n, 0.5f * params.get_float("constantwidth", 1.0f));
+  }
+  if (defining_active_) {
+    warn_once("points-in-object", line, "Points inside ObjectBegin/ObjectEnd are not supported and are skipped");
+    return;
+  }
+  if (!in_world_) args.fail("geometry outside WorldBegin/WorldEnd");
+  charge(n, line);
+  note_primitive(attrs_, line);
+  cloud.name = attrs_.has_identifier ? attrs_.identifier : make_primitive(Primitive::Kind::Patches, args).origin;
+  cloud.object_to_world = attrs_.ctm;
+  cloud.material = material_index(attrs_);
+  cloud.info = attrs_.object_info;
+  cloud.visible_camera = attrs_.visible_camera;
+  cloud.cast_shadows = attrs_.cast_shadows;
+  // Discs face the eye (an orthographic camera: its backward axis).
+  const Camera& camera = result_.scene.camera;
+  const glm::mat4 to_world = glm::inverse(camera.world_to_camera);
+  const bool ortho = camera.projection == Camera::Projection::Orthographic;
+  const glm::vec3 eye = ortho ? glm::normalize(glm::vec3(to_world * glm::vec4(0, 0, 1, 0)))
+                              : glm::vec3(to_world * glm::vec4(0, 0, 0, 1));
+  const size_t skipped = add_point_cloud(result_.scene, cloud, eye, ortho);
+  if (skipped > 0)
+    warn_once("points-skipped", line, "Points: " + std::to_string(skipped) +
+                                          " points with a position or width that is not finite and positive are skipped");
+  has_merge_target_ = false;
 }
 
 }  // namespace mp::rib

@@ -108,6 +108,7 @@ const std::unordered_map<std::string, Parser::Handler>& Parser::handlers() {
       {"Paraboloid", &Parser::req_quadric},
       {"Hyperboloid", &Parser::req_quadric},
       {"Torus", &Parser::req_quadric},
+      {"Points", &Parser::req_points},
       {"Basis", &Parser::req_basis},
       {"ObjectBegin", &Parser::req_object_begin},
       {"ObjectEnd", &Parser::req_object_end},

@@ -1,4 +1,4 @@
-#include "rib/rib_quadrics.h"
+#include "scene/quadrics.h"
 
 #include <algorithm>
 #include <array>
@@ -6,7 +6,7 @@
 
 #include "micropoly/error.h"
 
-namespace mp::rib {
+namespace mp {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -26,9 +26,9 @@ glm::dvec2 unit(double degrees) {
   return {std::cos(r), std::sin(r)};
 }
 
-// Pieces of at most kMaxArcDegrees covering an angle.
-int pieces(double degrees) {
-  return std::max(1, int(std::ceil(std::fabs(degrees) / kMaxArcDegrees - 1e-9)));
+// Pieces of at most `max_arc` degrees covering an angle.
+int pieces(double degrees, double max_arc) {
+  return std::max(1, int(std::ceil(std::fabs(degrees) / max_arc - 1e-9)));
 }
 
 // Tangent length of a cubic arc of `degrees` on the unit circle.
@@ -40,8 +40,8 @@ Cubic line(const glm::dvec3& a, const glm::dvec3& b) {
 
 // The arc of radius r about (rho, 0, z) in the xz-plane from phi0 to phi1
 // degrees, as cubic segments; boundary points computed once for both sides.
-std::vector<Cubic> arc(double rho, double z, double r, double phi0, double phi1) {
-  const int n = pieces(phi1 - phi0);
+std::vector<Cubic> arc(double rho, double z, double r, double phi0, double phi1, double max_arc) {
+  const int n = pieces(phi1 - phi0, max_arc);
   const double k = arc_k((phi1 - phi0) / n);
   auto point = [&](const glm::dvec2& e) { return glm::dvec3(rho + r * e.x, 0.0, z + r * e.y); };
   auto tangent = [&](const glm::dvec2& e) { return glm::dvec3(-r * e.y, 0.0, r * e.x); };
@@ -57,8 +57,8 @@ std::vector<Cubic> arc(double rho, double z, double r, double phi0, double phi1)
 
 // The profile swept about z from 0 to `theta_max` degrees: one net per
 // sweep span and profile segment, u along the sweep.
-std::vector<glm::vec3> sweep(const std::vector<Cubic>& profile, double theta_max) {
-  const int n = pieces(theta_max);
+std::vector<glm::vec3> sweep(const std::vector<Cubic>& profile, double theta_max, double max_arc) {
+  const int n = pieces(theta_max, max_arc);
   const double k = arc_k(theta_max / n);
   // R(e) q, and its derivative direction J R(e) q (linear in q).
   auto rotate = [](const glm::dvec2& e, const glm::dvec3& q) {
@@ -118,7 +118,8 @@ size_t quadric_arg_count(QuadricKind kind) {
   }
 }
 
-std::vector<glm::vec3> quadric_patches(QuadricKind kind, const std::vector<double>& args) {
+std::vector<glm::vec3> quadric_patches(QuadricKind kind, const std::vector<double>& args, double max_arc) {
+  if (!(max_arc > 0.0 && max_arc <= 90.0)) throw Error("arcs must be of 0 to 90 degrees");
   if (args.size() != quadric_arg_count(kind))
     throw Error("expected " + std::to_string(quadric_arg_count(kind)) + " numbers, found " +
                 std::to_string(args.size()));
@@ -136,7 +137,7 @@ std::vector<glm::vec3> quadric_patches(QuadricKind kind, const std::vector<doubl
       const double phi0 = zmin > -r ? asin_degrees(zmin / r) : -90.0;
       const double phi1 = zmax < r ? asin_degrees(zmax / r) : 90.0;
       if (phi0 == phi1) return {};
-      profile = arc(0.0, 0.0, r, phi0, phi1);
+      profile = arc(0.0, 0.0, r, phi0, phi1, max_arc);
       break;
     }
     case QuadricKind::Cylinder: {
@@ -180,11 +181,11 @@ std::vector<glm::vec3> quadric_patches(QuadricKind kind, const std::vector<doubl
       const double major = args[0], minor = args[1];
       const double phi0 = args[2], phi1 = phi0 + std::clamp(args[3] - args[2], -360.0, 360.0);
       if (minor == 0.0 || phi0 == phi1) return {};
-      profile = arc(major, 0.0, minor, phi0, phi1);
+      profile = arc(major, 0.0, minor, phi0, phi1, max_arc);
       break;
     }
   }
-  return sweep(profile, theta);
+  return sweep(profile, theta, max_arc);
 }
 
-}  // namespace mp::rib
+}  // namespace mp

@@ -1,6 +1,7 @@
 // RenderMan's quadrics (RI spec 3.2, section 5.4: Sphere, Cylinder, Cone,
 // Disk, Paraboloid, Hyperboloid, Torus) as bicubic Bezier nets, which the
-// pipeline bounds, splits and dices as any Patch.
+// pipeline bounds, splits and dices as any Patch: the RIB reader's quadrics,
+// and the unit sphere and disc that point clouds instance (points.h).
 //
 // Every quadric is a surface of revolution about z: a profile curve (a
 // circular arc, a line or a parabola, in the xz-plane, or a line in space
@@ -32,7 +33,7 @@
 
 #include <glm/glm.hpp>
 
-namespace mp::rib {
+namespace mp {
 
 enum class QuadricKind { Sphere, Cylinder, Cone, Disk, Paraboloid, Hyperboloid, Torus };
 
@@ -44,9 +45,12 @@ bool quadric_kind(const std::string& request, QuadricKind* kind);
 size_t quadric_arg_count(QuadricKind kind);
 
 // The quadric's Bezier nets, 16 points each (u along each row, as Patch),
-// from its request's numbers in RI order. Empty where the surface has no
-// area (a zero radius, height or sweep); throws mp::Error with a reason for
-// numbers that describe no surface (a Paraboloid whose z range crosses 0).
-std::vector<glm::vec3> quadric_patches(QuadricKind kind, const std::vector<double>& args);
+// from its request's numbers in RI order, arcs cut into pieces of at most
+// `max_arc` degrees (90: a radial error of 2.7e-4 of the radius per arc).
+// Empty where the surface has no area (a zero radius, height or sweep);
+// throws mp::Error with a reason for numbers that describe no surface (a
+// Paraboloid whose z range crosses 0).
+std::vector<glm::vec3> quadric_patches(QuadricKind kind, const std::vector<double>& args,
+                                       double max_arc = kMaxArcDegrees);
 
-}  // namespace mp::rib
+}  // namespace mp

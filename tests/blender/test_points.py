@@ -1,0 +1,106 @@
+"""Point clouds in Blender (run by blender -b, or a Python with the bpy
+module): Geometry Nodes' Distribute Points on Faces with a random radius per
+point and a material, above a floor under a sun that casts shadows,
+exported as one shared sphere prototype and one instance per point, and
+rendered against Cycles' direct light (PSNR >= 32 dB over pixels both
+cover, silhouettes IoU >= 0.98); hidden from the camera, the points still
+cast their shadows, as in Cycles (the floor and shadows alone against
+Cycles >= 30 dB, test_shadows.py's bar for hard shadows). Exits non-zero on
+failure."""
+
+import math
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import bpy  # noqa: E402
+
+import render_utils as ru  # noqa: E402
+
+RESULTS = []
+W, H = 320, 240
+CYCLES_SAMPLES = 128
+
+
+def check(name, condition, detail=""):
+    RESULTS.append(bool(condition))
+    print(f"{'ok  ' if condition else 'FAIL'} {name}" + (f": {detail}" if detail else ""))
+
+
+def points_scene():
+    """Returns the scene and the emitter, whose modifier outputs only points."""
+    scene = ru.reset_scene()
+    ru.add_camera(scene, (4.5, -5.5, 4.5), (0.0, 0.0, 0.0))
+    ru.add_sun(scene, (math.radians(30), 0.0, math.radians(40)))
+    bpy.ops.mesh.primitive_plane_add(size=10.0, location=(0.0, 0.0, -0.5))
+    bpy.context.object.name = "Floor"
+    bpy.context.object.data.materials.append(ru.diffuse_material("Floor", (0.6, 0.6, 0.6)))
+    bpy.ops.mesh.primitive_plane_add(size=4.0, location=(0.0, 0.0, 0.4))
+    emitter = bpy.context.object
+    emitter.name = "Emitter"
+    mod = emitter.modifiers.new("Points", "NODES")
+    tree = bpy.data.node_groups.new("Points", "GeometryNodeTree")
+    mod.node_group = tree
+    nodes, links = tree.nodes, tree.links
+    if hasattr(tree, "interface"):  # Blender 4.0 and later
+        tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+        tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    else:
+        tree.inputs.new("NodeSocketGeometry", "Geometry")
+        tree.outputs.new("NodeSocketGeometry", "Geometry")
+    group_in, group_out = nodes.new("NodeGroupInput"), nodes.new("NodeGroupOutput")
+    distribute = nodes.new("GeometryNodeDistributePointsOnFaces")
+    distribute.inputs["Density"].default_value = 4.0
+    distribute.inputs["Seed"].default_value = 7
+    radius = nodes.new("GeometryNodeSetPointRadius")
+    size = nodes.new("FunctionNodeRandomValue")
+    size.data_type = "FLOAT"
+    size.inputs[2].default_value, size.inputs[3].default_value = 0.08, 0.22  # Min, Max (float)
+    material = nodes.new("GeometryNodeSetMaterial")
+    material.inputs["Material"].default_value = ru.diffuse_material("Beads", (0.8, 0.35, 0.1))
+    links.new(group_in.outputs[0], distribute.inputs["Mesh"])
+    links.new(distribute.outputs["Points"], radius.inputs["Points"])
+    links.new(size.outputs[1], radius.inputs["Radius"])
+    links.new(radius.outputs[0], material.inputs["Geometry"])
+    links.new(material.outputs[0], group_out.inputs[0])
+    return scene, emitter
+
+
+def against_cycles(name, scene, threshold=32.0):
+    ru.setup_cycles(scene, samples=CYCLES_SAMPLES, shadows=True)
+    ref = ru.render_passes(scene, "CYCLES", W, H)["rgba"]
+    got = ru.render_passes(scene, "MICROPOLY", W, H, samples=16)["rgba"]
+    both = (ref[..., 3] > 0.999) & (got[..., 3] > 0.999)
+    iou = ru.iou(ref[..., 3], got[..., 3])
+    a, b = ref[both][:, :3], got[both][:, :3]
+    p = ru.psnr(a, b, peak=float(a.max())) if both.sum() else 0.0
+    check(f"{name}: against Cycles' direct light", p >= threshold and iou >= 0.98 and both.sum() > 8000,
+          f"{p:.1f} dB, IoU {iou:.4f}, {int(both.sum())} pixels")
+    return got
+
+
+def main():
+    scene, emitter = points_scene()
+    from micropoly import export
+
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    clouds = [inst.object.data for inst in depsgraph.object_instances if inst.object.type == "POINTCLOUD"]
+    count = sum(len(pc.points) for pc in clouds)
+    exported = export.export_scene(depsgraph)
+    got = (exported.scene.prototype_count, exported.scene.instance_count, exported.scene.mesh_count)
+    check("points: one sphere prototype, an instance per point", len(clouds) == 1 and count > 30 and
+          got == (1, count, 1), f"{count} points, exported {got}")
+    seen = against_cycles("points", scene)
+    # Hidden from the camera: gone from the image, their shadows stay.
+    emitter.visible_camera = False
+    # The floor and the points' shadows alone: test_shadows.py's bar for hard shadows.
+    hidden = against_cycles("points hidden from the camera", scene, threshold=30.0)
+    floor = (seen[..., 3] > 0.999) & (hidden[..., 3] > 0.999)
+    shadowed = hidden[..., :3].sum(axis=-1)[floor] < 0.5 * hidden[..., :3].sum(axis=-1)[floor].max()
+    check("points hidden from the camera: their shadows stay", 800 < int(shadowed.sum()),
+          f"{int(shadowed.sum())} floor pixels in shadow")
+    return 0 if all(RESULTS) else 1
+
+
+ru.run_test(main)
