@@ -7,7 +7,11 @@
 #include <string>
 
 #include "renderer_fixture.h"
+#include <sstream>
+
 #include "rib/rib_reader.h"
+#include "rib/rib_writer.h"
+#include "scene/quadrics.h"
 #include "scene/points.h"
 #include "scene_fixtures.h"
 
@@ -110,6 +114,47 @@ TEST_F(PointsTest, RibPointsAreDiscsFacingTheEye) {
   RibResult constant = read_rib_string(head + "Points \"P\" [" + P + "] \"constantwidth\" [0.2]\nWorldEnd\n", "p.rib");
   for (const Instance& inst : constant.scene.instances)
     EXPECT_NEAR(glm::length(glm::vec3(inst.object_to_world[0])), 0.1f, 1e-6f);
+}
+
+TEST(Points, UnitSphereIsWithinItsStatedError) {
+  // Quarter-turn arcs: 2.7e-4 of the radius per arc, a sphere two arcs deep.
+  const std::vector<glm::vec3> cps = quadric_patches(QuadricKind::Sphere, {1.0, -1.0, 1.0, 360.0}, kPointArcDegrees);
+  ASSERT_EQ(cps.size(), 8u * 16u);
+  double worst = 0.0;
+  for (size_t n = 0; n < 8; ++n)
+    for (int a = 0; a <= 16; ++a)
+      for (int b = 0; b <= 16; ++b) {
+        // De Casteljau along u, then v.
+        glm::dvec3 rows[4];
+        const double u = a / 16.0, v = b / 16.0;
+        auto cubic = [](glm::dvec3 p0, glm::dvec3 p1, glm::dvec3 p2, glm::dvec3 p3, double t) {
+          const double s = 1.0 - t;
+          return s * s * s * p0 + 3.0 * s * s * t * p1 + 3.0 * s * t * t * p2 + t * t * t * p3;
+        };
+        for (size_t j = 0; j < 4; ++j) {
+          const glm::vec3* p = &cps[16 * n + 4 * j];
+          rows[j] = cubic(glm::dvec3(p[0]), glm::dvec3(p[1]), glm::dvec3(p[2]), glm::dvec3(p[3]), u);
+        }
+        worst = std::max(worst, std::fabs(glm::length(cubic(rows[0], rows[1], rows[2], rows[3], v)) - 1.0));
+      }
+  EXPECT_LT(worst, 5.4e-4);
+  EXPECT_GT(worst, 1e-5);  // quarter-turn arcs are not exact: the bound is what they reach
+}
+
+TEST(Points, RibPointsRoundTrip) {
+  const std::string rib =
+      "WorldBegin\nPoints \"P\" [0 0 4  1 0 5  -1 1 6] \"width\" [0.2 0.3 0.4]\nWorldEnd\n";
+  const RibResult first = read_rib_string(rib, "p.rib");
+  std::ostringstream written;
+  write_rib(first.scene, written);
+  const RibResult second = read_rib_string(written.str(), "written.rib");
+  ASSERT_EQ(second.scene.instances.size(), 3u);
+  ASSERT_EQ(second.scene.prototypes.size(), 1u);
+  for (size_t i = 0; i < 3; ++i)
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r)
+        EXPECT_NEAR(second.scene.instances[i].object_to_world[c][r], first.scene.instances[i].object_to_world[c][r],
+                    1e-5f);
 }
 
 }  // namespace
