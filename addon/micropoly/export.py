@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import (_native, camera_view, export_attributes, export_instances, export_lights, export_materials,
-               export_mesh, export_motion, export_points)
+               export_curves, export_mesh, export_motion, export_points)
 
 
 class ExportError(Exception):
@@ -280,6 +280,13 @@ def export_scene(depsgraph, view=None, meshes=None, motion=None):
                 raise ExportError(
                     f"the computer ran out of memory exporting object '{obj.name}' after {out.objects} mesh "
                     "objects: render fewer or lighter objects, or lower their subdivision levels") from None
+        elif obj.type == "CURVES":
+            try:
+                if export_curves.export_curves(native_scene, materials, inst, _matrix(inst.matrix_world), out.warnings,
+                                               motion):
+                    out.objects += 1
+            except RuntimeError as e:
+                raise ExportError(f"curves '{obj.name}': {e}") from e
         elif obj.type == "POINTCLOUD":
             try:
                 if export_points.export_point_cloud(native_scene, materials, inst, _matrix(inst.matrix_world),

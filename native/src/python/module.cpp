@@ -12,6 +12,7 @@
 #include "micropoly/renderer.h"
 #include "micropoly/settings_util.h"
 #include "rib/rib_reader.h"
+#include "scene/curves.h"
 #include "scene/points.h"
 
 namespace py = pybind11;
@@ -600,6 +601,41 @@ PYBIND11_MODULE(_native, m) {
           "optionally: Object Info's random (instances,), object_color (instances, 4), pass_index (instances,), "
           "motion_object_to_world (instances, steps, 4, 4) and the RGBA Attribute nodes of type Object or "
           "Instancer read in each slot: attributes (instances, slots, 4).")
+      .def(
+          "add_curves",
+          [](Scene& s, const std::string& name, const Array<float>& points, const Array<float>& radii,
+             const Array<int>& offsets, const Array<float>& object_to_world, int material, bool visible_camera,
+             bool cast_shadows, std::vector<float> object_color, float pass_index, float random,
+             const Array<float>& attributes) {
+            CurveSet curves;
+            curves.name = name;
+            curves.points = to_points(points, "points");
+            if (radii.ndim() != 1) throw Error("curves '" + name + "': radii must be a (points,) array");
+            curves.radii.assign(radii.data(), radii.data() + radii.size());
+            if (offsets.ndim() != 1) throw Error("curves '" + name + "': offsets must be a (curves + 1,) array");
+            curves.offsets.assign(offsets.data(), offsets.data() + offsets.size());
+            curves.object_to_world = to_matrix(object_to_world, "object_to_world");
+            curves.material = material;
+            curves.visible_camera = visible_camera;
+            curves.cast_shadows = cast_shadows;
+            if (object_color.size() != 4) throw Error("curves '" + name + "': object_color must have 4 values (RGBA)");
+            curves.info.color = glm::vec4(object_color[0], object_color[1], object_color[2], object_color[3]);
+            curves.info.pass_index = pass_index;
+            curves.info.random = random;
+            if (attributes.size() != 0) {
+              if (attributes.ndim() != 2 || attributes.shape(1) != 4)
+                throw Error("curves '" + name + "': attributes must be a (slots, 4) array");
+              curves.info.attributes = to_rgba(attributes.data(), size_t(attributes.shape(0)));
+            }
+            return add_curves(s, curves);
+          },
+          py::arg("name"), py::arg("points"), py::arg("radii"), py::arg("offsets"),
+          py::arg("object_to_world") = Array<float>(), py::arg("material") = 0, py::arg("visible_camera") = true,
+          py::arg("cast_shadows") = true, py::arg("object_color") = std::vector<float>{1, 1, 1, 1},
+          py::arg("pass_index") = 0.0f, py::arg("random") = 0.0f, py::arg("attributes") = Array<float>(),
+          "Adds curves (Catmull-Rom keys: points (points, 3), radii (points,), object space; curve c has the "
+          "points [offsets[c], offsets[c + 1])) as round tubes of Bezier patches (scene/curves.h). Returns how "
+          "many curves were skipped (fewer than 2 points, or a point or radius not finite, a radius below 0).")
       .def(
           "add_points",
           [](Scene& s, const std::string& name, const Array<float>& positions, const Array<float>& radii,
