@@ -189,3 +189,17 @@ def _attribute_rgba(attribute):
         attribute.data.foreach_get("value", v)
         out[:, :3] = v.astype(np.float32)[:, None]
     return out
+
+
+def object_arguments(obj, inst, materials):
+    """What a point cloud or curves object brings to add_points / add_curves:
+    its first material, ray visibility and Object Info values, as keyword
+    arguments (meshes pass the same through add_mesh)."""
+    from . import export_mesh
+
+    visible_camera, cast_shadows = export_mesh.ray_visibility(obj)
+    slots = [materials.get(slot.material) for slot in obj.material_slots] or [0]
+    return dict(material=slots[0], visible_camera=visible_camera, cast_shadows=cast_shadows,
+                object_color=list(obj.color), pass_index=float(obj.pass_index),
+                random=export_mesh.object_random(obj.name, inst.random_id if inst.is_instance else None),
+                attributes=object_values(materials.object_attributes, obj))

@@ -40,13 +40,8 @@ def export_curves(native_scene, materials, inst, matrix, warnings, motion=None):
                             "Catmull-Rom curves")
     if motion is not None:
         warnings.append(f"curves '{obj.name}': curves render at the shutter's centre, without motion blur")
-    slots = [materials.get(slot.material) for slot in obj.material_slots] or [0]
-    skipped = native_scene.add_curves(
-        obj.name, positions.reshape(-1, 3), radii, offsets, object_to_world=matrix, material=slots[0],
-        visible_camera=visible_camera, cast_shadows=cast_shadows, object_color=list(obj.color),
-        pass_index=float(obj.pass_index),
-        random=export_mesh.object_random(obj.name, inst.random_id if inst.is_instance else None),
-        attributes=export_attributes.object_values(materials.object_attributes, obj))
+    skipped = native_scene.add_curves(obj.name, positions.reshape(-1, 3), radii, offsets, object_to_world=matrix,
+                                      **export_attributes.object_arguments(obj, inst, materials))
     if skipped:
         warnings.append(f"curves '{obj.name}': {skipped} curves with fewer than 2 points, or a point or radius that "
                         "is not finite, are skipped")

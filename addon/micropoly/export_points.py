@@ -39,14 +39,10 @@ def export_point_cloud(native_scene, materials, inst, matrix, warnings, motion=N
         return False
     radii = _attribute(pointcloud, "radius", 1, "value")
     radii = np.full(count, 0.01, dtype=np.float32) if radii is None else radii.reshape(-1)
-    slots = [materials.get(slot.material) for slot in obj.material_slots] or [0]
     if motion is not None:
         warnings.append(f"point cloud '{obj.name}': points render at the shutter's centre, without motion blur")
-    skipped = native_scene.add_points(
-        obj.name, positions, radii, object_to_world=matrix, material=slots[0], visible_camera=visible_camera,
-        cast_shadows=cast_shadows, object_color=list(obj.color), pass_index=float(obj.pass_index),
-        random=export_mesh.object_random(obj.name, inst.random_id if inst.is_instance else None),
-        attributes=export_attributes.object_values(materials.object_attributes, obj))
+    skipped = native_scene.add_points(obj.name, positions, radii, object_to_world=matrix,
+                                      **export_attributes.object_arguments(obj, inst, materials))
     if skipped:
         warnings.append(f"point cloud '{obj.name}': {skipped} points with a position or radius that is not finite "
                         "and positive are skipped")

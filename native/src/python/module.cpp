@@ -43,6 +43,20 @@ std::vector<glm::vec4> to_rgba(const float* v, size_t count) {
   return out;
 }
 
+// Object Info's values and the Attribute nodes' RGBA per slot of one object
+// (`what` names it in messages): object_color RGBA, attributes a multiple of 4.
+ObjectInfo to_object_info(const std::string& what, const std::vector<float>& object_color, float pass_index,
+                          float random, const Array<float>& attributes) {
+  if (object_color.size() != 4) throw Error(what + ": object_color must have 4 values (RGBA)");
+  if (attributes.size() % 4 != 0) throw Error(what + ": attributes must be RGBA per slot");
+  ObjectInfo info;
+  info.color = glm::vec4(object_color[0], object_color[1], object_color[2], object_color[3]);
+  info.pass_index = pass_index;
+  info.random = random;
+  info.attributes = to_rgba(attributes.data(), size_t(attributes.size()) / 4);
+  return info;
+}
+
 template <typename T>
 std::vector<T> to_vector(const Array<T>& a) {
   return std::vector<T>(a.data(), a.data() + a.size());
@@ -425,12 +439,7 @@ PYBIND11_MODULE(_native, m) {
              bool visible_camera, bool cast_shadows, std::vector<float> object_color, float pass_index, float random,
              const Array<float>& attributes) {
             Mesh mesh;
-            if (object_color.size() != 4) throw Error("mesh '" + name + "': object_color must have 4 values (RGBA)");
-            mesh.info.color = glm::vec4(object_color[0], object_color[1], object_color[2], object_color[3]);
-            mesh.info.pass_index = pass_index;
-            mesh.info.random = random;
-            if (attributes.size() % 4 != 0) throw Error("mesh '" + name + "': attributes must be RGBA per slot");
-            mesh.info.attributes = to_rgba(attributes.data(), size_t(attributes.size()) / 4);
+            mesh.info = to_object_info("mesh '" + name + "'", object_color, pass_index, random, attributes);
             mesh.visible_camera = visible_camera;
             mesh.cast_shadows = cast_shadows;
             mesh.corner_normals = to_points(corner_normals, "corner_normals");
@@ -618,15 +627,7 @@ PYBIND11_MODULE(_native, m) {
             curves.material = material;
             curves.visible_camera = visible_camera;
             curves.cast_shadows = cast_shadows;
-            if (object_color.size() != 4) throw Error("curves '" + name + "': object_color must have 4 values (RGBA)");
-            curves.info.color = glm::vec4(object_color[0], object_color[1], object_color[2], object_color[3]);
-            curves.info.pass_index = pass_index;
-            curves.info.random = random;
-            if (attributes.size() != 0) {
-              if (attributes.ndim() != 2 || attributes.shape(1) != 4)
-                throw Error("curves '" + name + "': attributes must be a (slots, 4) array");
-              curves.info.attributes = to_rgba(attributes.data(), size_t(attributes.shape(0)));
-            }
+            curves.info = to_object_info("curves '" + name + "'", object_color, pass_index, random, attributes);
             return add_curves(s, curves);
           },
           py::arg("name"), py::arg("points"), py::arg("radii"), py::arg("offsets"),
@@ -650,16 +651,7 @@ PYBIND11_MODULE(_native, m) {
             cloud.material = material;
             cloud.visible_camera = visible_camera;
             cloud.cast_shadows = cast_shadows;
-            if (object_color.size() != 4)
-              throw Error("point cloud '" + name + "': object_color must have 4 values (RGBA)");
-            cloud.info.color = glm::vec4(object_color[0], object_color[1], object_color[2], object_color[3]);
-            cloud.info.pass_index = pass_index;
-            cloud.info.random = random;
-            if (attributes.size() != 0) {
-              if (attributes.ndim() != 2 || attributes.shape(1) != 4)
-                throw Error("point cloud '" + name + "': attributes must be a (slots, 4) array");
-              cloud.info.attributes = to_rgba(attributes.data(), size_t(attributes.shape(0)));
-            }
+            cloud.info = to_object_info("point cloud '" + name + "'", object_color, pass_index, random, attributes);
             return add_point_cloud(s, cloud);
           },
           py::arg("name"), py::arg("positions"), py::arg("radii"), py::arg("object_to_world") = Array<float>(),
