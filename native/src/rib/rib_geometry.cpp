@@ -445,7 +445,7 @@ void Parser::req_patch_mesh(ArgReader& args) {
 
 // --- quadrics -------------------------------------------------------------------
 
-// RenderMan's quadrics become Bezier nets (rib_quadrics.h) and go on as a
+// RenderMan's quadrics become Bezier nets (scene/quadrics.h) and go on as a
 // Patch would: orientation, sides, visibility and instancing alike.
 void Parser::req_quadric(ArgReader& args) {
   QuadricKind kind{};

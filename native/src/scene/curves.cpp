@@ -1,9 +1,11 @@
 #include "scene/curves.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "micropoly/error.h"
+#include "scene/quadrics.h"
 
 namespace mp {
 namespace {
@@ -45,18 +47,13 @@ void tube(const std::vector<CurveSegment>& segs, std::vector<glm::vec3>& out) {
     normal = pl > 1e-12 ? p / pl : perpendicular(t);
     frames[j] = {normal, glm::cross(t, normal)};
   }
-  // Quarter-turn arcs on the unit circle: (cos, sin) at the span's ends and
-  // the tangent length; multiples of 90 degrees are exact.
-  const double kArc = 4.0 / 3.0 * std::tan(3.14159265358979323846 / 8.0);
-  const glm::dvec2 ends[5] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}, {1, 0}};
   for (size_t i = 0; i < n; ++i) {
     // Rows 0 and 1 take the segment's first joint's frame, rows 2 and 3 its
     // last's: the rings at the joints are exact and shared with the
     // neighbouring segments.
     const Frame* f[4] = {&frames[i], &frames[i], &frames[i + 1], &frames[i + 1]};
     for (int q = 0; q < 4; ++q) {
-      const glm::dvec2 e0 = ends[q], e1 = ends[q + 1];
-      const glm::dvec2 dirs[4] = {e0, e0 + kArc * glm::dvec2(-e0.y, e0.x), e1 - kArc * glm::dvec2(-e1.y, e1.x), e1};
+      const std::array<glm::dvec2, 4> dirs = unit_arc(90.0 * q, 90.0 * (q + 1));  // a quarter turn
       for (int row = 0; row < 4; ++row)
         for (int col = 0; col < 4; ++col) {
           const glm::dvec3 d = dirs[col].x * f[row]->n + dirs[col].y * f[row]->m;

@@ -42,15 +42,12 @@ Cubic line(const glm::dvec3& a, const glm::dvec3& b) {
 // degrees, as cubic segments; boundary points computed once for both sides.
 std::vector<Cubic> arc(double rho, double z, double r, double phi0, double phi1, double max_arc) {
   const int n = pieces(phi1 - phi0, max_arc);
-  const double k = arc_k((phi1 - phi0) / n);
   auto point = [&](const glm::dvec2& e) { return glm::dvec3(rho + r * e.x, 0.0, z + r * e.y); };
-  auto tangent = [&](const glm::dvec2& e) { return glm::dvec3(-r * e.y, 0.0, r * e.x); };
   std::vector<Cubic> out;
-  glm::dvec2 e0 = unit(phi0);
   for (int i = 0; i < n; ++i) {
-    const glm::dvec2 e1 = unit(phi0 + (phi1 - phi0) * (i + 1) / n);
-    out.push_back({point(e0), point(e0) + k * tangent(e0), point(e1) - k * tangent(e1), point(e1)});
-    e0 = e1;
+    const std::array<glm::dvec2, 4> c =
+        unit_arc(phi0 + (phi1 - phi0) * i / n, phi0 + (phi1 - phi0) * (i + 1) / n);
+    out.push_back({point(c[0]), point(c[1]), point(c[2]), point(c[3])});
   }
   return out;
 }
@@ -89,6 +86,12 @@ std::vector<glm::vec3> sweep(const std::vector<Cubic>& profile, double theta_max
 double asin_degrees(double x) { return std::asin(std::clamp(x, -1.0, 1.0)) * 180.0 / kPi; }
 
 }  // namespace
+
+std::array<glm::dvec2, 4> unit_arc(double from, double to) {
+  const double k = arc_k(to - from);
+  const glm::dvec2 e0 = unit(from), e1 = unit(to);
+  return {e0, e0 + k * glm::dvec2(-e0.y, e0.x), e1 - k * glm::dvec2(-e1.y, e1.x), e1};
+}
 
 bool quadric_kind(const std::string& request, QuadricKind* kind) {
   static const std::pair<const char*, QuadricKind> kNames[] = {

@@ -28,6 +28,7 @@
 // texture coordinates of the quadric as a whole.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,11 @@ namespace mp {
 enum class QuadricKind { Sphere, Cylinder, Cone, Disk, Paraboloid, Hyperboloid, Torus };
 
 constexpr double kMaxArcDegrees = 45.0;
+
+// The cubic Bezier arc on the unit circle from `from` to `to` degrees (at
+// most 90 apart): its 4 control points, the ends exact at multiples of 90
+// degrees and the same for angles a whole turn apart.
+std::array<glm::dvec2, 4> unit_arc(double from, double to);
 
 // The request name's kind; false for other names.
 bool quadric_kind(const std::string& request, QuadricKind* kind);
