@@ -141,6 +141,23 @@ TEST(Points, UnitSphereIsWithinItsStatedError) {
   EXPECT_GT(worst, 1e-5);  // quarter-turn arcs are not exact: the bound is what they reach
 }
 
+TEST(Points, RibPointsWithoutPositionsOrWithWrongWidthsAreErrors) {
+  auto message = [](const std::string& body) {
+    try {
+      read_rib_string("WorldBegin\n" + body + "\nWorldEnd\n", "p.rib");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message("Points \"width\" [1]").find("p.rib:2: Points: missing \"P\""), std::string::npos);
+  EXPECT_NE(message("Points \"P\" [0 0 1  1 0 1] \"width\" [0.1]").find("\"width\" has 1 values for 2 points"),
+            std::string::npos);
+  const RibResult skipped = read_rib_string("WorldBegin\nPoints \"P\" [0 0 1  1 0 1] \"width\" [0.1 -1]\nWorldEnd\n", "p.rib");
+  EXPECT_EQ(skipped.scene.instances.size(), 1u);
+  EXPECT_EQ(skipped.warnings.size(), 1u);
+}
+
 TEST(Points, RibPointsRoundTrip) {
   const std::string rib =
       "WorldBegin\nPoints \"P\" [0 0 4  1 0 5  -1 1 6] \"width\" [0.2 0.3 0.4]\nWorldEnd\n";
