@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import (_native, camera_view, export_attributes, export_instances, export_lights, export_materials,
-               export_curves, export_mesh, export_motion, export_points)
+               export_curves, export_mesh, export_motion, export_particle_hair, export_points)
 
 
 class ExportError(Exception):
@@ -257,6 +257,14 @@ def export_scene(depsgraph, view=None, meshes=None, motion=None):
         motion, export_attributes.InstanceAttributes(materials.object_attributes, out.warnings))
     for inst in depsgraph.object_instances:
         obj = inst.object
+        if obj.type == "MESH" and not inst.is_instance and len(obj.particle_systems) and \
+                getattr(inst, "show_particles", True):
+            try:
+                out.objects += export_particle_hair.export_particle_hair(
+                    native_scene, materials, inst, _matrix(inst.matrix_world), out.warnings,
+                    depsgraph.mode == "RENDER", motion)
+            except RuntimeError as e:
+                raise ExportError(f"particle hair of '{obj.name}': {e}") from e
         # An instancer whose own geometry is hidden (a particle emitter with
         # Show Emitter off for renders; Cycles reads the same flag).
         if obj.type == "MESH" and not getattr(inst, "show_self", True):

@@ -103,6 +103,7 @@ class NodeCompiler:
         self.neighbours_of_neighbours = False  # a filtered image inside a Bump's height
         self.heights = 0           # height functions (Bump) being compiled, innermost last
         self.uses_thin_film = False
+        self.uses_hair = False
         self.uses_subsurface_walk = False
         self.displacement_world = False
         self.displacement_bounds = []
@@ -407,6 +408,8 @@ class NodeCompiler:
         if self.uses_thin_film:
             # Ahead of the kernel headers (program_cache.cpp hoists it).
             includes = "#define MP_NODE_USES_THIN_FILM 1\n" + includes
+        if self.uses_hair:
+            includes = "#define MP_NODE_USES_HAIR 1\n" + includes
         if self.uses_subsurface_walk:
             includes = "#define MP_NODE_USES_SUBSURFACE_WALK 1\n" + includes
         source = includes + "".join(self.helpers) + disp_src + surf_src
@@ -642,6 +645,16 @@ class NodeCompiler:
             glossy = 1 if node.component == "GLOSSY" else 0
             add(f"  mp_add_toon(s, {weight} * {color}, {slot}, {self._f(node, 'Size')}, {self._f(node, 'Smooth')}, "
                 f"{glossy});")
+        elif t == "BSDF_HAIR_PRINCIPLED":
+            self.emit_principled_hair(node, weight, slot)
+        elif t == "BSDF_HAIR":
+            # Cycles' Hair BSDF: one component, along the curve (or a
+            # Tangent input), with the node's offset.
+            self.uses_hair = True
+            transmission = 1 if getattr(node, "component", "Reflection") == "Transmission" else 0
+            tangent = self._tangent(node) if node.inputs["Tangent"].is_linked else "g->fibre"
+            add(f"  mp_add_hair(s, {weight} * {color}, {slot}, {transmission}, {self._f(node, 'Offset')}, "
+                f"{self._f(node, 'RoughnessU')}, {self._f(node, 'RoughnessV')}, {tangent}, g->fibre_radius);")
         elif t == "BSDF_METALLIC":
             if getattr(node, "distribution", "GGX") == "BECKMANN":
                 self.warn(node, "the Beckmann distribution is shaded as GGX")
@@ -664,10 +677,42 @@ class NodeCompiler:
                 f"MP_FRESNEL_F82, {f0}, {tint}, {1 if getattr(node, 'distribution', 'GGX') == 'MULTI_GGX' else 0}, "
                 f"{film});")
         else:
-            # Anything else (hair, volumes, ray portals, shaders of newer
+            # Anything else (volumes, ray portals, shaders of newer
             # Blender): a diffuse of its Color input, and a warning.
             self.warn(node, "is not supported; it is shaded as a Diffuse BSDF of its color")
             add(f"  mp_add_diffuse(s, {weight} * {color}, {slot}, 0.0f);")
+
+    def emit_principled_hair(self, node, weight, slot):
+        """Principled Hair BSDF as Chiang et al.'s model (kernels/closures/mp_hair.h),
+        in each of its colour parametrisations. The per-strand Random is 0
+        unless linked (Curves Info's Random is not read yet); 4.x's Huang
+        model is shaded as Chiang's with a warning."""
+        self.uses_hair = True
+        f, c = self._f, self._c
+        if getattr(node, "model", "CHIANG") == "HUANG":
+            self.warn(node, "the Huang model is shaded as Chiang's (its Reflection, Transmission, Secondary "
+                            "Reflection and Aspect Ratio are not read)")
+        random = f(node, "Random") if node.inputs["Random"].is_linked else "0.0f"
+        if not node.inputs["Random"].is_linked and not (
+                self._unlinked_zero(node, "Random Roughness") and self._unlinked_zero(node, "Random Color")):
+            self.warn(node, "Random Roughness and Random Color need the strand's random value, which is not "
+                            "exported: strands are shaded with random 0")
+        var = f"hr{self.fn.counter}"
+        self.fn.counter += 1
+        add = self.fn.lines.append
+        add(f"  float {var}_k = 1.0f + 2.0f * ({random} - 0.5f) * {f(node, 'Random Roughness')};")
+        add(f"  float {var}_m = {f(node, 'Roughness')} * {var}_k, {var}_n = {f(node, 'Radial Roughness')} * {var}_k;")
+        mode = getattr(node, "parametrization", "COLOR")
+        if mode == "ABSORPTION":
+            sigma = c(node, "Absorption Coefficient")
+        elif mode == "MELANIN":
+            melanin = (f"{f(node, 'Melanin')} * (1.0f + 2.0f * ({random} - 0.5f) * "
+                       f"mp_nl_clamp01({f(node, 'Random Color')}))")
+            sigma = f"mp_hair_sigma_from_melanin({melanin}, {f(node, 'Melanin Redness')}, {c(node, 'Tint')}, {var}_n)"
+        else:
+            sigma = f"mp_hair_sigma_from_colour({c(node, 'Color')}, {var}_n)"
+        add(f"  mp_add_principled_hair(s, {weight}, {slot}, {sigma}, {var}_m, {var}_n, {f(node, 'Coat')}, "
+            f"{f(node, 'IOR')}, {f(node, 'Offset')}, g->fibre, g->fibre_radius);")
 
     def _note_thin_film(self, node):
         """A Thin Film Thickness that is linked or above 0 makes the program

@@ -49,6 +49,9 @@
 #define MP_CLOSURE_SUBSURFACE 8   /* Lambert, of the random walk's albedo from 4.x on (mp_subsurface.h) */
 #define MP_CLOSURE_CLEARCOAT 9    /* Principled 3.x's clearcoat: GTR1, IOR 1.5; a = b = alpha */
 #define MP_CLOSURE_PHONG 10       /* RenderMan's plastic specular, (n.h)^(1/a) per unit irradiance */
+#define MP_CLOSURE_HAIR 11        /* Principled Hair (Chiang); fields in mp_hair.h */
+#define MP_CLOSURE_HAIR_REFLECTION 12   /* Hair BSDF's components (mp_hair.h) */
+#define MP_CLOSURE_HAIR_TRANSMISSION 13
 
 /* How a glossy closure's Fresnel term is computed. */
 #define MP_FRESNEL_NONE 0       /* weight as it is (Glossy BSDF) */

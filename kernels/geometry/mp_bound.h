@@ -377,6 +377,13 @@ MP_INLINE uint mp_edge_rate_code(float len, FrameParams f) {
   return code;
 }
 
+/* Whether edge e of a sub-patch runs along the patch's u (splits along v
+ * rotate a sub-patch's corners, so edge 0 is not always a u edge). */
+MP_INLINE int mp_edge_runs_along_u(const SubPatch* sp, int e) {
+  float2 d = mp_corner(sp, e + 1) - mp_corner(sp, e);
+  return fabs(d.x) > fabs(d.y);
+}
+
 /* Screen length through the middle of the sub-patch, from the middle of edge
  * 3 to the middle of edge 1 (dir 0) or of edge 0 to edge 2 (dir 1): the
  * interior's own size, which may exceed its edges' (a bulge, or a patch with
@@ -646,6 +653,10 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
     return MP_CULL_OCCLUDED;
 
   /* Rate every edge that has none yet; score = length in target edges. */
+  int round = (flags & MP_PATCH_ROUND_U) != 0;
+  uint round_code = mp_edge_rate_code(0.0f, f);
+  while (round && MP_CODE_RATE(round_code) < MP_ROUND_MIN_RATE && MP_CODE_RATE(round_code) < (uint)f.max_grid)
+    ++round_code;
   uint codes[4];
   float score[4];
   int any_long = 0;
@@ -656,6 +667,7 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
       len = mp_edge_screen_length(points, patch_info, edges, curves, sp->patch, mp_corner(sp, e), mp_corner(sp, e + 1), f,
                                   &place);
       code = mp_edge_rate_code(len, f);
+      if (round && code && mp_edge_runs_along_u(sp, e)) code = max(code, round_code);
       sp->rates |= code << (8u * (uint)e);
     }
     codes[e] = code;
@@ -690,6 +702,15 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
   }
   uint nu, nv;
   mp_interior_rates(mid_u, mid_v, chord_u, chord_v, codes, f, &nu, &nv);
+  if (round) {
+    /* Across u as many as the u edges have, which the round minimum raised
+     * (an unrated edge at the depth limit is diced at the largest grid). */
+    int e = mp_edge_runs_along_u(sp, 0) ? 0 : 1;
+    uint mg = (uint)f.max_grid;
+    uint across = max(codes[e] ? MP_CODE_RATE(codes[e]) : mg, codes[e + 2] ? MP_CODE_RATE(codes[e + 2]) : mg);
+    if (e == 0) nu = max(nu, across);
+    else nv = max(nv, across);
+  }
   return MP_DICE | (nu << 8) | (nv << 16);
 }
 

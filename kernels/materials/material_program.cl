@@ -71,6 +71,8 @@ inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, f
   g.shadow_ray = 0;
   g.camera_ray = 1;
   g.backfacing = dot(n, v) < 0.0f;
+  g.fibre = (float3)(0.0f);
+  g.fibre_radius = 0.0f;
   g.P = (float3)(mp_row3(o->to_object, 0, p, 1.0f), mp_row3(o->to_object, 1, p, 1.0f), mp_row3(o->to_object, 2, p, 1.0f));
   g.N = mp_camera_normal_to_object(o, n);
   g.object = o;
@@ -239,6 +241,21 @@ __kernel void shade_program_grids(MP_SCENE_PARAMS __global const SubPatch* dicea
   if (grid_n[index].w > 0.5f) g.backfacing = grid_n[index].w > 1.5f;
   g.shadow_ray = alpha_only != 0;
   g.camera_ray = alpha_only == 0;
+#ifdef MP_NODE_USES_HAIR
+  {
+    /* Hair closures light a fibre along its tangent: the patch's v, which
+     * runs from root to tip on a hair tube (scene/curves.h). */
+    MpPlacement place = mp_instance_placement(instances, sp.instance);
+    float3 sp_p, dpdu, dpdv;
+    mp_surface_point(points, patch_info, patch_edges, edge_curves, sp.patch, uv.x, uv.y, &place, &sp_p, &dpdu, &dpdv);
+    float3 t = (float3)(mp_row3(o->to_object, 0, dpdv, 0.0f), mp_row3(o->to_object, 1, dpdv, 0.0f),
+                        mp_row3(o->to_object, 2, dpdv, 0.0f));
+    float lt = length(t);
+    g.fibre = lt > 0.0f && isfinite(lt) ? t / lt : (float3)(0.0f);
+    /* A tube's u is a quarter turn, a quarter of the circumference. */
+    if (patch_info[4 * (ulong)sp.patch + 2] & MP_PATCH_ROUND_U) g.fibre_radius = length(dpdu) * (2.0f / M_PI_F);
+  }
+#endif
   /* The next grid vertex along u and along v (the previous one on the
    * grid's far border): bump nodes difference towards them, and sharp lobes
    * widen by the normal's spread to them. */
@@ -326,6 +343,8 @@ float3 mp_world_radiance(float3 d, const MpProgramInputs* in, int camera_ray, fl
   g.shadow_ray = 0;
   g.camera_ray = camera_ray;
   g.backfacing = 0;
+  g.fibre = (float3)(0.0f);
+  g.fibre_radius = 0.0f;
   MpSurface s;
   mp_surface_init(&s, d);
   mp_node_surface(&g, &s);

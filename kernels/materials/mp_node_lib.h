@@ -13,6 +13,7 @@
 #include "core/mp_types.h"
 #include "closures/mp_closures.h"
 #include "closures/mp_principled.h"
+#include "closures/mp_hair.h"
 #include "textures/mp_vector_rotate.h"
 
 /* What the nodes can read at a shading point. Object-space position and
@@ -38,6 +39,9 @@ typedef struct MpNodeGlobals {
   int camera_ray;   /* shading what the camera sees (Light Path > Is Camera Ray): not for shadow
                        maps, displacement or the world's light, as in Cycles */
   int backfacing;   /* the surface faces away from the viewer (Geometry > Backfacing) */
+  float3 fibre;     /* unit direction of the patch's v (a hair tube's root to tip), object space;
+                       computed only for programs with hair closures (MP_NODE_USES_HAIR), else zero */
+  float fibre_radius; /* a hair tube's radius (camera space; 0 where unknown), likewise */
   float3 uv[MP_MAX_UV_LAYERS];
   MP_GLOBAL const DeviceObject* object; /* object <-> world (world-space nodes), or null */
   /* The object's values of the Attribute nodes of type Object or Instancer

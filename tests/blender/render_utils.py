@@ -305,12 +305,16 @@ def _load_exr(path, height, width):
     return px
 
 
-def render_passes(scene, engine, width, height, samples=16, transparent=True, cycles_data=False):
+def render_passes(scene, engine, width, height, samples=16, transparent=True, cycles_data=False, stored=True):
     """Renders and returns dict(rgba=(H,W,4), depth=(H,W), normal=(H,W,3)),
     rows top first, as float arrays. Blender 5.0 replaced the compositor's
     scene node tree; there only rgba is read back (depth and normal are None).
     Cycles' depth and normal are kept (with its stored reference) only where
-    a test asks for them with cycles_data; otherwise they are None."""
+    a test asks for them with cycles_data; otherwise they are None.
+    stored=False renders Cycles now, neither reading nor storing a reference:
+    for scenes whose geometry Blender makes anew in each session (particle
+    hair's children, which its threads place in a different order each
+    time)."""
     scene.render.engine = engine
     scene.render.resolution_x, scene.render.resolution_y = width, height
     scene.render.resolution_percentage = 100
@@ -323,7 +327,7 @@ def render_passes(scene, engine, width, height, samples=16, transparent=True, cy
     scene.display_settings.display_device = "sRGB"
     scene.view_settings.view_transform = "Standard"
     reference = None
-    if engine == "CYCLES":
+    if engine == "CYCLES" and stored:
         # Cycles' passes are rendered once per scene and Blender version
         # and kept with the tests (cycles_references.py).
         reference = cycles_references.Reference(scene, width, height, transparent)
@@ -331,6 +335,8 @@ def render_passes(scene, engine, width, height, samples=16, transparent=True, cy
         if stored is not None:
             return stored
     result = _render_passes(scene, engine, width, height)
+    if engine == "CYCLES" and not stored and not cycles_data:
+        result["depth"] = result["normal"] = None
     if reference is not None:
         if not cycles_data:
             result["depth"] = result["normal"] = None

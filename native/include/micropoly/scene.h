@@ -86,6 +86,9 @@ struct BezierPatches {
   bool visible_camera = true;  // as Mesh
   bool cast_shadows = true;
   ObjectInfo info;
+  // u runs around a round section (hair tubes): the camera dices at least a
+  // few micropolygons across u, whatever the size on screen (MP_PATCH_ROUND_U).
+  bool round_u = false;
 };
 
 // Instancing (RenderMan's ObjectBegin/ObjectInstance; Blender's instances):

@@ -109,6 +109,7 @@ const std::unordered_map<std::string, Parser::Handler>& Parser::handlers() {
       {"Hyperboloid", &Parser::req_quadric},
       {"Torus", &Parser::req_quadric},
       {"Points", &Parser::req_points},
+      {"Curves", &Parser::req_curves},
       {"Basis", &Parser::req_basis},
       {"ObjectBegin", &Parser::req_object_begin},
       {"ObjectEnd", &Parser::req_object_end},

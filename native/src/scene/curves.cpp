@@ -22,9 +22,53 @@ struct Frame {
   glm::dvec3 n, m;  // the section's axes: n, and m = t x n
 };
 
+// The most a tube piece's centre line may turn (the angles between its
+// control polygon's legs, a bound on the turning), and the most halvings
+// that keep to it.
+constexpr double kMaxTurnRadians = 0.5236;  // 30 degrees
+constexpr int kMaxHalvings = 4;
+
+double polygon_turn(const CurveSegment& s) {
+  double turn = 0.0;
+  for (int k = 0; k + 2 < 4; ++k) {
+    const glm::dvec3 a = s.p[k + 1] - s.p[k], b = s.p[k + 2] - s.p[k + 1];
+    const double la = glm::length(a), lb = glm::length(b);
+    if (la > 0.0 && lb > 0.0) turn += std::acos(std::clamp(glm::dot(a, b) / (la * lb), -1.0, 1.0));
+  }
+  return turn;
+}
+
+// The segment's halves at t = 1/2 (de Casteljau), centre line and radius.
+void halve(const CurveSegment& s, CurveSegment& a, CurveSegment& b) {
+  auto split = [](const auto* p, auto* lo, auto* hi) {
+    const auto p01 = 0.5 * (p[0] + p[1]), p12 = 0.5 * (p[1] + p[2]), p23 = 0.5 * (p[2] + p[3]);
+    const auto q0 = 0.5 * (p01 + p12), q1 = 0.5 * (p12 + p23), m = 0.5 * (q0 + q1);
+    lo[0] = p[0], lo[1] = p01, lo[2] = q0, lo[3] = m;
+    hi[0] = m, hi[1] = q1, hi[2] = p23, hi[3] = p[3];
+  };
+  split(s.p, a.p, b.p);
+  split(s.r, a.r, b.r);
+}
+
+// Appends `s`, halved until each piece turns by at most kMaxTurnRadians.
+void refine(const CurveSegment& s, int depth, std::vector<CurveSegment>& out) {
+  if (depth >= kMaxHalvings || polygon_turn(s) <= kMaxTurnRadians) {
+    out.push_back(s);
+    return;
+  }
+  CurveSegment a, b;
+  halve(s, a, b);
+  refine(a, depth + 1, out);
+  refine(b, depth + 1, out);
+}
+
 // Adds the tube around one curve's Bezier segments (centre line and radius,
-// each segment starting where the last ended) to `out`.
-void tube(const std::vector<CurveSegment>& segs, std::vector<glm::vec3>& out) {
+// each segment starting where the last ended) to `out`. Segments that turn
+// sharply are halved first: a piece's rows follow its frame's rotation only
+// to first order.
+void tube(const std::vector<CurveSegment>& input, std::vector<glm::vec3>& out) {
+  std::vector<CurveSegment> segs;
+  for (const CurveSegment& s : input) refine(s, 0, segs);
   const size_t n = segs.size();
   // A frame at each joint (n + 1), perpendicular to the curve's direction
   // there, carried along by projecting the last normal onto each new section
@@ -47,20 +91,49 @@ void tube(const std::vector<CurveSegment>& segs, std::vector<glm::vec3>& out) {
     normal = pl > 1e-12 ? p / pl : perpendicular(t);
     frames[j] = {normal, glm::cross(t, normal)};
   }
+  // The section's offset O(v) = r(v) d(v) turns with the frame as the
+  // centre line bends; its Bezier rows are a cubic Hermite of the offsets
+  // and their derivatives at the two joints, O' = r' d + r (w x d), where
+  // w = C' x C'' / |C'|^2 is the rotation-minimising frame's angular
+  // velocity. The rings at the joints are exact and shared with the
+  // neighbouring segments; between them the tube keeps its radius to about
+  // 1% for a segment that turns 90 degrees (rows that only blended the two
+  // rings would pinch it to cos(45) there).
+  auto spin = [](const glm::dvec3& d1, const glm::dvec3& d2) {
+    const double l2 = glm::dot(d1, d1);
+    return l2 > 0.0 ? glm::cross(d1, d2) / l2 : glm::dvec3(0.0);
+  };
   for (size_t i = 0; i < n; ++i) {
-    // Rows 0 and 1 take the segment's first joint's frame, rows 2 and 3 its
-    // last's: the rings at the joints are exact and shared with the
-    // neighbouring segments.
-    const Frame* f[4] = {&frames[i], &frames[i], &frames[i + 1], &frames[i + 1]};
+    const CurveSegment& sg = segs[i];
+    const glm::dvec3 w0 = spin(3.0 * (sg.p[1] - sg.p[0]), 6.0 * (sg.p[2] - 2.0 * sg.p[1] + sg.p[0]));
+    const glm::dvec3 w1 = spin(3.0 * (sg.p[3] - sg.p[2]), 6.0 * (sg.p[3] - 2.0 * sg.p[2] + sg.p[1]));
     for (int q = 0; q < 4; ++q) {
       const std::array<glm::dvec2, 4> dirs = unit_arc(90.0 * q, 90.0 * (q + 1));  // a quarter turn
       for (int row = 0; row < 4; ++row)
         for (int col = 0; col < 4; ++col) {
-          const glm::dvec3 d = dirs[col].x * f[row]->n + dirs[col].y * f[row]->m;
-          out.push_back(glm::vec3(segs[i].p[row] + segs[i].r[row] * d) + glm::vec3(0.0f));
+          const Frame& f = frames[row < 2 ? i : i + 1];
+          const glm::dvec3 d = dirs[col].x * f.n + dirs[col].y * f.m;
+          glm::dvec3 o = sg.r[row] * d;
+          if (row == 1) o += sg.r[0] / 3.0 * glm::cross(w0, d);
+          if (row == 2) o -= sg.r[3] / 3.0 * glm::cross(w1, d);
+          out.push_back(glm::vec3(sg.p[row] + o));
         }
     }
   }
+}
+
+// The patch set that holds a curve set's tubes, without patches yet.
+BezierPatches tube_set(const CurveSet& curves) {
+  BezierPatches set;
+  set.name = curves.name;
+  set.material = curves.material;
+  set.object_to_world = curves.object_to_world;
+  set.double_sided = true;
+  set.visible_camera = curves.visible_camera;
+  set.cast_shadows = curves.cast_shadows;
+  set.info = curves.info;
+  set.round_u = true;
+  return set;
 }
 
 }  // namespace
@@ -90,14 +163,7 @@ size_t add_curves(Scene& scene, const CurveSet& curves) {
     throw Error("curves '" + curves.name + "': the offsets must run from 0 to the number of points");
   for (size_t c = 0; c + 1 < off.size(); ++c)
     if (off[c + 1] < off[c]) throw Error("curves '" + curves.name + "': the offsets must not decrease");
-  BezierPatches set;
-  set.name = curves.name;
-  set.material = curves.material;
-  set.object_to_world = curves.object_to_world;
-  set.double_sided = true;
-  set.visible_camera = curves.visible_camera;
-  set.cast_shadows = curves.cast_shadows;
-  set.info = curves.info;
+  BezierPatches set = tube_set(curves);
   size_t skipped = 0;
   std::vector<glm::dvec3> k;
   std::vector<double> r;
@@ -121,6 +187,12 @@ size_t add_curves(Scene& scene, const CurveSet& curves) {
   }
   if (!set.control_points.empty()) scene.bezier_patches.push_back(std::move(set));
   return skipped;
+}
+
+void add_bezier_curves(Scene& scene, const CurveSet& meta, const std::vector<std::vector<CurveSegment>>& runs) {
+  BezierPatches set = tube_set(meta);
+  for (const std::vector<CurveSegment>& run : runs) add_tube(run, set.control_points);
+  if (!set.control_points.empty()) scene.bezier_patches.push_back(std::move(set));
 }
 
 }  // namespace mp

@@ -54,6 +54,12 @@ void catmull_rom_segments(const std::vector<glm::dvec3>& keys, const std::vector
 // as Bezier nets, kTubePatchesPerSegment per segment, appended to `out`.
 void add_tube(const std::vector<CurveSegment>& segments, std::vector<glm::vec3>& out);
 
+// Curves already in Bezier form (RIB's Curves through their basis) as one
+// BezierPatches set of tubes: each run is a chain of segments, each starting
+// where the last ended. The object's fields come from `meta` (its points,
+// radii and offsets are not read). Nothing is added for no segments.
+void add_bezier_curves(Scene& scene, const CurveSet& meta, const std::vector<std::vector<CurveSegment>>& runs);
+
 // Appends the curves' tubes as one BezierPatches set (none where no curve
 // has a segment). Curves of fewer than 2 points, or with a point or radius
 // that is not finite or a radius below 0, are skipped; returns how many

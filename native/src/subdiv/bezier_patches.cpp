@@ -18,8 +18,8 @@ void append_bezier_patches(const BezierPatches& set, const glm::mat4& to_space, 
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
       throw Error("bezier patches '" + set.name + "': a control point is not finite");
 
-  const subdiv_detail::PatchInfoCommon common =
-      subdiv_detail::make_patch_info_common(to_space, set.double_sided);
+  subdiv_detail::PatchInfoCommon common = subdiv_detail::make_patch_info_common(to_space, set.double_sided);
+  if (set.round_u) common.flags |= MP_PATCH_ROUND_U;
   out.points.reserve(out.points.size() + count * MP_PATCH_POINTS);
   out.info.reserve(out.info.size() + count);
   for (size_t patch_index = 0; patch_index < count; ++patch_index) {

@@ -27,8 +27,8 @@ std::shared_ptr<const PatchBuffer> build_shape(const PatchCache::Surface& s, int
   }
   share_patch_edges(*buffer, 0);
   // Materials and flags belong to the object, not the shape: placed later
-  // (all but whether the patch has smooth normals, which is the shape's).
-  for (glm::uvec4& info : buffer->info) info.y = 0, info.z &= MP_PATCH_SMOOTH_NORMALS;
+  // (all but MP_PATCH_SHAPE_FLAGS, which are the shape's).
+  for (glm::uvec4& info : buffer->info) info.y = 0, info.z &= MP_PATCH_SHAPE_FLAGS;
   return buffer;
 }
 

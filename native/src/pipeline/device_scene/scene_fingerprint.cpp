@@ -80,6 +80,7 @@ uint64_t patch_set_shape_key(const BezierPatches& set, int uv_layers) {
   h.value(uint32_t(2));
   h.value(uv_layers);
   h.values(set.control_points);
+  h.value(set.round_u);  // a shape flag (MP_PATCH_SHAPE_FLAGS)
   return h.result();
 }
 
@@ -109,6 +110,7 @@ void hash_mesh(Hasher& h, const Mesh& m) {
 
 void hash_patch_set(Hasher& h, const BezierPatches& b) {
   h.values(b.control_points);
+  h.value(b.round_u);
   h.value(b.material);
   h.value(b.object_to_world);
   h.value(b.double_sided);
@@ -255,6 +257,7 @@ ShadowGeometryKeys shadow_geometry_keys(const Scene& scene) {
     Hasher h;
     h.value(uint32_t(2));
     h.values(b.control_points);
+    h.value(b.round_u);
     *programs = hash_used_materials(h, scene, materials, b.material, {});
     h.value(b.object_to_world);
     h.value(b.double_sided);

@@ -91,7 +91,7 @@ void place_shape(const PatchBuffer& shape, const glm::mat4& to_camera, const Mes
     const int material = mesh ? (mesh->face_materials.empty() ? mesh->material : mesh->face_materials[info.w])
                               : set_material;
     info.y = unsigned(material);
-    info.z = flags | (info.z & MP_PATCH_SMOOTH_NORMALS);
+    info.z = flags | (info.z & MP_PATCH_SHAPE_FLAGS);
     out.info.push_back(info);
     if (size_t(material) < scene.materials.size()) {
       const Material& mat = scene.materials[size_t(material)];
