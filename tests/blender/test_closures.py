@@ -653,7 +653,7 @@ def case_unsupported_warning():
     """A shader Micropoly cannot run, reached twice in one material and once
     in another: exactly one warning per material naming both it and the node."""
     def odd(nt):
-        hair = nt.nodes.new("ShaderNodeBsdfHair")
+        hair = nt.nodes.new("ShaderNodeVolumeScatter")  # a volume shader where a surface is read
         hair.name = "Strands"
         add = nt.nodes.new("ShaderNodeAddShader")
         nt.links.new(hair.outputs[0], add.inputs[0])
@@ -664,7 +664,7 @@ def case_unsupported_warning():
         return mix.outputs[0]
 
     def odd2(nt):
-        hair = nt.nodes.new("ShaderNodeBsdfHair")
+        hair = nt.nodes.new("ShaderNodeVolumeScatter")
         hair.name = "Strands"
         return hair.outputs[0]
     scene = scene_with("odd", odd)

@@ -110,6 +110,7 @@ const std::unordered_map<std::string, Parser::Handler>& Parser::handlers() {
       {"Torus", &Parser::req_quadric},
       {"Points", &Parser::req_points},
       {"Curves", &Parser::req_curves},
+      {"NuPatch", &Parser::req_nupatch},
       {"Basis", &Parser::req_basis},
       {"ObjectBegin", &Parser::req_object_begin},
       {"ObjectEnd", &Parser::req_object_end},

@@ -231,7 +231,8 @@ class Parser {
   void req_patch_mesh(ArgReader&);
   void req_quadric(ArgReader&);  // Sphere, Cylinder, Cone, Disk, Paraboloid, Hyperboloid, Torus
   void req_points(ArgReader&);
-  void req_curves(ArgReader&);  // rib_curves.cpp
+  void req_curves(ArgReader&);   // rib_curves.cpp
+  void req_nupatch(ArgReader&);  // rib_nupatch.cpp
   void req_basis(ArgReader&);
   // Positions from "P" or "Pw"; false (with a warning) if the primitive must be skipped.
   bool read_positions(ArgReader& args, const ParamList& params, bool patch,
