@@ -4,7 +4,9 @@ Nodes' curves where they evaluate to Curves) -> round tubes: positions,
 radii and each curve's first point read with foreach_get and handed over in
 one call; the native side turns each curve's points, Catmull-Rom keys as
 Cycles reads hair, into Bezier tubes (native/src/scene/curves.h). Every
-curve reads its object's Object Info and Attribute values."""
+curve reads its object's Object Info and Attribute values. With motion
+blur, the object's transform and points at each step (export_motion.py)
+move the tubes."""
 
 import numpy as np
 
@@ -38,10 +40,14 @@ def export_curves(native_scene, materials, inst, matrix, warnings, motion=None):
         if np.any(types != 0):  # 0: Catmull-Rom
             warnings.append(f"curves '{obj.name}': Bezier, NURBS and poly curves render through their points as "
                             "Catmull-Rom curves")
-    if motion is not None:
-        warnings.append(f"curves '{obj.name}': curves render at the shutter's centre, without motion blur")
+    moving = {}
+    if motion is not None and not inst.is_instance:
+        empty = np.zeros(0, dtype=np.float32)
+        matrices, steps = motion.matrices.get(obj.name), motion.points.get(obj.name)
+        moving = dict(motion_points=empty if steps is None else steps,
+                      motion_object_to_world=empty if matrices is None else matrices)
     skipped = native_scene.add_curves(obj.name, positions.reshape(-1, 3), radii, offsets, object_to_world=matrix,
-                                      **export_attributes.object_arguments(obj, inst, materials))
+                                      **export_attributes.object_arguments(obj, inst, materials), **moving)
     if skipped:
         warnings.append(f"curves '{obj.name}': {skipped} curves with fewer than 2 points, or a point or radius that "
                         "is not finite, are skipped")

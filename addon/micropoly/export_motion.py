@@ -69,6 +69,11 @@ def _object_blurs(obj):
 
 
 def _points(obj, depsgraph):
+    if obj.type == "CURVES":  # the curves' points, as export_curves reads them
+        positions = obj.data.attributes["position"].data
+        points = np.empty(len(positions) * 3, dtype=np.float32)
+        positions.foreach_get("vector", points)
+        return points.reshape(-1, 3)
     subsurf, only = export_mesh.subdivision_modifier(obj)
     if subsurf is not None and only:
         return export_mesh.cage_points(obj, depsgraph)
@@ -134,10 +139,11 @@ def sample(setter, depsgraph, times):
         camera.append(camera_view.view_matrix(scene.camera.evaluated_get(depsgraph)))
         for inst in depsgraph.object_instances:
             obj = inst.object
-            if obj.type != "MESH" or not _object_blurs(obj):
+            if obj.type not in ("MESH", "CURVES") or not _object_blurs(obj):
                 continue
             if inst.is_instance:  # its transform only: a prototype does not deform
-                instances.setdefault(instance_key(inst), []).append(_rows(inst.matrix_world))
+                if obj.type == "MESH":
+                    instances.setdefault(instance_key(inst), []).append(_rows(inst.matrix_world))
                 continue
             matrices.setdefault(obj.name, []).append(np.array(inst.matrix_world, dtype=np.float32))
             points.setdefault(obj.name, []).append(_points(obj, depsgraph))

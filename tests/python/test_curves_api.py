@@ -56,3 +56,29 @@ def test_malformed_offsets_are_refused(offsets, message):
     points, radii, _ = strands(4)
     with pytest.raises(RuntimeError, match=message):
         s.add_curves("bad", points, radii, offsets)
+
+
+def test_moving_curves_blur_along_their_motion():
+    # Strands moving 1 unit along x during the shutter cover a wider band,
+    # as much alpha in all, centred where they are at the shutter's centre.
+    still, moving = base(), base()
+    points, radii, offsets = strands(1)
+    still.add_curves("hair", points, radii, offsets)
+    steps = np.stack([points + np.array([dx, 0.0, 0.0], np.float32) for dx in (-0.5, 0.0, 0.5)])
+    moving.set_motion(3)
+    moving.add_curves("hair", points, radii, offsets, motion_points=steps)
+    a = np.asarray(_native.Renderer().render(still)["rgba"])[..., 3]
+    b = np.asarray(_native.Renderer().render(moving)["rgba"])[..., 3]
+    assert b.sum() == pytest.approx(a.sum(), rel=0.05)
+    cols = np.arange(a.shape[1])
+    assert (b.sum(0) > 0.01).sum() > 3 * (a.sum(0) > 0.01).sum()
+    assert (b.sum(0) * cols).sum() / b.sum() == pytest.approx((a.sum(0) * cols).sum() / a.sum(), abs=1.0)
+
+
+def test_motion_of_another_shape_is_refused():
+    s = base()
+    points, radii, offsets = strands(2)
+    with pytest.raises(RuntimeError, match="motion step 0 has 4 points, not 8"):
+        s.add_curves("hair", points, radii, offsets, motion_points=np.zeros((3, 4, 3), np.float32))
+    with pytest.raises(RuntimeError, match="a motion point is not finite"):
+        s.add_curves("hair", points, radii, offsets, motion_points=np.full((3, 8, 3), np.nan, np.float32))

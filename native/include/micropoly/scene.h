@@ -89,6 +89,10 @@ struct BezierPatches {
   // u runs around a round section (hair tubes): the camera dices at least a
   // few micropolygons across u, whatever the size on screen (MP_PATCH_ROUND_U).
   bool round_u = false;
+  // Motion blur (Scene::motion_steps): the control points and the transform
+  // at each motion step, or empty where they do not move (as Mesh).
+  std::vector<std::vector<glm::vec3>> motion_control_points;
+  std::vector<glm::mat4> motion_object_to_world;
 };
 
 // Instancing (RenderMan's ObjectBegin/ObjectInstance; Blender's instances):

@@ -615,7 +615,8 @@ PYBIND11_MODULE(_native, m) {
           [](Scene& s, const std::string& name, const Array<float>& points, const Array<float>& radii,
              const Array<int>& offsets, const Array<float>& object_to_world, int material, bool visible_camera,
              bool cast_shadows, std::vector<float> object_color, float pass_index, float random,
-             const Array<float>& attributes) {
+             const Array<float>& attributes, const Array<float>& motion_points,
+             const Array<float>& motion_object_to_world) {
             CurveSet curves;
             curves.name = name;
             curves.points = to_points(points, "points");
@@ -628,15 +629,29 @@ PYBIND11_MODULE(_native, m) {
             curves.visible_camera = visible_camera;
             curves.cast_shadows = cast_shadows;
             curves.info = to_object_info("curves '" + name + "'", object_color, pass_index, random, attributes);
+            curves.motion_object_to_world = to_matrices(motion_object_to_world, "motion_object_to_world");
+            if (motion_points.size() > 0) {
+              if (motion_points.ndim() != 3 || motion_points.shape(2) != 3)
+                throw Error("curves '" + name + "': motion points must be a (steps, points, 3) array");
+              const size_t count = size_t(motion_points.shape(1));
+              for (py::ssize_t k = 0; k < motion_points.shape(0); ++k) {
+                std::vector<glm::vec3> step(count);
+                std::memcpy(step.data(), motion_points.data() + size_t(k) * count * 3, count * sizeof(glm::vec3));
+                curves.motion_points.push_back(std::move(step));
+              }
+            }
             return add_curves(s, curves);
           },
           py::arg("name"), py::arg("points"), py::arg("radii"), py::arg("offsets"),
           py::arg("object_to_world") = Array<float>(), py::arg("material") = 0, py::arg("visible_camera") = true,
           py::arg("cast_shadows") = true, py::arg("object_color") = std::vector<float>{1, 1, 1, 1},
           py::arg("pass_index") = 0.0f, py::arg("random") = 0.0f, py::arg("attributes") = Array<float>(),
+          py::arg("motion_points") = Array<float>(), py::arg("motion_object_to_world") = Array<float>(),
           "Adds curves (Catmull-Rom keys: points (points, 3), radii (points,), object space; curve c has the "
-          "points [offsets[c], offsets[c + 1])) as round tubes of Bezier patches (scene/curves.h). Returns how "
-          "many curves were skipped (fewer than 2 points, or a point or radius not finite, a radius below 0).")
+          "points [offsets[c], offsets[c + 1])) as round tubes of Bezier patches (scene/curves.h), with their "
+          "motion where they move: the points at each motion step (steps, points, 3) and the object-to-world "
+          "matrices (steps, 4, 4). Returns how many curves were skipped (fewer than 2 points, or a point or "
+          "radius not finite, a radius below 0).")
       .def(
           "add_points",
           [](Scene& s, const std::string& name, const Array<float>& positions, const Array<float>& radii,

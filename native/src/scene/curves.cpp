@@ -50,25 +50,45 @@ void halve(const CurveSegment& s, CurveSegment& a, CurveSegment& b) {
   split(s.r, a.r, b.r);
 }
 
-// Appends `s`, halved until each piece turns by at most kMaxTurnRadians.
-void refine(const CurveSegment& s, int depth, std::vector<CurveSegment>& out) {
-  if (depth >= kMaxHalvings || polygon_turn(s) <= kMaxTurnRadians) {
+// How many times to halve a segment: until each of its 2^k equal pieces
+// turns by at most kMaxTurnRadians.
+int halvings(const CurveSegment& s) {
+  int k = 0;
+  std::vector<CurveSegment> pieces{s}, next;
+  while (k < kMaxHalvings && std::any_of(pieces.begin(), pieces.end(),
+                                         [](const CurveSegment& p) { return polygon_turn(p) > kMaxTurnRadians; })) {
+    next.clear();
+    for (const CurveSegment& p : pieces) {
+      CurveSegment a, b;
+      halve(p, a, b);
+      next.push_back(a), next.push_back(b);
+    }
+    pieces.swap(next);
+    ++k;
+  }
+  return k;
+}
+
+// Appends `s` cut into 2^k equal pieces.
+void cut(const CurveSegment& s, int k, std::vector<CurveSegment>& out) {
+  if (k == 0) {
     out.push_back(s);
     return;
   }
   CurveSegment a, b;
   halve(s, a, b);
-  refine(a, depth + 1, out);
-  refine(b, depth + 1, out);
+  cut(a, k - 1, out);
+  cut(b, k - 1, out);
 }
 
 // Adds the tube around one curve's Bezier segments (centre line and radius,
-// each segment starting where the last ended) to `out`. Segments that turn
-// sharply are halved first: a piece's rows follow its frame's rotation only
-// to first order.
-void tube(const std::vector<CurveSegment>& input, std::vector<glm::vec3>& out) {
+// each segment starting where the last ended) to `out`, segment i cut into
+// 2^levels[i] pieces first: a piece's rows follow its frame's rotation only
+// to first order. A moving curve's steps take the shutter centre's levels,
+// so every step has the same patches.
+void tube(const std::vector<CurveSegment>& input, const std::vector<int>& levels, std::vector<glm::vec3>& out) {
   std::vector<CurveSegment> segs;
-  for (const CurveSegment& s : input) refine(s, 0, segs);
+  for (size_t i = 0; i < input.size(); ++i) cut(input[i], levels[i], segs);
   const size_t n = segs.size();
   // A frame at each joint (n + 1), perpendicular to the curve's direction
   // there, carried along by projecting the last normal onto each new section
@@ -151,7 +171,9 @@ void catmull_rom_segments(const std::vector<glm::dvec3>& k, const std::vector<do
 }
 
 void add_tube(const std::vector<CurveSegment>& segs, std::vector<glm::vec3>& out) {
-  if (!segs.empty()) tube(segs, out);
+  std::vector<int> levels(segs.size());
+  for (size_t i = 0; i < segs.size(); ++i) levels[i] = halvings(segs[i]);
+  if (!segs.empty()) tube(segs, levels, out);
 }
 
 size_t add_curves(Scene& scene, const CurveSet& curves) {
@@ -163,11 +185,22 @@ size_t add_curves(Scene& scene, const CurveSet& curves) {
     throw Error("curves '" + curves.name + "': the offsets must run from 0 to the number of points");
   for (size_t c = 0; c + 1 < off.size(); ++c)
     if (off[c + 1] < off[c]) throw Error("curves '" + curves.name + "': the offsets must not decrease");
+  for (size_t step = 0; step < curves.motion_points.size(); ++step) {
+    if (curves.motion_points[step].size() != curves.points.size())
+      throw Error("curves '" + curves.name + "': motion step " + std::to_string(step) + " has " +
+                  std::to_string(curves.motion_points[step].size()) + " points, not " +
+                  std::to_string(curves.points.size()));
+    for (const glm::vec3& v : curves.motion_points[step])
+      if (!finite(v)) throw Error("curves '" + curves.name + "': a motion point is not finite");
+  }
   BezierPatches set = tube_set(curves);
+  set.motion_object_to_world = curves.motion_object_to_world;
+  set.motion_control_points.resize(curves.motion_points.size());
   size_t skipped = 0;
   std::vector<glm::dvec3> k;
   std::vector<double> r;
   std::vector<CurveSegment> segs;
+  std::vector<int> levels;
   for (size_t c = 0; c + 1 < off.size(); ++c) {
     k.clear(), r.clear();
     bool ok = off[c + 1] - off[c] >= 2;
@@ -183,7 +216,15 @@ size_t add_curves(Scene& scene, const CurveSet& curves) {
       continue;
     }
     catmull_rom_segments(k, r, segs);
-    tube(segs, set.control_points);
+    levels.resize(segs.size());
+    for (size_t i = 0; i < segs.size(); ++i) levels[i] = halvings(segs[i]);
+    tube(segs, levels, set.control_points);
+    // Each motion step's tube, cut as the shutter centre's is.
+    for (size_t step = 0; step < curves.motion_points.size(); ++step) {
+      for (int p = off[c]; p < off[c + 1]; ++p) k[size_t(p - off[c])] = curves.motion_points[step][size_t(p)];
+      catmull_rom_segments(k, r, segs);
+      tube(segs, levels, set.motion_control_points[step]);
+    }
   }
   if (!set.control_points.empty()) scene.bezier_patches.push_back(std::move(set));
   return skipped;

@@ -36,6 +36,11 @@ struct CurveSet {
   ObjectInfo info;
   bool visible_camera = true;
   bool cast_shadows = true;
+  // Motion blur (Scene::motion_steps): the points and the transform at each
+  // motion step, or empty where they do not move (as Mesh). Each step's
+  // tubes are cut as the shutter centre's are, so the patches match.
+  std::vector<std::vector<glm::vec3>> motion_points;
+  std::vector<glm::mat4> motion_object_to_world;
 };
 
 constexpr int kTubePatchesPerSegment = 4;

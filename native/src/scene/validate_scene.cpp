@@ -135,6 +135,33 @@ void validate_mesh_motion(const Mesh& m, size_t steps) {
                  what, m.name);
 }
 
+// Motion steps of a patch set, as of a mesh: one per Scene step, the same
+// number of control points each, finite.
+void validate_patches_motion(const BezierPatches& b, size_t steps) {
+  const char* what = "patch set";
+  if (!b.motion_object_to_world.empty()) {
+    if (b.motion_object_to_world.size() != steps)
+      fail(what, b.name, "has " + std::to_string(b.motion_object_to_world.size()) + " motion transforms for " +
+                             std::to_string(steps) + " motion steps");
+    for (const glm::mat4& t : b.motion_object_to_world)
+      if (!finite(t)) fail(what, b.name, "has a motion transform with NaN or infinite values");
+  }
+  if (b.motion_control_points.empty()) return;
+  if (b.motion_control_points.size() != steps)
+    fail(what, b.name, "has " + std::to_string(b.motion_control_points.size()) + " sets of motion points for " +
+                           std::to_string(steps) + " motion steps");
+  for (size_t k = 0; k < steps; ++k) {
+    if (b.motion_control_points[k].size() != b.control_points.size())
+      fail(what, b.name, "changes its patches during the shutter: motion step " + std::to_string(k) + " has " +
+                             std::to_string(b.motion_control_points[k].size()) + " control points, not " +
+                             std::to_string(b.control_points.size()));
+    for (const glm::vec3& p : b.motion_control_points[k])
+      if (!finite(p)) fail(what, b.name, "has a NaN or infinite motion point at step " + std::to_string(k));
+    check_extent(b.motion_control_points[k],
+                 b.motion_object_to_world.empty() ? b.object_to_world : b.motion_object_to_world[k], what, b.name);
+  }
+}
+
 void validate_mesh(const Mesh& m, size_t materials) {
   const char* what = "mesh";
   if (!finite(m.object_to_world)) fail(what, m.name, "transform contains NaN or infinite values");
@@ -397,7 +424,10 @@ void validate_scene(const Scene& scene) {
     for (const glm::vec4& p : im.pixels)
       if (!finite(p)) fail("image", im.name, "has NaN or infinite pixels");
   }
-  for (const BezierPatches& b : scene.bezier_patches) validate_patches(b, scene.materials.size());
+  for (const BezierPatches& b : scene.bezier_patches) {
+    validate_patches(b, scene.materials.size());
+    validate_patches_motion(b, size_t(scene.motion_steps));
+  }
   validate_instances(scene);
 }
 

@@ -68,6 +68,7 @@ void place_motion(const Scene& scene, const std::vector<PatchCache::Surface>& su
   out.motion_points.reserve(steps * out.patches.points.size());
   out.motion_curves.reserve(steps * out.patches.curves.size());
   std::vector<Mesh> moved(scene.meshes.size());
+  std::vector<BezierPatches> moved_sets(scene.bezier_patches.size());
   for (size_t k = 0; k < steps; ++k) {
     std::vector<PatchCache::Surface> at_step = surfaces;
     for (size_t i = 0; i < scene.meshes.size(); ++i)
@@ -76,14 +77,23 @@ void place_motion(const Scene& scene, const std::vector<PatchCache::Surface>& su
         moved[i].points = scene.meshes[i].motion_points[k];
         at_step[i].mesh = &moved[i];
       }
+    // Patch sets follow the meshes in `surfaces`.
+    for (size_t j = 0; j < scene.bezier_patches.size(); ++j)
+      if (!scene.bezier_patches[j].motion_control_points.empty()) {
+        moved_sets[j] = scene.bezier_patches[j];
+        moved_sets[j].control_points = scene.bezier_patches[j].motion_control_points[k];
+        at_step[scene.meshes.size() + j].set = &moved_sets[j];
+      }
     const auto shapes = cache->shapes(at_step, out.patches.uv_layers);
     const glm::mat4& w2c = scene.camera.motion_world_to_camera.empty() ? scene.camera.world_to_camera
                                                                         : scene.camera.motion_world_to_camera[k];
     for (size_t i = 0; i < surfaces.size(); ++i) {
       const Mesh* mesh = surfaces[i].mesh;
+      const BezierPatches* set = surfaces[i].set;
       const glm::mat4& o2w = mesh ? (mesh->motion_object_to_world.empty() ? mesh->object_to_world
                                                                           : mesh->motion_object_to_world[k])
-                                  : surfaces[i].set->object_to_world;
+                                  : (set->motion_object_to_world.empty() ? set->object_to_world
+                                                                         : set->motion_object_to_world[k]);
       place_positions(*shapes[i], w2c * o2w, out.motion_points, out.motion_curves);
     }
     if (out.motion_points.size() != (k + 1) * out.patches.points.size() ||

@@ -111,6 +111,9 @@ void hash_mesh(Hasher& h, const Mesh& m) {
 void hash_patch_set(Hasher& h, const BezierPatches& b) {
   h.values(b.control_points);
   h.value(b.round_u);
+  h.value(b.motion_control_points.size());
+  for (const std::vector<glm::vec3>& step : b.motion_control_points) h.values(step);
+  h.values(b.motion_object_to_world);
   h.value(b.material);
   h.value(b.object_to_world);
   h.value(b.double_sided);
@@ -258,6 +261,9 @@ ShadowGeometryKeys shadow_geometry_keys(const Scene& scene) {
     h.value(uint32_t(2));
     h.values(b.control_points);
     h.value(b.round_u);
+    h.value(b.motion_control_points.size());
+    for (const std::vector<glm::vec3>& step : b.motion_control_points) h.values(step);
+    h.values(b.motion_object_to_world);
     *programs = hash_used_materials(h, scene, materials, b.material, {});
     h.value(b.object_to_world);
     h.value(b.double_sided);
