@@ -119,6 +119,9 @@ TEST_F(RibCurvesTest, RoundTripKeepsTheCurves) {
   std::ostringstream written;
   write_rib(first.scene, written);
   const RibResult second = read_rib_string(written.str(), "written.rib");
+  ASSERT_EQ(second.scene.bezier_patches.size(), 1u);
+  EXPECT_TRUE(second.scene.bezier_patches[0].round_u);  // tubes keep their round dicing
+  EXPECT_EQ(second.scene.bezier_patches[0].control_points, first.scene.bezier_patches[0].control_points);
   const double a = coverage(renderer_->render(first.scene)), b = coverage(renderer_->render(second.scene));
   EXPECT_GT(a, 300.0);
   EXPECT_NEAR(a / b, 1.0, 1e-4);

@@ -263,10 +263,16 @@ void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
   const int line = args.request().line;
   warn_unknown(params, {"material", "materialname", "program", "programparams", "programdisplaces", "programshades",
                         "programalpha", "displacementbound", "displacementworld", "objectcolor", "objectalpha",
-                        "objectindex", "objectrandom", "objectattributes"}, [&](const std::string& name) {
+                        "objectindex", "objectrandom", "objectattributes", "roundu"}, [&](const std::string& name) {
     warn_once("attribute-micropoly:" + name, line,
               "Attribute \"micropoly\": parameter \"" + name + "\" is ignored");
   });
+  // Patches whose u runs around a round section (hair tubes written back).
+  if (params.find("roundu")) {
+    int round = 0;
+    params.get_int("roundu", 0, 1, &round);
+    attrs_.round_u = round != 0;
+  }
   // What Object Info reads of the following objects.
   ObjectInfo& info = attrs_.object_info;
   glm::vec3 rgb(info.color);

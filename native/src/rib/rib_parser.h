@@ -53,6 +53,9 @@ struct Attributes {
   glm::vec3 opacity{1.0f};
   Material surface;           // model and shader parameters; color/opacity apply at emission
   bool double_sided = true;   // Sides 2 is RenderMan's default
+  // Attribute "micropoly" "int roundu": patches whose u runs around a round
+  // section (hair tubes written back; BezierPatches::round_u).
+  bool round_u = false;
   // True when the current orientation differs from the handedness of the
   // current coordinate system, i.e. the primitives' normals are flipped. Both
   // flip together under transformations, so only Orientation and
@@ -135,6 +138,7 @@ class Parser {
     glm::mat4 object_to_world;
     int material;
     bool double_sided;
+    bool round_u;
     bool visible_camera;
     bool cast_shadows;
     ObjectInfo object_info;

@@ -618,11 +618,17 @@ void write_patch_requests(std::string& o, const std::vector<glm::vec3>& control_
   }
 }
 
+// Hair tubes keep their round dicing (BezierPatches::round_u).
+void write_round_u(std::string& o, const BezierPatches& b) {
+  if (b.round_u) o += "  Attribute \"micropoly\" \"int roundu\" [1]\n";
+}
+
 void write_patches(std::string& o, const BezierPatches& b, const std::vector<Material>& materials,
                    const std::vector<MaterialProgram>& programs) {
   // The reader joins consecutive patches of one attribute block into one set.
   o += "AttributeBegin\n";
   write_object_state(o, b, materials, programs);
+  write_round_u(o, b);
   write_patch_requests(o, b.control_points);
   o += "AttributeEnd\n";
 }
@@ -684,6 +690,7 @@ void write_prototype(std::string& o, const Prototype& p, const WrittenPrototype&
     o += "AttributeBegin\n  ConcatTransform ";
     put_matrix(o, b.object_to_world);
     o += '\n';
+    write_round_u(o, b);
     write_patch_requests(o, b.control_points);
     o += "AttributeEnd\n";
   }
