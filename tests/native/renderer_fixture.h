@@ -28,4 +28,11 @@ class SharedRendererTest : public ::testing::Test {
   static inline std::string setup_error_;
 };
 
+// The image's alpha summed: how many pixels its surfaces cover.
+inline double coverage(const RenderResult& r) {
+  double sum = 0.0;
+  for (size_t i = 3; i < r.rgba.size(); i += 4) sum += r.rgba[i];
+  return sum;
+}
+
 }  // namespace mp::test

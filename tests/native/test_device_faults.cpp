@@ -37,12 +37,6 @@ Scene fault_scene(float cube_x = 0.0f) {
   return s;
 }
 
-double coverage(const RenderResult& r) {
-  double sum = 0;
-  for (size_t i = 0; i < static_cast<size_t>(r.width) * r.height; ++i) sum += r.rgba[4 * i + 3];
-  return sum;
-}
-
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 // One planted fault: the plan, the phase the message must name, and what

@@ -20,12 +20,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-double coverage(const RenderResult& r) {
-  double sum = 0.0;
-  for (size_t i = 0; i < size_t(r.width) * r.height; ++i) sum += r.rgba[4 * i + 3];
-  return sum;
-}
-
 // A 4 x 3 grid of points 1 apart about the origin, radii 0.1 to 0.32.
 PointCloud grid_cloud(PointShape shape) {
   PointCloud c;

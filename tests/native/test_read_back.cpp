@@ -40,12 +40,6 @@ void expect_same(const RenderResult& a, const RenderResult& b) {
   EXPECT_EQ(a.normal, b.normal);
 }
 
-double coverage(const RenderResult& r) {
-  double sum = 0;
-  for (size_t i = 3; i < r.rgba.size(); i += 4) sum += r.rgba[i];
-  return sum;
-}
-
 using ReadBackTest = SharedRendererTest;
 
 TEST_F(ReadBackTest, OverlappedFramesEqualFramesRenderedOneAtATime) {

@@ -21,12 +21,6 @@ namespace {
 
 class RenderTest : public SharedRendererTest {};
 
-double coverage(const RenderResult& r) {
-  double sum = 0;
-  for (size_t i = 0; i < static_cast<size_t>(r.width) * r.height; ++i) sum += r.rgba[4 * i + 3];
-  return sum;
-}
-
 // Raster position of a world point, as the renderer maps it (RenderMan screen
 // window: the shorter image side spans [-1, 1]).
 glm::vec2 project(const Scene& s, glm::vec3 p) {

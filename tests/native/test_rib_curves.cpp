@@ -18,12 +18,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-double coverage(const RenderResult& r) {
-  double sum = 0.0;
-  for (size_t i = 0; i < size_t(r.width) * r.height; ++i) sum += r.rgba[4 * i + 3];
-  return sum;
-}
-
 // Orthographic, looking down -z at the window [-2.5, 2.5] x [-1.875, 1.875]
 // on 160 x 120 pixels (32 a unit).
 const char* kHead =

@@ -122,12 +122,6 @@ std::string ortho_frame(double s, const std::string& camera, const std::string& 
          "\nWorldEnd\n";
 }
 
-double coverage(const RenderResult& r) {
-  double sum = 0.0;
-  for (size_t i = 0; i < size_t(r.width) * r.height; ++i) sum += r.rgba[4 * i + 3];
-  return sum;
-}
-
 TEST_F(RibNuPatchRender, BSplineNuPatchIsTheBSplinePatchMesh) {
   // 5 x 5 control points of a wavy sheet, uniform cubic knots: the NuPatch
   // over its whole domain is the nonperiodic B-spline PatchMesh.

@@ -217,12 +217,6 @@ std::string ortho_frame(double s, const std::string& body) {
          "\nTranslate 0 0 5\nWorldBegin\nSurface \"constant\"\n" + body + "\nWorldEnd\n";
 }
 
-double coverage(const RenderResult& r) {
-  double sum = 0.0;
-  for (size_t i = 0; i < size_t(r.width) * r.height; ++i) sum += r.rgba[4 * i + 3];
-  return sum;
-}
-
 class RibQuadricsRender : public SharedRendererTest {
  protected:
   RenderResult render(const std::string& rib) {
