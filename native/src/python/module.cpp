@@ -85,6 +85,21 @@ std::vector<glm::mat4> to_matrices(const Array<float>& a, const char* what) {
   return out;
 }
 
+// (steps, N, 3) points, one set per motion step; `owner` names the object
+// in the error.
+std::vector<std::vector<glm::vec3>> to_motion_points(const Array<float>& a, const std::string& owner) {
+  std::vector<std::vector<glm::vec3>> out;
+  if (a.size() == 0) return out;
+  if (a.ndim() != 3 || a.shape(2) != 3) throw Error(owner + ": motion points must be a (steps, points, 3) array");
+  const size_t count = size_t(a.shape(1));
+  for (py::ssize_t k = 0; k < a.shape(0); ++k) {
+    std::vector<glm::vec3> step(count);
+    std::memcpy(step.data(), a.data() + size_t(k) * count * 3, count * sizeof(glm::vec3));
+    out.push_back(std::move(step));
+  }
+  return out;
+}
+
 glm::vec3 to_vec3(const std::vector<float>& v, const char* what) {
   if (v.size() != 3) throw Error(std::string(what) + " needs 3 values");
   return {v[0], v[1], v[2]};
@@ -310,17 +325,7 @@ PYBIND11_MODULE(_native, m) {
             if (index < -n || index >= n) throw Error("set_mesh_motion: no mesh " + std::to_string(index));
             Mesh& m = s.meshes[size_t(index < 0 ? index + n : index)];
             m.motion_object_to_world = to_matrices(object_to_world, "object_to_world");
-            m.motion_points.clear();
-            if (points.size() > 0) {
-              if (points.ndim() != 3 || points.shape(2) != 3)
-                throw Error("mesh '" + m.name + "': motion points must be a (steps, N, 3) array");
-              const size_t count = size_t(points.shape(1));
-              for (py::ssize_t k = 0; k < points.shape(0); ++k) {
-                std::vector<glm::vec3> step(count);
-                std::memcpy(step.data(), points.data() + size_t(k) * count * 3, count * sizeof(glm::vec3));
-                m.motion_points.push_back(std::move(step));
-              }
-            }
+            m.motion_points = to_motion_points(points, "mesh '" + m.name + "'");
           },
           py::arg("index"), py::arg("points") = Array<float>(), py::arg("object_to_world") = Array<float>(),
           "Motion of mesh `index` (negative: from the end): its points (steps, N, 3) where it deforms, its "
@@ -630,16 +635,7 @@ PYBIND11_MODULE(_native, m) {
             curves.cast_shadows = cast_shadows;
             curves.info = to_object_info("curves '" + name + "'", object_color, pass_index, random, attributes);
             curves.motion_object_to_world = to_matrices(motion_object_to_world, "motion_object_to_world");
-            if (motion_points.size() > 0) {
-              if (motion_points.ndim() != 3 || motion_points.shape(2) != 3)
-                throw Error("curves '" + name + "': motion points must be a (steps, points, 3) array");
-              const size_t count = size_t(motion_points.shape(1));
-              for (py::ssize_t k = 0; k < motion_points.shape(0); ++k) {
-                std::vector<glm::vec3> step(count);
-                std::memcpy(step.data(), motion_points.data() + size_t(k) * count * 3, count * sizeof(glm::vec3));
-                curves.motion_points.push_back(std::move(step));
-              }
-            }
+            curves.motion_points = to_motion_points(motion_points, "curves '" + name + "'");
             return add_curves(s, curves);
           },
           py::arg("name"), py::arg("points"), py::arg("radii"), py::arg("offsets"),
