@@ -243,12 +243,16 @@ def export_scene(depsgraph, view=None, meshes=None, motion=None):
     seen = set()
     for inst in depsgraph.object_instances:
         obj = inst.object
-        if obj.type == "MESH":
+        if obj.type in ("MESH", "CURVES", "POINTCLOUD"):
+            # Every material before any geometry: the UV layers, attributes
+            # and Hair Info values a surface carries are those the
+            # materials ask for.
             pointers = (obj.as_pointer(), obj.data.as_pointer())
             if pointers not in seen:  # thousands of instances of one object: its materials once
                 seen.add(pointers)
                 for slot in obj.material_slots:
                     materials.get(slot.material)
+        if obj.type == "MESH":
             if motion is None and not inst.is_instance:
                 key = export_instances.InstanceTable.key(inst.object, shared_data=True)
                 if key is not None:

@@ -157,7 +157,9 @@ class InstanceAttributes:
             return -1
         arrays = {}
         for name in names & set(points.attributes.keys()):
-            arrays[name] = _attribute_rgba(points.attributes[name])
+            rgba = attribute_rgba(points.attributes[name])
+            if rgba is not None:
+                arrays[name] = rgba
         if not arrays:
             return -1
         rows = None
@@ -170,24 +172,28 @@ class InstanceAttributes:
         return self._geometry[pointer]
 
 
-def _attribute_rgba(attribute):
+def attribute_rgba(attribute):
     """A geometry attribute's values as (n, 4) RGBA, as Cycles converts
-    them to a colour: a number as (v, v, v, 1), a vector as (x, y, z, 1)."""
-    n = len(attribute.data)
+    them to a colour: a number as (v, v, v, 1), a vector as (x, y, z, 1),
+    a 2D vector as (x, y, 0, 1); None for a type it does not read."""
+    sizes = {"FLOAT_COLOR": ("color", 4), "BYTE_COLOR": ("color", 4), "FLOAT_VECTOR": ("vector", 3),
+             "FLOAT2": ("vector", 2), "FLOAT": ("value", 1), "INT": ("value", 1), "INT8": ("value", 1),
+             "BOOLEAN": ("value", 1)}
     kind = attribute.data_type
+    if kind not in sizes:
+        return None
+    prop, size = sizes[kind]
+    n = len(attribute.data)
+    flat = np.empty(n * size, dtype={"FLOAT": np.float32, "FLOAT_COLOR": np.float32, "BYTE_COLOR": np.float32,
+                                     "FLOAT_VECTOR": np.float32, "FLOAT2": np.float32, "BOOLEAN": bool}.get(kind, np.int32))
+    attribute.data.foreach_get(prop, flat)
+    values = flat.astype(np.float32).reshape(n, size)
     out = np.zeros((n, 4), dtype=np.float32)
     out[:, 3] = 1.0
-    if kind in ("FLOAT_COLOR", "BYTE_COLOR"):
-        attribute.data.foreach_get("color", out.reshape(-1))
-    elif kind in ("FLOAT_VECTOR", "FLOAT2"):
-        width = 3 if kind == "FLOAT_VECTOR" else 2
-        v = np.zeros(n * width, dtype=np.float32)
-        attribute.data.foreach_get("vector", v)
-        out[:, :width] = v.reshape(n, width)
-    elif kind in ("FLOAT", "INT", "BOOLEAN", "INT8"):
-        v = np.zeros(n, dtype={"FLOAT": np.float32, "BOOLEAN": bool}.get(kind, np.int32))
-        attribute.data.foreach_get("value", v)
-        out[:, :3] = v.astype(np.float32)[:, None]
+    if size == 1:
+        out[:, :3] = values
+    else:
+        out[:, :size] = values
     return out
 
 

@@ -16,7 +16,7 @@ default surface."""
 from . import export_images, node_compiler
 
 # Material programs see at most this many UV maps (MP_MAX_UV_LAYERS).
-MAX_UV_LAYERS = 4
+MAX_UV_LAYERS = 8
 
 
 def _input(node, *names, default=None):
@@ -134,6 +134,20 @@ class MaterialTable:
                                  f"'{name or 'the active color attribute'}' reads zero")
             return -1, -1
         return tuple(self.uv_layer(("attribute", name, k)) for k in (0, 1))
+
+    def layer_count(self):
+        """How many UV layers the materials compiled so far read."""
+        return len(self.uv_names)
+
+    def hair_info_layers(self):
+        """Two layers holding a curve's Hair Info values per point:
+        (intercept, length) and (random, thickness) (export_curves); zero on
+        meshes. (-1, -1) when the layers run out."""
+        if len(self.uv_names) + sum(("hair", k) not in self.uv_names for k in (0, 1)) > MAX_UV_LAYERS:
+            self.warnings.append(f"more than {MAX_UV_LAYERS} UV layers and attributes are used; Hair Info "
+                                 "reads zero")
+            return -1, -1
+        return tuple(self.uv_layer(("hair", k)) for k in (0, 1))
 
     def object_attribute(self, name, instancer):
         """The slot of Attribute node value `name` (type Instancer when

@@ -165,22 +165,9 @@ def _attribute_corners(mesh, name, n_loops, counts):
         layer = attrs.get(name)
     if layer is None or layer.domain not in ("POINT", "CORNER", "FACE"):
         return None
-    sizes = {"FLOAT_COLOR": ("color", 4), "BYTE_COLOR": ("color", 4), "FLOAT_VECTOR": ("vector", 3),
-             "FLOAT2": ("vector", 2), "FLOAT": ("value", 1), "INT": ("value", 1), "BOOLEAN": ("value", 1)}
-    if layer.data_type not in sizes:
+    rgba = export_attributes.attribute_rgba(layer)
+    if rgba is None:
         return None
-    prop, size = sizes[layer.data_type]
-    count = len(layer.data)
-    flat = np.empty(count * size, dtype=np.float32 if layer.data_type not in ("INT", "BOOLEAN") else
-                    (np.int32 if layer.data_type == "INT" else bool))
-    layer.data.foreach_get(prop, flat)
-    values = flat.astype(np.float32).reshape(count, size)
-    rgba = np.zeros((count, 4), dtype=np.float32)
-    rgba[:, 3] = 1.0
-    if size == 1:
-        rgba[:, :3] = values
-    else:
-        rgba[:, :size] = values
     if layer.domain == "CORNER":
         return rgba
     if layer.domain == "POINT":
@@ -193,13 +180,16 @@ def _attribute_corners(mesh, name, n_loops, counts):
 def _uv_layers(mesh, names, n_loops, counts):
     """(len(names), n_loops, 2) per face corner: a name is a UV map ("" the
     active render one), ("tangent", map, k) for half k of that map's
-    tangents (xy, then z and the bitangent sign), or ("attribute", name, k)
-    for half k of an attribute's RGBA (_attribute_corners). A map or
+    tangents (xy, then z and the bitangent sign), ("attribute", name, k)
+    for half k of an attribute's RGBA (_attribute_corners), or ("hair", k)
+    for Hair Info's values (zero on meshes). A map or
     attribute the mesh lacks reads zero, as in Cycles."""
     out = np.zeros((len(names), n_loops, 2), dtype=np.float32)
     tangents = {}
     attributes = {}
     for k, name in enumerate(names):
+        if isinstance(name, tuple) and name[0] == "hair":
+            continue  # Hair Info reads zero on meshes, as in Cycles
         if isinstance(name, tuple) and name[0] == "attribute":
             if name[1] not in attributes:
                 attributes[name[1]] = _attribute_corners(mesh, name[1], n_loops, counts)
@@ -293,33 +283,31 @@ def _hash_string(name):
     return i
 
 
-def _hash_uint2(kx, ky):
-    """Cycles' hash_uint2: Bob Jenkins' lookup3 final mix of two words."""
-    m = 0xFFFFFFFF
+def hash_uint2(kx, ky):
+    """Cycles' hash_uint2 of arrays of 32-bit words: Bob Jenkins' lookup3
+    final mix of two words, element-wise (uint32)."""
+    m = np.uint64(0xFFFFFFFF)
+    kx = np.asarray(kx, dtype=np.int64).astype(np.uint64) & m
+    ky = np.asarray(ky, dtype=np.int64).astype(np.uint64) & m
 
-    def rot(x, k):
-        return ((x << k) | (x >> (32 - k))) & m
-    a = b = c = (0xDEADBEEF + (2 << 2) + 13) & m
+    def mix(x, y, k):  # x ^= y; x -= rot(y, k), without wrapping below zero
+        rot = ((y << np.uint64(k)) | (y >> np.uint64(32 - k))) & m
+        return ((x ^ y) + (m + np.uint64(1) - rot)) & m
+    a = b = c = np.full(np.broadcast(kx, ky).shape, 0xDEADBEEF + (2 << 2) + 13, dtype=np.uint64)
     a, b = (a + kx) & m, (b + ky) & m
-    c ^= b
-    c = (c - rot(b, 14)) & m
-    a ^= c
-    a = (a - rot(c, 11)) & m
-    b ^= a
-    b = (b - rot(a, 25)) & m
-    c ^= b
-    c = (c - rot(b, 16)) & m
-    a ^= c
-    a = (a - rot(c, 4)) & m
-    b ^= a
-    b = (b - rot(a, 14)) & m
-    c ^= b
-    return (c - rot(b, 24)) & m
+    c = mix(c, b, 14)
+    a = mix(a, c, 11)
+    b = mix(b, a, 25)
+    c = mix(c, b, 16)
+    a = mix(a, c, 4)
+    b = mix(b, a, 14)
+    c = mix(c, b, 24)
+    return c.astype(np.uint32)
 
 
 def name_random_id(name):
     """The random id Cycles gives an object of its own: the hash of its name."""
-    return _hash_uint2(_hash_string(name), 0)
+    return int(hash_uint2(_hash_string(name), 0))
 
 
 def object_random(name, random_id=None):

@@ -9,11 +9,15 @@ times a root-to-tip blend bent by Shape, zero at a closed tip).
 
 Blender's Python API hands out the path cache one point at a time
 (ParticleSystem.co_hair); reading it is the one per-point loop in the
-export, about 1 s per million points."""
+export, about 1 s per million points. A material that reads a UV map gets
+each strand's root UV on the emitter (ParticleSystem.uv_on_emitter, one
+call per strand, as Cycles reads it). Hair Info is computed as for Curves
+objects, the strands of all the object's systems numbered in one run;
+attributes read zero (Cycles gives the emitter's colour attributes)."""
 
 import numpy as np
 
-from . import export_attributes
+from . import export_attributes, export_curves
 
 
 def _shape_radius(shape, root, tip, t):
@@ -56,11 +60,34 @@ def strands(obj, psys, render):
     return pos, radii
 
 
+def _root_uvs(obj, psys, name):
+    """(strands, 2): each strand's root UV on the emitter in UV map `name`
+    ("" the active render one), or None where the mesh has no such map."""
+    layers = obj.data.uv_layers
+    names = [layer.name for layer in layers]
+    if not name:
+        name = next((layer.name for layer in layers if layer.active_render), None)
+    modifier = next((m for m in obj.modifiers if m.type == "PARTICLE_SYSTEM" and m.particle_system == psys), None)
+    if name not in names or modifier is None:
+        return None
+    parents, children = len(psys.particles), len(psys.child_particles)
+    first, count = (parents, children) if psys.settings.child_type != "NONE" and children > 0 else (0, parents)
+    # Children take their UV from the system; the particle handed over is
+    # the first, as Cycles hands it.
+    particles = psys.particles
+    uv_no = names.index(name)
+    uv = np.fromiter((c for p in range(first, first + count)
+                      for c in psys.uv_on_emitter(modifier, particles[p if p < parents else 0], particle_no=p,
+                                                  uv_no=uv_no)), dtype=np.float32, count=2 * count)
+    return uv.reshape(count, 2)
+
+
 def export_particle_hair(native_scene, materials, inst, matrix, warnings, render, motion=None):
     """Adds the hair particle systems of the mesh object `inst` renders;
     returns how many were added."""
     obj = inst.object
     added = 0
+    first_curve = 0  # Hair Info's random numbers the strands of all systems in one run
     for psys in obj.particle_systems:
         s = psys.settings
         # Hair rendered as objects or collections reaches the export as
@@ -80,8 +107,18 @@ def export_particle_hair(native_scene, materials, inst, matrix, warnings, render
             warnings.append(f"particle hair '{obj.name}/{psys.name}': hair renders at the shutter's centre, "
                             "without motion blur")
         offsets = np.arange(0, (count + 1) * steps, steps, dtype=np.int32)
-        skipped = native_scene.add_curves(f"{obj.name}/{psys.name}", pos.reshape(-1, 3), radii.reshape(-1),
-                                          offsets, object_to_world=matrix, **args)
+        positions, radii = pos.reshape(-1, 3), radii.reshape(-1)
+
+        def root_uv(name):
+            uv = _root_uvs(obj, psys, name)
+            return None if uv is None else np.repeat(uv, steps, axis=0)
+        layers = export_curves.point_layers(
+            materials.uv_names, len(positions),
+            export_curves.hair_info(positions, offsets, radii, export_curves.transform_scale(matrix), first_curve),
+            lambda name: None, root_uv)
+        first_curve += count
+        skipped = native_scene.add_curves(f"{obj.name}/{psys.name}", positions, radii, offsets,
+                                          object_to_world=matrix, point_layers=layers, **args)
         if skipped:
             warnings.append(f"particle hair '{obj.name}/{psys.name}': {skipped} strands with a point that is not "
                             "finite are skipped")

@@ -76,6 +76,12 @@ class NoResources:
     def attribute_layers(self, name):
         return -1, -1
 
+    def hair_info_layers(self):
+        return -1, -1
+
+    def layer_count(self):
+        return 1
+
     def object_attribute(self, name, instancer):
         return -1
 
@@ -344,7 +350,8 @@ class NodeCompiler:
             self.shader_input(output, "Surface", "(float3)(1.0f)")
             return ""
         surf_src = self._function("void mp_node_surface(const MpNodeGlobals* g, MpSurface* s)", surface_body)
-        includes = "".join(f'#include "textures/{h}"\n' for h in sorted(self.headers))
+        includes = "#define MP_NODE_USES_UV_LAYERS 1\n"  # the world reads none
+        includes += "".join(f'#include "textures/{h}"\n' for h in sorted(self.headers))
         return includes + "".join(self.helpers) + disp_src + surf_src
 
     # ---- the material -----------------------------------------------------------
@@ -401,6 +408,8 @@ class NodeCompiler:
             self.warnings.append(f"material '{self.material.name}': its shader tree can add up to {self.closures} "
                                  f"closures at a point; past {MAX_CLOSURES} the last are left out")
         includes = "".join(f'#include "textures/{h}"\n' for h in sorted(self.headers))
+        # Only the UV layers taken so far (every one this program reads).
+        includes = f"#define MP_NODE_USES_UV_LAYERS {max(1, self.resources.layer_count())}\n" + includes
         if self.uses_neighbours:
             includes = "#define MP_NODE_USES_NEIGHBOURS 1\n" + includes
         if self.neighbours_of_neighbours:
@@ -684,9 +693,9 @@ class NodeCompiler:
 
     def emit_principled_hair(self, node, weight, slot):
         """Principled Hair BSDF as Chiang et al.'s model (kernels/closures/mp_hair.h),
-        in each of its colour parametrisations. The per-strand Random is 0
-        unless linked (Curves Info's Random is not read yet); 4.x's Huang
-        model is shaded as Chiang's with a warning."""
+        in each of its colour parametrisations. An unlinked Random is the
+        strand's own (Hair Info's, as Cycles takes it); 4.x's Huang model is
+        shaded as Chiang's with a warning."""
         self.uses_hair = True
         f, c = self._f, self._c
         if getattr(node, "model", "CHIANG") == "HUANG":
@@ -695,8 +704,8 @@ class NodeCompiler:
         random = f(node, "Random") if node.inputs["Random"].is_linked else "0.0f"
         if not node.inputs["Random"].is_linked and not (
                 self._unlinked_zero(node, "Random Roughness") and self._unlinked_zero(node, "Random Color")):
-            self.warn(node, "Random Roughness and Random Color need the strand's random value, which is not "
-                            "exported: strands are shaded with random 0")
+            _, kb = self.resources.hair_info_layers()
+            random = f"g->uv[{kb}].x" if kb >= 0 else "0.0f"
         var = f"hr{self.fn.counter}"
         self.fn.counter += 1
         add = self.fn.lines.append

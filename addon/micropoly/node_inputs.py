@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Input nodes: where a shading point is and what it sees (Texture
 Coordinate, UV Map, Geometry, Tangent, Fresnel, Layer Weight, Attribute,
-Light Path, Object Info) and constants (Value, RGB).
+Hair Info, Light Path, Object Info) and constants (Value, RGB).
 
 Each function takes the NodeCompiler and the node and returns the node's
 outputs by socket identifier as (expression, kind, value range or None);
@@ -108,6 +108,29 @@ def emit_attribute(c, node):
             "Alpha": (f"{rgba}.w", FLOAT, None)}
 
 
+def emit_hair_info(c, node):
+    """Hair Info (Curves Info in 4.x): a curve's intercept (its arc length
+    to the point over its length, linear between keys), length, random
+    (Cycles' hash of the curve's number) and thickness (its diameter),
+    carried per point in two attribute layers (export_curves.py); Tangent
+    Normal from the fibre's direction. Zero on meshes, as in Cycles."""
+    ka, kb = c.resources.hair_info_layers()
+    zero = ("0.0f", FLOAT, (0.0, 0.0))
+    if ka < 0:
+        outs = {"Is Strand": zero, "Intercept": zero, "Length": zero, "Thickness": zero, "Random": zero,
+                "Tangent Normal": ("(float3)(0.0f)", VEC, None)}
+    else:
+        # Every curve has a length; meshes read zero.
+        strand = c.fn.temp(FLOAT, f"(g->uv[{ka}].y > 0.0f ? 1.0f : 0.0f)", (0.0, 1.0))
+        outs = {"Is Strand": strand, "Intercept": (f"g->uv[{ka}].x", FLOAT, (0.0, 1.0)),
+                "Length": (f"g->uv[{ka}].y", FLOAT, None), "Random": (f"g->uv[{kb}].x", FLOAT, (0.0, 1.0)),
+                "Thickness": (f"g->uv[{kb}].y", FLOAT, None)}
+        if node.outputs["Tangent Normal"].is_linked:
+            c.uses_hair = True  # the fibre's direction (material_program.cl)
+            outs["Tangent Normal"] = c.fn.temp(VEC, f"{strand[0]} * mp_hair_tangent_normal(g)")
+    return {node.outputs[name].identifier: value for name, value in outs.items() if name in node.outputs}
+
+
 def emit_light_path(c, node):
     """Light Path: what a camera ray shading direct light sees (every
     depth 0, no scattering), a shadow map's ray where Micropoly
@@ -154,6 +177,7 @@ NODES = {
     "LAYER_WEIGHT": emit_layer_weight,
     "ATTRIBUTE": emit_attribute,
     "VERTEX_COLOR": emit_attribute,
+    "HAIR_INFO": emit_hair_info,
     "LIGHT_PATH": emit_light_path,
     "OBJECT_INFO": emit_object_info,
     "VALUE": emit_value,

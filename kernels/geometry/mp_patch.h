@@ -73,7 +73,7 @@
  * layers + layer)]. Inside the patch UVs are bilinear in the corners (exact
  * for flat faces and for OpenSubdiv's linearly interpolated face-varying
  * data); mp_patch_uv in mp_surface.h evaluates them watertight. */
-#define MP_MAX_UV_LAYERS 4
+#define MP_MAX_UV_LAYERS 8
 
 /* Smooth shading normals: 4 float4 per patch at patch_normals[4 * patch],
  * the normals at corners (0,0), (1,0), (1,1), (0,1) (camera space on the

@@ -94,7 +94,7 @@ inline MpNodeGlobals mp_node_globals(__global const DeviceObject* o, float3 p, f
   g.generated = (float3)(size.x > MP_FLAT_TEXSPACE ? rel.x / (2.0f * size.x) : 0.0f,
                          size.y > MP_FLAT_TEXSPACE ? rel.y / (2.0f * size.y) : 0.0f,
                          size.z > MP_FLAT_TEXSPACE ? rel.z / (2.0f * size.z) : 0.0f) + (float3)(0.5f, 0.5f, 0.5f);
-  for (uint k = 0; k < MP_MAX_UV_LAYERS; ++k) {
+  for (uint k = 0; k < MP_NODE_USES_UV_LAYERS; ++k) {
     float2 t = k < in->uv_layers ? mp_patch_uv(in->uvs, in->uv_layers, in->edges, patch, k, uv.x, uv.y) : (float2)(0.0f);
     g.uv[k] = (float3)(t.x, t.y, 0.0f);
   }
@@ -119,7 +119,7 @@ inline MpNodeGlobals mp_node_globals_step(const MpNodeGlobals* g, const MpNodeGl
   r.generated = g->generated + tx * (x->generated - g->generated) + ty * (y->generated - g->generated);
   r.camera = g->camera + tx * (x->camera - g->camera) + ty * (y->camera - g->camera);
   r.window = g->window + tx * (x->window - g->window) + ty * (y->window - g->window);
-  for (uint k = 0; k < MP_MAX_UV_LAYERS; ++k) r.uv[k] = g->uv[k] + tx * (x->uv[k] - g->uv[k]) + ty * (y->uv[k] - g->uv[k]);
+  for (uint k = 0; k < MP_NODE_USES_UV_LAYERS; ++k) r.uv[k] = g->uv[k] + tx * (x->uv[k] - g->uv[k]) + ty * (y->uv[k] - g->uv[k]);
   r.dx = 0;
   r.dy = 0;
   return r;
@@ -327,7 +327,7 @@ float3 mp_world_radiance(float3 d, const MpProgramInputs* in, int camera_ray, fl
   g.generated = d;
   g.camera = camera;
   g.window = window;
-  for (uint k = 0; k < MP_MAX_UV_LAYERS; ++k) g.uv[k] = (float3)(0.0f);
+  for (uint k = 0; k < MP_NODE_USES_UV_LAYERS; ++k) g.uv[k] = (float3)(0.0f);
   g.object = 0;
   g.attributes = 0;
   g.attribute_count = 0;

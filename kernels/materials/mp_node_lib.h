@@ -26,6 +26,14 @@
  * node compiler turns a BSDF's into object space where it enters the
  * closures (MpSurface's normals, which shade_program_grids maps to camera
  * space). */
+/* How many UV layers a program reads: the node compiler says
+ * ("#define MP_NODE_USES_UV_LAYERS n", the layers the scene's materials had
+ * taken when it compiled this one), so a program keeps only those in its
+ * globals; every layer where it does not say. */
+#ifndef MP_NODE_USES_UV_LAYERS
+#define MP_NODE_USES_UV_LAYERS MP_MAX_UV_LAYERS
+#endif
+
 typedef struct MpNodeGlobals {
   float3 P;
   float3 N;  /* unit normal, object space */
@@ -42,7 +50,7 @@ typedef struct MpNodeGlobals {
   float3 fibre;     /* unit direction of the patch's v (a hair tube's root to tip), object space;
                        computed only for programs with hair closures (MP_NODE_USES_HAIR), else zero */
   float fibre_radius; /* a hair tube's radius (camera space; 0 where unknown), likewise */
-  float3 uv[MP_MAX_UV_LAYERS];
+  float3 uv[MP_NODE_USES_UV_LAYERS]; /* the layers the program reads (see below) */
   MP_GLOBAL const DeviceObject* object; /* object <-> world (world-space nodes), or null */
   /* The object's values of the Attribute nodes of type Object or Instancer
    * (the slots the add-on numbers, export_attributes.py), or null. */
@@ -168,6 +176,16 @@ MP_INLINE float3 mp_uv_tangent(const MpNodeGlobals* g, int ta, int tb, float* si
 MP_INLINE float3 mp_world_tangent(const MpNodeGlobals* g, float3 t) {
   float3 w = mp_object_normal_to_world(g, t);
   return cross(g->Nw, mp_nl_safe_normalize(cross(w, g->Nw)));
+}
+
+/* Hair Info's Tangent Normal: the direction to the viewer with its part
+ * along the fibre removed (Cycles' curve_tangent_normal), in world space;
+ * zero off hair (g->fibre unset). */
+MP_INLINE float3 mp_hair_tangent_normal(const MpNodeGlobals* g) {
+  float3 t = g->object ? mp_nl_rows(g->object->to_world, g->fibre) : g->fibre;
+  float tt = dot(t, t);
+  if (!(tt > 0.0f)) return MP_F3(0.0f, 0.0f, 0.0f);
+  return mp_nl_safe_normalize(g->I - t * (dot(t, g->I) / tt));
 }
 
 /* The cosine between the view and object-space normal n (the Principled

@@ -14,6 +14,7 @@
 #include "rib/rib_reader.h"
 #include "rib/rib_writer.h"
 #include "renderer_fixture.h"
+#include "scene/curves.h"
 #include "core/mp_compat.h"
 #include "materials/mp_surface_record.h"
 #include "pipeline/materials/material_programs.h"
@@ -113,6 +114,67 @@ TEST_F(MaterialProgramTest, SurfaceProgramReadsUVLayers) {
   s.meshes[0] = grid_mesh(12, 6.0f, SubdivScheme::CatmullClark);
   set_affine_uvs(s.meshes[0]);
   expect_affine_uv_colours(renderer_->render(s), "subdivided grid");
+}
+
+// A curve's per-point values (CurveSet::point_layers) reach the program
+// blended linearly along it, on every piece the tube's bends cut a segment
+// into: a zig-zag towards the camera whose keys are evenly spaced in x
+// carries x itself, which a Catmull-Rom curve reproduces exactly in its
+// inner segments, so the value read is the point's x to within the tube's
+// radius.
+TEST_F(MaterialProgramTest, CurvePointValuesFollowTheCurve) {
+  Scene s = facing_plane(static_cast<int>(Material::Model::Constant));
+  s.meshes.clear();
+  s.settings.width = s.settings.height = 160;
+  s.material_programs.push_back({"along", std::string(kNoDisplacement) +
+                                              "void mp_node_surface(const MpNodeGlobals* g, MpSurface* s) {"
+                                              " mp_add_emission(s, (float3)(g->uv[0].x, (g->P.x + 2.0f) / 4.0f,"
+                                              " g->uv[0].y)); }\n"});
+  s.materials[0].program_shades = true;
+  CurveSet curves;
+  curves.name = "zig-zag";
+  curves.point_layers.resize(1);
+  for (int k = 0; k <= 8; ++k) {
+    const float x = -2.0f + 0.5f * float(k);
+    curves.points.emplace_back(x, 0.3f * float(k % 3) - 0.3f, k % 2 ? 0.5f : -0.5f);
+    curves.radii.push_back(0.08f);
+    curves.point_layers[0].emplace_back((x + 2.0f) / 4.0f, 0.25f);
+  }
+  curves.offsets = {0, 9};
+  ASSERT_EQ(add_curves(s, curves), 0u);
+  ASSERT_EQ(s.bezier_patches.size(), 1u);
+  const BezierPatches& set = s.bezier_patches[0];
+  ASSERT_EQ(set.uv_layers.size(), 1u);
+  EXPECT_EQ(set.uv_layers[0].size(), set.control_points.size() / 4);
+  EXPECT_GT(set.control_points.size() / 16, size_t(8 * kTubePatchesPerSegment)) << "the bends cut no segment";
+  // Each ring's centre (the mean of its four quarters' first points) is on
+  // the curve: in the inner segments its x is what the value says.
+  for (size_t p = 0; p + kTubePatchesPerSegment <= set.control_points.size() / 16; p += kTubePatchesPerSegment)
+    for (int row : {0, 3}) {
+      glm::vec3 centre(0.0f);
+      for (int q = 0; q < kTubePatchesPerSegment; ++q) centre += set.control_points[16 * (p + q) + 4 * row] / 4.0f;
+      if (std::fabs(centre.x) > 1.45f) continue;
+      for (int q = 0; q < kTubePatchesPerSegment; ++q)
+        for (int corner : {0, 1}) {
+          const float value = set.uv_layers[0][4 * (p + q) + (row ? 2 : 0) + corner].x;
+          EXPECT_NEAR(value, (centre.x + 2.0f) / 4.0f, 1e-5f) << "patch " << p + q << " row " << row;
+        }
+    }
+  const RenderResult r = renderer_->render(s);
+  double error = 0.0, worst = 0.0;
+  int covered = 0;
+  for (size_t px = 0; px < r.rgba.size(); px += 4) {
+    if (r.rgba[px + 3] < 0.999f || r.rgba[px + 1] < 0.2f || r.rgba[px + 1] > 0.8f) continue;  // inner segments
+    const double e = std::fabs(double(r.rgba[px]) - double(r.rgba[px + 1]));
+    error += e, worst = std::max(worst, e), ++covered;
+    EXPECT_NEAR(r.rgba[px + 2], 0.25f, 1e-4f);
+  }
+  // A surface point is at most the radius from the centre line in x: 0.08
+  // over the 4 units the values span. A piece given another piece's values
+  // would be off by up to a segment's 0.125.
+  ASSERT_GT(covered, 100);
+  EXPECT_LT(worst, 0.08 / 4.0 + 0.003) << covered << " pixels";
+  EXPECT_LT(error / covered, 0.015);
 }
 
 // RIB carries material programs (Attribute "micropoly" "string program"):

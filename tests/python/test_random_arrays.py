@@ -140,11 +140,26 @@ def add_mesh(rng, scene):
         )
 
 
+def add_curves(rng, scene):
+    n_points = int(rng.integers(0, 30))
+    offsets = np.sort(rng.integers(0, n_points + 1, size=int(rng.integers(1, 5)))).astype(np.int32)
+    kwargs = {}
+    if rng.random() < 0.5:
+        kwargs["point_layers"] = array(rng, (int(rng.integers(1, 10)), n_points, 2))
+    if rng.random() < 0.2:
+        steps = int(rng.integers(0, 4))
+        kwargs["motion_points"] = array(rng, (steps, n_points, 3))
+    scene.add_curves("c", array(rng, (n_points, 3)), array(rng, (n_points,)),
+                     offsets if rng.random() < 0.7 else array(rng, (int(rng.integers(0, 5)),), "int"), **kwargs)
+
+
 def one_call(rng, scene):
-    which = rng.choice(["mesh", "mesh", "mesh", "camera", "motion", "dof", "material", "program", "light", "image",
-                        "world", "settings"])
+    which = rng.choice(["mesh", "mesh", "mesh", "curves", "camera", "motion", "dof", "material", "program", "light",
+                        "image", "world", "settings"])
     if which == "mesh":
         add_mesh(rng, scene)
+    elif which == "curves":
+        add_curves(rng, scene)
     elif which == "camera":
         scene.set_camera(array(rng, (4, 4)), orthographic=bool(rng.random() < 0.3), fov_degrees=scalar(rng),
                          clip_near=scalar(rng), clip_far=scalar(rng),

@@ -89,6 +89,11 @@ struct BezierPatches {
   // u runs around a round section (hair tubes): the camera dices at least a
   // few micropolygons across u, whatever the size on screen (MP_PATCH_ROUND_U).
   bool round_u = false;
+  // What material programs read as UV layer k (as Mesh::uv_layers): 4 values
+  // per patch, at its corners (0,0), (1,0), (1,1), (0,1), interpolated
+  // bilinearly across it. Hair tubes carry their curves' UVs, attributes and
+  // Hair Info values here (scene/curves.h). Empty: zeros.
+  std::vector<std::vector<glm::vec2>> uv_layers;
   // Motion blur (Scene::motion_steps): the control points and the transform
   // at each motion step, or empty where they do not move (as Mesh).
   std::vector<std::vector<glm::vec3>> motion_control_points;
@@ -285,7 +290,8 @@ struct Camera {
   // as Cycles defines them.
   float lens_radius = 0.0f;
   float focus_distance = 10.0f;
-  int aperture_blades = 0;
+  int aperture_blades = 0;  // at most kMaxApertureBlades
+  static constexpr int kMaxApertureBlades = 1000;
   float aperture_rotation = 0.0f;
   float aperture_ratio = 1.0f;
   // Motion blur (Scene::motion_steps): the camera at each step, or empty.

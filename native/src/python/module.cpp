@@ -621,7 +621,7 @@ PYBIND11_MODULE(_native, m) {
              const Array<int>& offsets, const Array<float>& object_to_world, int material, bool visible_camera,
              bool cast_shadows, std::vector<float> object_color, float pass_index, float random,
              const Array<float>& attributes, const Array<float>& motion_points,
-             const Array<float>& motion_object_to_world) {
+             const Array<float>& motion_object_to_world, const Array<float>& point_layers) {
             CurveSet curves;
             curves.name = name;
             curves.points = to_points(points, "points");
@@ -636,6 +636,14 @@ PYBIND11_MODULE(_native, m) {
             curves.info = to_object_info("curves '" + name + "'", object_color, pass_index, random, attributes);
             curves.motion_object_to_world = to_matrices(motion_object_to_world, "motion_object_to_world");
             curves.motion_points = to_motion_points(motion_points, "curves '" + name + "'");
+            if (point_layers.size() > 0) {
+              if (point_layers.ndim() != 3 || point_layers.shape(2) != 2)
+                throw Error("curves '" + name + "': point_layers must be a (layers, points, 2) array");
+              for (py::ssize_t k = 0; k < point_layers.shape(0); ++k) {
+                const auto* first = reinterpret_cast<const glm::vec2*>(point_layers.data(k, 0, 0));
+                curves.point_layers.emplace_back(first, first + point_layers.shape(1));
+              }
+            }
             return add_curves(s, curves);
           },
           py::arg("name"), py::arg("points"), py::arg("radii"), py::arg("offsets"),
@@ -643,10 +651,12 @@ PYBIND11_MODULE(_native, m) {
           py::arg("cast_shadows") = true, py::arg("object_color") = std::vector<float>{1, 1, 1, 1},
           py::arg("pass_index") = 0.0f, py::arg("random") = 0.0f, py::arg("attributes") = Array<float>(),
           py::arg("motion_points") = Array<float>(), py::arg("motion_object_to_world") = Array<float>(),
+          py::arg("point_layers") = Array<float>(),
           "Adds curves (Catmull-Rom keys: points (points, 3), radii (points,), object space; curve c has the "
           "points [offsets[c], offsets[c + 1])) as round tubes of Bezier patches (scene/curves.h), with their "
           "motion where they move: the points at each motion step (steps, points, 3) and the object-to-world "
-          "matrices (steps, 4, 4). Returns how many curves were skipped (fewer than 2 points, or a point or "
+          "matrices (steps, 4, 4). point_layers (layers, points, 2): what material programs read as UV layer "
+          "k, one value per point, linear along the curve. Returns how many curves were skipped (fewer than 2 points, or a point or "
           "radius not finite, a radius below 0).")
       .def(
           "add_points",

@@ -119,7 +119,7 @@ void Parser::micropoly_option(ArgReader& args, const ParamList& params) {
   // Depth of field beyond RiDepthOfField: Cycles' aperture shape and the
   // coarser dicing of blurred surfaces.
   Camera& cam = result_.scene.camera;
-  params.get_int("apertureblades", 0, 1000, &cam.aperture_blades);
+  params.get_int("apertureblades", 0, Camera::kMaxApertureBlades, &cam.aperture_blades);
   cam.aperture_rotation = params.get_float_checked("aperturerotation", cam.aperture_rotation,
                                                    [](float v) { return std::isfinite(v); }, "a finite angle in radians");
   cam.aperture_ratio = params.get_float_checked("apertureratio", cam.aperture_ratio, positive, "a positive number");

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 
+#include "geometry/mp_patch.h"
 #include "micropoly/error.h"
 #include "scene/quadrics.h"
 
@@ -142,6 +143,25 @@ void tube(const std::vector<CurveSegment>& input, const std::vector<int>& levels
   }
 }
 
+// Appends to the set's UV layers the corner values of one curve's tube
+// patches (as tube() emits them: segment i cut into 2^levels[i] pieces, four
+// quarter-turn patches each, v along the curve): the values at the curve's
+// keys, from point `first` on, blended linearly along each segment.
+void tube_layers(const CurveSet& curves, size_t first, const std::vector<int>& levels, BezierPatches& set) {
+  for (size_t l = 0; l < curves.point_layers.size(); ++l) {
+    const std::vector<glm::vec2>& values = curves.point_layers[l];
+    std::vector<glm::vec2>& out = set.uv_layers[l];
+    for (size_t i = 0; i < levels.size(); ++i) {
+      const int pieces = 1 << levels[i];
+      for (int j = 0; j < pieces; ++j) {
+        const glm::vec2 lo = glm::mix(values[first + i], values[first + i + 1], float(j) / float(pieces));
+        const glm::vec2 hi = glm::mix(values[first + i], values[first + i + 1], float(j + 1) / float(pieces));
+        for (int q = 0; q < kTubePatchesPerSegment; ++q) out.insert(out.end(), {lo, lo, hi, hi});
+      }
+    }
+  }
+}
+
 // The patch set that holds a curve set's tubes, without patches yet.
 BezierPatches tube_set(const CurveSet& curves) {
   BezierPatches set;
@@ -153,6 +173,7 @@ BezierPatches tube_set(const CurveSet& curves) {
   set.cast_shadows = curves.cast_shadows;
   set.info = curves.info;
   set.round_u = true;
+  set.uv_layers.resize(curves.point_layers.size());
   return set;
 }
 
@@ -193,6 +214,17 @@ size_t add_curves(Scene& scene, const CurveSet& curves) {
     for (const glm::vec3& v : curves.motion_points[step])
       if (!finite(v)) throw Error("curves '" + curves.name + "': a motion point is not finite");
   }
+  if (curves.point_layers.size() > MP_MAX_UV_LAYERS)
+    throw Error("curves '" + curves.name + "': " + std::to_string(curves.point_layers.size()) +
+                " UV layers; at most " + std::to_string(MP_MAX_UV_LAYERS) + " are supported");
+  for (const std::vector<glm::vec2>& layer : curves.point_layers) {
+    if (layer.size() != curves.points.size())
+      throw Error("curves '" + curves.name + "': a UV layer has " + std::to_string(layer.size()) +
+                  " values; it needs one per point (" + std::to_string(curves.points.size()) + ")");
+    for (const glm::vec2& v : layer)
+      if (!std::isfinite(v.x) || !std::isfinite(v.y))
+        throw Error("curves '" + curves.name + "': a UV layer value is not finite");
+  }
   BezierPatches set = tube_set(curves);
   set.motion_object_to_world = curves.motion_object_to_world;
   set.motion_control_points.resize(curves.motion_points.size());
@@ -219,6 +251,7 @@ size_t add_curves(Scene& scene, const CurveSet& curves) {
     levels.resize(segs.size());
     for (size_t i = 0; i < segs.size(); ++i) levels[i] = halvings(segs[i]);
     tube(segs, levels, set.control_points);
+    tube_layers(curves, size_t(off[c]), levels, set);
     // Each motion step's tube, cut as the shutter centre's is.
     for (size_t step = 0; step < curves.motion_points.size(); ++step) {
       for (int p = off[c]; p < off[c + 1]; ++p) k[size_t(p - off[c])] = curves.motion_points[step][size_t(p)];

@@ -31,6 +31,11 @@ struct CurveSet {
   std::vector<glm::vec3> points;  // object space, all curves' keys in order
   std::vector<float> radii;       // one per point
   std::vector<int> offsets;       // curves + 1: curve c has points [offsets[c], offsets[c + 1])
+  // What material programs read as UV layer k (BezierPatches::uv_layers): one
+  // value per point, linear along each segment in its parameter, as Cycles
+  // interpolates curve-key attributes (a curve's own values repeat on its
+  // points). The add-on puts UV maps, attributes and Hair Info here.
+  std::vector<std::vector<glm::vec2>> point_layers;
   glm::mat4 object_to_world{1.0f};
   int material = 0;
   ObjectInfo info;

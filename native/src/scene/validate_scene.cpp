@@ -233,6 +233,16 @@ void validate_patches(const BezierPatches& b, size_t materials) {
   if (!finite(b.object_to_world)) fail("patch set", b.name, "transform contains NaN or infinite values");
   check_extent(b.control_points, b.object_to_world, "patch set", b.name);
   check_material_index(b.material, materials, "patch set", b.name);
+  if (b.uv_layers.size() > MP_MAX_UV_LAYERS)
+    fail("patch set", b.name, "has " + std::to_string(b.uv_layers.size()) + " UV layers; at most " +
+                                  std::to_string(MP_MAX_UV_LAYERS) + " are supported");
+  for (const auto& layer : b.uv_layers) {
+    if (layer.size() != b.control_points.size() / 4)
+      fail("patch set", b.name, "has a UV layer of " + std::to_string(layer.size()) + " values; it needs 4 per patch (" +
+                                    std::to_string(b.control_points.size() / 4) + ")");
+    for (const glm::vec2& uv : layer)
+      if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) fail("patch set", b.name, "has a NaN or infinite UV value");
+  }
 }
 
 // Prototypes are checked once, in their own space; each instance by its
@@ -341,8 +351,9 @@ void validate_scene(const Scene& scene) {
       throw Error("camera focus distance must be a positive number when depth of field is on");
     if (!(c.aperture_ratio > 0) || !std::isfinite(c.aperture_ratio))
       throw Error("camera aperture ratio must be a positive number");
-    if (!std::isfinite(c.aperture_rotation) || c.aperture_blades < 0)
-      throw Error("camera aperture blades must be >= 0 and its rotation finite");
+    if (!std::isfinite(c.aperture_rotation) || c.aperture_blades < 0 || c.aperture_blades > Camera::kMaxApertureBlades)
+      throw Error("camera aperture blades must be in [0, " + std::to_string(Camera::kMaxApertureBlades) +
+                  "] and its rotation finite");
   }
   if (scene.motion_steps != 0 && (scene.motion_steps < 2 || scene.motion_steps > kMaxMotionSteps))
     throw Error("motion blur needs 2 to " + std::to_string(kMaxMotionSteps) + " motion steps, not " +
@@ -399,8 +410,9 @@ void validate_scene(const Scene& scene) {
     throw Error("world: the radiance map's size does not match its width and height");
   for (float v : w.radiance)
     if (!std::isfinite(v)) throw Error("world: the radiance map holds a NaN or infinite value");
-  if (!std::isfinite(w.diffuse) || !std::isfinite(w.glossy) || w.diffuse < 0.0f || w.glossy < 0.0f)
-    throw Error("world: its diffuse and glossy visibility must be finite and not negative");
+  // Ray Visibility as a fraction of the light (RIB's reader takes the same range).
+  if (!(w.diffuse >= 0.0f && w.diffuse <= 1.0f && w.glossy >= 0.0f && w.glossy <= 1.0f))
+    throw Error("world: its diffuse and glossy visibility must be in [0, 1]");
   if (scene.settings.world_probes < 0 || scene.settings.world_probes > 64)
     throw Error("world: world_probes must be 0 to 64, not " + std::to_string(scene.settings.world_probes));
   for (size_t i = 0; i < scene.lights.size(); ++i) {

@@ -1,5 +1,6 @@
 // Bicubic Bezier patch sets: the 16 control points already are the device
 // net (cp[4*j + i], u fastest); the partners repeat the interior points.
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -22,12 +23,20 @@ void append_bezier_patches(const BezierPatches& set, const glm::mat4& to_space, 
   if (set.round_u) common.flags |= MP_PATCH_ROUND_U;
   out.points.reserve(out.points.size() + count * MP_PATCH_POINTS);
   out.info.reserve(out.info.size() + count);
+  for (const auto& layer : set.uv_layers)
+    if (layer.size() != 4 * count)
+      throw Error("bezier patches '" + set.name + "': a UV layer has " + std::to_string(layer.size()) +
+                  " values; it needs 4 per patch");
+  // The set's corner UVs of each layer the buffer holds (zeros past its own).
+  std::vector<glm::vec2> corners(4 * size_t(std::max(out.uv_layers, 0)));
   for (size_t patch_index = 0; patch_index < count; ++patch_index) {
     subdiv_detail::DevicePatch patch;
     for (int k = 0; k < 16; ++k) patch[k] = glm::dvec3(set.control_points[16 * patch_index + k]);
     subdiv_detail::set_bezier_partners(patch);
-    subdiv_detail::append_device_patch(patch, MP_PATCH_BEZIER, set.material, int(patch_index), common,
-                                       out);
+    for (size_t k = 0; k < corners.size(); ++k)
+      corners[k] = k / 4 < set.uv_layers.size() ? set.uv_layers[k / 4][4 * patch_index + k % 4] : glm::vec2(0.0f);
+    subdiv_detail::append_device_patch(patch, MP_PATCH_BEZIER, set.material, int(patch_index), common, out,
+                                       set.uv_layers.empty() ? nullptr : corners.data());
   }
 }
 

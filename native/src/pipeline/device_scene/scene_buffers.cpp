@@ -257,9 +257,14 @@ HostSceneData prepare_scene_data(const Scene& scene, PatchCache* cache) {
   for (const Instance& inst : scene.instances) attribute_slots(inst.info);
   for (const Mesh& mesh : scene.meshes)
     out.patches.uv_layers = std::max(out.patches.uv_layers, int(mesh.uv_layers.size()));
-  for (const Prototype& proto : scene.prototypes)
+  for (const BezierPatches& set : scene.bezier_patches)
+    out.patches.uv_layers = std::max(out.patches.uv_layers, int(set.uv_layers.size()));
+  for (const Prototype& proto : scene.prototypes) {
     for (const Mesh& mesh : proto.meshes)
       out.patches.uv_layers = std::max(out.patches.uv_layers, int(mesh.uv_layers.size()));
+    for (const BezierPatches& set : proto.bezier_patches)
+      out.patches.uv_layers = std::max(out.patches.uv_layers, int(set.uv_layers.size()));
+  }
   // Each surface's patches share their edges' curves (patch_edges.h), so
   // neighbouring patches dice watertight; separate surfaces do not.
   std::vector<PatchCache::Surface> surfaces;
