@@ -175,6 +175,15 @@ TEST_F(MaterialProgramTest, CurvePointValuesFollowTheCurve) {
   ASSERT_GT(covered, 100);
   EXPECT_LT(worst, 0.08 / 4.0 + 0.003) << covered << " pixels";
   EXPECT_LT(error / covered, 0.015);
+
+  // Written to RIB (each Patch with its corner values) and read back.
+  std::ostringstream written;
+  write_rib(s, written);
+  const RibResult back = read_rib_string(written.str(), "curves.rib");
+  ASSERT_EQ(back.scene.bezier_patches.size(), 1u);
+  EXPECT_EQ(back.scene.bezier_patches[0].uv_layers, set.uv_layers);
+  const RenderResult again = renderer_->render(back.scene);
+  EXPECT_EQ(again.rgba, r.rgba);
 }
 
 // RIB carries material programs (Attribute "micropoly" "string program"):

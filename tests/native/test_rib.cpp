@@ -279,7 +279,9 @@ TEST(RibOrientation, MirroringFlipsTheHandedness) {
 TEST(RibOrientation, PatchesFollowDpduCrossDpdv) {
   // RenderMan's patch normal is dPdu x dPdv (flipped when inside out).
   // Here dPdu = +y and dPdv = +x, so the normal is -z: towards the camera.
-  const std::string patch = "Patch \"bilinear\" \"P\" [0 0 0  0 1 0  1 0 0  1 1 0]\n";
+  // Its corner values say which corner each is: (u, v) = (y, x).
+  const std::string patch = "Patch \"bilinear\" \"P\" [0 0 0  0 1 0  1 0 0  1 1 0] "
+                            "\"varying float[2] micropoly:uv0\" [0 0  1 0  0 1  1 1]\n";
   for (bool reversed : {false, true}) {
     const mp::RibResult r = parse("Translate 0 0 5\nWorldBegin\n" +
                                   std::string(reversed ? "ReverseOrientation\n" : "") + patch +
@@ -292,6 +294,12 @@ TEST(RibOrientation, PatchesFollowDpduCrossDpdv) {
     const glm::vec3 n = glm::inverseTranspose(glm::mat3(to_camera)) * glm::cross(dpdu, dpdv);
     const glm::vec3 p = apply(to_camera, cp[5]);
     EXPECT_EQ(glm::dot(n, -p) > 0.0f, !reversed);
+    // The corners (0,0), (1,0), (1,1), (0,1) keep their values, mirrored or not.
+    ASSERT_EQ(set.uv_layers.size(), 1u);
+    const int corner_points[4] = {0, 3, 15, 12};
+    for (int c = 0; c < 4; ++c)
+      EXPECT_EQ(set.uv_layers[0][size_t(c)], glm::vec2(cp[size_t(corner_points[c])].y, cp[size_t(corner_points[c])].x))
+          << "corner " << c << (reversed ? " reversed" : "");
   }
 }
 

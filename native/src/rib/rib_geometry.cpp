@@ -399,6 +399,7 @@ void Parser::req_patch(ArgReader& args) {
   else
     bilinear_to_bezier(points.data(), net);
   prim.patch_points.assign(net, net + 16);
+  read_patch_primvars(args, params, &prim);
   prim.mergeable = true;
   place(std::move(prim), args);
 }

@@ -374,6 +374,29 @@ void Parser::read_face_materials(ArgReader& args, const ParamList& params, size_
   *out = args.int_array(*p->value, 0, count - 1, "micropoly:material");
 }
 
+void Parser::read_patch_primvars(ArgReader& args, const ParamList& params, Primitive* prim) const {
+  prim->patch_uvs.clear();
+  for (int k = 0; k < MP_MAX_UV_LAYERS; ++k) {
+    const std::string name = "micropoly:uv" + std::to_string(k);
+    const Param* p = params.find(name);
+    if (!p) {
+      prim->patch_uvs.emplace_back(4, glm::vec2(0.0f));  // a gap reads zeros
+      continue;
+    }
+    const std::vector<double>& v = p->value->numbers;
+    if (p->decl.is_string() || p->decl.components() != 2 || v.size() != 8)
+      args.fail_at(p->line, "\"" + name + "\" needs two floats at each of the patch's 4 corners, found " +
+                                std::to_string(v.size()) + " values");
+    auto at = [&](int i) { return glm::vec2(static_cast<float>(v[size_t(2 * i)]), static_cast<float>(v[size_t(2 * i + 1)])); };
+    // RenderMan's (u0 v0), (u1 v0), (u0 v1), (u1 v1) -> (0,0), (1,0), (1,1), (0,1).
+    prim->patch_uvs.push_back({at(0), at(1), at(3), at(2)});
+  }
+  // Layers are numbered densely: the zeros past the last given one go.
+  while (!prim->patch_uvs.empty() &&
+         !params.find("micropoly:uv" + std::to_string(prim->patch_uvs.size() - 1)))
+    prim->patch_uvs.pop_back();
+}
+
 void Parser::read_mesh_primvars(ArgReader& args, const ParamList& params, const std::vector<int>& corners,
                                  size_t npoints, Mesh* mesh) const {
   mesh->uv_layers.clear();

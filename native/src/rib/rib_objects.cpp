@@ -20,17 +20,28 @@
 namespace mp::rib {
 namespace {
 
-// Appends `src`'s UV layers for its corners to `dst`, which had `dst_corners`
-// corners; a layer one side lacks reads zeros there, as a missing layer does.
-void append_uv_layers(Mesh& dst, size_t dst_corners, const Mesh& src) {
-  const size_t layers = std::max(dst.uv_layers.size(), src.uv_layers.size());
-  dst.uv_layers.resize(layers, std::vector<glm::vec2>(dst_corners, glm::vec2(0.0f)));
+// Appends UV layers `src` (src_count values each) to `dst` (dst_count each);
+// a layer one side lacks reads zeros there, as a missing layer does.
+void append_layers(std::vector<std::vector<glm::vec2>>& dst, size_t dst_count,
+                   const std::vector<std::vector<glm::vec2>>& src, size_t src_count) {
+  const size_t layers = std::max(dst.size(), src.size());
+  dst.resize(layers, std::vector<glm::vec2>(dst_count, glm::vec2(0.0f)));
   for (size_t k = 0; k < layers; ++k) {
-    if (k < src.uv_layers.size())
-      dst.uv_layers[k].insert(dst.uv_layers[k].end(), src.uv_layers[k].begin(), src.uv_layers[k].end());
+    if (k < src.size())
+      dst[k].insert(dst[k].end(), src[k].begin(), src[k].end());
     else
-      dst.uv_layers[k].resize(dst_corners + src.face_vertex_indices.size(), glm::vec2(0.0f));
+      dst[k].resize(dst_count + src_count, glm::vec2(0.0f));
   }
+}
+
+void append_uv_layers(Mesh& dst, size_t dst_corners, const Mesh& src) {
+  append_layers(dst.uv_layers, dst_corners, src.uv_layers, src.face_vertex_indices.size());
+}
+
+// Appends a patch primitive's corner UVs to the set it joins, which had
+// `first` patches before it.
+void append_patch_uvs(BezierPatches& dst, size_t first, const Primitive& prim) {
+  append_layers(dst.uv_layers, 4 * first, prim.patch_uvs, prim.patch_points.size() / 4);
 }
 
 // Appends `src`'s corner normals; when only one side has them, the other's
@@ -154,10 +165,11 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
   } else {
     if (merge) {
       BezierPatches& dst = scene.bezier_patches[merge_.index];
-      const size_t first = dst.control_points.size();
+      const size_t first = dst.control_points.size() / 16;
       dst.control_points.insert(dst.control_points.end(), prim.patch_points.begin(),
                                 prim.patch_points.end());
-      if (flip) mirror_patches_u(dst.control_points, first);
+      append_patch_uvs(dst, first, prim);
+      if (flip) mirror_patches_u(dst, first);
       return;
     }
     if (moving)
@@ -165,6 +177,7 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
     BezierPatches set;
     set.name = name;
     set.control_points = prim.patch_points;
+    set.uv_layers = prim.patch_uvs;
     set.object_to_world = object_to_world;
     set.material = material;
     set.double_sided = attrs.double_sided;
@@ -172,7 +185,7 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
     set.visible_camera = attrs.visible_camera;
     set.cast_shadows = attrs.cast_shadows;
     set.info = attrs.object_info;
-    if (flip) mirror_patches_u(set.control_points, 0);
+    if (flip) mirror_patches_u(set, 0);
     scene.bezier_patches.push_back(std::move(set));
   }
   has_merge_target_ = prim.mergeable && !moving;
@@ -253,6 +266,7 @@ void Parser::add_instance(ObjectDef& def, const std::string& key, int line) {
         BezierPatches set;
         set.name = p.origin;
         set.control_points = p.patch_points;
+        set.uv_layers = p.patch_uvs;
         set.object_to_world = p.local;
         proto.bezier_patches.push_back(std::move(set));
       }

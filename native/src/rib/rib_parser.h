@@ -84,6 +84,7 @@ struct Primitive {
   Kind kind = Kind::Mesh;
   Mesh mesh;                             // Kind::Mesh
   std::vector<glm::vec3> patch_points;   // Kind::Patches: Bezier nets, 16 per patch
+  std::vector<std::vector<glm::vec2>> patch_uvs;  // Kind::Patches: BezierPatches::uv_layers
   glm::mat4 local{1.0f};                 // relative to the object definition's frame
   bool mergeable = false;                // Polygon/Patch runs may share one scene object
   std::string origin;                    // "Request (file:line)" for naming
@@ -269,12 +270,16 @@ class Parser {
   // left empty when the parameter is absent.
   void read_face_materials(ArgReader& args, const ParamList& params, size_t faces,
                            std::vector<int>* out) const;
-  // UV layers ("micropoly:uv0".."micropoly:uv3", float[2], per face corner
+  // UV layers ("micropoly:uv0".."micropoly:uv7", float[2], per face corner
   // or per vertex) for the face corners `corners` (vertex indices), the
   // Generated texture space ("micropoly:texspacelocation", "...size") and,
   // for polygon meshes, shading normals ("N", per face corner or vertex).
   void read_mesh_primvars(ArgReader& args, const ParamList& params, const std::vector<int>& corners,
                            size_t npoints, Mesh* mesh) const;
+  // A Patch's corner UVs ("varying float[2] micropoly:uvK": 4 per layer, u
+  // fastest, as RenderMan orders a patch's varying values) into
+  // prim->patch_uvs (BezierPatches::uv_layers' corner order).
+  void read_patch_primvars(ArgReader& args, const ParamList& params, Primitive* prim) const;
   // Refuses a program `source` that reaches beyond the device
   // (rib_program_check.h) unless any path is allowed (the file is trusted).
   void check_program(const std::string& source, const ParamList& params, const std::string& what) const;

@@ -607,13 +607,21 @@ void write_mesh(std::string& o, const Mesh& m, const std::vector<Material>& mate
   o += "AttributeEnd\n";
 }
 
-// One Patch request per 4x4 net in the default Bezier basis (step 3).
-void write_patch_requests(std::string& o, const std::vector<glm::vec3>& control_points) {
+// One Patch request per 4x4 net in the default Bezier basis (step 3), with
+// its corner UVs (u fastest, RenderMan's order for a patch's varying values).
+void write_patch_requests(std::string& o, const BezierPatches& b) {
+  const std::vector<glm::vec3>& control_points = b.control_points;
   o += "  Basis \"bezier\" 3 \"bezier\" 3\n";
   for (size_t p = 0; p + 16 <= control_points.size(); p += 16) {
     o += "  Patch \"bicubic\" \"P\" ";
     put_points(o, std::vector<glm::vec3>(control_points.begin() + static_cast<long>(p),
                                          control_points.begin() + static_cast<long>(p + 16)));
+    for (size_t k = 0; k < b.uv_layers.size(); ++k) {
+      const glm::vec2* c = &b.uv_layers[k][p / 4];
+      const glm::vec2 corners[4] = {c[0], c[1], c[3], c[2]};
+      o += " \"varying float[2] micropoly:uv" + std::to_string(k) + "\" ";
+      put_floats(o, &corners[0].x, 8);
+    }
     o += '\n';
   }
 }
@@ -629,7 +637,7 @@ void write_patches(std::string& o, const BezierPatches& b, const std::vector<Mat
   o += "AttributeBegin\n";
   write_object_state(o, b, materials, programs);
   write_round_u(o, b);
-  write_patch_requests(o, b.control_points);
+  write_patch_requests(o, b);
   o += "AttributeEnd\n";
 }
 
@@ -691,7 +699,7 @@ void write_prototype(std::string& o, const Prototype& p, const WrittenPrototype&
     put_matrix(o, b.object_to_world);
     o += '\n';
     write_round_u(o, b);
-    write_patch_requests(o, b.control_points);
+    write_patch_requests(o, b);
     o += "AttributeEnd\n";
   }
   o += "ObjectEnd\n";

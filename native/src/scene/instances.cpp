@@ -22,11 +22,18 @@ void reverse_faces(Mesh& mesh, size_t first_face, size_t first_index) {
   }
 }
 
-void mirror_patches_u(std::vector<glm::vec3>& cps, size_t first) {
-  for (size_t p = first; p + 16 <= cps.size(); p += 16)
+void mirror_patches_u(BezierPatches& set, size_t first_patch) {
+  std::vector<glm::vec3>& cps = set.control_points;
+  for (size_t p = 16 * first_patch; p + 16 <= cps.size(); p += 16)
     for (size_t j = 0; j < 4; ++j) {
       std::swap(cps[p + 4 * j + 0], cps[p + 4 * j + 3]);
       std::swap(cps[p + 4 * j + 1], cps[p + 4 * j + 2]);
+    }
+  // Corners (0,0), (1,0), (1,1), (0,1): u = 0 and u = 1 trade places.
+  for (std::vector<glm::vec2>& layer : set.uv_layers)
+    for (size_t c = 4 * first_patch; c + 4 <= layer.size(); c += 4) {
+      std::swap(layer[c + 0], layer[c + 1]);
+      std::swap(layer[c + 2], layer[c + 3]);
     }
 }
 
@@ -63,7 +70,7 @@ Scene with_instances_made_real(const Scene& scene) {
     for (const BezierPatches& b : proto.bezier_patches) {
       BezierPatches copy = b;
       place(copy, inst, proto.name, i);
-      if (inst.reverse_orientation) mirror_patches_u(copy.control_points);
+      if (inst.reverse_orientation) mirror_patches_u(copy);
       out.bezier_patches.push_back(std::move(copy));
     }
   }

@@ -12,7 +12,8 @@ namespace mp {
 // `first_index`, with the per-corner data (UVs, corner normals) that belongs
 // to them.
 void reverse_faces(Mesh& mesh, size_t first_face = 0, size_t first_index = 0);
-// Mirrors each 4x4 net from `first` on in u, which negates dPdu and so the normal.
-void mirror_patches_u(std::vector<glm::vec3>& control_points, size_t first = 0);
+// Mirrors each patch from `first_patch` on in u, which negates dPdu and so
+// the normal: its 4x4 net and its corner UVs.
+void mirror_patches_u(BezierPatches& set, size_t first_patch = 0);
 
 }  // namespace mp

@@ -69,7 +69,7 @@ PrototypeVariants prototype_variants(const Scene& scene) {
         } else {
           BezierPatches b = proto.bezier_patches[size_t(s) - proto.meshes.size()];
           adapt(b);
-          if (inst.reverse_orientation) mirror_patches_u(b.control_points);
+          if (inst.reverse_orientation) mirror_patches_u(b);
           out.sets.push_back(std::move(b));
           out.surfaces.push_back({nullptr, &out.sets.back()});
         }
