@@ -241,22 +241,24 @@ def export_scene(depsgraph, view=None, meshes=None, motion=None):
     # depsgraph instances stay instances and move by their transforms).
     shared = {}
     seen = set()
+    used = {}  # the materials of every surface, compiled before any geometry
     for inst in depsgraph.object_instances:
         obj = inst.object
         if obj.type in ("MESH", "CURVES", "POINTCLOUD"):
-            # Every material before any geometry: the UV layers, attributes
-            # and Hair Info values a surface carries are those the
-            # materials ask for.
+            # The UV layers, attributes and Hair Info values a surface
+            # carries are those the materials ask for.
             pointers = (obj.as_pointer(), obj.data.as_pointer())
             if pointers not in seen:  # thousands of instances of one object: its materials once
                 seen.add(pointers)
-                for slot in obj.material_slots:
-                    materials.get(slot.material)
+                used.update((slot.material, None) for slot in obj.material_slots)
+                materials.point_clouds = materials.point_clouds or obj.type == "POINTCLOUD"
         if obj.type == "MESH":
             if motion is None and not inst.is_instance:
                 key = export_instances.InstanceTable.key(inst.object, shared_data=True)
                 if key is not None:
                     shared[key] = shared.get(key, 0) + 1
+    for material in used:
+        materials.get(material)
     instances = export_instances.InstanceTable(
         motion, export_attributes.InstanceAttributes(materials.object_attributes, out.warnings))
     for inst in depsgraph.object_instances:

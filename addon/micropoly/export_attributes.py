@@ -13,7 +13,12 @@ instance) and slot, looked up where Cycles and EEVEE look them up
 A number or boolean reads as (v, v, v, 1), a list of up to four numbers as
 its values over (0, 0, 0, 1); a name found nowhere reads zero. Slots are
 numbered by the material compiler (export_materials.Materials.object_attribute)
-before any object is exported, so every object carries all of them."""
+before any object is exported, so every object carries all of them.
+
+Each slot is (name, kind): "OBJECT", "INSTANCER", or for point clouds,
+whose every point is an instance of its own, "POINT" (a geometry attribute
+on the points) and "POINT_INFO" (Point Info's values); those two are
+filled per point by export_points.py and read zero everywhere else."""
 
 import numpy as np
 
@@ -51,7 +56,9 @@ def object_values(slots, obj):
     """(slots, 4): an object's own values (Object type, and Instancer type
     outside instances)."""
     out = np.zeros((len(slots), 4), dtype=np.float32)
-    for k, (name, _) in enumerate(slots):
+    for k, (name, kind) in enumerate(slots):
+        if kind not in ("OBJECT", "INSTANCER"):
+            continue
         v = rgba(obj, name) or rgba(getattr(obj, "data", None), name)
         if v is not None:
             out[k] = v
@@ -104,9 +111,9 @@ class InstanceAttributes:
         out = bases[e[:, 0]]
         for g, (_, arrays) in enumerate(self._instancers):
             mine = e[:, 1] == g
-            for k, (name, dupli) in enumerate(self.slots):
+            for k, (name, kind) in enumerate(self.slots):
                 a = arrays.get(name)
-                if not dupli or a is None:
+                if kind != "INSTANCER" or a is None:
                     continue
                 # A value the particle settings give comes first.
                 take = mine & ~found[e[:, 0], k] & (e[:, 2] >= 0) & (e[:, 2] < len(a))
@@ -121,8 +128,8 @@ class InstanceAttributes:
         first = np.zeros((n, 4), dtype=np.float32)
         found = np.zeros(n, dtype=bool)
         last = object_values(self.slots, obj)
-        for k, (name, dupli) in enumerate(self.slots):
-            if not dupli:
+        for k, (name, kind) in enumerate(self.slots):
+            if kind != "INSTANCER":
                 continue
             v = rgba(settings, name)
             if v is not None:
@@ -142,7 +149,7 @@ class InstanceAttributes:
         if pointer in self._geometry:
             return self._geometry[pointer]
         self._geometry[pointer] = -1
-        names = {name for name, dupli in self.slots if dupli}
+        names = {name for name, kind in self.slots if kind == "INSTANCER"}
         if not names or not any(m.type == "NODES" for m in getattr(parent, "modifiers", ())):
             return -1
         import bpy

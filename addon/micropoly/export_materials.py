@@ -103,6 +103,9 @@ class MaterialTable:
         # Attribute nodes of type Object or Instancer: (name, instancer) per
         # slot (export_attributes.py).
         self.object_attributes = []
+        # Whether the scene has point clouds: only then does an Attribute
+        # node of type Geometry take a slot for their points' values.
+        self.point_clouds = False
         self.images = export_images.ImageTable(native_scene)
         native_scene.add_material(name="default", **material_parameters(None))
 
@@ -149,11 +152,14 @@ class MaterialTable:
             return -1, -1
         return tuple(self.uv_layer(("hair", k)) for k in (0, 1))
 
-    def object_attribute(self, name, instancer):
-        """The slot of Attribute node value `name` (type Instancer when
-        `instancer`, else Object) that every object carries
-        (export_attributes.py)."""
-        key = (name, instancer)
+    def object_attribute(self, name, kind):
+        """The slot of value `name` of `kind` that every object carries
+        (export_attributes.py): Attribute nodes of type Object ("OBJECT") or
+        Instancer ("INSTANCER"), a point cloud's attribute ("POINT") or
+        Point Info ("POINT_INFO")."""
+        if kind in ("POINT", "POINT_INFO") and not self.point_clouds:
+            return -1
+        key = (name, kind)
         if key not in self.object_attributes:
             self.object_attributes.append(key)
         return self.object_attributes.index(key)

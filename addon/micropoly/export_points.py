@@ -3,11 +3,14 @@
 shape Cycles gives points: positions and radii read with foreach_get, handed
 over in one call; the native side places one shared unit sphere per point
 (native/src/scene/points.h). A point without a radius attribute has Cycles'
-0.01. Every point reads its cloud's Object Info and Attribute values."""
+0.01. Every point reads its cloud's Object Info and Attribute values, and
+its own in the slots of kind "POINT" (the cloud's attributes, which
+Attribute nodes of type Geometry read) and "POINT_INFO" (Point Info: its
+random number, Cycles' hash of its number, and its radius in world units)."""
 
 import numpy as np
 
-from . import export_attributes, export_mesh
+from . import export_attributes, export_curves, export_mesh
 
 
 def _attribute(pointcloud, name, width, prop):
@@ -41,8 +44,23 @@ def export_point_cloud(native_scene, materials, inst, matrix, warnings, motion=N
     radii = np.full(count, 0.01, dtype=np.float32) if radii is None else radii.reshape(-1)
     if motion is not None:
         warnings.append(f"point cloud '{obj.name}': points render at the shutter's centre, without motion blur")
-    skipped = native_scene.add_points(obj.name, positions, radii, object_to_world=matrix,
-                                      **export_attributes.object_arguments(obj, inst, materials))
+    args = export_attributes.object_arguments(obj, inst, materials)
+    slots = materials.object_attributes
+    if any(kind in ("POINT", "POINT_INFO") for _, kind in slots):
+        values = np.repeat(args.pop("attributes")[None], count, axis=0)
+        for k, (name, kind) in enumerate(slots):
+            if kind == "POINT_INFO":
+                values[:, k, 0] = export_mesh.random_from_ids(export_mesh.hash_uint2(np.arange(count), 0)
+                                                              .astype(np.int64))
+                values[:, k, 1] = radii * export_curves.transform_scale(matrix)
+                values[:, k, 2] = 1.0
+            elif kind == "POINT":
+                attr = pointcloud.attributes.get(name)
+                rgba = export_attributes.attribute_rgba(attr) if attr is not None and attr.domain == "POINT" else None
+                if rgba is not None:
+                    values[:, k] = rgba
+        args["point_attributes"] = values
+    skipped = native_scene.add_points(obj.name, positions, radii, object_to_world=matrix, **args)
     if skipped:
         warnings.append(f"point cloud '{obj.name}': {skipped} points with a position or radius that is not finite "
                         "and positive are skipped")

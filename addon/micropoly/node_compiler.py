@@ -82,7 +82,7 @@ class NoResources:
     def layer_count(self):
         return 1
 
-    def object_attribute(self, name, instancer):
+    def object_attribute(self, name, kind):
         return -1
 
     def image(self, image, warn):

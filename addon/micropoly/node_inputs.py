@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Input nodes: where a shading point is and what it sees (Texture
 Coordinate, UV Map, Geometry, Tangent, Fresnel, Layer Weight, Attribute,
-Hair Info, Light Path, Object Info) and constants (Value, RGB).
+Hair Info, Point Info, Light Path, Object Info) and constants (Value, RGB).
 
 Each function takes the NodeCompiler and the node and returns the node's
 outputs by socket identifier as (expression, kind, value range or None);
@@ -82,14 +82,16 @@ def emit_layer_weight(c, node):
 
 
 def emit_attribute(c, node):
-    """Attribute (Geometry type) and Color Attribute: a mesh attribute's
-    value per face corner, interpolated over the surface as UVs are
-    (two layers: RG and BA); Attribute of type Object or Instancer: the
-    object's or instance's value (export_attributes.py)."""
+    """Attribute (Geometry type) and Color Attribute: a mesh's or curve's
+    attribute, interpolated over the surface as UVs are (two layers: RG and
+    BA), plus a point cloud's, one value per point (a slot each point
+    carries: meshes and curves read zero there, points zero in the layers);
+    Attribute of type Object or Instancer: the object's or instance's value
+    (export_attributes.py)."""
     kind = getattr(node, "attribute_type", "GEOMETRY") if node.type == "ATTRIBUTE" else "GEOMETRY"
     if kind in ("OBJECT", "INSTANCER"):
         # One value per object or instance (export_attributes.py).
-        slot = c.resources.object_attribute(node.attribute_name, kind == "INSTANCER")
+        slot = c.resources.object_attribute(node.attribute_name, kind)
         if slot < 0:
             return {}
         rgba = c.fn.temp("float4", f"mp_object_attribute(g, {slot}u)")[0]
@@ -99,9 +101,15 @@ def emit_attribute(c, node):
     else:
         name = node.layer_name if node.type == "VERTEX_COLOR" else node.attribute_name
         ka, kb = c.resources.attribute_layers(name)
-        if ka < 0:
+        slot = c.resources.object_attribute(name, "POINT")
+        parts = []
+        if ka >= 0:
+            parts.append(f"(float4)(g->uv[{ka}].x, g->uv[{ka}].y, g->uv[{kb}].x, g->uv[{kb}].y)")
+        if slot >= 0:
+            parts.append(f"mp_object_attribute(g, {slot}u)")
+        if not parts:
             return {}
-        rgba = c.fn.temp("float4", f"(float4)(g->uv[{ka}].x, g->uv[{ka}].y, g->uv[{kb}].x, g->uv[{kb}].y)")[0]
+        rgba = c.fn.temp("float4", " + ".join(parts))[0]
     color = (f"{rgba}.xyz", VEC, None)
     # Fac: a float attribute's value, a colour's or vector's average (Cycles).
     return {"Color": color, "Vector": color, "Fac": (f"dot({rgba}.xyz, (float3)(1.0f / 3.0f))", FLOAT, None),
@@ -128,6 +136,24 @@ def emit_hair_info(c, node):
         if node.outputs["Tangent Normal"].is_linked:
             c.uses_hair = True  # the fibre's direction (material_program.cl)
             outs["Tangent Normal"] = c.fn.temp(VEC, f"{strand[0]} * mp_hair_tangent_normal(g)")
+    return {node.outputs[name].identifier: value for name, value in outs.items() if name in node.outputs}
+
+
+def emit_point_info(c, node):
+    """Point Info: a point's centre (world space), radius and random
+    number (Cycles' hash of its number), from the slot each point of a
+    cloud carries (export_points.py: random, radius, 1 on points); zero
+    elsewhere, as in Cycles."""
+    slot = c.resources.object_attribute("micropoly:point info", "POINT_INFO")
+    if slot < 0:
+        outs = {"Position": ("(float3)(0.0f)", VEC, None), "Radius": ("0.0f", FLOAT, (0.0, 0.0)),
+                "Random": ("0.0f", FLOAT, (0.0, 0.0))}
+    else:
+        info = c.fn.temp("float4", f"mp_object_attribute(g, {slot}u)")[0]
+        centre = ("(g->object ? (float3)(g->object->to_world[3], g->object->to_world[7], "
+                  "g->object->to_world[11]) : (float3)(0.0f))")
+        outs = {"Position": c.fn.temp(VEC, f"{info}.z * {centre}"), "Radius": (f"{info}.y", FLOAT, None),
+                "Random": (f"{info}.x", FLOAT, (0.0, 1.0))}
     return {node.outputs[name].identifier: value for name, value in outs.items() if name in node.outputs}
 
 
@@ -178,6 +204,7 @@ NODES = {
     "ATTRIBUTE": emit_attribute,
     "VERTEX_COLOR": emit_attribute,
     "HAIR_INFO": emit_hair_info,
+    "POINT_INFO": emit_point_info,
     "LIGHT_PATH": emit_light_path,
     "OBJECT_INFO": emit_object_info,
     "VALUE": emit_value,

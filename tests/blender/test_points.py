@@ -5,8 +5,10 @@ exported as one shared sphere prototype and one instance per point, and
 rendered against Cycles' direct light (PSNR >= 32 dB over pixels both
 cover, silhouettes IoU >= 0.98); hidden from the camera, the points still
 cast their shadows, as in Cycles (the floor and shadows alone against
-Cycles >= 30 dB, test_shadows.py's bar for hard shadows). Exits non-zero on
-failure."""
+Cycles >= 30 dB, test_shadows.py's bar for hard shadows). Then what point
+materials read, shown through emission: Point Info's Random, Radius and
+Position and an attribute of the points read by name (their radius),
+against Cycles >= 35 dB over the pixels both cover. Exits non-zero on failure."""
 
 import math
 import os
@@ -80,6 +82,50 @@ def against_cycles(name, scene, threshold=32.0):
     return got
 
 
+def scaled(nodes, links, value, factor):
+    math = nodes.new("ShaderNodeMath")
+    math.operation = "MULTIPLY"
+    links.new(value, math.inputs[0])
+    math.inputs[1].default_value = factor
+    return math.outputs[0]
+
+
+def info_material(nodes, links, info):
+    """Emission of (Random, 4 x Radius, 2 x the points' "radius" attribute
+    read by an Attribute node)."""
+    xyz, attribute = nodes.new("ShaderNodeCombineXYZ"), nodes.new("ShaderNodeAttribute")
+    attribute.attribute_name = "radius"
+    links.new(info.outputs["Random"], xyz.inputs[0])
+    links.new(scaled(nodes, links, info.outputs["Radius"], 4.0), xyz.inputs[1])
+    links.new(scaled(nodes, links, attribute.outputs["Fac"], 2.0), xyz.inputs[2])
+    return xyz.outputs[0]
+
+
+def position_material(nodes, links, info):
+    """Emission of the point's centre, 0.25 x Position + 0.5."""
+    shift = nodes.new("ShaderNodeVectorMath")
+    shift.operation = "MULTIPLY_ADD"
+    links.new(info.outputs["Position"], shift.inputs[0])
+    shift.inputs[1].default_value = (0.25, 0.25, 0.25)
+    shift.inputs[2].default_value = (0.5, 0.5, 0.5)
+    return shift.outputs[0]
+
+
+def emission_against_cycles(name, scene, emitter, build):
+    m, emission = ru.emission_material(name)
+    nodes, links = m.node_tree.nodes, m.node_tree.links
+    links.new(build(nodes, links, nodes.new("ShaderNodePointInfo")), emission.inputs["Color"])
+    setter = next(n for n in emitter.modifiers["Points"].node_group.nodes if n.type == "SET_MATERIAL")
+    setter.inputs["Material"].default_value = m
+    ru.setup_cycles(scene, samples=32)
+    ref = ru.render_passes(scene, "CYCLES", W, H)["rgba"]
+    got = ru.render_passes(scene, "MICROPOLY", W, H, samples=16)["rgba"]
+    both = (ref[..., 3] > 0.999) & (got[..., 3] > 0.999)
+    a, b = ref[both][:, :3], got[both][:, :3]
+    p = ru.psnr(a, b, peak=float(a.max())) if both.sum() else 0.0
+    check(f"points: {name} against Cycles", p >= 35.0 and both.sum() > 8000, f"{p:.1f} dB, {int(both.sum())} pixels")
+
+
 def main():
     scene, emitter = points_scene()
     from micropoly import export
@@ -100,6 +146,11 @@ def main():
     shadowed = hidden[..., :3].sum(axis=-1)[floor] < 0.5 * hidden[..., :3].sum(axis=-1)[floor].max()
     check("points hidden from the camera: their shadows stay", 800 < int(shadowed.sum()),
           f"{int(shadowed.sum())} floor pixels in shadow")
+    emitter.visible_camera = True
+    bpy.data.objects["Floor"].hide_render = True
+    emission_against_cycles("Point Info's Random and Radius, the points' radius attribute", scene, emitter,
+                            info_material)
+    emission_against_cycles("Point Info's Position", scene, emitter, position_material)
     return 0 if all(RESULTS) else 1
 
 

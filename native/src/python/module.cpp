@@ -662,7 +662,8 @@ PYBIND11_MODULE(_native, m) {
           "add_points",
           [](Scene& s, const std::string& name, const Array<float>& positions, const Array<float>& radii,
              const Array<float>& object_to_world, int material, bool visible_camera, bool cast_shadows,
-             std::vector<float> object_color, float pass_index, float random, const Array<float>& attributes) {
+             std::vector<float> object_color, float pass_index, float random, const Array<float>& attributes,
+             const Array<float>& point_attributes) {
             PointCloud cloud;
             cloud.name = name;
             cloud.positions = to_points(positions, "positions");
@@ -673,15 +674,24 @@ PYBIND11_MODULE(_native, m) {
             cloud.visible_camera = visible_camera;
             cloud.cast_shadows = cast_shadows;
             cloud.info = to_object_info("point cloud '" + name + "'", object_color, pass_index, random, attributes);
+            if (point_attributes.size() > 0) {
+              if (point_attributes.ndim() != 3 || point_attributes.shape(2) != 4)
+                throw Error("point cloud '" + name + "': point_attributes must be a (points, slots, 4) array");
+              for (py::ssize_t i = 0; i < point_attributes.shape(0); ++i) {
+                const auto* first = reinterpret_cast<const glm::vec4*>(point_attributes.data(i, 0, 0));
+                cloud.point_attributes.emplace_back(first, first + point_attributes.shape(1));
+              }
+            }
             return add_point_cloud(s, cloud);
           },
           py::arg("name"), py::arg("positions"), py::arg("radii"), py::arg("object_to_world") = Array<float>(),
           py::arg("material") = 0, py::arg("visible_camera") = true, py::arg("cast_shadows") = true,
           py::arg("object_color") = std::vector<float>{1, 1, 1, 1}, py::arg("pass_index") = 0.0f,
           py::arg("random") = 0.0f, py::arg("attributes") = Array<float>(),
+          py::arg("point_attributes") = Array<float>(),
           "Adds a point cloud (positions (points, 3) and radii (points,), object space) as spheres, Cycles' "
           "shape for points: one instance of a shared unit sphere per point (scene/points.h), each reading the "
-          "cloud's Object Info and attributes (slots, 4). Returns how many points were skipped (a position or "
+          "cloud's Object Info and attributes (slots, 4), or its own attributes (points, slots, 4). Returns how many points were skipped (a position or "
           "radius not finite, a radius not positive).")
       .def("validate", [](const Scene& s) { validate_scene(s); })
       .def_property_readonly("prototype_count", [](const Scene& s) { return s.prototypes.size(); })

@@ -42,6 +42,9 @@ size_t add_point_cloud(Scene& scene, const PointCloud& cloud, const glm::vec3& e
   if (cloud.positions.size() != cloud.radii.size())
     throw Error("point cloud '" + cloud.name + "': " + std::to_string(cloud.positions.size()) + " positions but " +
                 std::to_string(cloud.radii.size()) + " radii");
+  if (!cloud.point_attributes.empty() && cloud.point_attributes.size() != cloud.positions.size())
+    throw Error("point cloud '" + cloud.name + "': " + std::to_string(cloud.point_attributes.size()) +
+                " points' attributes for " + std::to_string(cloud.positions.size()) + " points");
   const int prototype = unit_prototype(scene, cloud.shape);
   // Radii are object-space lengths: the object's scale carries them (its
   // cube root for a disc, which faces the eye in world space).
@@ -73,6 +76,7 @@ size_t add_point_cloud(Scene& scene, const PointCloud& cloud, const glm::vec3& e
     }
     inst.material = cloud.material;
     inst.info = cloud.info;
+    if (!cloud.point_attributes.empty()) inst.info.attributes = cloud.point_attributes[i];
     inst.visible_camera = cloud.visible_camera;
     inst.cast_shadows = cloud.cast_shadows;
     scene.instances.push_back(std::move(inst));

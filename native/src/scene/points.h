@@ -25,6 +25,9 @@ struct PointCloud {
   glm::mat4 object_to_world{1.0f};
   int material = 0;
   ObjectInfo info;  // the cloud's; every point reads it
+  // Each point's own Attribute values (ObjectInfo::attributes), or empty:
+  // every point reads info.attributes.
+  std::vector<std::vector<glm::vec4>> point_attributes;
   bool visible_camera = true;
   bool cast_shadows = true;
 };
