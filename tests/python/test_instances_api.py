@@ -126,5 +126,5 @@ def test_attribute_values_convert_as_cycles_converts_them():
         data = Owner({"m": 2.0}, {})
 
     obj = Obj({"f": 0.5}, {})
-    values = ea.object_values([("f", False), ("m", True), ("none", False)], obj)
-    np.testing.assert_array_equal(values, [[0.5, 0.5, 0.5, 1.0], [2.0, 2.0, 2.0, 1.0], [0, 0, 0, 0]])
+    values = ea.object_values([("f", "OBJECT"), ("m", "INSTANCER"), ("none", "OBJECT"), ("f", "POINT")], obj)
+    np.testing.assert_array_equal(values, [[0.5, 0.5, 0.5, 1.0], [2.0, 2.0, 2.0, 1.0], [0, 0, 0, 0], [0, 0, 0, 0]])
