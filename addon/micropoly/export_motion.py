@@ -6,10 +6,11 @@ it (CENTER) or ends at it (END); the position is a Render setting from 4.x
 and a Cycles one before. The scene is evaluated (RenderEngine.frame_set) at
 2^steps + 1 times evenly spread over the shutter, like Cycles' object motion
 steps, and the camera's transform, each object's transform and, where it
-deforms, its points are kept per step. The native scene moves linearly
-between steps; shading uses the shutter's centre, at which the scene is
-exported last. The shutter curve shapes when samples see the scene.
-Instances (geometry nodes, particles) render without motion.
+deforms, its points are kept per step; so are the strands of particle
+hair (per object and system). The native scene moves linearly between
+steps; shading uses the shutter's centre, at which the scene is exported
+last. The shutter curve shapes when samples see the scene. Instances
+(geometry nodes, particles) move by their transforms.
 """
 
 import math
@@ -17,7 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import camera_view, export_mesh
+from . import camera_view, export_mesh, export_particle_hair
 
 
 def shutter_position(scene):
@@ -111,6 +112,7 @@ class Motion:
     curve: np.ndarray = None
     matrices: dict = field(default_factory=dict)
     points: dict = field(default_factory=dict)
+    hair: dict = field(default_factory=dict)  # (object, particle system) name -> (steps, points, 3)
     instances: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
 
@@ -132,7 +134,8 @@ class Motion:
 def sample(setter, depsgraph, times):
     """Evaluates the scene at each time (leaving it at the last) and returns
     its Motion; what does not move is left out."""
-    camera, matrices, points, instances = [], {}, {}, {}
+    camera, matrices, points, hair, instances = [], {}, {}, {}, {}
+    render = depsgraph.mode == "RENDER"
     for time in times:
         frame_set(setter, time)
         scene = depsgraph.scene
@@ -147,12 +150,24 @@ def sample(setter, depsgraph, times):
                 continue
             matrices.setdefault(obj.name, []).append(np.array(inst.matrix_world, dtype=np.float32))
             points.setdefault(obj.name, []).append(_points(obj, depsgraph))
+            for psys in export_particle_hair.hair_systems(obj):
+                strands = export_particle_hair.strands(obj, psys, render)
+                if strands is not None:
+                    hair.setdefault((obj.name, psys.name), []).append(strands[0].reshape(-1, 3))
     motion = Motion(times=times, curve=shutter_curve(depsgraph.scene))
     camera = np.stack(camera)
     motion.camera = camera if not np.all(camera == camera[0]) else None
     for key, steps in instances.items():
         if len(steps) == len(times) and any(s != steps[0] for s in steps):  # else: rendered still
             motion.instances[key] = np.asarray(steps, dtype=np.float32).reshape(-1, 4, 4)
+    for key, steps in hair.items():
+        if len(steps) != len(times) or len({s.shape for s in steps}) != 1:
+            motion.warnings.append(f"particle hair '{key[0]}/{key[1]}' changes its strands during the shutter: "
+                                   "it renders without deformation blur")
+            continue
+        stacked = np.stack(steps)
+        if not np.all(stacked == stacked[0]):
+            motion.hair[key] = stacked
     for name, steps in matrices.items():
         if len(steps) != len(times):
             continue  # not in every step: rendered still

@@ -82,18 +82,22 @@ def _root_uvs(obj, psys, name):
     return uv.reshape(count, 2)
 
 
+def hair_systems(obj):
+    """The particle systems of `obj` that render as hair strands (hair
+    rendered as objects or collections reaches the export as depsgraph
+    instances; emitter particles are not hair)."""
+    return [p for p in getattr(obj, "particle_systems", ()) if p.settings.type == "HAIR" and
+            p.settings.render_type == "PATH"]
+
+
 def export_particle_hair(native_scene, materials, inst, matrix, warnings, render, motion=None):
     """Adds the hair particle systems of the mesh object `inst` renders;
     returns how many were added."""
     obj = inst.object
     added = 0
     first_curve = 0  # Hair Info's random numbers the strands of all systems in one run
-    for psys in obj.particle_systems:
+    for psys in hair_systems(obj):
         s = psys.settings
-        # Hair rendered as objects or collections reaches the export as
-        # depsgraph instances; emitter particles are not hair.
-        if s.type != "HAIR" or s.render_type != "PATH":
-            continue
         got = strands(obj, psys, render)
         if got is None:
             continue
@@ -103,9 +107,15 @@ def export_particle_hair(native_scene, materials, inst, matrix, warnings, render
         slots = obj.material_slots
         if 1 <= s.material <= len(slots):
             args["material"] = materials.get(slots[s.material - 1].material)
+        moving = {}
         if motion is not None:
-            warnings.append(f"particle hair '{obj.name}/{psys.name}': hair renders at the shutter's centre, "
-                            "without motion blur")
+            # Its strands and its object's transform at each step, where they move.
+            empty = np.zeros(0, dtype=np.float32)
+            steps_points, matrices = motion.hair.get((obj.name, psys.name)), motion.matrices.get(obj.name)
+            if steps_points is not None and steps_points.shape[1] != count * steps:
+                steps_points = None  # the shutter's centre has other strands
+            moving = dict(motion_points=empty if steps_points is None else steps_points,
+                          motion_object_to_world=empty if matrices is None else matrices)
         offsets = np.arange(0, (count + 1) * steps, steps, dtype=np.int32)
         positions, radii = pos.reshape(-1, 3), radii.reshape(-1)
 
@@ -118,7 +128,7 @@ def export_particle_hair(native_scene, materials, inst, matrix, warnings, render
             lambda name: None, root_uv)
         first_curve += count
         skipped = native_scene.add_curves(f"{obj.name}/{psys.name}", positions, radii, offsets,
-                                          object_to_world=matrix, point_layers=layers, **args)
+                                          object_to_world=matrix, point_layers=layers, **args, **moving)
         if skipped:
             warnings.append(f"particle hair '{obj.name}/{psys.name}': {skipped} strands with a point that is not "
                             "finite are skipped")
