@@ -296,7 +296,10 @@ def export_scene(depsgraph, view=None, meshes=None, motion=None):
                     "objects: render fewer or lighter objects, or lower their subdivision levels") from None
         elif obj.type == "CURVES":
             try:
-                if export_curves.export_curves(native_scene, materials, inst, _matrix(inst.matrix_world), out.warnings,
+                if inst.is_instance:  # fur on scattered creatures: one prototype per curves data
+                    if instances.add(native_scene, materials, meshes, inst, out.warnings, depsgraph):
+                        out.objects += 1
+                elif export_curves.export_curves(native_scene, materials, inst, _matrix(inst.matrix_world), out.warnings,
                                                motion):
                     out.objects += 1
             except RuntimeError as e:

@@ -123,8 +123,10 @@ def export_curves(native_scene, materials, inst, matrix, warnings, motion=None):
         types = np.empty(count, dtype=np.int8 if kinds.data_type == "INT8" else np.int32)
         kinds.data.foreach_get("value", types)
         if np.any(types != 0):  # 0: Catmull-Rom
-            warnings.append(f"curves '{obj.name}': Bezier, NURBS and poly curves render through their points as "
-                            "Catmull-Rom curves")
+            # Cycles reads the same points the same way (its hair export takes
+            # the control points whatever the type).
+            warnings.append(f"curves '{obj.name}': Bezier, NURBS and poly curves render as Cycles renders them, "
+                            "Catmull-Rom curves through their points (handles and weights are not read)")
     moving = {}
     if motion is not None and not inst.is_instance:
         empty = np.zeros(0, dtype=np.float32)

@@ -3,7 +3,8 @@
 collection instances, instancing by vertices or faces) and linked duplicates
 (objects that share one mesh) -> Scene prototypes and instances (scene.h).
 
-Each distinct mesh becomes one prototype, exported once; every instance then
+Each distinct mesh (or Curves object's curves) becomes one prototype,
+exported once; every instance then
 costs only its matrix and Object Info values, gathered in numpy arrays and
 handed over in one call per prototype. Two placements share a prototype when
 they render the same mesh with the same material slots and ray visibility:
@@ -15,7 +16,7 @@ not by the object that places it).
 
 import numpy as np
 
-from . import export_attributes, export_mesh, export_motion
+from . import export_attributes, export_curves, export_mesh, export_motion
 
 
 class InstanceTable:
@@ -41,8 +42,11 @@ class InstanceTable:
         """What a placement of `obj` shares its prototype by, or None where
         the object is exported on its own (shared_data: only where it
         renders a cage or an evaluated mesh other objects may share: not a
-        mesh its own modifiers or shape keys made)."""
+        mesh its own modifiers or shape keys made). Curves: their evaluated
+        data."""
         slots = tuple(slot.material.name_full if slot.material else "" for slot in obj.material_slots)
+        if obj.type == "CURVES":
+            return ("curves", obj.data.as_pointer()), slots, export_mesh.ray_visibility(obj)
         subsurf, only = export_mesh.subdivision_modifier(obj)
         if subsurf is not None and only:
             if obj.original.data.shape_keys is not None:
@@ -65,9 +69,13 @@ class InstanceTable:
             key = key if key is not None else self.key(obj)
             if key not in self._prototypes:
                 identity = np.identity(4, dtype=np.float32)
-                made = export_mesh.export_object(native_scene, materials, meshes, obj, identity, warnings,
-                                                 is_instance=True, depsgraph=depsgraph)
-                self._prototypes[key] = native_scene.mesh_to_prototype(-1, obj.name) if made else None
+                if obj.type == "CURVES":
+                    made = export_curves.export_curves(native_scene, materials, inst, identity, warnings)
+                    self._prototypes[key] = native_scene.patch_set_to_prototype(-1, obj.name) if made else None
+                else:
+                    made = export_mesh.export_object(native_scene, materials, meshes, obj, identity, warnings,
+                                                     is_instance=True, depsgraph=depsgraph)
+                    self._prototypes[key] = native_scene.mesh_to_prototype(-1, obj.name) if made else None
             entry = (self._prototypes[key], tuple(obj.color), float(obj.pass_index),
                      export_mesh.name_random_id(obj.name), key[-1])
             self._objects[pointers] = entry

@@ -145,8 +145,7 @@ def sample(setter, depsgraph, times):
             if obj.type not in ("MESH", "CURVES") or not _object_blurs(obj):
                 continue
             if inst.is_instance:  # its transform only: a prototype does not deform
-                if obj.type == "MESH":
-                    instances.setdefault(instance_key(inst), []).append(_rows(inst.matrix_world))
+                instances.setdefault(instance_key(inst), []).append(_rows(inst.matrix_world))
                 continue
             matrices.setdefault(obj.name, []).append(np.array(inst.matrix_world, dtype=np.float32))
             points.setdefault(obj.name, []).append(_points(obj, depsgraph))

@@ -7,6 +7,9 @@ Curves and Rounded Ribbons (alpha IoU >= 0.95); and the same field 0.1
 pixel wide, whose coverage (the alpha summed) is within 3 % of Cycles'.
 The field's shading is reported, not asserted: strands a few pixels wide
 and thinner shade darker than Cycles' (docs/blender.md, "Curves").
+Last, the field instanced by Geometry Nodes on the points of a grid (fur
+on scattered patches): one prototype and an instance per point, against
+Cycles' 3D Curves (PSNR >= 30 dB over pixels both cover, IoU >= 0.95).
 Exits non-zero on failure."""
 
 import math
@@ -117,7 +120,47 @@ def main():
         ref = ru.render_passes(scene, "CYCLES", W, H)["rgba"][..., 3]
         check(f"0.1-pixel strands: coverage against Cycles' {name}", abs(got.sum() / ref.sum() - 1.0) <= 0.03,
               f"alpha summed {got.sum():.1f} against {ref.sum():.1f}")
+
+    scene, hair = hair_scene(0.012, 0.004)
+    bpy.data.objects["Floor"].hide_render = True
+    points = scatter_curves(hair)
+    exported = export.export_scene(bpy.context.evaluated_depsgraph_get())
+    got = (exported.scene.prototype_count, exported.scene.instance_count, exported.scene.patch_set_count)
+    check("instanced curves: one prototype, an instance per point", got == (1, points, 0) and points >= 16,
+          f"{points} points, exported {got}")
+    ru.setup_cycles(scene, samples=CYCLES_SAMPLES, shadows=True)
+    set_shape(scene, "THICK")
+    compare("instanced curves against Cycles' 3D Curves", ru.render_passes(scene, "CYCLES", W, H)["rgba"],
+            ru.render_passes(scene, "MICROPOLY", W, H, samples=16)["rgba"], min_psnr=30.0, min_iou=0.95)
     return 0 if all(RESULTS) else 1
+
+
+def scatter_curves(hair):
+    """Geometry Nodes on a grid's points placing the hair, at 0.35 of its
+    size, on each; the hair itself is not rendered. Returns how many."""
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=4, y_subdivisions=4, size=2.0, location=(0.0, 0.0, 0.0))
+    grid = bpy.context.object
+    grid.name = "Scatter"
+    mod = grid.modifiers.new("Scatter", "NODES")
+    tree = bpy.data.node_groups.new("Scatter", "GeometryNodeTree")
+    mod.node_group = tree
+    nodes, links = tree.nodes, tree.links
+    if hasattr(tree, "interface"):  # Blender 4.0 and later
+        tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+        tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    else:
+        tree.inputs.new("NodeSocketGeometry", "Geometry")
+        tree.outputs.new("NodeSocketGeometry", "Geometry")
+    group_in, group_out = nodes.new("NodeGroupInput"), nodes.new("NodeGroupOutput")
+    info = nodes.new("GeometryNodeObjectInfo")
+    info.inputs["Object"].default_value = hair
+    place = nodes.new("GeometryNodeInstanceOnPoints")
+    place.inputs["Scale"].default_value = (0.35, 0.35, 0.35)
+    links.new(group_in.outputs[0], place.inputs["Points"])
+    links.new(info.outputs["Geometry"], place.inputs["Instance"])
+    links.new(place.outputs["Instances"], group_out.inputs[0])
+    hair.hide_render = True
+    return len(grid.data.vertices)
 
 
 ru.run_test(main)

@@ -45,6 +45,22 @@ std::vector<glm::vec4> to_rgba(const float* v, size_t count) {
 
 // Object Info's values and the Attribute nodes' RGBA per slot of one object
 // (`what` names it in messages): object_color RGBA, attributes a multiple of 4.
+// Moves surface `index` of `list` (negative: from the end) into a new
+// prototype's `member`; returns the prototype's index.
+template <typename Surface>
+size_t to_prototype(Scene& s, std::vector<Surface>& list, std::vector<Surface> Prototype::*member, int index,
+                    const std::string& name, const char* missing) {
+  const int n = int(list.size());
+  if (index < -n || index >= n) throw Error(missing + std::to_string(index));
+  const auto at = list.begin() + (index < 0 ? index + n : index);
+  Prototype p;
+  p.name = name.empty() ? at->name : name;
+  (p.*member).push_back(std::move(*at));
+  list.erase(at);
+  s.prototypes.push_back(std::move(p));
+  return s.prototypes.size() - 1;
+}
+
 ObjectInfo to_object_info(const std::string& what, const std::vector<float>& object_color, float pass_index,
                           float random, const Array<float>& attributes) {
   if (object_color.size() != 4) throw Error(what + ": object_color must have 4 values (RGBA)");
@@ -538,20 +554,20 @@ PYBIND11_MODULE(_native, m) {
       .def(
           "mesh_to_prototype",
           [](Scene& s, int index, const std::string& name) {
-            const int n = int(s.meshes.size());
-            if (index < -n || index >= n) throw Error("mesh_to_prototype: no mesh " + std::to_string(index));
-            const auto at = s.meshes.begin() + (index < 0 ? index + n : index);
-            Prototype p;
-            p.name = name.empty() ? at->name : name;
-            p.meshes.push_back(std::move(*at));
-            s.meshes.erase(at);
-            s.prototypes.push_back(std::move(p));
-            return s.prototypes.size() - 1;
+            return to_prototype(s, s.meshes, &Prototype::meshes, index, name, "mesh_to_prototype: no mesh ");
           },
           py::arg("index") = -1, py::arg("name") = "",
           "Moves mesh `index` (negative: from the end) out of the scene into a new prototype (scene.h), rendered "
           "only where instances place it; returns the prototype's index. Its object_to_world places it in the "
           "prototype's own space.")
+      .def(
+          "patch_set_to_prototype",
+          [](Scene& s, int index, const std::string& name) {
+            return to_prototype(s, s.bezier_patches, &Prototype::bezier_patches, index, name,
+                                "patch_set_to_prototype: no patch set ");
+          },
+          py::arg("index") = -1, py::arg("name") = "",
+          "As mesh_to_prototype, for patch set `index` (curves' tubes, quadrics' patches).")
       .def(
           "add_instances",
           [](Scene& s, int prototype, const Array<float>& object_to_world, const Array<float>& random,
