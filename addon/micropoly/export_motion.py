@@ -7,7 +7,7 @@ and a Cycles one before. The scene is evaluated (RenderEngine.frame_set) at
 2^steps + 1 times evenly spread over the shutter, like Cycles' object motion
 steps, and the camera's transform, each object's transform and, where it
 deforms, its points are kept per step; so are the strands of particle
-hair (per object and system). The native scene moves linearly between
+hair (per object and system) and the points of point clouds. The native scene moves linearly between
 steps; shading uses the shutter's centre, at which the scene is exported
 last. The shutter curve shapes when samples see the scene. Instances
 (geometry nodes, particles) move by their transforms.
@@ -70,7 +70,7 @@ def _object_blurs(obj):
 
 
 def _points(obj, depsgraph):
-    if obj.type == "CURVES":  # the curves' points, as export_curves reads them
+    if obj.type in ("CURVES", "POINTCLOUD"):  # their points, as export_curves and export_points read them
         positions = obj.data.attributes["position"].data
         points = np.empty(len(positions) * 3, dtype=np.float32)
         positions.foreach_get("vector", points)
@@ -113,6 +113,8 @@ class Motion:
     matrices: dict = field(default_factory=dict)
     points: dict = field(default_factory=dict)
     hair: dict = field(default_factory=dict)  # (object, particle system) name -> (steps, points, 3)
+    # Point clouds by instance_key: ((steps, 4, 4) matrices or None, (steps, points, 3) positions or None).
+    clouds: dict = field(default_factory=dict)
     instances: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
 
@@ -134,7 +136,7 @@ class Motion:
 def sample(setter, depsgraph, times):
     """Evaluates the scene at each time (leaving it at the last) and returns
     its Motion; what does not move is left out."""
-    camera, matrices, points, hair, instances = [], {}, {}, {}, {}
+    camera, matrices, points, hair, instances, clouds = [], {}, {}, {}, {}, {}
     render = depsgraph.mode == "RENDER"
     for time in times:
         frame_set(setter, time)
@@ -142,6 +144,12 @@ def sample(setter, depsgraph, times):
         camera.append(camera_view.view_matrix(scene.camera.evaluated_get(depsgraph)))
         for inst in depsgraph.object_instances:
             obj = inst.object
+            if obj.type == "POINTCLOUD" and _object_blurs(obj):
+                # Instances or not (Geometry Nodes' points come as instances):
+                # the transform and the points at each step.
+                clouds.setdefault(instance_key(inst), []).append((np.array(inst.matrix_world, dtype=np.float32),
+                                                                  _points(obj, depsgraph)))
+                continue
             if obj.type not in ("MESH", "CURVES") or not _object_blurs(obj):
                 continue
             if inst.is_instance:  # its transform only: a prototype does not deform
@@ -159,6 +167,16 @@ def sample(setter, depsgraph, times):
     for key, steps in instances.items():
         if len(steps) == len(times) and any(s != steps[0] for s in steps):  # else: rendered still
             motion.instances[key] = np.asarray(steps, dtype=np.float32).reshape(-1, 4, 4)
+    for key, steps in clouds.items():
+        if len(steps) != len(times) or len({p.shape for _, p in steps}) != 1:
+            motion.warnings.append(f"point cloud '{key[-1]}' changes its points during the shutter: it renders "
+                                   "without motion blur")
+            continue
+        at = np.stack([m for m, _ in steps])
+        positions = np.stack([p for _, p in steps])
+        moving = (None if np.all(at == at[0]) else at, None if np.all(positions == positions[0]) else positions)
+        if moving[0] is not None or moving[1] is not None:
+            motion.clouds[key] = moving
     for key, steps in hair.items():
         if len(steps) != len(times) or len({s.shape for s in steps}) != 1:
             motion.warnings.append(f"particle hair '{key[0]}/{key[1]}' changes its strands during the shutter: "

@@ -6,11 +6,13 @@ over in one call; the native side places one shared unit sphere per point
 0.01. Every point reads its cloud's Object Info and Attribute values, and
 its own in the slots of kind "POINT" (the cloud's attributes, which
 Attribute nodes of type Geometry read) and "POINT_INFO" (Point Info: its
-random number, Cycles' hash of its number, and its radius in world units)."""
+random number, Cycles' hash of its number, and its radius in world units).
+With motion blur, each point moves with the cloud's transform and its own
+position at every step (export_motion.py)."""
 
 import numpy as np
 
-from . import export_attributes, export_curves, export_mesh
+from . import export_attributes, export_curves, export_mesh, export_motion
 
 
 def _attribute(pointcloud, name, width, prop):
@@ -42,8 +44,13 @@ def export_point_cloud(native_scene, materials, inst, matrix, warnings, motion=N
         return False
     radii = _attribute(pointcloud, "radius", 1, "value")
     radii = np.full(count, 0.01, dtype=np.float32) if radii is None else radii.reshape(-1)
-    if motion is not None:
-        warnings.append(f"point cloud '{obj.name}': points render at the shutter's centre, without motion blur")
+    moving = {}
+    steps = motion.clouds.get(export_motion.instance_key(inst)) if motion is not None else None
+    if steps is not None:
+        matrices, points = steps
+        empty = np.zeros(0, dtype=np.float32)
+        moving = dict(motion_points=empty if points is None else points,
+                      motion_object_to_world=empty if matrices is None else matrices)
     args = export_attributes.object_arguments(obj, inst, materials)
     slots = materials.object_attributes
     if any(kind in ("POINT", "POINT_INFO") for _, kind in slots):
@@ -60,7 +67,7 @@ def export_point_cloud(native_scene, materials, inst, matrix, warnings, motion=N
                 if rgba is not None:
                     values[:, k] = rgba
         args["point_attributes"] = values
-    skipped = native_scene.add_points(obj.name, positions, radii, object_to_world=matrix, **args)
+    skipped = native_scene.add_points(obj.name, positions, radii, object_to_world=matrix, **args, **moving)
     if skipped:
         warnings.append(f"point cloud '{obj.name}': {skipped} points with a position or radius that is not finite "
                         "and positive are skipped")

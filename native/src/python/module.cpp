@@ -679,7 +679,8 @@ PYBIND11_MODULE(_native, m) {
           [](Scene& s, const std::string& name, const Array<float>& positions, const Array<float>& radii,
              const Array<float>& object_to_world, int material, bool visible_camera, bool cast_shadows,
              std::vector<float> object_color, float pass_index, float random, const Array<float>& attributes,
-             const Array<float>& point_attributes) {
+             const Array<float>& point_attributes, const Array<float>& motion_points,
+             const Array<float>& motion_object_to_world) {
             PointCloud cloud;
             cloud.name = name;
             cloud.positions = to_points(positions, "positions");
@@ -698,16 +699,20 @@ PYBIND11_MODULE(_native, m) {
                 cloud.point_attributes.emplace_back(first, first + point_attributes.shape(1));
               }
             }
+            cloud.motion_positions = to_motion_points(motion_points, "point cloud '" + name + "'");
+            cloud.motion_object_to_world = to_matrices(motion_object_to_world, "motion_object_to_world");
             return add_point_cloud(s, cloud);
           },
           py::arg("name"), py::arg("positions"), py::arg("radii"), py::arg("object_to_world") = Array<float>(),
           py::arg("material") = 0, py::arg("visible_camera") = true, py::arg("cast_shadows") = true,
           py::arg("object_color") = std::vector<float>{1, 1, 1, 1}, py::arg("pass_index") = 0.0f,
           py::arg("random") = 0.0f, py::arg("attributes") = Array<float>(),
-          py::arg("point_attributes") = Array<float>(),
+          py::arg("point_attributes") = Array<float>(), py::arg("motion_points") = Array<float>(),
+          py::arg("motion_object_to_world") = Array<float>(),
           "Adds a point cloud (positions (points, 3) and radii (points,), object space) as spheres, Cycles' "
           "shape for points: one instance of a shared unit sphere per point (scene/points.h), each reading the "
-          "cloud's Object Info and attributes (slots, 4), or its own attributes (points, slots, 4). Returns how many points were skipped (a position or "
+          "cloud's Object Info and attributes (slots, 4), or its own attributes (points, slots, 4); with motion "
+          "blur, the positions (steps, points, 3) and transforms (steps, 4, 4) at each step move them. Returns how many points were skipped (a position or "
           "radius not finite, a radius not positive).")
       .def("validate", [](const Scene& s) { validate_scene(s); })
       .def_property_readonly("prototype_count", [](const Scene& s) { return s.prototypes.size(); })

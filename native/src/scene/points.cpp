@@ -1,5 +1,6 @@
 #include "scene/points.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "micropoly/error.h"
@@ -45,6 +46,14 @@ size_t add_point_cloud(Scene& scene, const PointCloud& cloud, const glm::vec3& e
   if (!cloud.point_attributes.empty() && cloud.point_attributes.size() != cloud.positions.size())
     throw Error("point cloud '" + cloud.name + "': " + std::to_string(cloud.point_attributes.size()) +
                 " points' attributes for " + std::to_string(cloud.positions.size()) + " points");
+  for (const std::vector<glm::vec3>& step : cloud.motion_positions)
+    if (step.size() != cloud.positions.size())
+      throw Error("point cloud '" + cloud.name + "': a motion step has " + std::to_string(step.size()) +
+                  " positions for " + std::to_string(cloud.positions.size()) + " points");
+  if (!cloud.motion_positions.empty() && !cloud.motion_object_to_world.empty() &&
+      cloud.motion_positions.size() != cloud.motion_object_to_world.size())
+    throw Error("point cloud '" + cloud.name + "': motion positions and transforms differ in steps");
+  const size_t steps = std::max(cloud.motion_positions.size(), cloud.motion_object_to_world.size());
   const int prototype = unit_prototype(scene, cloud.shape);
   // Radii are object-space lengths: the object's scale carries them (its
   // cube root for a disc, which faces the eye in world space).
@@ -62,9 +71,18 @@ size_t add_point_cloud(Scene& scene, const PointCloud& cloud, const glm::vec3& e
     Instance inst;
     inst.prototype = prototype;
     if (cloud.shape == PointShape::Sphere) {
-      glm::mat4 local(r);
-      local[3] = glm::vec4(p, 1.0f);
-      inst.object_to_world = cloud.object_to_world * local;
+      auto placed = [&](const glm::mat4& object_to_world, const glm::vec3& at) {
+        glm::mat4 local(r);
+        local[3] = glm::vec4(at, 1.0f);
+        return object_to_world * local;
+      };
+      inst.object_to_world = placed(cloud.object_to_world, p);
+      for (size_t k = 0; k < steps; ++k) {
+        const glm::vec3 at = cloud.motion_positions.empty() ? p : cloud.motion_positions[k][i];
+        inst.motion_object_to_world.push_back(placed(
+            cloud.motion_object_to_world.empty() ? cloud.object_to_world : cloud.motion_object_to_world[k],
+            finite(at) ? at : p));
+      }
     } else {
       const glm::vec3 at = glm::vec3(cloud.object_to_world * glm::vec4(p, 1.0f));
       const glm::vec3 to_eye = eye_is_direction ? eye : eye - at;

@@ -28,6 +28,11 @@ struct PointCloud {
   // Each point's own Attribute values (ObjectInfo::attributes), or empty:
   // every point reads info.attributes.
   std::vector<std::vector<glm::vec4>> point_attributes;
+  // Motion blur (Scene::motion_steps): the positions and the transform at
+  // each step, or empty where they do not move; each point's instance
+  // moves with them (spheres only: discs face the camera at the centre).
+  std::vector<std::vector<glm::vec3>> motion_positions;
+  std::vector<glm::mat4> motion_object_to_world;
   bool visible_camera = true;
   bool cast_shadows = true;
 };
