@@ -16,7 +16,7 @@ not by the object that places it).
 
 import numpy as np
 
-from . import export_attributes, export_curves, export_mesh, export_motion
+from . import export_curves, export_mesh, export_motion
 
 
 class InstanceTable:
