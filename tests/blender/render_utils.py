@@ -377,6 +377,25 @@ def _render_passes(scene, engine, width, height):
     return result
 
 
+def motion_blur(scene, shutter=1.0):
+    """Render > Motion Blur on, a shutter of `shutter` frames centred on the
+    frame, and keyframes inserted from now on linear (both renderers read
+    the same settings)."""
+    r = scene.render
+    r.use_motion_blur = True
+    r.motion_blur_shutter = shutter
+    (r if hasattr(r, "motion_blur_position") else scene.cycles).motion_blur_position = "CENTER"
+    bpy.context.preferences.edit.keyframe_new_interpolation_type = "LINEAR"
+
+
+def blurred_psnr(ref, got):
+    """(PSNR, pixels) of two motion-blurred RGBA images: few pixels are
+    wholly covered, so colour (premultiplied) and alpha are compared
+    wherever either image has any."""
+    seen = (ref[..., 3] > 0.01) | (got[..., 3] > 0.01)
+    return psnr(ref[seen], got[seen], peak=float(ref[seen].max())), int(seen.sum())
+
+
 def iou(a, b, threshold=0.5):
     ma, mb = a > threshold, b > threshold
     union = np.logical_or(ma, mb).sum()
