@@ -164,54 +164,87 @@ MP_INLINE int mp_hair_frame(float3 t, float3 v, float3* x, float3* y, float3* z)
   return 1;
 }
 
-/* Principled Hair (Chiang) towards v from light direction l, per unit
- * radiance arriving from l over unit solid angle (the lobes integrate to
- * the fibre's albedo; no cosine, as light reaches a fibre from any side).
- * n: the surface normal at the vertex, which places it across the fibre. */
-MP_INLINE float3 mp_hair_chiang(const MpClosure* c, float3 n, float3 l, float3 v) {
+/* What Chiang's lobes take from the view alone: the fibre frame, the
+ * vertex's offset h across the fibre, the angles of the refracted path and
+ * the attenuations A_p of R, TT, TRT and the rest. Computed once per vertex
+ * and read for every direction light arrives from (an area light's 16
+ * points), where only the longitudinal and azimuthal terms change. */
+typedef struct {
   float3 x, y, z;
-  if (!mp_hair_frame(c->tangent, v, &x, &y, &z)) return MP_F3(0.0f, 0.0f, 0.0f);
-  float eta = c->f82.y, alpha = c->f82.z;
-  float v_lobe = mp_hair_variance(c->a), s = mp_hair_logistic_scale(c->b);
-  float v_r = mp_hair_variance(fmin(fmax(c->f82.x * c->a, 0.001f), 1.0f));
-  float h = fmin(fmax(dot(cross(n, x), z), -1.0f), 1.0f);
+  float sin_o, cos_o, phi_o, gamma_o, gamma_t;
+  float v_lobe, v_r, s;
+  float s1, c1, s2, c2, s4, c4; /* the cuticle's tilt: sin and cos of alpha, 2 alpha, 4 alpha */
+  float3 a0, a1, a2, a3;
+  int ok;
+} MpHairView;
 
-  float sin_o = dot(v, x), cos_o = sqrt(fmax(1.0f - sin_o * sin_o, 0.0f));
-  float phi_o = atan2(dot(v, z), dot(v, y));
-  float sin_t = sin_o / eta, cos_t = sqrt(fmax(1.0f - sin_t * sin_t, 0.0f));
-  float cos_gamma_o = sqrt(fmax(1.0f - h * h, 0.0f)), gamma_o = asin(h);
-  float sin_gamma_t = h * cos_o / sqrt(fmax(eta * eta - sin_o * sin_o, 1e-12f));
+/* The view's part of Principled Hair (Chiang) towards v; n: the surface
+ * normal at the vertex, which places it across the fibre. */
+MP_INLINE MpHairView mp_hair_chiang_view(const MpClosure* c, float3 n, float3 v) {
+  MpHairView w;
+  w.ok = mp_hair_frame(c->tangent, v, &w.x, &w.y, &w.z);
+  if (!w.ok) return w;
+  float eta = c->f82.y, alpha = c->f82.z;
+  w.v_lobe = mp_hair_variance(c->a);
+  w.s = mp_hair_logistic_scale(c->b);
+  w.v_r = mp_hair_variance(fmin(fmax(c->f82.x * c->a, 0.001f), 1.0f));
+  float h = fmin(fmax(dot(cross(n, w.x), w.z), -1.0f), 1.0f);
+
+  w.sin_o = dot(v, w.x);
+  w.cos_o = sqrt(fmax(1.0f - w.sin_o * w.sin_o, 0.0f));
+  w.phi_o = atan2(dot(v, w.z), dot(v, w.y));
+  float sin_t = w.sin_o / eta, cos_t = sqrt(fmax(1.0f - sin_t * sin_t, 0.0f));
+  float cos_gamma_o = sqrt(fmax(1.0f - h * h, 0.0f));
+  w.gamma_o = asin(h);
+  float sin_gamma_t = h * w.cos_o / sqrt(fmax(eta * eta - w.sin_o * w.sin_o, 1e-12f));
   sin_gamma_t = fmin(fmax(sin_gamma_t, -1.0f), 1.0f);
-  float cos_gamma_t = sqrt(fmax(1.0f - sin_gamma_t * sin_gamma_t, 0.0f)), gamma_t = asin(sin_gamma_t);
+  float cos_gamma_t = sqrt(fmax(1.0f - sin_gamma_t * sin_gamma_t, 0.0f));
+  w.gamma_t = asin(sin_gamma_t);
   float3 sigma = c->f0 * (2.0f * cos_gamma_t / fmax(cos_t, 1e-6f));
   float3 tr = MP_F3(exp(-sigma.x), exp(-sigma.y), exp(-sigma.z));
   /* Attenuation of R, TT, TRT and the rest (a geometric series). */
-  float f = mp_fresnel_dielectric(cos_o * cos_gamma_o, eta);
-  float3 a0 = MP_F3(f, f, f);
-  float3 a1 = (1.0f - f) * (1.0f - f) * tr;
-  float3 a2 = a1 * tr * f;
+  float f = mp_fresnel_dielectric(w.cos_o * cos_gamma_o, eta);
+  w.a0 = MP_F3(f, f, f);
+  w.a1 = (1.0f - f) * (1.0f - f) * tr;
+  w.a2 = w.a1 * tr * f;
   float3 tf = tr * f;
-  float3 a3 = a2 * MP_F3(tf.x / fmax(1.0f - tf.x, 1e-6f), tf.y / fmax(1.0f - tf.y, 1e-6f),
-                         tf.z / fmax(1.0f - tf.z, 1e-6f));
-
-  float sin_i = dot(l, x), cos_i = sqrt(fmax(1.0f - sin_i * sin_i, 0.0f));
-  float phi = atan2(dot(l, z), dot(l, y)) - phi_o;
+  w.a3 = w.a2 * MP_F3(tf.x / fmax(1.0f - tf.x, 1e-6f), tf.y / fmax(1.0f - tf.y, 1e-6f),
+                      tf.z / fmax(1.0f - tf.z, 1e-6f));
   /* The cuticle's scales tilt each lobe by -2, 1 and 4 times alpha. */
-  float s1 = sin(alpha), c1 = sqrt(fmax(1.0f - s1 * s1, 0.0f));
-  float s2 = 2.0f * s1 * c1, c2 = c1 * c1 - s1 * s1;
-  float s4 = 2.0f * s2 * c2, c4 = c2 * c2 - s2 * s2;
-  float sin_r = sin_i * c2 + cos_i * s2, cos_r = fabs(cos_i * c2 - sin_i * s2);
-  float sin_tt = sin_i * c1 - cos_i * s1, cos_tt = fabs(cos_i * c1 + sin_i * s1);
-  float sin_trt = sin_i * c4 - cos_i * s4, cos_trt = fabs(cos_i * c4 + sin_i * s4);
+  w.s1 = sin(alpha);
+  w.c1 = sqrt(fmax(1.0f - w.s1 * w.s1, 0.0f));
+  w.s2 = 2.0f * w.s1 * w.c1;
+  w.c2 = w.c1 * w.c1 - w.s1 * w.s1;
+  w.s4 = 2.0f * w.s2 * w.c2;
+  w.c4 = w.c2 * w.c2 - w.s2 * w.s2;
+  return w;
+}
 
-  float3 out = a0 * (mp_hair_longitudinal(sin_r, cos_r, sin_o, cos_o, v_r) *
-                     mp_hair_azimuthal(phi, 0, s, gamma_o, gamma_t));
-  out += a1 * (mp_hair_longitudinal(sin_tt, cos_tt, sin_o, cos_o, 0.25f * v_lobe) *
-               mp_hair_azimuthal(phi, 1, s, gamma_o, gamma_t));
-  out += a2 * (mp_hair_longitudinal(sin_trt, cos_trt, sin_o, cos_o, 4.0f * v_lobe) *
-               mp_hair_azimuthal(phi, 2, s, gamma_o, gamma_t));
-  out += a3 * (mp_hair_longitudinal(sin_i, cos_i, sin_o, cos_o, 4.0f * v_lobe) * (0.5f / MP_HAIR_PI));
+/* Principled Hair (Chiang) of view `w` from light direction l, per unit
+ * radiance arriving from l over unit solid angle (the lobes integrate to
+ * the fibre's albedo; no cosine, as light reaches a fibre from any side). */
+MP_INLINE float3 mp_hair_chiang_from(const MpHairView* w, float3 l) {
+  if (!w->ok) return MP_F3(0.0f, 0.0f, 0.0f);
+  float sin_i = dot(l, w->x), cos_i = sqrt(fmax(1.0f - sin_i * sin_i, 0.0f));
+  float phi = atan2(dot(l, w->z), dot(l, w->y)) - w->phi_o;
+  float sin_r = sin_i * w->c2 + cos_i * w->s2, cos_r = fabs(cos_i * w->c2 - sin_i * w->s2);
+  float sin_tt = sin_i * w->c1 - cos_i * w->s1, cos_tt = fabs(cos_i * w->c1 + sin_i * w->s1);
+  float sin_trt = sin_i * w->c4 - cos_i * w->s4, cos_trt = fabs(cos_i * w->c4 + sin_i * w->s4);
+
+  float3 out = w->a0 * (mp_hair_longitudinal(sin_r, cos_r, w->sin_o, w->cos_o, w->v_r) *
+                        mp_hair_azimuthal(phi, 0, w->s, w->gamma_o, w->gamma_t));
+  out += w->a1 * (mp_hair_longitudinal(sin_tt, cos_tt, w->sin_o, w->cos_o, 0.25f * w->v_lobe) *
+                  mp_hair_azimuthal(phi, 1, w->s, w->gamma_o, w->gamma_t));
+  out += w->a2 * (mp_hair_longitudinal(sin_trt, cos_trt, w->sin_o, w->cos_o, 4.0f * w->v_lobe) *
+                  mp_hair_azimuthal(phi, 2, w->s, w->gamma_o, w->gamma_t));
+  out += w->a3 * (mp_hair_longitudinal(sin_i, cos_i, w->sin_o, w->cos_o, 4.0f * w->v_lobe) * (0.5f / MP_HAIR_PI));
   return out;
+}
+
+/* Principled Hair (Chiang) towards v from light direction l. */
+MP_INLINE float3 mp_hair_chiang(const MpClosure* c, float3 n, float3 l, float3 v) {
+  MpHairView w = mp_hair_chiang_view(c, n, v);
+  return mp_hair_chiang_from(&w, l);
 }
 
 /* Cycles' Hair BSDF lobes towards v from l (the same measure as

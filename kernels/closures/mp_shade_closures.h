@@ -51,6 +51,10 @@ MP_INLINE float3 mp_hair_area_light(const MpClosure* c, float3 n, float3 v, MP_G
   float area = length(u) * length(w) * (ellipse ? MP_PI : 4.0f);
   float3 sum = MP_F3(0.0f, 0.0f, 0.0f);
   int count = 0;
+  /* Chiang's lobes: the view's part once for all 16 points. */
+  int chiang = c->kind == MP_CLOSURE_HAIR;
+  MpHairView view;
+  if (chiang) view = mp_hair_chiang_view(c, n, v);
   for (int i = 0; i < 4; ++i)
     for (int k = 0; k < 4; ++k) {
       float a = 0.5f * (float)i - 0.75f, b = 0.5f * (float)k - 0.75f;
@@ -61,7 +65,7 @@ MP_INLINE float3 mp_hair_area_light(const MpClosure* c, float3 n, float3 v, MP_G
       if (!(d2 > 0.0f)) continue;
       float3 l = q / sqrt(d2);
       float facing = -dot(l, dir); /* the light emits along +dir */
-      if (facing > 0.0f) sum += mp_hair_lobes(c, n, l, v) * (facing / d2);
+      if (facing > 0.0f) sum += (chiang ? mp_hair_chiang_from(&view, l) : mp_hair_lobes(c, n, l, v)) * (facing / d2);
     }
   return count > 0 ? sum * (area / (float)count) : sum;
 }
