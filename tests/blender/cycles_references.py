@@ -232,6 +232,11 @@ def fingerprint(scene):
     for name in ("render", "cycles", "view_settings", "display_settings"):
         _walk(getattr(scene, name), 3, out, name + ".")
     out.append(f"camera {scene.camera.name if scene.camera else None}")
+    # Cycles' hair shape (3D Curves or Rounded Ribbons), where there is hair.
+    hair = any(obj.type == "CURVES" or any(p.settings.type == "HAIR" for p in getattr(obj, "particle_systems", ()))
+               for obj in scene.objects)
+    if hair and hasattr(scene, "cycles_curves"):
+        out.append(f"hair shape {scene.cycles_curves.shape}")
     for layer in scene.view_layers:
         _walk(layer, 1, out, f"view_layer {layer.name} ")
     seen = set()

@@ -113,12 +113,22 @@ def position_material(nodes, links, info):
     return shift.outputs[0]
 
 
+def set_points_material(emitter, m):
+    """The points' material, set by the tree's Set Material node. The
+    emitter's own slot gets it too: the mesh renders nothing (the tree
+    outputs only points), but the Cycles references know a scene by its
+    objects' material slots, not by what a node tree assigns."""
+    next(n for n in emitter.modifiers["Points"].node_group.nodes if n.type == "SET_MATERIAL").inputs[
+        "Material"].default_value = m
+    emitter.data.materials.clear()
+    emitter.data.materials.append(m)
+
+
 def emission_against_cycles(name, scene, emitter, build):
     m, emission = ru.emission_material(name)
     nodes, links = m.node_tree.nodes, m.node_tree.links
     links.new(build(nodes, links, nodes.new("ShaderNodePointInfo")), emission.inputs["Color"])
-    setter = next(n for n in emitter.modifiers["Points"].node_group.nodes if n.type == "SET_MATERIAL")
-    setter.inputs["Material"].default_value = m
+    set_points_material(emitter, m)
     ru.setup_cycles(scene, samples=32)
     ref = ru.render_passes(scene, "CYCLES", W, H)["rgba"]
     got = ru.render_passes(scene, "MICROPOLY", W, H, samples=16)["rgba"]
@@ -164,8 +174,7 @@ def main():
     m, emission = ru.emission_material("Moving points")
     m.node_tree.links.new(info_material(m.node_tree.nodes, m.node_tree.links, m.node_tree.nodes.new(
         "ShaderNodePointInfo")), emission.inputs["Color"])
-    next(n for n in emitter.modifiers["Points"].node_group.nodes if n.type == "SET_MATERIAL").inputs[
-        "Material"].default_value = m
+    set_points_material(emitter, m)
     ru.setup_cycles(scene, samples=64)
     ref = ru.render_passes(scene, "CYCLES", W, H)["rgba"]
     got = ru.render_passes(scene, "MICROPOLY", W, H, samples=64)["rgba"]  # blur is noise at 16 samples
