@@ -268,7 +268,7 @@ def export_scene(depsgraph, view=None, meshes=None, motion=None):
             try:
                 out.objects += export_particle_hair.export_particle_hair(
                     native_scene, materials, inst, _matrix(inst.matrix_world), out.warnings,
-                    depsgraph.mode == "RENDER", motion)
+                    depsgraph.mode == "RENDER", motion, as_ribbons=export_curves.ribbons(scene))
             except RuntimeError as e:
                 raise ExportError(f"particle hair of '{obj.name}': {e}") from e
         # An instancer whose own geometry is hidden (a particle emitter with
@@ -300,7 +300,7 @@ def export_scene(depsgraph, view=None, meshes=None, motion=None):
                     if instances.add(native_scene, materials, meshes, inst, out.warnings, depsgraph):
                         out.objects += 1
                 elif export_curves.export_curves(native_scene, materials, inst, _matrix(inst.matrix_world), out.warnings,
-                                               motion):
+                                                 motion, as_ribbons=export_curves.ribbons(scene)):
                     out.objects += 1
             except RuntimeError as e:
                 raise ExportError(f"curves '{obj.name}': {e}") from e

@@ -98,8 +98,15 @@ def _curve_uv(curves, name, counts):
     return None if rgba is None else rgba[:, :2]
 
 
-def export_curves(native_scene, materials, inst, matrix, warnings, motion=None):
-    """Adds the curves `inst` renders; returns whether anything was added."""
+def ribbons(scene):
+    """Whether strands render as ribbons facing each view, Cycles' Rounded
+    Ribbons (its default), rather than as round tubes, its 3D Curves."""
+    return getattr(getattr(scene, "cycles_curves", None), "shape", "RIBBONS") == "RIBBONS"
+
+
+def export_curves(native_scene, materials, inst, matrix, warnings, motion=None, as_ribbons=True):
+    """Adds the curves `inst` renders (as ribbons or tubes: `as_ribbons`);
+    returns whether anything was added."""
     obj = inst.object
     curves = obj.data
     count, points = len(curves.curves), len(curves.points)
@@ -140,8 +147,8 @@ def export_curves(native_scene, materials, inst, matrix, warnings, motion=None):
                           lambda name: _curve_attribute(curves, name, counts),
                           lambda name: _curve_uv(curves, name, counts))
     skipped = native_scene.add_curves(obj.name, positions, radii, offsets, object_to_world=matrix,
-                                      point_layers=layers, **export_attributes.object_arguments(obj, inst, materials),
-                                      **moving)
+                                      point_layers=layers, ribbons=as_ribbons,
+                                      **export_attributes.object_arguments(obj, inst, materials), **moving)
     if skipped:
         warnings.append(f"curves '{obj.name}': {skipped} curves with fewer than 2 points, or a point or radius that "
                         "is not finite, are skipped")

@@ -70,7 +70,8 @@ class InstanceTable:
             if key not in self._prototypes:
                 identity = np.identity(4, dtype=np.float32)
                 if obj.type == "CURVES":
-                    made = export_curves.export_curves(native_scene, materials, inst, identity, warnings)
+                    made = export_curves.export_curves(native_scene, materials, inst, identity, warnings,
+                                                       as_ribbons=export_curves.ribbons(depsgraph.scene))
                     self._prototypes[key] = native_scene.patch_set_to_prototype(-1, obj.name) if made else None
                 else:
                     made = export_mesh.export_object(native_scene, materials, meshes, obj, identity, warnings,

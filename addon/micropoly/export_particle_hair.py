@@ -90,7 +90,7 @@ def hair_systems(obj):
             p.settings.render_type == "PATH"]
 
 
-def export_particle_hair(native_scene, materials, inst, matrix, warnings, render, motion=None):
+def export_particle_hair(native_scene, materials, inst, matrix, warnings, render, motion=None, as_ribbons=True):
     """Adds the hair particle systems of the mesh object `inst` renders;
     returns how many were added."""
     obj = inst.object
@@ -128,7 +128,8 @@ def export_particle_hair(native_scene, materials, inst, matrix, warnings, render
             lambda name: None, root_uv)
         first_curve += count
         skipped = native_scene.add_curves(f"{obj.name}/{psys.name}", positions, radii, offsets,
-                                          object_to_world=matrix, point_layers=layers, **args, **moving)
+                                          object_to_world=matrix, point_layers=layers, ribbons=as_ribbons,
+                                          **args, **moving)
         if skipped:
             warnings.append(f"particle hair '{obj.name}/{psys.name}': {skipped} strands with a point that is not "
                             "finite are skipped")

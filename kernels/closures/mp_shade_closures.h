@@ -270,7 +270,7 @@ MP_INLINE float3 mp_shade_closures(float3 p, float3 ng, int faced, int ortho, co
     nf[k] = mode >= MP_NORMAL_INPUT ? mp_valid_reflection_normal(ngf, v, n) : n;
     if (mode == MP_NORMAL_INPUT) nd[k] = nf[k];
   }
-  int hair = 0;
+  int hair = 0, ribbon = shadow && shadow->ribbon;
   float fibre_radius = 0.0f;
   float3 fibre_axis = zero;
   for (int i = 0; i < s->count; ++i) {
@@ -279,6 +279,18 @@ MP_INLINE float3 mp_shade_closures(float3 p, float3 ng, int faced, int ortho, co
     if (mp_closure_is_hair(s->c[i].kind)) {
       hair = 1;
       if (s->c[i].film > fibre_radius) fibre_radius = s->c[i].film, fibre_axis = s->c[i].tangent;
+    }
+  }
+  /* A ribbon's vertex sits at offset h = N . s across the strip (mp_ribbon.h,
+   * s square to the fibre and the view), so the fibre's axis is a radius
+   * times h back along s. */
+  float3 axis_point = p;
+  if (ribbon && shadow && fibre_radius > 0.0f) {
+    float3 side = cross(fibre_axis, v);
+    float ls = length(side);
+    if (ls > 1e-12f) {
+      side = side / ls;
+      axis_point = p - (clamp(dot(ng, side), -1.0f, 1.0f) * fibre_radius) * side;
     }
   }
   float3 out = zero, ambient = zero;
@@ -355,12 +367,23 @@ MP_INLINE float3 mp_shade_closures(float3 p, float3 ng, int faced, int ortho, co
        * where the way to the lamp stays outside it). */
       float3 across = l - fibre_axis * (dot(fibre_axis, l) / fmax(dot(fibre_axis, fibre_axis), 1e-20f));
       float la = length(across);
-      if (hair && fibre_radius > 0.0f && la > 1e-3f && dot(nd[0], l) < 0.0f)
+      /* A ribbon stands for the fibre, and the lights' maps hold it as a
+       * strip through the axis facing each light: every vertex of it looks
+       * from outside the fibre, on the lamp's side (a fibre does not shadow
+       * itself, as in Cycles, whose shadow rays skip their own segment). */
+      if (hair && ribbon && fibre_radius > 0.0f && la > 1e-3f)
+        cl_hair *= mp_shadow_visibility(shadow->maps, k, axis_point + across * (1.05f * fibre_radius / la), l,
+                                        shadow->footprint);
+      else if (hair && fibre_radius > 0.0f && la > 1e-3f && dot(nd[0], l) < 0.0f)
         cl_hair *= mp_shadow_visibility(shadow->maps, k, p - nd[0] * fibre_radius + across * (1.05f * fibre_radius / la),
                                         l, shadow->footprint);
       else if (hair)
-        cl_hair *= mp_shadow_visibility(shadow->maps, k, p, shadow->normal, shadow->footprint);
-      cl *= mp_shadow_visibility(shadow->maps, k, p, shadow->normal, shadow->footprint);
+        cl_hair *= mp_shadow_visibility(shadow->maps, k, p, ribbon ? l : shadow->normal, shadow->footprint);
+      /* A ribbon's vertex is compared on the plane square to the lamp (a
+       * round fibre's surface faces every way; the strip's own plane, or
+       * its rounded normal's, would tilt the comparison across the filter
+       * into the neighbouring strands' depths). */
+      cl *= mp_shadow_visibility(shadow->maps, k, p, ribbon ? l : shadow->normal, shadow->footprint);
     }
     for (int i = 0; i < s->count; ++i) {
       const MpClosure* c = &s->c[i];

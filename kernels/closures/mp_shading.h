@@ -179,11 +179,15 @@ MP_INLINE float mp_spot_mask(MP_GLOBAL const DeviceLight* lt, float3 p) {
 }
 
 /* What shading needs to shadow a vertex: the maps (mp_shadow.h), the
- * receiver's geometric normal (its tangent plane) and pixel footprint. */
+ * receiver's geometric normal (its tangent plane) and pixel footprint, and
+ * whether it is a ribbon's (mp_ribbon.h): a strip facing the camera that
+ * stands for a round fibre, whose tangent plane says nothing of the fibre
+ * as the lights see it. */
 typedef struct {
   const MpShadowMaps* maps;
   float3 normal;
   float footprint;
+  int ribbon;
 } MpShadowQuery;
 
 /* A shading normal n (unit, on the viewer's side of the geometric normal

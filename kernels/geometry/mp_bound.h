@@ -124,6 +124,36 @@ MP_INLINE void mp_subpatch_hull(const MP_GLOBAL float4* cp, uint type, const Sub
     }
 }
 
+/* Boxes (camera space) holding a ribbon's sub-patch (mp_ribbon.h), as
+ * mp_subpatch_hull does for other patches, but placed already: the
+ * sub-segment's centre net (blossoming along v), each point grown by the
+ * largest placed radius of the segment in every direction, which holds the
+ * strip whichever way it turns (by sqrt 2 radii in a light's view, where
+ * the strip also moves a radius away from the light). The net is repeated across u (u spans the
+ * width, which the radius covers), so its u lengths are zero and a ribbon
+ * straddling the eye plane is cut along its length. */
+MP_INLINE void mp_ribbon_hull(const MP_GLOBAL float4* cp, const SubPatch* sp, const MpPlacement* place, float3* lo,
+                              float3* hi) {
+  float v0 = fmin(fmin(sp->corner[1], sp->corner[3]), fmin(sp->corner[5], sp->corner[7]));
+  float v1 = fmax(fmax(sp->corner[1], sp->corner[3]), fmax(sp->corner[5], sp->corner[7]));
+  float Wv[16];
+  mp_subsegment_weights(v0, v1, Wv);
+  float r = 0.0f;
+  for (int j = 0; j < 4; ++j) r = fmax(r, mp_ribbon_radius(cp, j, place));
+  if (place->push > 0.0f) r *= 1.41422f;
+  float reach = MP_PATCH_DISPLACEMENT_BOUND(cp);
+  float3 grow = MP_F3(r + reach, r + reach, r + reach) + MP_PATCH_MOTION_REACH(cp);
+  for (int l = 0; l < 4; ++l) {
+    float3 c = MP_F3(0.0f, 0.0f, 0.0f);
+    for (int j = 0; j < 4; ++j) c += Wv[4 * l + j] * MP_XYZ(cp[4 * j]);
+    c = mp_place_point(place, c);
+    for (int i = 0; i < 4; ++i) {
+      lo[4 * l + i] = c - grow;
+      hi[4 * l + i] = c + grow;
+    }
+  }
+}
+
 /* A camera-space point in the view's space (FrameParams.view). */
 MP_INLINE float3 mp_to_view(float3 p, FrameParams f) {
   if (!f.has_view) return p;
@@ -331,6 +361,8 @@ MP_INLINE float mp_edge_screen_length(const MP_GLOBAL float4* points, const MP_G
   float3 p[MP_EDGE_SEGMENTS + 1];
   int e = a.y == 0.0f && b.y == 0.0f ? 0 : a.x == 1.0f && b.x == 1.0f ? 1 : a.y == 1.0f && b.y == 1.0f ? 2
         : a.x == 0.0f && b.x == 0.0f ? 3 : -1;
+  uint type = patch_info[4 * (ulong)patch];
+  if (type == MP_PATCH_CURVE) e = -1; /* ribbons have no stored edges (mp_surface_point) */
   if (e >= 0) {
     float ta = (e & 1) ? a.y : a.x, tb = (e & 1) ? b.y : b.x;
     const MP_GLOBAL uint* refs = edges + (ulong)patch * MP_EDGE_REFS + 2u * (uint)e;
@@ -352,14 +384,14 @@ MP_INLINE float mp_edge_screen_length(const MP_GLOBAL float4* points, const MP_G
     int swap = b.x < a.x || (b.x == a.x && b.y < a.y);
     float2 lo = swap ? b : a, hi = swap ? a : b;
     const MP_GLOBAL float4* cp = points + (ulong)patch * MP_PATCH_POINTS;
-    uint type = patch_info[4 * (ulong)patch];
     for (int k = 0; k <= MP_EDGE_SEGMENTS; ++k) {
       float2 uv = lo + (hi - lo) * ((float)k / (float)MP_EDGE_SEGMENTS);
       float3 du, dv;
-      mp_eval_patch(cp, type, uv.x, uv.y, &p[k], &du, &dv);
+      mp_eval_placed(cp, type, uv.x, uv.y, place, &p[k], &du, &dv);
     }
   }
-  for (int k = 0; k <= MP_EDGE_SEGMENTS; ++k) p[k] = mp_place_point(place, p[k]);
+  if (e >= 0)
+    for (int k = 0; k <= MP_EDGE_SEGMENTS; ++k) p[k] = mp_place_point(place, p[k]);
   return mp_polyline_screen_length(p, MP_EDGE_SEGMENTS + 1, f);
 }
 
@@ -377,12 +409,6 @@ MP_INLINE uint mp_edge_rate_code(float len, FrameParams f) {
   return code;
 }
 
-/* Whether edge e of a sub-patch runs along the patch's u (splits along v
- * rotate a sub-patch's corners, so edge 0 is not always a u edge). */
-MP_INLINE int mp_edge_runs_along_u(const SubPatch* sp, int e) {
-  float2 d = mp_corner(sp, e + 1) - mp_corner(sp, e);
-  return fabs(d.x) > fabs(d.y);
-}
 
 /* Screen length through the middle of the sub-patch, from the middle of edge
  * 3 to the middle of edge 1 (dir 0) or of edge 0 to edge 2 (dir 1): the
@@ -398,8 +424,7 @@ MP_INLINE float mp_mid_screen_length(const MP_GLOBAL float4* cp, uint type, cons
   for (int k = 0; k <= MP_EDGE_SEGMENTS; ++k) {
     float2 uv = a + (b - a) * ((float)k / (float)MP_EDGE_SEGMENTS);
     float3 du, dv;
-    mp_eval_patch(cp, type, uv.x, uv.y, &p[k], &du, &dv);
-    p[k] = mp_place_point(place, p[k]);
+    mp_eval_placed(cp, type, uv.x, uv.y, place, &p[k], &du, &dv);
   }
   float len = mp_polyline_screen_length(p, MP_EDGE_SEGMENTS + 1, f);
   *chord = len >= 0.0f ? mp_project_view_unplaced(p[MP_EDGE_SEGMENTS], f) - mp_project_view_unplaced(p[0], f)
@@ -627,6 +652,7 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
   uint depth = MP_INFO_DEPTH(sp->info);
   int can_split = (int)depth < f.max_depth;
   MpPlacement place = mp_instance_placement(instances, sp->instance);
+  mp_place_facing(&place, f);
   float3 reach = MP_F3(0.0f, 0.0f, 0.0f);
   if (sp->instance != MP_NO_INSTANCE)
     reach = MP_F3(instances[sp->instance].reach[0], instances[sp->instance].reach[1], instances[sp->instance].reach[2]);
@@ -641,8 +667,12 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
     if (d) return d;
   }
   float3 lo[16], hi[16];
-  mp_subpatch_hull(cp, type, sp, lo, hi);
-  mp_place_boxes(&place, lo, hi, 16);
+  if (type == MP_PATCH_CURVE) {
+    mp_ribbon_hull(cp, sp, &place, lo, hi);
+  } else {
+    mp_subpatch_hull(cp, type, sp, lo, hi);
+    mp_place_boxes(&place, lo, hi, 16);
+  }
   mp_grow_boxes(lo, hi, 16, reach);
   mp_boxes_to_view(lo, hi, 16, f);
   MpBound b = mp_bound_boxes(lo, hi, 16, f);
@@ -657,6 +687,20 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
   uint round_code = mp_edge_rate_code(0.0f, f);
   while (round && MP_CODE_RATE(round_code) < MP_ROUND_MIN_RATE && MP_CODE_RATE(round_code) < (uint)f.max_grid)
     ++round_code;
+  /* Ribbons (mp_ribbon.h) thinner than the target micropolygon: RenderMan's
+   * shading rate is an area, so along the strand their micropolygons may
+   * grow by as much as the strand is thin, up to MP_SHEAR_STRETCH, as a
+   * sheared grid's may (mp_interior_rates). Only a ribbon's sides are
+   * stretched, which no other patch shares (its ends, which the next
+   * segment shares, keep their own rate). Across is the direction of the
+   * patch's u (the split corners may turn it). */
+  float stretch = 1.0f;
+  int across = mp_edge_runs_along_u(sp, 0) ? 0 : 1; /* mid-line direction across the strand */
+  if (type == MP_PATCH_CURVE && !straddles) {
+    float2 chord;
+    float width = mp_mid_screen_length(cp, type, sp, across, f, &chord, &place);
+    if (width >= 0.0f) stretch = clamp(f.micropoly_edge / fmax(width, 1e-6f), 1.0f, MP_SHEAR_STRETCH);
+  }
   uint codes[4];
   float score[4];
   int any_long = 0;
@@ -666,6 +710,7 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
     if (code == 0u) {
       len = mp_edge_screen_length(points, patch_info, edges, curves, sp->patch, mp_corner(sp, e), mp_corner(sp, e + 1), f,
                                   &place);
+      if (stretch > 1.0f && len > 0.0f && (e & 1) != across) len /= stretch;
       code = mp_edge_rate_code(len, f);
       if (round && code && mp_edge_runs_along_u(sp, e)) code = max(code, round_code);
       sp->rates |= code << (8u * (uint)e);
@@ -678,6 +723,10 @@ MP_INLINE uint mp_classify(const MP_GLOBAL float4* points, const MP_GLOBAL uint*
   float mid_u = mp_mid_screen_length(cp, type, sp, 0, f, &chord_u, &place);
   float mid_v = mp_mid_screen_length(cp, type, sp, 1, f, &chord_v, &place);
   if (straddles) mid_u = mid_v = MP_UNMEASURABLE;
+  if (stretch > 1.0f) {
+    if (across == 0 && mid_v > 0.0f) mid_v /= stretch;
+    if (across == 1 && mid_u > 0.0f) mid_u /= stretch;
+  }
   float limit = 1.41421356f * (float)f.max_grid * f.micropoly_edge;
   int long_u = mid_u > limit, long_v = mid_v > limit;
 

@@ -28,6 +28,13 @@ MP_INLINE float2 mp_corner(const SubPatch* sp, int k) {
   return MP_F2(sp->corner[2 * k], sp->corner[2 * k + 1]);
 }
 
+/* Whether edge e of a sub-patch runs along the patch's u (splits along v
+ * rotate a sub-patch's corners, so edge 0 is not always a u edge). */
+MP_INLINE int mp_edge_runs_along_u(const SubPatch* sp, int e) {
+  float2 d = mp_corner(sp, e + 1) - mp_corner(sp, e);
+  return fabs(d.x) > fabs(d.y);
+}
+
 /* Vertex k of n along the segment a -> b. With a, b binary fractions and n a
  * power of two this is exact, so it does not matter from which end or in
  * which sub-patch a shared edge vertex is computed. */

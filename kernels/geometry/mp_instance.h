@@ -34,12 +34,22 @@ typedef struct {
   float4 r[3];
   float4 n[3];
   int placed; /* 0: the identity (patches placed on their own) */
+  /* Where the view that evaluates the patch looks from, camera space: the
+   * eye (w = 1) or, for an orthographic view, the unit direction towards it
+   * (w = 0). Only ribbons (MP_PATCH_CURVE) read it; the camera's own eye
+   * unless mp_place_facing says otherwise. */
+  float4 eye;
+  /* 1 in a light's view: ribbons move a radius away from the light
+   * (mp_ribbon.h); 0 elsewhere. */
+  float push;
 } MpPlacement;
 
 MP_INLINE MpPlacement mp_placement_none(void) {
   MpPlacement m;
   for (int k = 0; k < 3; ++k) m.r[k] = m.n[k] = MP_F4(0.0f, 0.0f, 0.0f, 0.0f);
   m.placed = 0;
+  m.eye = MP_F4(0.0f, 0.0f, 0.0f, 1.0f);
+  m.push = 0.0f;
   return m;
 }
 
@@ -50,7 +60,27 @@ MP_INLINE MpPlacement mp_placement_rows(const MP_GLOBAL float* rows, const MP_GL
     m.n[k] = MP_F4(normal_rows[4 * k], normal_rows[4 * k + 1], normal_rows[4 * k + 2], 0.0f);
   }
   m.placed = 1;
+  m.eye = MP_F4(0.0f, 0.0f, 0.0f, 1.0f);
+  m.push = 0.0f;
   return m;
+}
+
+/* The eye of view f (FrameParams: camera space -> its space by the rigid
+ * rows `view`, looking down -z) for the ribbons a placement evaluates: the
+ * view's origin, -R^T t, or for an orthographic view its +z axis, R^T z. */
+MP_INLINE void mp_place_facing(MpPlacement* m, FrameParams f) {
+  m->push = f.view_kind == MP_VIEW_SHADOW ? 1.0f : 0.0f;
+  if (!f.has_view) {
+    m->eye = f.ortho ? MP_F4(0.0f, 0.0f, 1.0f, 0.0f) : MP_F4(0.0f, 0.0f, 0.0f, 1.0f);
+    return;
+  }
+  const float* v = f.view;
+  if (f.ortho) {
+    m->eye = MP_F4(v[8], v[9], v[10], 0.0f);
+    return;
+  }
+  m->eye = MP_F4(-(v[0] * v[3] + v[4] * v[7] + v[8] * v[11]), -(v[1] * v[3] + v[5] * v[7] + v[9] * v[11]),
+                 -(v[2] * v[3] + v[6] * v[7] + v[10] * v[11]), 1.0f);
 }
 
 /* The placement of a sub-patch's instance at the shutter's centre. */

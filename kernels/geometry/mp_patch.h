@@ -22,6 +22,16 @@
 #define MP_PATCH_POINTS 20
 #define MP_PATCH_BEZIER 0u
 #define MP_PATCH_GREGORY 1u
+/* MP_PATCH_CURVE: one cubic segment of a strand, drawn as a ribbon that
+ * faces each view (RenderMan's RiCurves, Cycles' Rounded Ribbons; see
+ * mp_ribbon.h). v runs along the strand, u across it. Row j (j = 0..3) holds
+ * the segment's j-th Bezier control point C_j = cp[4*j] and three points
+ * cp[4*j + k] = C_j + r_j e_k (k = 1, 2, 3; e_k the axes), r_j the radius
+ * control value: any affine placement carries the radius with the points,
+ * as the mean length of the three offsets. The partners cp[16], cp[17] (and
+ * again cp[18], cp[19]) are the lower and upper corners of a box around the
+ * whole ribbon in any orientation, so a hull of all 20 points bounds it. */
+#define MP_PATCH_CURVE 2u
 
 /* PatchInfo (uint4): x = type, y = material index, z = flags, w = primitive id
  * (the face or patch index in its object, used to make sample ids stable).

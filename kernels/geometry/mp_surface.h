@@ -14,6 +14,7 @@
 #define MP_SURFACE_H
 
 #include "geometry/mp_instance.h"
+#include "geometry/mp_ribbon.h"
 
 /* Bernstein evaluation of curve `ref` at t along the referring edge: its
  * position (which = 0) or its normal cubic (which = 1, not normalised). */
@@ -57,7 +58,16 @@ MP_INLINE void mp_surface_point(const MP_GLOBAL float4* points, const MP_GLOBAL 
                                 const MP_GLOBAL uint* edges, const MP_GLOBAL float4* curves, uint patch, float u,
                                 float v, const MpPlacement* place, float3* P, float3* dPdu, float3* dPdv) {
   const MP_GLOBAL float4* cp = points + (ulong)patch * MP_PATCH_POINTS;
-  mp_eval_patch(cp, patch_info[4 * (ulong)patch], u, v, P, dPdu, dPdv);
+  uint type = patch_info[4 * (ulong)patch];
+  if (type == MP_PATCH_CURVE) {
+    /* A ribbon faces each view: its edges are not stored curves. Segments
+     * meet at a shared centre point and radius, where both evaluate the
+     * same end of their Bezier bases. */
+    float3 n;
+    mp_eval_ribbon(cp, u, v, place, P, dPdu, dPdv, &n);
+    return;
+  }
+  mp_eval_patch(cp, type, u, v, P, dPdu, dPdv);
   float t;
   int e = mp_boundary_edge(u, v, &t);
   if (e >= 0) {
@@ -79,9 +89,7 @@ MP_INLINE float3 mp_patch_normal(const MP_GLOBAL float4* cp, uint type, float u,
   for (int k = 0; k < 3 && !(length(n) > 1e-7f * scale && length(n) > 0.0f); ++k) {
     float t = k == 0 ? 1e-4f : k == 1 ? 1e-3f : 1e-2f;
     float3 p;
-    mp_eval_patch(cp, type, u + (0.5f - u) * t, v + (0.5f - v) * t, &p, &dpdu, &dpdv);
-    dpdu = mp_place_vector(place, dpdu);
-    dpdv = mp_place_vector(place, dpdv);
+    mp_eval_placed(cp, type, u + (0.5f - u) * t, v + (0.5f - v) * t, place, &p, &dpdu, &dpdv);
     n = cross(dpdu, dpdv);
     scale = length(dpdu) * length(dpdv);
   }
@@ -96,7 +104,9 @@ MP_INLINE float3 mp_surface_normal(const MP_GLOBAL float4* points, const MP_GLOB
                                    const MP_GLOBAL uint* edges, const MP_GLOBAL float4* curves, uint patch, float u,
                                    float v, float3 dPdu, float3 dPdv, const MpPlacement* place) {
   const MP_GLOBAL float4* cp = points + (ulong)patch * MP_PATCH_POINTS;
-  float3 n = mp_patch_normal(cp, patch_info[4 * (ulong)patch], u, v, dPdu, dPdv, place);
+  uint type = patch_info[4 * (ulong)patch];
+  float3 n = mp_patch_normal(cp, type, u, v, dPdu, dPdv, place);
+  if (type == MP_PATCH_CURVE) return n;
   float t;
   int e = mp_boundary_edge(u, v, &t);
   if (e >= 0) {

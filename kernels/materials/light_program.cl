@@ -25,12 +25,12 @@ __kernel void light_program_surfaces(MP_SCENE_PARAMS FrameParams f, __global con
   float alpha, spread2;
   if (!mp_record_load(records, stride, k, &s, &head, &alpha, &spread2)) return;
   const uint index = (uint)head.y, object = (uint)head.z;
-  const int faced = head.w;
+  const int faced = head.w & 1, ribbon = (head.w >> 1) & 1;
   float3 p = grid_p[index].xyz, n = grid_n[index].xyz;
   /* Shadows compare with the surface's tangent plane (for smooth-shaded
    * polygons, which shade.cl gave their interpolated normal, that normal's). */
   MpShadowMaps maps = MP_SHADOW_INPUTS;
-  MpShadowQuery shadow = {&maps, n, mp_pixel_footprint(-p.z, f)};
+  MpShadowQuery shadow = {&maps, n, mp_pixel_footprint(-p.z, f), ribbon};
   /* Sharp lobes widened by the normal's spread across the micropolygon. */
   mp_surface_prepare(&s, spread2, p, f.ortho);
   MpRefractScene refract = {refract_nodes, refract_tris, refract_roots[object]};

@@ -252,8 +252,10 @@ __kernel void shade_program_grids(MP_SCENE_PARAMS __global const SubPatch* dicea
                         mp_row3(o->to_object, 2, dpdv, 0.0f));
     float lt = length(t);
     g.fibre = lt > 0.0f && isfinite(lt) ? t / lt : (float3)(0.0f);
-    /* A tube's u is a quarter turn, a quarter of the circumference. */
+    /* A tube's u is a quarter turn, a quarter of the circumference; a
+     * ribbon's u spans its width, the diameter. */
     if (patch_info[4 * (ulong)sp.patch + 2] & MP_PATCH_ROUND_U) g.fibre_radius = length(dpdu) * (2.0f / M_PI_F);
+    if (patch_info[4 * (ulong)sp.patch] == MP_PATCH_CURVE) g.fibre_radius = 0.5f * length(dpdu);
   }
 #endif
   /* The next grid vertex along u and along v (the previous one on the
@@ -305,7 +307,9 @@ __kernel void shade_program_grids(MP_SCENE_PARAMS __global const SubPatch* dicea
   /* The light program lights it (light_program.cl), with the normal's
    * spread across the micropolygon (mp_normal_spread2): the grid's normals,
    * final since shade.cl. */
-  mp_record_store(records, record_stride, k, &s, (uint)index, object, faced, alpha,
+  /* Bit 1 of the faced word: a ribbon's vertex (MpShadowQuery.ribbon). */
+  int ribbon = patch_info[4 * (ulong)sp.patch] == MP_PATCH_CURVE;
+  mp_record_store(records, record_stride, k, &s, (uint)index, object, faced | (ribbon << 1), alpha,
                   mp_normal_spread2(n, grid_n[gx].xyz, grid_n[gy].xyz));
 }
 

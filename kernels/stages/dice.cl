@@ -10,8 +10,16 @@
 #include "geometry/mp_grid.h"
 #include "core/mp_scene_data.h"
 
+/* The view a diced sub-patch belongs to: one of the pass' views (a light's
+ * shadow maps), or the pass' own. Ribbons turn to face it (mp_ribbon.h). */
+inline FrameParams mp_dice_view(const SubPatch* sp, FrameParams f, __global const FrameParams* views,
+                                uint view_count) {
+  return view_count > 0u ? views[MP_INFO_VIEW(sp->info)] : f;
+}
+
 __kernel void dice_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, uint count, FrameParams f,
-                         __global float4* grid_p, __global float4* grid_n, __global const uint* vertex_offsets) {
+                         __global const FrameParams* views, uint view_count, __global float4* grid_p,
+                         __global float4* grid_n, __global const uint* vertex_offsets) {
   uint gid = get_global_id(0), i, j;
   SubPatch sp;
   float2 uv;
@@ -19,8 +27,31 @@ __kernel void dice_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, uint
   if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
   float3 p, dpdu, dpdv;
   MpPlacement place = mp_instance_placement(instances, sp.instance);
-  mp_surface_point(points, patch_info, patch_edges, edge_curves, sp.patch, uv.x, uv.y, &place, &p, &dpdu, &dpdv);
+  mp_place_facing(&place, mp_dice_view(&sp, f, views, view_count));
   uint flags = mp_placed_flags(patch_info, instances, sp.patch, sp.instance);
+  if (patch_info[4 * (ulong)sp.patch] == MP_PATCH_CURVE) {
+    /* A ribbon shades with the round normal of the strand it stands for,
+     * which faces its view: w = 1 says so (shade.cl), as for smooth normals
+     * (at the ribbon's very edges the normal is square to the view, and
+     * the strip's edge seen from the eye lies a radius off that tangent). */
+    /* A grid across the whole width shades its vertices inward by its
+     * rate across (mp_ribbon_shading_scale). */
+    float scale = 1.0f;
+    float u0 = fmin(fmin(sp.corner[0], sp.corner[2]), fmin(sp.corner[4], sp.corner[6]));
+    float u1 = fmax(fmax(sp.corner[0], sp.corner[2]), fmax(sp.corner[4], sp.corner[6]));
+    if (u0 == 0.0f && u1 == 1.0f) {
+      MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
+      int e = mp_edge_runs_along_u(&sp, 0) ? 0 : 1; /* the edges across the strand: e and e + 2 */
+      uint across = max(max(g.n[e], g.n[e + 2]), e == 0 ? g.nu : g.nv);
+      scale = mp_ribbon_shading_scale(across);
+    }
+    float3 n;
+    mp_eval_ribbon_shaded(points + (ulong)sp.patch * MP_PATCH_POINTS, uv.x, uv.y, &place, scale, &p, &dpdu, &dpdv, &n);
+    grid_p[index] = (float4)(p, 1.0f);
+    grid_n[index] = (float4)(n, 1.0f);
+    return;
+  }
+  mp_surface_point(points, patch_info, patch_edges, edge_curves, sp.patch, uv.x, uv.y, &place, &p, &dpdu, &dpdv);
   /* Displaced materials move shared edge vertices along the edge's own normal
    * (watertight); others shade with the patch's normal, which keeps polygon
    * faces flat. */
@@ -90,8 +121,10 @@ __kernel void dice_motion_positions(MP_SCENE_PARAMS __global const SubPatch* dic
   ulong index;
   if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
   float3 p, dpdu, dpdv;
-  /* An instance's prototype does not move: its step is the instance's transform at that step. */
+  /* An instance's prototype does not move: its step is the instance's transform at that step.
+   * Only the camera's view moves (FrameParams.motion_steps), so ribbons face its eye. */
   MpPlacement place = mp_instance_placement_at_step(instances, instance_motion, instance_count, sp.instance, step);
+  mp_place_facing(&place, f);
   if (sp.instance == MP_NO_INSTANCE)
     mp_surface_point(motion_points + (ulong)step * point_count, patch_info, patch_edges,
                      motion_curves + (ulong)step * curve_count, sp.patch, uv.x, uv.y, &place, &p, &dpdu, &dpdv);

@@ -22,11 +22,13 @@ __kernel void shade_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, uin
   float3 p = grid_p[index].xyz, n = grid_n[index].xyz;
   /* Shadows compare with the surface's own tangent plane (mp_shadow.h). */
   MpShadowMaps maps = MP_SHADOW_INPUTS;
-  MpShadowQuery shadow = {&maps, n, mp_pixel_footprint(-p.z, f)};
+  MpShadowQuery shadow = {&maps, n, mp_pixel_footprint(-p.z, f),
+                          patch_info[4 * (ulong)sp.patch] == MP_PATCH_CURVE};
   /* Smooth-shaded polygons: their interpolated normal replaces the surface's
    * for shading, node programs and the Normal pass (w = 1: already faced).
    * Displaced surfaces keep the normal of their displaced grid. */
-  int faced = 0;
+  /* Ribbons' normals face their view already (dice.cl, w = 1). */
+  int faced = grid_n[index].w > 0.5f;
   /* The surface itself faces away from the viewer. */
   int away = dot(n, f.ortho ? (float3)(0.0f, 0.0f, 1.0f) : -p) < 0.0f;
   int smooth = (patch_info[4 * (ulong)sp.patch + 2] & MP_PATCH_SMOOTH_NORMALS) && !(m.program[1] > 0.0f);
@@ -43,6 +45,8 @@ __kernel void shade_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, uin
     }
   }
   if (m.program[2] > 0.0f) return; /* shaded by its node program (material_program.cl) */
+  /* w goes on to the sampler as the held-out share (mp_raster.h): none. */
+  if (faced && !smooth) grid_n[index].w = 0.0f;
   /* The normal one step along u and v (mp_normal_spread2). Smooth-shaded
    * polygons take their neighbours' interpolated normals from the patch
    * (their grid normals are being replaced by this kernel), the rest the

@@ -8,13 +8,14 @@
 #include <string>
 
 #include "host_dicer.h"
+#include "scene/curves.h"
 #include "scene_fixtures.h"
 
 namespace mp::test {
 namespace {
 
 struct Checked {
-  size_t diced = 0, vertices = 0, gregory = 0, violations = 0;
+  size_t diced = 0, vertices = 0, gregory = 0, ribbons = 0, violations = 0;
   std::string first_violation;
   // The net's plane (mp_net_plane, mp_plane_near_depth): points of
   // micropolygons nearer than its bound over the pixel they fall in, and
@@ -37,7 +38,13 @@ Checked check_scene(const Scene& scene) {
     float u1 = std::max({sp.corner[0], sp.corner[2], sp.corner[4], sp.corner[6]});
     float v0 = std::min({sp.corner[1], sp.corner[3], sp.corner[5], sp.corner[7]});
     float v1 = std::max({sp.corner[1], sp.corner[3], sp.corner[5], sp.corner[7]});
-    mp_subpatch_net_boxes(cp, type, u0, v0, u1, v1, lo, hi);
+    if (type == MP_PATCH_CURVE) {
+      const MpPlacement none = mp_placement_none();
+      mp_ribbon_hull(cp, &sp, &none, lo, hi);
+    } else {
+      mp_subpatch_net_boxes(cp, type, u0, v0, u1, v1, lo, hi);
+    }
+    c.ribbons += type == MP_PATCH_CURVE;
     MpBound bound = mp_bound_boxes(lo, hi, 16, f);
     glm::vec3 box_lo(3e38f), box_hi(-3e38f);
     for (int k = 0; k < 16; ++k) box_lo = glm::min(box_lo, lo[k]), box_hi = glm::max(box_hi, hi[k]);
@@ -82,6 +89,14 @@ Checked check_scene(const Scene& scene) {
   return c;
 }
 
+// An orthographic camera from (3, 2, 4) at the origin over the window
+// [-w, w] x [-h, h].
+void view_orthographically(Scene& s, float w, float h) {
+  s.camera = look_at({3.0f, 2.0f, 4.0f}, {0, 0, 0});
+  s.camera.projection = Camera::Projection::Orthographic;
+  s.camera.screen_left = -w, s.camera.screen_right = w, s.camera.screen_bottom = -h, s.camera.screen_top = h;
+}
+
 TEST(Bounds, DicedVerticesLieInsideTheirSubPatchBounds) {
   Scene s = base_scene(640, 480, 1);
   s.camera = look_at({2.0f, 1.5f, 3.0f}, {0, 0, 0}, 50.0f);
@@ -110,14 +125,44 @@ TEST(Bounds, OrthographicAndNearCameraBoundsAreConservative) {
   EXPECT_EQ(near.violations, 0u) << near.first_violation;
   EXPECT_EQ(near.plane_violations, 0u) << near.first_plane_violation;
   EXPECT_GT(near.diced, 50u);
-  s.camera = look_at({3.0f, 2.0f, 4.0f}, {0, 0, 0});
-  s.camera.projection = Camera::Projection::Orthographic;
-  s.camera.screen_left = -2.5f, s.camera.screen_right = 2.5f, s.camera.screen_bottom = -2.0f, s.camera.screen_top = 2.0f;
+  view_orthographically(s, 2.5f, 2.0f);
   Checked ortho = check_scene(s);
   EXPECT_EQ(ortho.violations, 0u) << ortho.first_violation;
   EXPECT_EQ(ortho.plane_violations, 0u) << ortho.first_plane_violation;
   EXPECT_GT(ortho.plane_tighter, ortho.plane_points / 4);  // 65% here
   EXPECT_GT(ortho.diced, 50u);
+}
+
+// Ribbons (mp_ribbon.h) turn to face the eye: their bound is their centre
+// net grown by the radius, which holds them from any view. Strands of
+// changing radius bend about the camera, some near enough to straddle the
+// eye plane and some seen end on.
+TEST(Bounds, RibbonsStayInsideTheirBoundsFromAnyView) {
+  Scene s = base_scene(320, 240, 1);
+  s.camera = look_at({0.2f, 0.3f, 2.0f}, {0, 0, 0}, 60.0f);
+  CurveSet curves;
+  curves.name = "strands";
+  curves.ribbons = true;
+  for (int c = 0; c < 24; ++c) {
+    curves.offsets.push_back(int(curves.points.size()));
+    const float a = 0.26f * float(c);
+    for (int k = 0; k < 6; ++k) {
+      const float t = float(k) / 5.0f;
+      curves.points.emplace_back(std::cos(a) * (0.3f + t), std::sin(a) * (0.3f + t) + 0.2f * std::sin(5.0f * t),
+                                 1.9f * t - 1.0f + 0.1f * float(c % 3));
+      curves.radii.push_back(0.004f + 0.05f * t * (1.0f - t) * float(c % 4));
+    }
+  }
+  curves.offsets.push_back(int(curves.points.size()));
+  ASSERT_EQ(add_curves(s, curves), 0u);
+  Checked c = check_scene(s);
+  EXPECT_EQ(c.violations, 0u) << c.first_violation;
+  EXPECT_EQ(c.ribbons, c.diced);
+  EXPECT_GT(c.diced, 100u);
+  view_orthographically(s, 2.0f, 1.5f);
+  Checked ortho = check_scene(s);
+  EXPECT_EQ(ortho.violations, 0u) << ortho.first_violation;
+  EXPECT_GT(ortho.diced, 24u);
 }
 
 TEST(Bounds, APlaneCullsALayerTheNearestDepthCannot) {

@@ -1,5 +1,5 @@
 // RIB Curves (rib/rib_curves.cpp): linear and cubic curves in every basis,
-// periodic or not, as round tubes. Coverage against the analytic areas of
+// periodic or not, as ribbons facing the eye. Coverage against the analytic areas of
 // the strips they project to, the same curve through different bases, and
 // the request's errors.
 #include <gtest/gtest.h>
@@ -36,7 +36,7 @@ class RibCurvesTest : public SharedRendererTest {
 
 TEST_F(RibCurvesTest, LinearCurveCoversItsStrip) {
   // 3 long, 0.2 wide, a turn of 90 degrees at its middle vertex: the strip's
-  // area, less nothing at the open ends (round tubes project to width x length).
+  // area, less nothing at the open ends (ribbons facing the eye are width x length).
   const double a = area("Curves \"linear\" [3] \"nonperiodic\" \"P\" [-1.5 -0.5 0  0 -0.5 0  0 1 0] \"constantwidth\" [0.2]");
   // Two legs of 1.5 meeting at a right angle: the outer corner's square
   // quarter (0.1 x 0.1) is covered, the inner overlap counted once.
@@ -59,11 +59,9 @@ TEST_F(RibCurvesTest, BasesDrawTheSameCurve) {
       "0.4 1 0  1.2 -1 0  2 1 0] \"constantwidth\" [0.15]";
   const RibResult b = read(bspline);
   ASSERT_EQ(b.scene.bezier_patches.size(), 1u);
-  // Three segments, four quarter patches each, each segment halved where it
-  // turns by more than 30 degrees (scene/curves.cpp).
-  const size_t cps = b.scene.bezier_patches[0].control_points.size();
-  EXPECT_EQ(cps % (4u * 16u), 0u);
-  EXPECT_GT(cps, 3u * 4u * 16u);
+  // Three segments, one ribbon patch each (scene/curves.cpp).
+  EXPECT_TRUE(b.scene.bezier_patches[0].ribbons);
+  EXPECT_EQ(b.scene.bezier_patches[0].control_points.size(), 3u * 16u);
   // The same segments written as a Bezier curve: each B-spline segment's
   // Bezier points are (p0 + 4p1 + p2)/6, (2p1 + p2)/3, (p1 + 2p2)/3, (p1 + 4p2 + p3)/6.
   const double xs[6] = {-2, -1.2, -0.4, 0.4, 1.2, 2}, ys[6] = {-1, 1, -1, 1, -1, 1};
@@ -114,7 +112,8 @@ TEST_F(RibCurvesTest, RoundTripKeepsTheCurves) {
   write_rib(first.scene, written);
   const RibResult second = read_rib_string(written.str(), "written.rib");
   ASSERT_EQ(second.scene.bezier_patches.size(), 1u);
-  EXPECT_TRUE(second.scene.bezier_patches[0].round_u);  // tubes keep their round dicing
+  EXPECT_TRUE(second.scene.bezier_patches[0].ribbons);  // ribbons stay ribbons
+  EXPECT_FALSE(second.scene.bezier_patches[0].round_u);
   EXPECT_EQ(second.scene.bezier_patches[0].control_points, first.scene.bezier_patches[0].control_points);
   const double a = coverage(renderer_->render(first.scene)), b = coverage(renderer_->render(second.scene));
   EXPECT_GT(a, 300.0);
@@ -150,7 +149,7 @@ TEST(RibCurves, BadCurvesAreErrorsOrSkipped) {
       "WorldEnd\n",
       "c.rib");
   ASSERT_EQ(skipped.scene.bezier_patches.size(), 1u);
-  EXPECT_EQ(skipped.scene.bezier_patches[0].control_points.size(), 4u * 16u);
+  EXPECT_EQ(skipped.scene.bezier_patches[0].control_points.size(), 16u);
   EXPECT_EQ(skipped.warnings.size(), 1u);
 }
 

@@ -17,6 +17,7 @@
 #include "pipeline/shadows/shadow_page_pool.h"
 #include "renderer_fixture.h"
 #include "scene_fixtures.h"
+#include "scene/curves.h"
 
 namespace mp::test {
 namespace {
@@ -311,6 +312,49 @@ TEST_F(ShadowRenderTest, SunCastsTheOccludersShapeAlongItsDirection) {
     EXPECT_NEAR(got.centroid.x, c.x, 0.5) << "slant " << slant;
     EXPECT_NEAR(got.centroid.y, c.y, 0.5) << "slant " << slant;
   }
+}
+
+// A strand's shadow is a round tube's, whichever way the light comes from:
+// a horizontal strand along y under a sun slanted by theta across it
+// shadows a band 2 r / cos(theta) wide on the floor. Ribbons face the
+// light's view, not the camera's (which looks straight down: a ribbon
+// facing it would cast a band only 2 r wide): their shadow is the one of a
+// flat plate square to the sun, to the pixel. The maps widen a band this
+// thin by about half a pixel (3.6 % here, the plate's as well), and the
+// tubes' 16 sides narrow it a little.
+TEST_F(ShadowRenderTest, StrandsShadowAsRoundTubesFromASlantedSun) {
+  const float theta = 0.9f, r = 0.12f, h = 1.0f;
+  Light sun;
+  sun.type = Light::Type::Distant;
+  sun.intensity = 2.0f;
+  sun.direction = glm::normalize(glm::vec3(std::sin(theta), 0.0f, -std::cos(theta)));
+  const double area = 3.0 * 2.0 * r / std::cos(theta) * kPx * kPx;
+  const glm::vec2 centre = raster({h * std::tan(theta), 0.0f});
+  double got[3];  // tubes, ribbons, the plate
+  for (int k = 0; k < 3; ++k) {
+    Scene s = floor_scene(sun);
+    if (k < 2) {
+      CurveSet strand;
+      strand.name = "strand";
+      strand.points = {{0, -1.5f, h}, {0, 0, h}, {0, 1.5f, h}};
+      strand.radii = {r, r, r};
+      strand.offsets = {0, 3};
+      strand.visible_camera = false;
+      strand.ribbons = k == 1;
+      ASSERT_EQ(add_curves(s, strand), 0u);
+    } else {
+      const glm::vec3 across = r * glm::vec3(std::cos(theta), 0.0f, std::sin(theta));
+      Mesh plate = polygon({glm::vec3(0, -1.5f, h) - across, glm::vec3(0, -1.5f, h) + across,
+                            glm::vec3(0, 1.5f, h) + across, glm::vec3(0, 1.5f, h) - across});
+      plate.visible_camera = false;
+      s.meshes.push_back(plate);
+    }
+    const ShadowShape shape = shadow_shape(visibility(*renderer_, s));
+    got[k] = shape.area_px / area;
+    EXPECT_NEAR(shape.centroid.x, centre.x, 0.5) << k;
+    EXPECT_NEAR(got[k], 1.0, 0.045) << k;
+  }
+  EXPECT_NEAR(got[1] / got[2], 1.0, 0.005) << "ribbons " << got[1] << ", plate " << got[2];
 }
 
 TEST_F(ShadowRenderTest, PointAndSpotLightsMagnifyTheShadowBySimilarTriangles) {

@@ -1,6 +1,7 @@
 """Scene.add_curves from Python: curves become round tubes of 4 patches per
-segment that render where the curve runs, bad curves are skipped and
-counted, and malformed arrays are refused with a message, never a crash."""
+segment, or ribbons of one, that render where the curve runs, bad curves
+are skipped and counted, and malformed arrays are refused with a message,
+never a crash."""
 
 import numpy as np
 import pytest
@@ -25,10 +26,11 @@ def strands(n, keys=4):
     return points.reshape(-1, 3), np.full(n * keys, 0.05, np.float32), offsets
 
 
-def test_curves_render_as_tubes():
+@pytest.mark.parametrize("ribbons", [False, True])
+def test_curves_render_as_tubes_or_ribbons(ribbons):
     s = base()
     points, radii, offsets = strands(4)
-    assert s.add_curves("hair", points, radii, offsets) == 0
+    assert s.add_curves("hair", points, radii, offsets, ribbons=ribbons) == 0
     assert s.patch_set_count == 1
     r = _native.Renderer().render(s)
     alpha = np.asarray(r["rgba"])[..., 3]
@@ -58,15 +60,16 @@ def test_malformed_offsets_are_refused(offsets, message):
         s.add_curves("bad", points, radii, offsets)
 
 
-def test_moving_curves_blur_along_their_motion():
+@pytest.mark.parametrize("ribbons", [False, True])
+def test_moving_curves_blur_along_their_motion(ribbons):
     # Strands moving 1 unit along x during the shutter cover a wider band,
     # as much alpha in all, centred where they are at the shutter's centre.
     still, moving = base(), base()
     points, radii, offsets = strands(1)
-    still.add_curves("hair", points, radii, offsets)
+    still.add_curves("hair", points, radii, offsets, ribbons=ribbons)
     steps = np.stack([points + np.array([dx, 0.0, 0.0], np.float32) for dx in (-0.5, 0.0, 0.5)])
     moving.set_motion(3)
-    moving.add_curves("hair", points, radii, offsets, motion_points=steps)
+    moving.add_curves("hair", points, radii, offsets, motion_points=steps, ribbons=ribbons)
     a = np.asarray(_native.Renderer().render(still)["rgba"])[..., 3]
     b = np.asarray(_native.Renderer().render(moving)["rgba"])[..., 3]
     assert b.sum() == pytest.approx(a.sum(), rel=0.05)

@@ -149,6 +149,7 @@ def add_curves(rng, scene):
     if rng.random() < 0.2:
         steps = int(rng.integers(0, 4))
         kwargs["motion_points"] = array(rng, (steps, n_points, 3))
+    kwargs["ribbons"] = bool(rng.random() < 0.5)
     scene.add_curves("c", array(rng, (n_points, 3)), array(rng, (n_points,)),
                      offsets if rng.random() < 0.7 else array(rng, (int(rng.integers(0, 5)),), "int"), **kwargs)
 

@@ -89,6 +89,10 @@ struct BezierPatches {
   // u runs around a round section (hair tubes): the camera dices at least a
   // few micropolygons across u, whatever the size on screen (MP_PATCH_ROUND_U).
   bool round_u = false;
+  // Each patch is a strand segment drawn as a ribbon facing each view
+  // (MP_PATCH_CURVE; its 16 points laid out as kernels/geometry/mp_patch.h
+  // says: per row j the centre point and the three radius points).
+  bool ribbons = false;
   // What material programs read as UV layer k (as Mesh::uv_layers): 4 values
   // per patch, at its corners (0,0), (1,0), (1,1), (0,1), interpolated
   // bilinearly across it. Hair tubes carry their curves' UVs, attributes and

@@ -637,8 +637,9 @@ PYBIND11_MODULE(_native, m) {
              const Array<int>& offsets, const Array<float>& object_to_world, int material, bool visible_camera,
              bool cast_shadows, std::vector<float> object_color, float pass_index, float random,
              const Array<float>& attributes, const Array<float>& motion_points,
-             const Array<float>& motion_object_to_world, const Array<float>& point_layers) {
+             const Array<float>& motion_object_to_world, const Array<float>& point_layers, bool ribbons) {
             CurveSet curves;
+            curves.ribbons = ribbons;
             curves.name = name;
             curves.points = to_points(points, "points");
             if (radii.ndim() != 1) throw Error("curves '" + name + "': radii must be a (points,) array");
@@ -667,9 +668,10 @@ PYBIND11_MODULE(_native, m) {
           py::arg("cast_shadows") = true, py::arg("object_color") = std::vector<float>{1, 1, 1, 1},
           py::arg("pass_index") = 0.0f, py::arg("random") = 0.0f, py::arg("attributes") = Array<float>(),
           py::arg("motion_points") = Array<float>(), py::arg("motion_object_to_world") = Array<float>(),
-          py::arg("point_layers") = Array<float>(),
+          py::arg("point_layers") = Array<float>(), py::arg("ribbons") = false,
           "Adds curves (Catmull-Rom keys: points (points, 3), radii (points,), object space; curve c has the "
-          "points [offsets[c], offsets[c + 1])) as round tubes of Bezier patches (scene/curves.h), with their "
+          "points [offsets[c], offsets[c + 1])) as round tubes of Bezier patches (scene/curves.h), or with "
+          "ribbons=True as ribbons facing each view (Cycles' Rounded Ribbons), with their "
           "motion where they move: the points at each motion step (steps, points, 3) and the object-to-world "
           "matrices (steps, 4, 4). point_layers (layers, points, 2): what material programs read as UV layer "
           "k, one value per point, linear along the curve. Returns how many curves were skipped (fewer than 2 points, or a point or "

@@ -1,10 +1,10 @@
 // RiCurves (RI spec 3.2, section 5.6): linear and cubic curves in the
 // current v basis and step, periodic or not, with widths per segment end
 // ("varying"), per control point ("vertex") or one for all. Each segment is
-// turned into a cubic Bezier centre line with its radius and swept into a
-// round tube (scene/curves.h); RenderMan draws curves without normals as
-// ribbons facing the eye, which cover the same width. Every count is
-// checked against the arrays present before anything is built.
+// turned into a cubic Bezier centre line with its radius and drawn, as
+// RenderMan draws curves without normals, as a ribbon facing the eye
+// (scene/curves.h, kernels/geometry/mp_ribbon.h). Every count is checked
+// against the arrays present before anything is built.
 #include <climits>
 #include <cmath>
 
@@ -42,7 +42,7 @@ void Parser::req_curves(ArgReader& args) {
     if (p.name != "P" && p.name != "width" && p.name != "constantwidth")
       warn_once("primvar:" + p.name, p.line,
                 "primitive variable \"" + p.name + "\" is ignored" +
-                    (p.name == "N" ? " (curves are drawn round, as tubes, not as ribbons facing N)" : ""));
+                    (p.name == "N" ? " (curves are drawn as ribbons facing the eye, not N)" : ""));
   const Param* P = params.find("P");
   if (!P) args.fail("missing \"P\" (control points)");
   if (P->decl.is_string() || P->decl.components() != 3) args.fail_at(P->line, "\"P\" must hold points (3 values each)");
@@ -81,7 +81,7 @@ void Parser::req_curves(ArgReader& args) {
     return;
   }
   if (!in_world_) args.fail("geometry outside WorldBegin/WorldEnd");
-  charge(size_t(segments_total) * kTubePatchesPerSegment * 16, line);
+  charge(size_t(segments_total) * 16, line);  // one ribbon patch a segment
   note_primitive(attrs_, line);
 
   const Mat4d conv = to_bezier_conversion(attrs_.vbasis.matrix);
@@ -149,6 +149,7 @@ void Parser::req_curves(ArgReader& args) {
   meta.info = attrs_.object_info;
   meta.visible_camera = attrs_.visible_camera;
   meta.cast_shadows = attrs_.cast_shadows;
+  meta.ribbons = true;
   add_bezier_curves(result_.scene, meta, runs);
   has_merge_target_ = false;
 }

@@ -263,7 +263,7 @@ void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
   const int line = args.request().line;
   warn_unknown(params, {"material", "materialname", "program", "programparams", "programdisplaces", "programshades",
                         "programalpha", "displacementbound", "displacementworld", "objectcolor", "objectalpha",
-                        "objectindex", "objectrandom", "objectattributes", "roundu"}, [&](const std::string& name) {
+                        "objectindex", "objectrandom", "objectattributes", "roundu", "ribbons"}, [&](const std::string& name) {
     warn_once("attribute-micropoly:" + name, line,
               "Attribute \"micropoly\": parameter \"" + name + "\" is ignored");
   });
@@ -272,6 +272,12 @@ void Parser::micropoly_attribute(ArgReader& args, const ParamList& params) {
     int round = 0;
     params.get_int("roundu", 0, 1, &round);
     attrs_.round_u = round != 0;
+  }
+  // Patches that are ribbons' strand segments (ribbons written back).
+  if (params.find("ribbons")) {
+    int ribbons = 0;
+    params.get_int("ribbons", 0, 1, &ribbons);
+    attrs_.ribbons = ribbons != 0;
   }
   // What Object Info reads of the following objects.
   ObjectInfo& info = attrs_.object_info;

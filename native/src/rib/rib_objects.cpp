@@ -131,6 +131,7 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
   const bool merge = prim.mergeable && !moving && has_merge_target_ && merge_.kind == prim.kind &&
                      merge_.object_to_world == object_to_world && merge_.material == material &&
                      merge_.double_sided == attrs.double_sided && merge_.round_u == attrs.round_u &&
+                     merge_.ribbons == attrs.ribbons &&
                      merge_.visible_camera == attrs.visible_camera &&
                      merge_.cast_shadows == attrs.cast_shadows && merge_.object_info == attrs.object_info &&
                      merge_.identifier == attrs.identifier &&
@@ -182,6 +183,7 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
     set.material = material;
     set.double_sided = attrs.double_sided;
     set.round_u = attrs.round_u;
+    set.ribbons = attrs.ribbons;
     set.visible_camera = attrs.visible_camera;
     set.cast_shadows = attrs.cast_shadows;
     set.info = attrs.object_info;
@@ -197,6 +199,7 @@ void Parser::add_to_scene(const Primitive& prim, const glm::mat4& xform, const A
     merge_.material = material;
     merge_.double_sided = attrs.double_sided;
     merge_.round_u = attrs.round_u;
+    merge_.ribbons = attrs.ribbons;
     merge_.visible_camera = attrs.visible_camera;
     merge_.cast_shadows = attrs.cast_shadows;
     merge_.object_info = attrs.object_info;

@@ -34,7 +34,7 @@ struct Limits {
   static constexpr size_t kMaxFileBytes = size_t(1) << 30;
   static constexpr size_t kMaxBlockDepth = 1000;    // nested Begin/End blocks
   static constexpr int kMaxLights = 1024;
-  static constexpr size_t kMaxSceneElements = size_t(1) << 27;  // points + indices
+  static constexpr size_t kMaxSceneElements = size_t(1) << 29;  // points + indices (6 GiB of points)
   static constexpr int kMaxResolution = 65536;
   static constexpr int kMaxPixelSamples = 64;
   static constexpr size_t kMaxTexels = size_t(1) << 27;  // all texture images together
@@ -56,6 +56,10 @@ struct Attributes {
   // Attribute "micropoly" "int roundu": patches whose u runs around a round
   // section (hair tubes written back; BezierPatches::round_u).
   bool round_u = false;
+  // Attribute "micropoly" "int ribbons": patches that are strand segments
+  // drawn as ribbons facing each view (ribbons written back;
+  // BezierPatches::ribbons).
+  bool ribbons = false;
   // True when the current orientation differs from the handedness of the
   // current coordinate system, i.e. the primitives' normals are flipped. Both
   // flip together under transformations, so only Orientation and
@@ -140,6 +144,7 @@ class Parser {
     int material;
     bool double_sided;
     bool round_u;
+    bool ribbons;
     bool visible_camera;
     bool cast_shadows;
     ObjectInfo object_info;

@@ -626,9 +626,11 @@ void write_patch_requests(std::string& o, const BezierPatches& b) {
   }
 }
 
-// Hair tubes keep their round dicing (BezierPatches::round_u).
+// Hair tubes keep their round dicing (BezierPatches::round_u), ribbons
+// their kind (BezierPatches::ribbons).
 void write_round_u(std::string& o, const BezierPatches& b) {
   if (b.round_u) o += "  Attribute \"micropoly\" \"int roundu\" [1]\n";
+  if (b.ribbons) o += "  Attribute \"micropoly\" \"int ribbons\" [1]\n";
 }
 
 void write_patches(std::string& o, const BezierPatches& b, const std::vector<Material>& materials,

@@ -162,6 +162,19 @@ void tube_layers(const CurveSet& curves, size_t first, const std::vector<int>& l
   }
 }
 
+// Appends to the set's UV layers the corner values of one curve's ribbon
+// patches, one a segment (u across, v along): as tube_layers without cuts.
+void ribbon_layers(const CurveSet& curves, size_t first, size_t segments, BezierPatches& set) {
+  for (size_t l = 0; l < curves.point_layers.size(); ++l) {
+    const std::vector<glm::vec2>& values = curves.point_layers[l];
+    std::vector<glm::vec2>& out = set.uv_layers[l];
+    for (size_t i = 0; i < segments; ++i) {
+      const glm::vec2 lo = values[first + i], hi = values[first + i + 1];
+      out.insert(out.end(), {lo, lo, hi, hi});
+    }
+  }
+}
+
 // The patch set that holds a curve set's tubes, without patches yet.
 BezierPatches tube_set(const CurveSet& curves) {
   BezierPatches set;
@@ -172,7 +185,8 @@ BezierPatches tube_set(const CurveSet& curves) {
   set.visible_camera = curves.visible_camera;
   set.cast_shadows = curves.cast_shadows;
   set.info = curves.info;
-  set.round_u = true;
+  set.round_u = !curves.ribbons;
+  set.ribbons = curves.ribbons;
   set.uv_layers.resize(curves.point_layers.size());
   return set;
 }
@@ -189,6 +203,18 @@ void catmull_rom_segments(const std::vector<glm::dvec3>& k, const std::vector<do
   for (long a = 0; a + 1 < n; ++a)
     segs.push_back({{key(a), key(a) + (key(a + 1) - key(a - 1)) / 6.0, key(a + 1) - (key(a + 2) - key(a)) / 6.0, key(a + 1)},
                     {rad(a), rad(a) + (rad(a + 1) - rad(a - 1)) / 6.0, rad(a + 1) - (rad(a + 2) - rad(a)) / 6.0, rad(a + 1)}});
+}
+
+void add_ribbon(const CurveSegment& s, std::vector<glm::vec3>& out) {
+  // A radius control value may dip below zero near a tip (Catmull-Rom's
+  // inner values); the offsets' length takes its size.
+  for (int j = 0; j < 4; ++j) {
+    const double r = std::fabs(s.r[j]);
+    out.push_back(glm::vec3(s.p[j]));
+    out.push_back(glm::vec3(s.p[j] + glm::dvec3(r, 0.0, 0.0)));
+    out.push_back(glm::vec3(s.p[j] + glm::dvec3(0.0, r, 0.0)));
+    out.push_back(glm::vec3(s.p[j] + glm::dvec3(0.0, 0.0, r)));
+  }
 }
 
 void add_tube(const std::vector<CurveSegment>& segs, std::vector<glm::vec3>& out) {
@@ -248,6 +274,16 @@ size_t add_curves(Scene& scene, const CurveSet& curves) {
       continue;
     }
     catmull_rom_segments(k, r, segs);
+    if (curves.ribbons) {
+      for (const CurveSegment& sg : segs) add_ribbon(sg, set.control_points);
+      ribbon_layers(curves, size_t(off[c]), segs.size(), set);
+      for (size_t step = 0; step < curves.motion_points.size(); ++step) {
+        for (int p = off[c]; p < off[c + 1]; ++p) k[size_t(p - off[c])] = curves.motion_points[step][size_t(p)];
+        catmull_rom_segments(k, r, segs);
+        for (const CurveSegment& sg : segs) add_ribbon(sg, set.motion_control_points[step]);
+      }
+      continue;
+    }
     levels.resize(segs.size());
     for (size_t i = 0; i < segs.size(); ++i) levels[i] = halvings(segs[i]);
     tube(segs, levels, set.control_points);
@@ -265,7 +301,11 @@ size_t add_curves(Scene& scene, const CurveSet& curves) {
 
 void add_bezier_curves(Scene& scene, const CurveSet& meta, const std::vector<std::vector<CurveSegment>>& runs) {
   BezierPatches set = tube_set(meta);
-  for (const std::vector<CurveSegment>& run : runs) add_tube(run, set.control_points);
+  for (const std::vector<CurveSegment>& run : runs) {
+    if (!meta.ribbons) add_tube(run, set.control_points);
+    else
+      for (const CurveSegment& sg : run) add_ribbon(sg, set.control_points);
+  }
   if (!set.control_points.empty()) scene.bezier_patches.push_back(std::move(set));
 }
 

@@ -41,6 +41,10 @@ struct CurveSet {
   ObjectInfo info;
   bool visible_camera = true;
   bool cast_shadows = true;
+  // Ribbons facing each view (Cycles' Rounded Ribbons, RenderMan's Curves;
+  // one MP_PATCH_CURVE patch a segment) instead of round tubes (Cycles' 3D
+  // Curves, kTubePatchesPerSegment patches a segment).
+  bool ribbons = false;
   // Motion blur (Scene::motion_steps): the points and the transform at each
   // motion step, or empty where they do not move (as Mesh). Each step's
   // tubes are cut as the shutter centre's are, so the patches match.
@@ -60,17 +64,20 @@ struct CurveSegment {
 // keys doubled (Cycles' hair curves).
 void catmull_rom_segments(const std::vector<glm::dvec3>& keys, const std::vector<double>& radii,
                           std::vector<CurveSegment>& segments);
+// One segment as a ribbon's 16 points (BezierPatches::ribbons), appended
+// to `out`.
+void add_ribbon(const CurveSegment& segment, std::vector<glm::vec3>& out);
 // The tube around consecutive segments (each starting where the last ended)
 // as Bezier nets, kTubePatchesPerSegment per segment, appended to `out`.
 void add_tube(const std::vector<CurveSegment>& segments, std::vector<glm::vec3>& out);
 
 // Curves already in Bezier form (RIB's Curves through their basis) as one
-// BezierPatches set of tubes: each run is a chain of segments, each starting
+// BezierPatches set of tubes, or ribbons where meta.ribbons says: each run is a chain of segments, each starting
 // where the last ended. The object's fields come from `meta` (its points,
 // radii and offsets are not read). Nothing is added for no segments.
 void add_bezier_curves(Scene& scene, const CurveSet& meta, const std::vector<std::vector<CurveSegment>>& runs);
 
-// Appends the curves' tubes as one BezierPatches set (none where no curve
+// Appends the curves' tubes (or ribbons) as one BezierPatches set (none where no curve
 // has a segment). Curves of fewer than 2 points, or with a point or radius
 // that is not finite or a radius below 0, are skipped; returns how many
 // were. Throws mp::Error for offsets that do not describe the points.

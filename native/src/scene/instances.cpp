@@ -23,6 +23,9 @@ void reverse_faces(Mesh& mesh, size_t first_face, size_t first_index) {
 }
 
 void mirror_patches_u(BezierPatches& set, size_t first_patch) {
+  // A ribbon has no sides to swap: it turns to face each view, and its
+  // rows are points, not a net (MP_PATCH_CURVE).
+  if (set.ribbons) return;
   std::vector<glm::vec3>& cps = set.control_points;
   for (size_t p = 16 * first_patch; p + 16 <= cps.size(); p += 16)
     for (size_t j = 0; j < 4; ++j) {

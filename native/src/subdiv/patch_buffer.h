@@ -35,6 +35,11 @@ void append_polygon_patches(const Mesh& mesh, const glm::mat4& to_space, PatchBu
 // Bezier patch sets (RIB Patch/PatchMesh after basis conversion).
 void append_bezier_patches(const BezierPatches& set, const glm::mat4& to_space, PatchBuffer& out);
 
+// A ribbon patch's (MP_PATCH_CURVE) partners: the corners of a box around
+// the strip in any orientation, from its points as they are placed (run
+// again after any transform of them).
+void bound_ribbon(glm::vec4* cp);
+
 // Fills `edges` (and `curves`) for patches [first, size()): edges that two
 // patches share, within a tolerance, get one curve and bit-identical corner
 // points; an edge whose other side is two half-length edges (a transition

@@ -185,6 +185,17 @@ void share_patch_edges(PatchBuffer& buffer, size_t first) {
   const size_t count = buffer.size() - first;
   buffer.edges.resize(buffer.size() * MP_EDGE_REFS, MP_NO_CURVE);
   if (count == 0) return;
+  // Ribbons turn to face each view and evaluate their edges themselves
+  // (mp_ribbon.h): no curves, no welding. Each edge names curve 0 forwards,
+  // which only tells mp_patch_uv to interpolate along the edge's own
+  // direction.
+  bool ribbons = true;
+  for (size_t p = first; p < buffer.size() && ribbons; ++p) ribbons = buffer.info[p].x == MP_PATCH_CURVE;
+  if (ribbons) {
+    for (size_t p = first; p < buffer.size(); ++p)
+      for (int e = 0; e < 4; ++e) buffer.edges[p * MP_EDGE_REFS + 2 * size_t(e)] = 0u;
+    return;
+  }
   auto point = [&](size_t patch, int k) -> glm::vec4& { return buffer.points[patch * MP_PATCH_POINTS + size_t(k)]; };
 
   // Welding tolerance: a few float steps at the surface's scale and distance.

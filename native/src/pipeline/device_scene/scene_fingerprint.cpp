@@ -81,6 +81,7 @@ uint64_t patch_set_shape_key(const BezierPatches& set, int uv_layers) {
   h.value(uv_layers);
   h.values(set.control_points);
   h.value(set.round_u);  // a shape flag (MP_PATCH_SHAPE_FLAGS)
+  h.value(set.ribbons);
   h.value(set.uv_layers.size());
   for (const auto& layer : set.uv_layers) h.values(layer);
   return h.result();
@@ -113,6 +114,7 @@ void hash_mesh(Hasher& h, const Mesh& m) {
 void hash_patch_set(Hasher& h, const BezierPatches& b) {
   h.values(b.control_points);
   h.value(b.round_u);
+  h.value(b.ribbons);
   h.value(b.uv_layers.size());
   for (const auto& layer : b.uv_layers) h.values(layer);
   h.value(b.motion_control_points.size());
@@ -265,6 +267,8 @@ ShadowGeometryKeys shadow_geometry_keys(const Scene& scene) {
     h.value(uint32_t(2));
     h.values(b.control_points);
     h.value(b.round_u);
+    h.value(b.ribbons);
+  h.value(b.ribbons);
     h.value(b.motion_control_points.size());
     for (const std::vector<glm::vec3>& step : b.motion_control_points) h.values(step);
     h.values(b.motion_object_to_world);

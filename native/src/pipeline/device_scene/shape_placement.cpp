@@ -93,6 +93,7 @@ void place_shape(const PatchBuffer& shape, const glm::mat4& to_camera, const Mes
     info.y = unsigned(material);
     info.z = flags | (info.z & MP_PATCH_SHAPE_FLAGS);
     out.info.push_back(info);
+    if (info.x == MP_PATCH_CURVE) bound_ribbon(&out.points[(first + p) * MP_PATCH_POINTS]);
     if (size_t(material) < scene.materials.size()) {
       const Material& mat = scene.materials[size_t(material)];
       if (mat.program >= 0 && mat.program_displaces)

@@ -17,7 +17,7 @@ BoundSplitResult MicropolygonPass::run(const PassView& view, const ViewTarget& t
     std::optional<DeviceSession::Activity> activity;
     if (target.dice_activity) activity.emplace(session_, target.dice_activity);
     stages_.layout.run(diceable, count, f, grids, timer_);
-    stages_.dice.run(diceable, count, scene_, f, grids, timer_);
+    stages_.dice.run(diceable, count, scene_, f, view.views.views, view.views.count, grids, timer_);
     if (target.motion) stages_.dice.run_motion(diceable, count, scene_, f, grids, timer_);
     stages_.programs.displace(diceable, count, scene_, f, grids, timer_, target.normals);
     if (target.motion) stages_.dice.displaced(diceable, count, f, grids, timer_);

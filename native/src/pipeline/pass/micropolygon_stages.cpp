@@ -119,8 +119,9 @@ void DiceStage::displaced(const cl::Buffer& diceable, cl_uint count, const Frame
 }
 
 void DiceStage::run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
-                    GridBuffers& grids, StageTimer& timer) {
-  cl::Kernel& kernel = kernel_.bind(scene, diceable, count, f, grids.p, grids.n, grids.vertex_offsets);
+                    const cl::Buffer& views, cl_uint view_count, GridBuffers& grids, StageTimer& timer) {
+  cl::Kernel& kernel = kernel_.bind(scene, diceable, count, f, views, view_count, grids.p, grids.n,
+                                    grids.vertex_offsets);
   cl::Event e;
   session_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, round_up_range(grids.vertex_total), cl::NDRange(64),
                                         nullptr, &e);

@@ -97,8 +97,10 @@ struct ShadowInputs {
 class DiceStage {
  public:
   explicit DiceStage(DeviceSession& session);
+  // `views`: the pass' views (count of them; none for the frame's own),
+  // which ribbons turn to face (kernels/geometry/mp_ribbon.h).
   void run(const cl::Buffer& diceable, cl_uint count, const SceneBuffers& scene, const FrameParams& f,
-           GridBuffers& grids, StageTimer& timer);
+           const cl::Buffer& views, cl_uint view_count, GridBuffers& grids, StageTimer& timer);
   // Motion blur: the same grids' positions at every motion step
   // (grids.motion_p). Run before displacement: `displaced` then moves them
   // by what displacement added at the shutter centre.
