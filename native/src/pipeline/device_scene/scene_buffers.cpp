@@ -376,8 +376,13 @@ void set_world_glossy(DeviceSession& session, const cl::Buffer& maps, SceneBuffe
 
 SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data) {
   SceneBuffers b;
-  // Read by a write that does not block: it must live until the finish below.
+  // Read by writes that do not block: they must live until the finish
+  // below, or until upload_or_drain has drained the queue after a failure
+  // (so they are made out here, not in the body that unwinding leaves).
   const std::vector<glm::vec4> no_world_glossy(1, glm::vec4(0.0f));
+  // Every patch's box (the prototypes' in their own space); the host keeps
+  // those of the patches placed on their own, which its root orders sort.
+  const std::vector<glm::vec4> bounds = patch_bounds(data.patches);
   upload_or_drain(session, [&] {
     b.points = upload(session, data.patches.points);
     b.patch_info = upload(session, data.patches.info);
@@ -390,10 +395,6 @@ SceneBuffers upload_scene_data(DeviceSession& session, const HostSceneData& data
     b.lights = upload(session, data.lights);
     b.patch_uvs = upload(session, data.patches.uvs);
     b.patch_normals = upload(session, data.patches.normals);
-    // Every patch's box (the prototypes' in their own space) lives until the
-    // queue finishes below; the host keeps those of the patches placed on
-    // their own, which its root orders sort.
-    const std::vector<glm::vec4> bounds = patch_bounds(data.patches);
     b.patch_bounds = upload(session, bounds);
     b.instances = upload(session, data.instances);
     b.patch_nodes = upload(session, data.patch_nodes);
