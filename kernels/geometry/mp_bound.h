@@ -107,10 +107,8 @@ MP_INLINE void mp_subpatch_net_boxes(const MP_GLOBAL float4* cp, uint type, floa
  * displacement bound (mp_patch.h) so that culling and splitting never clip
  * displaced geometry: the sub-patch's surface lies in their convex hull. */
 MP_INLINE void mp_subpatch_hull(const MP_GLOBAL float4* cp, uint type, const SubPatch* sp, float3* lo, float3* hi) {
-  float u0 = fmin(fmin(sp->corner[0], sp->corner[2]), fmin(sp->corner[4], sp->corner[6]));
-  float u1 = fmax(fmax(sp->corner[0], sp->corner[2]), fmax(sp->corner[4], sp->corner[6]));
-  float v0 = fmin(fmin(sp->corner[1], sp->corner[3]), fmin(sp->corner[5], sp->corner[7]));
-  float v1 = fmax(fmax(sp->corner[1], sp->corner[3]), fmax(sp->corner[5], sp->corner[7]));
+  float u0, v0, u1, v1;
+  mp_subpatch_range(sp, &u0, &v0, &u1, &v1);
   mp_subpatch_net_boxes(cp, type, u0, v0, u1, v1, lo, hi);
   float reach = MP_PATCH_DISPLACEMENT_BOUND(cp);
   /* Moving patches: the sub-net at every step lies within the centre's
@@ -134,8 +132,8 @@ MP_INLINE void mp_subpatch_hull(const MP_GLOBAL float4* cp, uint type, const Sub
  * straddling the eye plane is cut along its length. */
 MP_INLINE void mp_ribbon_hull(const MP_GLOBAL float4* cp, const SubPatch* sp, const MpPlacement* place, float3* lo,
                               float3* hi) {
-  float v0 = fmin(fmin(sp->corner[1], sp->corner[3]), fmin(sp->corner[5], sp->corner[7]));
-  float v1 = fmax(fmax(sp->corner[1], sp->corner[3]), fmax(sp->corner[5], sp->corner[7]));
+  float u0, v0, u1, v1;
+  mp_subpatch_range(sp, &u0, &v0, &u1, &v1);
   float Wv[16];
   mp_subsegment_weights(v0, v1, Wv);
   float r = 0.0f;

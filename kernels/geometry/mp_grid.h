@@ -28,6 +28,21 @@ MP_INLINE float2 mp_corner(const SubPatch* sp, int k) {
   return MP_F2(sp->corner[2 * k], sp->corner[2 * k + 1]);
 }
 
+/* The view a sub-patch belongs to: the pass's own (f), or one of several
+ * (shadow maps) by the view index in its info. */
+MP_INLINE FrameParams mp_subpatch_view(const SubPatch* sp, FrameParams f, const MP_GLOBAL FrameParams* views,
+                                       uint view_count) {
+  return view_count > 0u ? views[MP_INFO_VIEW(sp->info)] : f;
+}
+
+/* The box [u0, u1] x [v0, v1] of a sub-patch's corners in the patch's (u, v). */
+MP_INLINE void mp_subpatch_range(const SubPatch* sp, float* u0, float* v0, float* u1, float* v1) {
+  *u0 = fmin(fmin(sp->corner[0], sp->corner[2]), fmin(sp->corner[4], sp->corner[6]));
+  *u1 = fmax(fmax(sp->corner[0], sp->corner[2]), fmax(sp->corner[4], sp->corner[6]));
+  *v0 = fmin(fmin(sp->corner[1], sp->corner[3]), fmin(sp->corner[5], sp->corner[7]));
+  *v1 = fmax(fmax(sp->corner[1], sp->corner[3]), fmax(sp->corner[5], sp->corner[7]));
+}
+
 /* Whether edge e of a sub-patch runs along the patch's u (splits along v
  * rotate a sub-patch's corners, so edge 0 is not always a u edge). */
 MP_INLINE int mp_edge_runs_along_u(const SubPatch* sp, int e) {

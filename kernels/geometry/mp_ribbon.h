@@ -39,17 +39,6 @@ MP_INLINE float mp_ribbon_radius(const MP_GLOBAL float4* cp, int j, const MpPlac
   return r * (1.0f / 3.0f);
 }
 
-/* The largest radius control value, in the patch's own space (a bound on
- * the radius anywhere on the segment). */
-MP_INLINE float mp_ribbon_max_radius(const MP_GLOBAL float4* cp) {
-  float r = 0.0f;
-  for (int j = 0; j < 4; ++j) {
-    float3 c = MP_XYZ(cp[4 * j]);
-    for (int k = 1; k <= 3; ++k) r = fmax(r, length(MP_XYZ(cp[4 * j + k]) - c));
-  }
-  return r;
-}
-
 /* Where across a strip diced n micropolygons across (a power of two) its
  * vertices are shaded, as a fraction of their offsets h: shading is
  * interpolated linearly between vertices, so a strip one micropolygon

@@ -46,13 +46,6 @@ inline SubPatch mp_root_subpatch(uint r, uint patch_count, uint root_count, __gl
   return sp;
 }
 
-/* The view a sub-patch belongs to: the pass's own (f), or one of several
- * (shadow maps) by the view index in its info. */
-inline FrameParams mp_subpatch_view(const SubPatch* sp, FrameParams f, __global const FrameParams* views,
-                                    uint view_count) {
-  return view_count > 0u ? views[MP_INFO_VIEW(sp->info)] : f;
-}
-
 /* ---- breadth-first ------------------------------------------------------ */
 
 /* Initial queue: one whole-domain sub-patch per patch and view. */

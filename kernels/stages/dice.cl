@@ -10,13 +10,6 @@
 #include "geometry/mp_grid.h"
 #include "core/mp_scene_data.h"
 
-/* The view a diced sub-patch belongs to: one of the pass' views (a light's
- * shadow maps), or the pass' own. Ribbons turn to face it (mp_ribbon.h). */
-inline FrameParams mp_dice_view(const SubPatch* sp, FrameParams f, __global const FrameParams* views,
-                                uint view_count) {
-  return view_count > 0u ? views[MP_INFO_VIEW(sp->info)] : f;
-}
-
 __kernel void dice_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, uint count, FrameParams f,
                          __global const FrameParams* views, uint view_count, __global float4* grid_p,
                          __global float4* grid_n, __global const uint* vertex_offsets) {
@@ -27,18 +20,17 @@ __kernel void dice_grids(MP_SCENE_PARAMS __global const SubPatch* diceable, uint
   if (!mp_grid_vertex(gid, count, vertex_offsets, f.max_grid, diceable, &sp, &i, &j, &uv, &index)) return;
   float3 p, dpdu, dpdv;
   MpPlacement place = mp_instance_placement(instances, sp.instance);
-  mp_place_facing(&place, mp_dice_view(&sp, f, views, view_count));
+  mp_place_facing(&place, mp_subpatch_view(&sp, f, views, view_count)); /* ribbons face it (mp_ribbon.h) */
   uint flags = mp_placed_flags(patch_info, instances, sp.patch, sp.instance);
   if (patch_info[4 * (ulong)sp.patch] == MP_PATCH_CURVE) {
     /* A ribbon shades with the round normal of the strand it stands for,
      * which faces its view: w = 1 says so (shade.cl), as for smooth normals
      * (at the ribbon's very edges the normal is square to the view, and
-     * the strip's edge seen from the eye lies a radius off that tangent). */
-    /* A grid across the whole width shades its vertices inward by its
+     * the strip's edge seen from the eye lies a radius off that tangent).
+     * A grid across the whole width shades its vertices inward by its
      * rate across (mp_ribbon_shading_scale). */
-    float scale = 1.0f;
-    float u0 = fmin(fmin(sp.corner[0], sp.corner[2]), fmin(sp.corner[4], sp.corner[6]));
-    float u1 = fmax(fmax(sp.corner[0], sp.corner[2]), fmax(sp.corner[4], sp.corner[6]));
+    float scale = 1.0f, u0, v0, u1, v1;
+    mp_subpatch_range(&sp, &u0, &v0, &u1, &v1);
     if (u0 == 0.0f && u1 == 1.0f) {
       MpGridShape g = mp_grid_shape(&sp, (uint)f.max_grid);
       int e = mp_edge_runs_along_u(&sp, 0) ? 0 : 1; /* the edges across the strand: e and e + 2 */
